@@ -1,0 +1,260 @@
+"""Slow flow on the 1:1 resonance manifold and its escape criterion (paper eqs 11, 18, 21).
+
+First integral (eq 18), ``gamma = theta - Psi - Omega tau``:
+
+    C(gamma, xi) = xi - Omega J(xi) - F G(xi) cos(gamma).
+
+Averaging ``-F q sin(Omega tau + Psi)`` with ``q = 2 G sin(theta) + ...`` gives
+``-F G cos(gamma)``, so eq (18) follows from eq (12) with ``q_1 = -i G``; the slow flow
+(eq 11) is Hamiltonian in the canonical pair ``(gamma, J)``:
+``J' = -dC/dgamma = -F G sin(gamma)``, ``gamma' = dC/dJ = omega - Omega - F omega G'(xi) cos(gamma)``.
+This is the sign convention of the true system ``q' = p, p' = -q + q^3 + F sin(Omega tau + Psi)``
+(eq 1); the printed eq (5) has its signs swapped (it should read ``q' = dH/dp, p' = -dH/dq``).
+
+Escape criterion (used everywhere in this package)
+--------------------------------------------------
+Write ``h(xi) = xi - Omega J(xi)``, ``a(xi) = h - F G`` (C on the ray gamma = 0) and
+``b(xi) = h + F G`` (C on gamma = pi).  For F > 0, C is strictly increasing in gamma on
+(0, pi) and even in gamma, so on each circle xi = const the level ``c`` is attained (in the
+upper half) at exactly one gamma iff ``a(xi) <= c <= b(xi)``.  The component of the level set
+``C = c0`` through ``(gamma0, xi0)`` is therefore, in the upper half, a graph ``gamma(xi)``
+over the maximal xi-interval around xi0 on which ``a < c0 < b``; its ends lie on the rays
+gamma = 0 or pi, where it joins its mirror image, unless the interval reaches xi_max.
+Hence the IC escapes (the level curve (21) reaches the circle xi = xi_max) iff
+
+    max_{xi in [xi0, xi_max]} a(xi)  <=  c0  <=  min_{xi in [xi0, xi_max]} b(xi).
+
+Interior maxima of ``a`` are the saddles on gamma = 0 (``a'(xi) = 0``, i.e.
+``1 - Omega/omega - F G' = 0``, eq 25); interior minima of ``b`` are saddles on gamma = pi;
+the ends ``xi = xi_max`` are the tangencies of eqs (22)-(24).  ``a`` and ``b`` are tabulated
+on a fine xi grid with their critical points (located by Brent's method) inserted as nodes,
+so that ``a`` is monotone between nodes and the suffix max/min are exact.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy import optimize
+
+from .._validate import XI_SEPARATRIX, _arr, check_energy, check_finite, check_nonnegative, \
+    check_positive, check_threshold
+from .action_angle import _G, _J, _angle_energy, _dG_dxi, _omega, check_fourier
+
+__all__ = ["first_integral", "escapes_on_manifold", "slow_flow_escapes", "slow_flow_profile",
+           "slow_flow_rhs", "xi_from_J", "saddles"]
+
+
+def _scalar(name, value, check):
+    a = check(name, value)
+    if a.ndim != 0:
+        raise ValueError(f"{name} must be a scalar here, got shape {a.shape}")
+    return float(a)
+
+
+def first_integral(gamma, xi, F, Omega, fourier="paper"):
+    """First integral of the slow flow, eq (18): ``C = xi - Omega J(xi) - F G(xi) cos(gamma)``.
+
+    Broadcasts all array arguments.  ``0 <= xi <= 1/4`` (G(1/4) = 0 limit), ``F >= 0``,
+    ``Omega > 0``.
+    """
+    check_fourier(fourier)
+    gamma = check_finite("gamma", gamma)
+    xi = check_energy("xi", xi, allow_separatrix=True)
+    F = check_nonnegative("F", F)
+    Omega = check_positive("Omega", Omega)
+    return xi - Omega * _J(xi) - F * _G(xi, fourier) * np.cos(gamma)
+
+
+# ----------------------------------------------------------------------------- profile
+def _h_prime(xi, Omega):
+    with np.errstate(divide="ignore"):
+        return 1.0 - Omega / _omega(xi)
+
+
+def _ab_prime(xi, F, Omega, fourier):
+    hp = _h_prime(xi, Omega)
+    gp = _dG_dxi(xi, fourier)
+    return hp - F * gp, hp + F * gp
+
+
+def _xi_grid(lo, hi, n):
+    """Grid on [lo, hi] clustered at both ends (Chebyshev-Lobatto spacing)."""
+    t = np.linspace(0.0, 1.0, n)
+    x = lo + (hi - lo) * 0.5 * (1.0 - np.cos(np.pi * t))
+    x[0], x[-1] = lo, hi
+    return x
+
+
+def _critical_points(xi, F, Omega, fourier, which):
+    """Roots of a'(xi) (which=0) or b'(xi) (which=1) on the open interval of the grid.
+
+    Returns (roots, kinds) with kind +1 for a local max, -1 for a local min.
+    """
+    inner = xi[1:-1] if xi[-1] >= XI_SEPARATRIX else xi[1:]
+    if inner.size < 2:
+        return np.empty(0), np.empty(0, int)
+    d = _ab_prime(inner, F, Omega, fourier)[which]
+    s = np.sign(d)
+    idx = np.nonzero(s[:-1] * s[1:] < 0)[0]
+    roots, kinds = [], []
+
+    def f(x):
+        return float(_ab_prime(np.asarray(x), F, Omega, fourier)[which])
+
+    for i in idx:
+        r = optimize.brentq(f, inner[i], inner[i + 1], xtol=1e-15, rtol=1e-15, maxiter=200)
+        roots.append(r)
+        kinds.append(1 if s[i] > 0 else -1)
+    return np.asarray(roots, float), np.asarray(kinds, int)
+
+
+class SlowFlowProfile:
+    """Tabulated ``a(xi)``, ``b(xi)`` on [0, xi_max] with critical points as nodes.
+
+    Attributes: ``xi``, ``h``, ``a``, ``b``, ``A`` (suffix max of a), ``B`` (suffix min of b),
+    ``a_max``/``b_min`` (xi of interior local maxima of a / minima of b: saddles on
+    gamma = 0 / pi), ``a_min``/``b_max`` (centres).
+    """
+
+    def __init__(self, F, Omega, xi_max, fourier="paper", n=1500, lo=0.0):
+        self.F, self.Omega, self.xi_max, self.fourier = F, Omega, xi_max, fourier
+        base = _xi_grid(lo, xi_max, n)
+        ra, ka = _critical_points(base, F, Omega, fourier, 0)
+        rb, kb = _critical_points(base, F, Omega, fourier, 1)
+        self.a_max, self.a_min = ra[ka > 0], ra[ka < 0]
+        self.b_min, self.b_max = rb[kb < 0], rb[kb > 0]
+        xi = np.unique(np.concatenate([base, ra, rb]))
+        self.xi = xi
+        self.J = _J(xi)
+        self.Gv = _G(xi, fourier)
+        self.h = xi - Omega * self.J
+        self.a = self.h - F * self.Gv
+        self.b = self.h + F * self.Gv
+        self.A = np.maximum.accumulate(self.a[::-1])[::-1]
+        self.B = np.minimum.accumulate(self.b[::-1])[::-1]
+
+    def suffix(self, xi0):
+        """(max a, min b) over [xi0, xi_max] for xi0 < xi_max, excluding a(xi0), b(xi0)."""
+        j = np.searchsorted(self.xi, xi0, side="right")
+        j = np.minimum(j, self.xi.size - 1)
+        return self.A[j], self.B[j]
+
+
+def slow_flow_profile(F, Omega, xi_max, fourier="paper", n=1500):
+    """Build the :class:`SlowFlowProfile` (a, b, suffix extrema, critical points) for one
+    parameter set; see the module docstring."""
+    check_fourier(fourier)
+    F = _scalar("F", F, check_nonnegative)
+    Omega = _scalar("Omega", Omega, check_positive)
+    xi_max = _scalar("xi_max", xi_max, check_threshold)
+    return SlowFlowProfile(F, Omega, xi_max, fourier, n)
+
+
+def saddles(F, Omega, xi_max=XI_SEPARATRIX, fourier="paper"):
+    """Saddles of the slow flow below xi_max (eq 25), as a list of ``(gamma, xi)``.
+
+    gamma = 0 saddles are interior maxima of ``a(xi)``, gamma = pi saddles interior minima of
+    ``b(xi)``; each root of ``a'`` / ``b'`` is bracketed on a fine grid and polished by Brent's
+    method (the paper uses Newton-Raphson, Sec. 3.2).
+    """
+    prof = slow_flow_profile(F, Omega, xi_max, fourier)
+    out = [(0.0, float(x)) for x in prof.a_max if x < xi_max]
+    out += [(np.pi, float(x)) for x in prof.b_min if x < xi_max]
+    return sorted(out, key=lambda t: t[1])
+
+
+def _escapes_rm(gamma, xi, prof):
+    """Escape classification for validated points (gamma, xi) given a profile."""
+    F, Omega, xi_max = prof.F, prof.Omega, prof.xi_max
+    gamma, xi = np.broadcast_arrays(gamma, xi)
+    out = np.ones(gamma.shape, dtype=bool)
+    inside = xi < xi_max
+    if F == 0.0:
+        out[inside] = False
+        return out
+    g, x = gamma[inside], xi[inside]
+    c0 = x - Omega * _J(x) - F * _G(x, prof.fourier) * np.cos(g)
+    A, B = prof.suffix(x)
+    out[inside] = (A <= c0) & (c0 <= B)
+    return out
+
+
+def escapes_on_manifold(gamma, xi, F, Omega, xi_max, fourier="paper"):
+    """Does the slow-flow level curve (21) through ``(gamma, xi)`` reach ``xi = xi_max``?
+
+    Boolean array (True = escapes), broadcast over gamma and xi; points with
+    ``xi >= xi_max`` escape.  F, Omega, xi_max are scalars.  Criterion: see module docstring
+    (``max a <= C(gamma, xi) <= min b`` over ``[xi, xi_max]``).
+    """
+    check_fourier(fourier)
+    gamma = check_finite("gamma", gamma)
+    xi = check_energy("xi", xi, allow_separatrix=True)
+    prof = slow_flow_profile(F, Omega, xi_max, fourier)
+    return _escapes_rm(gamma, xi, prof)
+
+
+def slow_flow_escapes(q0, p0, F, Omega, Psi, xi_max, fourier="paper"):
+    """Analytic escape prediction for initial conditions ``(q0, p0)`` at tau = 0.
+
+    Each IC is mapped to ``(theta0, xi0)`` (eqs 7, 14), ``gamma0 = theta0 - Psi``, and
+    classified by whether the level curve of C (eq 18) through ``(gamma0, xi0)`` reaches
+    ``xi_max`` (eq 21).  ICs with ``H0 >= xi_max`` or ``|q0| >= 1`` escape.  Broadcasts q0 and
+    p0; F, Omega, Psi, xi_max are scalars.  Returns a bool array (True = escapes).
+    """
+    check_fourier(fourier)
+    q0 = check_finite("q0", q0)
+    p0 = check_finite("p0", p0)
+    _scalar("Psi", Psi, check_finite)
+    prof = slow_flow_profile(F, Omega, xi_max, fourier)
+    q0, p0 = np.broadcast_arrays(q0, p0)
+    H = 0.5 * p0 * p0 + 0.5 * q0 * q0 - 0.25 * q0 ** 4
+    inside = (np.abs(q0) < 1.0) & (H < prof.xi_max)
+    out = np.ones(q0.shape, dtype=bool)
+    theta, xi = _angle_energy(q0[inside], p0[inside])
+    out[inside] = _escapes_rm(theta - float(Psi), xi, prof)
+    return out
+
+
+# ----------------------------------------------------------------------------- Cartesian flow
+def xi_from_J(Jv):
+    """Invert eq (19): energy xi with ``J(xi) = Jv`` (0 <= Jv <= 4/(3 pi)), Newton on dJ/dxi = 1/omega."""
+    Jv = check_nonnegative("Jv", Jv)
+    Jmax = float(_J(np.asarray(XI_SEPARATRIX)))
+    if (Jv > Jmax).any():
+        raise ValueError(f"Jv must be <= J(1/4) = {Jmax}")
+    # initial guess from a monotone table, then Newton steps
+    tab_x = _xi_grid(0.0, XI_SEPARATRIX, 4001)
+    tab_J = _J(tab_x)
+    x = np.interp(Jv, tab_J, tab_x)
+    for _ in range(4):
+        inner = (x > 0) & (x < XI_SEPARATRIX)
+        xs = np.where(inner, x, 0.1)
+        x = np.where(inner, x - (_J(xs) - Jv) * _omega(xs), x)
+        x = np.clip(x, 0.0, XI_SEPARATRIX)
+    return x
+
+
+def slow_flow_rhs(X, Y, F, Omega, fourier="paper"):
+    """Slow flow (11) in Cartesian slow variables ``X = sqrt(2J) cos(gamma)``, ``Y = sqrt(2J) sin(gamma)``.
+
+    With ``J' = -F G sin(gamma)`` and ``gamma' = omega - Omega - F omega G'(xi) cos(gamma)``:
+    ``X' = J' cos(gamma)/r - Y gamma'``, ``Y' = J' sin(gamma)/r + X gamma'`` (``r^2 = 2J``).
+    Regular at the well bottom (there ``X' = 0``, ``Y' = -F/2`` for ``G ~ r/2``).  Returns
+    ``(dX, dY)``; C (eq 18) is conserved.
+    """
+    X = np.asarray(X, float)
+    Y = np.asarray(Y, float)
+    r2 = X * X + Y * Y
+    r = np.sqrt(r2)
+    xi = xi_from_J(0.5 * r2)
+    small = r < 1e-12
+    rs = np.where(small, 1.0, r)
+    xs = np.where(small, 1e-30, xi)
+    c, s = np.where(small, 1.0, X / rs), np.where(small, 0.0, Y / rs)
+    w = _omega(xs)
+    Jdot = -F * _G(xs, fourier) * s
+    gdot = w - Omega - F * w * _dG_dxi(xs, fourier) * c
+    dX = Jdot * c / rs - Y * gdot
+    dY = Jdot * s / rs + X * gdot
+    dX = np.where(small, 0.0, dX)
+    dY = np.where(small, -0.5 * F, dY)
+    return dX, dY
