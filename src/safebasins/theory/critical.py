@@ -1,0 +1,271 @@
+"""Critical forcing F_cr(Omega) for escape from one initial point on the RM (paper eqs 22-26).
+
+With ``h(xi) = xi - Omega J(xi)``, ``h0 = h(xi0)``, ``G0 = G(xi0)``, ``c = cos(gamma0)`` the IC
+escapes iff (see :mod:`safebasins.theory.slow_flow`) for every ``xi`` in ``(xi0, xi_max]``
+
+    (A)  F (G(xi) - G0 c) >= h(xi) - h0      (level curve stays above the ray gamma = 0)
+    (B)  F (G(xi) + G0 c) >= h0 - h(xi)      (level curve stays below the ray gamma = pi)
+
+Each is linear in F, so the escaping set of F is an interval ``[F_lo, F_hi]`` and
+``F_cr = F_lo = max`` of the lower bounds ``L_A = (h - h0)/(G - G0 c)``,
+``L_B = (h0 - h)/(G + G0 c)`` over xi (where the denominators are positive).  Denominators
+can be negative (G decreases to 0 at the separatrix): those constraints are upper bounds, and
+if ``F_lo > F_hi`` the IC never escapes in the slow flow (``F_cr = NaN``, mechanism "none").
+
+Where the maximum sits names the mechanism:
+
+* ``xi = xi_max`` in (A): the level curve becomes tangent to ``xi = xi_max`` at gamma* = 0, eq (24)
+  with the + sign:  ``F = (h(xi_max) - h0) / (G(xi_max) - G0 c)``.  Labelled **SMM** when, at
+  that F, the slow flow has a saddle on the ray gamma = 0 *above* xi_max (``a(xi)`` has a local
+  maximum in (xi_max, 1/4)) — the paper's "saddle maximum mechanism" (Sec. 2.2, Fig. 3, red
+  dotted line); otherwise **MM_0**.
+* ``xi = xi_max`` in (B): tangency at gamma* = pi, eq (24) with the - sign: **MM_pi**
+  (Fig. 3, green dashed line).
+* an interior maximum of L_A (L_B): at that F the curve through the IC passes through a
+  saddle on gamma = 0 (pi) below xi_max (``a' = 0`` there, eqs 25-26): **SM**.
+  (An interior maximum of ``L_A`` in xi is exactly a point where ``a(xi) = C0`` and
+  ``a'(xi) = 0`` with ``a`` locally maximal, i.e. a saddle.)
+
+For the zero IC this reduces to ``F_cr = max_{0 < xi <= xi_max} |xi - Omega J(xi)| / G(xi)``.
+"""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from .._validate import XI_SEPARATRIX, _arr, check_energy, check_finite, check_positive, \
+    check_threshold
+from .action_angle import _G, _J, _dG_dxi, _omega, check_fourier
+from .slow_flow import _scalar, _xi_grid
+
+__all__ = ["critical_forcing", "MECHANISMS"]
+
+MECHANISMS = ("none", "MM_0", "MM_pi", "SM", "SMM")
+NONE, MM_0, MM_PI, SM, SMM = range(5)
+
+
+def _bisect(fun, lo, hi, n_iter=60):
+    """Vectorised bisection for a sign change fun(lo) > 0 > fun(hi)."""
+    lo, hi = lo.copy(), hi.copy()
+    for _ in range(n_iter):
+        mid = 0.5 * (lo + hi)
+        pos = fun(mid) > 0
+        lo = np.where(pos, mid, lo)
+        hi = np.where(pos, hi, mid)
+    return 0.5 * (lo + hi)
+
+
+def _interior_max(L, valid, xi, refine_fun, n_iter=60):
+    """Largest interior local maximum of L (rows = Omega) with its xi, refined on the derivative.
+
+    refine_fun(rows, x) -> sign-carrying derivative of L at x for the given rows.
+    """
+    nO, N = L.shape
+    Lm = np.where(valid, L, -np.inf)
+    left = Lm[:, :-2]                            # nodes 1..N-2 (Lm[:, 0] is -inf)
+    mid = Lm[:, 1:-1]
+    right = Lm[:, 2:]
+    is_max = np.isfinite(mid) & (mid >= left) & (mid >= right)
+    cand = np.where(is_max, mid, -np.inf)
+    k = np.argmax(cand, axis=1)
+    val = cand[np.arange(nO), k]
+    exists = np.isfinite(val)
+    i = k + 1                                   # node index
+    x_node = xi[i]
+    x_out = np.where(exists, x_node, np.nan)
+    v_out = np.where(exists, val, np.nan)
+    rows = np.nonzero(exists)[0]
+    if rows.size:
+        lo = xi[i[rows] - 1]
+        hi = xi[i[rows] + 1]
+        lo = np.where(i[rows] - 1 == 0, lo + 1e-9 * (hi - lo), lo)
+        hi = np.where(i[rows] + 1 == N - 1, hi - 1e-9 * (hi - lo), hi)
+        s_lo = refine_fun(rows, lo)
+        s_hi = refine_fun(rows, hi)
+        ok = (s_lo > 0) & (s_hi < 0)
+        if ok.any():
+            r = rows[ok]
+            x_ref = _bisect(lambda x: refine_fun(r, x), lo[ok], hi[ok], n_iter)
+            x_out[r] = x_ref
+    return x_out, v_out, exists
+
+
+def critical_forcing(Omega, xi_max, xi0=0.0, gamma0=0.0, fourier="paper", n_grid=2001):
+    """Critical forcing amplitude F_cr(Omega) of the slow flow (eqs 22-26).
+
+    Parameters
+    ----------
+    Omega : array_like, > 0
+        Forcing frequencies (becomes the coordinate ``Omega``).
+    xi_max : float in (0, 1/4]
+        Energy truncation level.
+    xi0, gamma0 : float
+        Initial point on the RM (``0 <= xi0 < xi_max``; gamma0 = theta0 - Psi).  Zero IC by default.
+    fourier : "paper" | "exact"
+        Which G (eq 20) to use.
+    n_grid : int
+        Nodes of the xi grid used to bracket the maxima (refined by bisection).
+
+    Returns
+    -------
+    xarray.Dataset over ``Omega`` with
+      ``F_cr``   smallest F at which the level curve through (gamma0, xi0) reaches xi_max
+                 (NaN if it never does),
+      ``mechanism`` int8, flag_values [0..4], flag_meanings "none MM_0 MM_pi SM SMM",
+      ``F_MM_0`` eq (24) through gamma* = 0 where no gamma = 0 saddle lies above xi_max
+                 (NaN otherwise, and where the tangency value is not a positive lower bound),
+      ``F_SMM``  the same eq (24) value where such a saddle exists above xi_max (the branches
+                 F_MM_0 and F_SMM are disjoint; their union is eq (24) with gamma* = 0),
+      ``F_MM_pi`` eq (24) through gamma* = pi,
+      ``F_SM``   largest F of eqs (25)-(26) with the saddle in (xi0, xi_max) (NaN if none),
+      ``xi_saddle``, ``gamma_saddle`` the saddle of the F_SM branch (gamma 0 or pi),
+      ``xi_saddle_smm`` the saddle above xi_max on the F_SMM branch.
+    F_cr equals the largest existing branch, provided no upper-bound constraint excludes it.
+    Attributes: xi_max, xi0, gamma0, fourier.
+    """
+    check_fourier(fourier)
+    Om = np.atleast_1d(check_positive("Omega", Omega)).astype(float)
+    if Om.ndim != 1:
+        raise ValueError("Omega must be a scalar or 1-D array")
+    xm = _scalar("xi_max", xi_max, check_threshold)
+    x0 = _scalar("xi0", xi0, lambda n, v: check_energy(n, v))
+    if x0 >= xm:
+        raise ValueError(f"xi0 must be < xi_max ({xm}), got {x0}")
+    g0 = _scalar("gamma0", gamma0, check_finite)
+    if not isinstance(n_grid, (int, np.integer)) or n_grid < 16:
+        raise ValueError("n_grid must be an integer >= 16")
+
+    nO = Om.size
+    xi = _xi_grid(x0, xm, int(n_grid))
+    Jg, Gg = _J(xi), _G(xi, fourier)
+    J0, G0 = float(_J(np.asarray(x0))), float(_G(np.asarray(x0), fourier))
+    c = np.cos(g0)
+    h = xi[None, :] - Om[:, None] * Jg[None, :]
+    h0 = x0 - Om * J0
+    numA = h - h0[:, None]
+    numB = -numA
+    dA = Gg - G0 * c
+    dB = Gg + G0 * c
+    tiny = 1e-14
+    with np.errstate(divide="ignore", invalid="ignore"):
+        LA = numA / dA[None, :]
+        LB = numB / dB[None, :]
+    posA, posB = dA > tiny, dB > tiny
+    posA[0] = posB[0] = False                 # xi0 itself: trivially satisfied
+    # upper bounds and infeasible zero-denominator constraints
+    negA, negB = dA < -tiny, dB < -tiny
+    negA[0] = negB[0] = False
+    zA = ~(posA | negA)
+    zB = ~(posB | negB)
+    zA[0] = zB[0] = False
+    U = np.full(nO, np.inf)
+    if negA.any():
+        U = np.minimum(U, np.min(np.where(negA[None, :], LA, np.inf), axis=1))
+    if negB.any():
+        U = np.minimum(U, np.min(np.where(negB[None, :], LB, np.inf), axis=1))
+    infeasible = np.zeros(nO, bool)
+    if zA.any():
+        infeasible |= np.any(zA[None, :] & (numA > 1e-13), axis=1)
+    if zB.any():
+        infeasible |= np.any(zB[None, :] & (numB > 1e-13), axis=1)
+
+    # --- endpoint tangencies, eq (24)
+    end_ok = xm < XI_SEPARATRIX
+    FA_end = np.where(posA[-1] & end_ok, LA[:, -1], np.nan)
+    FB_end = np.where(posB[-1] & end_ok, LB[:, -1], np.nan)
+    FA_end = np.where(FA_end > 0, FA_end, np.nan)
+    FB_end = np.where(FB_end > 0, FB_end, np.nan)
+
+    # --- interior maxima (saddle mechanism), refined on the sign of dL/dxi
+    def dLA(rows, x):
+        om = Om[rows]
+        hp = 1.0 - om / _omega(x)
+        num = x - om * _J(x) - h0[rows]
+        return hp * (_G(x, fourier) - G0 * c) - num * _dG_dxi(x, fourier)
+
+    def dLB(rows, x):
+        om = Om[rows]
+        hp = 1.0 - om / _omega(x)
+        num = h0[rows] - (x - om * _J(x))
+        return -hp * (_G(x, fourier) + G0 * c) - num * _dG_dxi(x, fourier)
+
+    def L_at(x, rows, which):
+        om = Om[rows]
+        hh = x - om * _J(x)
+        Gx = _G(x, fourier)
+        if which == 0:
+            return (hh - h0[rows]) / (Gx - G0 * c)
+        return (h0[rows] - hh) / (Gx + G0 * c)
+
+    xA, vA, eA = _interior_max(LA, posA[None, :] & np.ones((nO, 1), bool), xi, dLA)
+    xB, vB, eB = _interior_max(LB, posB[None, :] & np.ones((nO, 1), bool), xi, dLB)
+    for xs, vs, es, w in ((xA, vA, eA, 0), (xB, vB, eB, 1)):
+        r = np.nonzero(es)[0]
+        if r.size:
+            vs[r] = np.maximum(vs[r], L_at(xs[r], r, w))
+    vA = np.where(eA & (vA > 0), vA, np.nan)
+    vB = np.where(eB & (vB > 0), vB, np.nan)
+    useB = np.nan_to_num(vB, nan=-np.inf) > np.nan_to_num(vA, nan=-np.inf)
+    F_SM = np.where(useB, vB, vA)
+    xi_saddle = np.where(np.isnan(F_SM), np.nan, np.where(useB, xB, xA))
+    gamma_saddle = np.where(np.isnan(F_SM), np.nan, np.where(useB, np.pi, 0.0))
+
+    # --- SMM: does a(xi) = h - F G have a local max in (xi_max, 1/4) at F = FA_end?
+    xi_smm = np.full(nO, np.nan)
+    has_smm = np.zeros(nO, bool)
+    rows = np.nonzero(np.isfinite(FA_end))[0]
+    if rows.size and xm < XI_SEPARATRIX:
+        up = _xi_grid(xm, XI_SEPARATRIX, 600)[:-1]
+        dG_up = _dG_dxi(up, fourier)
+        w_up = _omega(up)
+        ap = (1.0 - Om[rows, None] / w_up[None, :]) - FA_end[rows, None] * dG_up[None, :]
+        sgn = ap > 0
+        change = sgn[:, :-1] & ~sgn[:, 1:]
+        hit = change.any(axis=1)
+        if hit.any():
+            rr = rows[hit]
+            j = np.argmax(change[hit], axis=1)
+            Fr = FA_end[rr]
+
+            def dap(x, rr=rr, Fr=Fr):
+                return 1.0 - Om[rr] / _omega(x) - Fr * _dG_dxi(x, fourier)
+
+            xi_smm[rr] = _bisect(dap, up[j], up[j + 1])
+            has_smm[rr] = True
+    F_MM_0 = np.where(has_smm, np.nan, FA_end)
+    F_SMM = np.where(has_smm, FA_end, np.nan)
+
+    # --- overall threshold and mechanism
+    stack = np.stack([F_MM_0, FB_end, F_SM, F_SMM])           # codes 1, 2, 3, 4
+    filled = np.nan_to_num(stack, nan=-np.inf)
+    best = np.argmax(filled, axis=0)
+    F_cr = filled[best, np.arange(nO)]
+    mech = (best + 1).astype(np.int8)
+    ok = np.isfinite(F_cr) & ~infeasible & (F_cr <= U * (1 + 1e-12))
+    F_cr = np.where(ok, F_cr, np.nan)
+    mech = np.where(ok, mech, NONE).astype(np.int8)
+
+    def var(values, long_name):
+        return ("Omega", values, {"units": "1", "long_name": long_name})
+
+    ds = xr.Dataset(
+        {
+            "F_cr": var(F_cr, "critical forcing amplitude (slow flow, eqs 22-26)"),
+            "mechanism": ("Omega", mech, {
+                "long_name": "escape mechanism setting F_cr",
+                "flag_values": np.arange(5, dtype=np.int8),
+                "flag_meanings": " ".join(MECHANISMS)}),
+            "F_MM_0": var(F_MM_0, "maximum mechanism through gamma*=0, eq (24), no saddle above xi_max"),
+            "F_MM_pi": var(FB_end, "maximum mechanism through gamma*=pi, eq (24)"),
+            "F_SM": var(F_SM, "saddle mechanism, eqs (25)-(26)"),
+            "F_SMM": var(F_SMM, "saddle maximum mechanism: eq (24) at gamma*=0 with a saddle above xi_max"),
+            "xi_saddle": var(xi_saddle, "averaged energy of the saddle on the F_SM branch"),
+            "gamma_saddle": ("Omega", gamma_saddle,
+                             {"units": "rad", "long_name": "slow phase of the saddle on the F_SM branch"}),
+            "xi_saddle_smm": var(xi_smm, "averaged energy of the saddle above xi_max on the F_SMM branch"),
+        },
+        coords={"Omega": ("Omega", Om, {"units": "1", "long_name": "forcing frequency"})},
+        attrs={"xi_max": xm, "xi0": x0, "gamma0": g0, "fourier": fourier,
+               "description": "slow-flow (isolated 1:1 resonance) escape threshold, Karmi et al. eqs 18-26"},
+    )
+    return ds
