@@ -12,32 +12,33 @@ from safebasins.integrity import grid_spacing
 FOURIER_CHOICES = ("paper", "exact")
 
 
-def theory():
-    """The theory package, or an ImportError naming what is missing."""
-    try:
-        mod = importlib.import_module("safebasins.theory")
-    except ImportError as exc:  # pragma: no cover - depends on the checkout
-        raise ImportError(f"safebasins.theory is not available: {exc}") from exc
-    return mod
+_THEORY_SUBMODULES = ("slow_flow", "critical", "basins", "action_angle")
+_NUMERICS_SUBMODULES = ("charts", "bisection", "maps")
+
+
+def _lookup(pkg, submodules, name):
+    mod = importlib.import_module(pkg)
+    fn = getattr(mod, name, None)
+    if fn is not None:
+        return fn
+    for sub in submodules:  # the contract names may not be re-exported by __init__ yet
+        try:
+            fn = getattr(importlib.import_module(f"{pkg}.{sub}"), name, None)
+        except ImportError:
+            continue
+        if fn is not None:
+            return fn
+    raise ImportError(f"{pkg} has no {name!r} yet (see docs/contracts.md)")
 
 
 def theory_fn(name):
-    mod = theory()
-    fn = getattr(mod, name, None)
-    if fn is None:
-        raise ImportError(f"safebasins.theory has no {name!r} yet (see docs/contracts.md)")
-    return fn
+    """A contract function of safebasins.theory (ImportError naming it if not there)."""
+    return _lookup("safebasins.theory", _THEORY_SUBMODULES, name)
 
 
 def numerics_fn(name):
-    try:
-        mod = importlib.import_module("safebasins.numerics")
-    except ImportError as exc:  # pragma: no cover
-        raise ImportError(f"safebasins.numerics is not available: {exc}") from exc
-    fn = getattr(mod, name, None)
-    if fn is None:
-        raise ImportError(f"safebasins.numerics has no {name!r} yet (see docs/contracts.md)")
-    return fn
+    """A contract function of safebasins.numerics (ImportError naming it if not there)."""
+    return _lookup("safebasins.numerics", _NUMERICS_SUBMODULES, name)
 
 
 def fourier_list(fourier):

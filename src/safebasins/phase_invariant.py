@@ -22,8 +22,8 @@ all-safe circles is an interval ``[0, xi_true)``.  Hence
 
 and its integrity has a closed form: ``GIM = J(xi_true) / J(xi_max)`` (area = 2 pi J),
 ``LIM = IF = sqrt(xi_true / xi_max)`` (inscribed radius sqrt(2 xi)).  ``xi_true`` is
-found by bisection on "some gamma of the circle escapes" (monotone in xi by the same
-argument) with a fine gamma grid; if the LPT through the well bottom escapes,
+found by nested grid refinement of "some gamma of the circle escapes" (monotone in xi
+by the same argument) with a fine gamma grid; if the LPT through the well bottom escapes,
 ``xi_true = 0``.  A finite set of phases gives a superset of this disk.
 
 Numeric
@@ -60,35 +60,43 @@ def default_phases(n_psi=16):
     return 2 * np.pi * np.arange(n) / n
 
 
-def _circle_escapes(xi, F, Omega, xi_max, fourier, gamma):
+def _first_escaping_circle(lo, hi, n_xi, F, Omega, xi_max, fourier, gamma):
+    """Grid search on [lo, hi]: (last all-safe xi, first xi with an escaping point) or None."""
     esc = theory_fn("escapes_on_manifold")
-    return bool(np.any(esc(gamma, np.full_like(gamma, xi), F, Omega, xi_max, fourier=fourier)))
+    xs = np.linspace(lo, hi, n_xi)
+    e = np.asarray(esc(gamma[:, None], xs[None, :], F, Omega, xi_max, fourier=fourier), dtype=bool).any(axis=0)
+    k = np.flatnonzero(e)
+    if k.size == 0:
+        return None
+    k = int(k[0])
+    return (xs[k - 1] if k > 0 else None), xs[k]
 
 
-def xi_true_analytic(F, Omega, xi_max, fourier="paper", *, n_gamma=1024, tol=1e-7):
+def xi_true_analytic(F, Omega, xi_max, fourier="paper", *, n_gamma=512, n_xi=400, levels=3):
     """Largest xi such that every circle ``xi' < xi`` of the resonance manifold is safe.
 
-    Bisection on the monotone predicate "some point of the circle escapes", tested on
-    ``n_gamma`` equally spaced gamma (an escaping arc narrower than 2 pi / n_gamma can
-    be missed, biasing xi_true upward by at most the xi-extent of such an arc).
+    The predicate "some point of the circle escapes" is monotone in xi (module
+    docstring); it is tested on ``n_gamma`` equally spaced gamma (even, so the rays
+    gamma = 0 and pi where the level curves turn are included) and refined ``levels``
+    times on ``n_xi``-point xi grids, giving a resolution of about
+    ``xi_max / (n_xi - 1)**levels``.  Returns 0 if the well bottom (the limiting phase
+    trajectory) escapes and ``xi_max`` if nothing below xi_max escapes.
     """
     F = float(V.check_nonnegative("F", F))
     Omega = float(V.check_positive("Omega", Omega))
     xi_max = float(V.check_threshold("xi_max", xi_max))
     fourier_list(fourier)
-    gamma = 2 * np.pi * np.arange(V.check_positive_int("n_gamma", n_gamma)) / n_gamma
-    lo = 0.0
-    hi = min(xi_max, 0.25 - 1e-9)  # circle at xi_max itself escapes by definition
-    if _circle_escapes(1e-12, F, Omega, xi_max, fourier, gamma):
-        return 0.0
-    if not _circle_escapes(hi * (1 - 1e-9), F, Omega, xi_max, fourier, gamma):
-        return hi
-    while hi - lo > tol:
-        mid = 0.5 * (lo + hi)
-        if _circle_escapes(mid, F, Omega, xi_max, fourier, gamma):
-            hi = mid
-        else:
-            lo = mid
+    n_gamma = V.check_positive_int("n_gamma", n_gamma)
+    n_gamma += n_gamma % 2
+    gamma = 2 * np.pi * np.arange(n_gamma) / n_gamma
+    lo, hi = 0.0, xi_max * (1 - 1e-12)
+    for _ in range(V.check_positive_int("levels", levels)):
+        r = _first_escaping_circle(lo, hi, V.check_positive_int("n_xi", n_xi), F, Omega, xi_max, fourier, gamma)
+        if r is None:
+            return hi if hi >= xi_max * (1 - 1e-9) else lo
+        if r[0] is None:
+            return lo
+        lo, hi = r
     return lo
 
 
@@ -135,7 +143,7 @@ def _assemble(safe, true, q, p, Psi, lead_dims, lead_coords, xi_norm):
 
 
 def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fourier="paper", n_psi=16,
-                             n_gamma=1024):
+                             n_gamma=512):
     """Analytic phase-invariant safe basin and its integrity.
 
     Parameters
