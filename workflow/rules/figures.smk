@@ -14,8 +14,7 @@ import sys as _fig_sys
 from safebasins.plotting import catalog as _figcat
 
 _FIG_PLOTTING = ["src/safebasins/plotting/core.py", "src/safebasins/plotting/__init__.py"]
-_FIG_CFG = config.get("figures", {}) if isinstance(config, dict) else {}
-_FIG_DPI = int(_FIG_CFG.get("dpi", 180))
+_FIG_DPI = 180  # PNG resolution (the PDF is vector, rasters inside it embedded at this dpi)
 
 FIGURE_TARGETS = [p for nn in _figcat.FIGURES for p in _figcat.figure_paths(nn)]
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 ANALYTIC = "results/data/analytic"
 NUMERIC = "results/data/numeric"
+PARAMS = "results/params"  # resolved parameters (t_eval lists of Figs 20-22)
 FIGURE_DIR = "results/figures"
 NOTEBOOK_DIR = "results/notebooks"
 LOG_DIR = "results/logs/figures"
@@ -198,7 +199,8 @@ FIGURES = {
              "… 0.071. Near zero for small F, growing with F."),
     "20": dict(
         slug="dsb_esb_zoom", builder="figure_dsb_esb",
-        inputs={"numeric": f"{NUMERIC}/chart_fig20.nc"}, options=dict(t_evals=[500, 11000]),
+        inputs={"numeric": f"{NUMERIC}/chart_fig20.nc", "params": f"{PARAMS}/fig20.yaml"},
+        options=dict(t_evals=None),
         paper="Zoomed SB Escape Chart simulation for F = 0.0876, Ω = 0.95, Ψ = π, ξ_max = 0.25, "
               "the resolution is 300×300. Left: t_eval = 500 EC. Right: t_eval = 11,000 EC, DSB "
               "(grey) and ESB (black).",
@@ -207,14 +209,16 @@ FIGURES = {
              "smoother boundary."),
     "21": dict(
         slug="dsb_esb_full", builder="figure_dsb_esb",
-        inputs={"numeric": f"{NUMERIC}/chart_fig21.nc"}, options=dict(t_evals=[500, 11000]),
+        inputs={"numeric": f"{NUMERIC}/chart_fig21.nc", "params": f"{PARAMS}/fig21.yaml"},
+        options=dict(t_evals=None),
         paper="Entire SB Escape Chart simulation for F = 0.0876, Ω = 0.95, Ψ = π, ξ_max = 0.25, "
               "the resolution is 300×300. Left: t_eval = 500 EC. Right: t_eval = 11,000 EC, DSB "
               "(grey) and ESB (black).",
         look="Full view of the basins of Figure 20."),
     "22": dict(
         slug="sb_area_vs_time", builder="figure_area_vs_time",
-        inputs={"numeric": f"{NUMERIC}/chart_fig21.nc"}, options={},
+        inputs={"numeric": f"{NUMERIC}/chart_fig21.nc", "params": f"{PARAMS}/fig22.yaml"},
+        options=dict(t_evals=None),
         paper="Log of SB area in pixels fading with t_eval for DSB (dashed) and ESB (solid), "
               "F = 0.0876, Ω = 0.95, Ψ = π, ξ_max = 0.25, the resolution is 300×300.",
         look="Natural log of the number of safe pixels of the Figure 21 chart as a function of "

@@ -272,6 +272,17 @@ def curve_labels(ds, dim="curve"):
     return labels, constant
 
 
+def ic_text(const):
+    """Title text for the constant curve parameters; the zero IC is named as such."""
+    const = dict(const)
+    if "xi0" in const and float(const["xi0"]) == 0.0:
+        const.pop("xi0")
+        const.pop("gamma0", None)
+        txt = param_text(const)
+        return (txt + ", zero IC") if txt else "zero IC"
+    return param_text(const)
+
+
 def _mechanism_array(da):
     m = np.asarray(da, dtype=float)
     m = np.where(np.isfinite(m), m, 0).astype(int)
@@ -371,8 +382,9 @@ def figure_fcr(analytic, *, color_by="curve", show_branches=False, F_max=None, t
     draw_fcr(ax, ds, color_by=color_by, show_branches=show_branches)
     _fcr_ylim(ax, [ds["F_cr"]], F_max)
     _, const = curve_labels(ds)
+    const.pop("Psi", None)  # F_cr on the RM does not depend on the forcing phase
     fourier = _attr(ds, "fourier")
-    head = param_text(const)
+    head = ic_text(const)
     if fourier and fourier != "paper":
         head += f"  (G: {fourier} first harmonic)"
     ax.set_title(title or f"Theoretical escape threshold, {head}")
@@ -482,7 +494,7 @@ def figure_fcr_comparison(analytic, numeric, *, layout="overlay", F_max=None, ti
                 Line2D([], [], marker="o", ls="none", mfc="0.6", mec="k", mew=0.5,
                        label=f"numeric (bisection, {fmt_value(cycles)} EC)" if cycles else "numeric")]
         ax.legend(handles=h + extra, loc="best")
-    head = param_text(const)
+    head = ic_text(const)
     sub = []
     if cycles:
         sub.append(f"{fmt_value(cycles)} EC")
@@ -779,7 +791,7 @@ def figure_nested_basins(analytic, numeric, *, param="xi_max", title=None, t_eva
 # --------------------------------------------------------------------------------------------
 # Fig 18: period map + predicted boundary
 # --------------------------------------------------------------------------------------------
-def figure_period_map(analytic, numeric, *, title=None, figsize=(7.6, 6.4), s=0.15,
+def figure_period_map(analytic, numeric, *, title=None, figsize=(7.6, 6.4), s=0.8,
                       max_points=None):
     strobe = open_dataset(numeric)
     basin = open_dataset(analytic)
@@ -883,8 +895,34 @@ def draw_dsb_esb(ax, chart, t_eval):
     ax.set_title(rf"$t_{{eval}}$ = {t_eval:,.0f} EC")
 
 
-def figure_dsb_esb(numeric, *, t_evals=(500, 11000), title=None, figsize=(11.5, 5.6)):
+def load_params(src):
+    """Resolved parameter file (results/params/figNN.yaml) -> dict; dict/None pass through."""
+    if src is None or isinstance(src, dict):
+        return src or {}
+    import yaml
+
+    with open(src) as fh:
+        return yaml.safe_load(fh) or {}
+
+
+def _t_evals(chart, params, t_evals, default):
+    """Evaluation times: explicit > parameter file ``t_eval`` > chart attribute > default."""
+    if t_evals is not None:
+        return [float(t) for t in np.atleast_1d(t_evals)]
+    p = load_params(params)
+    if p.get("t_eval") is not None:
+        return [float(t) for t in np.atleast_1d(p["t_eval"])]
+    a = _attr(chart, "t_eval")
+    if a is not None:
+        return [float(t) for t in np.atleast_1d(a)]
+    return list(default)
+
+
+def figure_dsb_esb(numeric, params=None, *, t_evals=None, title=None, figsize=(11.5, 5.6)):
+    """Figs 20-21: DSB grey / ESB black at the first (left) and last (right) t_eval."""
     chart = open_dataset(numeric)
+    cycles = float(_attr(chart, "cycles", default=11000))
+    t_evals = _t_evals(chart, params, t_evals, (min(500.0, cycles), cycles))
     fig, axes = plt.subplots(1, len(t_evals), figsize=figsize, layout="constrained", squeeze=False)
     for ax, t in zip(axes[0], t_evals):
         draw_dsb_esb(ax, chart, t)
@@ -896,8 +934,8 @@ def figure_dsb_esb(numeric, *, t_evals=(500, 11000), title=None, figsize=(11.5, 
     params = {k: _attr(chart, k) for k in ("F", "Omega", "Psi")}
     params["xi_max"] = xi
     res = f"{chart.sizes.get('q0', '?')}x{chart.sizes.get('p0', '?')}"
-    fig.suptitle(title or ("Safe basins by displacement (grey) and energy (black) criterion: " +
-                           param_text(params) + f", resolution {res}"), fontsize=10.5)
+    fig.suptitle(title or ("Safe basins by the displacement (DSB, grey) and energy (ESB, black) "
+                           "criterion\n" + param_text(params) + f", resolution {res}"), fontsize=10.5)
     return fig
 
 
@@ -908,13 +946,11 @@ def safe_area_curve(ec, t_evals):
     return a.size - np.searchsorted(a, t, side="right")
 
 
-def figure_area_vs_time(numeric, *, t_evals=None, n_t=400, title=None, figsize=(6.6, 4.4)):
-    """Fig 22: ln(SB area in pixels) vs t_eval, DSB dashed, ESB solid."""
+def figure_area_vs_time(numeric, params=None, *, t_evals=None, title=None, figsize=(6.6, 4.4)):
+    """Fig 22: ln(SB area in pixels) vs t_eval, DSB dashed, ESB solid (one point per t_eval)."""
     chart = open_dataset(numeric)
     cycles = float(_attr(chart, "cycles", default=11000))
-    if t_evals is None:
-        t_evals = np.unique(np.r_[np.linspace(0, cycles, n_t), np.geomspace(1, cycles, n_t // 2)])
-    t_evals = np.asarray(t_evals, float)
+    t_evals = np.asarray(_t_evals(chart, params, t_evals, np.linspace(cycles / 100, cycles, 100)), float)
     esb = _first(escape_cycles(chart, "energy"), "xi_max")
     dsb = _first(escape_cycles(chart, "displacement"), "q_max")
     fig, ax = plt.subplots(figsize=figsize, layout="constrained")
@@ -924,7 +960,8 @@ def figure_area_vs_time(numeric, *, t_evals=None, n_t=400, title=None, figsize=(
         area = safe_area_curve(ec, t_evals).astype(float)
         with np.errstate(divide="ignore"):
             la = np.where(area > 0, np.log(area), np.nan)
-        ax.plot(t_evals, la, ls=ls, color="k", lw=1.6, label=lab)
+        ax.plot(t_evals, la, ls=ls, color="k", lw=1.4, marker="o" if t_evals.size <= 40 else None,
+                ms=3, label=lab)
     ax.set_xlabel(LABELS["t_eval"])
     ax.set_ylabel(r"$\ln$(SB area / pixels)")
     ax.set_xlim(0, t_evals.max())
@@ -951,8 +988,16 @@ def describe(**datasets):
     for name, src in datasets.items():
         if src is None:
             continue
-        ds = open_dataset(src)
         where = src if isinstance(src, (str, os.PathLike)) else "<dataset>"
+        if isinstance(src, dict) or str(src).endswith((".yaml", ".yml")):
+            p = load_params(src)
+            lines.append(f"[{name}] {where}")
+            for k, v in p.items():
+                if k != "tasks":
+                    txt = repr(v)
+                    lines.append(f"  {k}: {txt if len(txt) < 120 else txt[:117] + '...'}")
+            continue
+        ds = open_dataset(src)
         lines.append(f"[{name}] {where}")
         dims = ", ".join(f"{k}={v}" for k, v in ds.sizes.items())
         lines.append(f"  dims: {dims}")
