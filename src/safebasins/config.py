@@ -120,6 +120,14 @@ def _best_error(errors):
     return best_match(errors)
 
 
+def _flatten(errors):
+    for e in errors:
+        if e.context:
+            yield from _flatten(e.context)
+        else:
+            yield e
+
+
 def _format_schema_error(err) -> str:
     path = list(err.absolute_path)
     key = _key(path)
@@ -139,12 +147,16 @@ def _format_schema_error(err) -> str:
             key = _key(path + [missing[0]])
             msg = f"missing required key {missing[0]!r}"
     elif err.validator in ("oneOf", "anyOf") and err.context:
-        # report the most specific failure inside the alternatives
-        sub = _best_error(err.context)
-        if sub is not None and list(sub.absolute_path) != path:
+        # report the most specific failure inside the alternatives: the deepest one, and
+        # rather a value error (maximum, minimum, ...) than "wrong type" of another branch
+        subs = list(_flatten(err.context))
+        subs.sort(key=lambda e: (-len(list(e.absolute_path)), e.validator in ("type", "oneOf", "anyOf", "required")))
+        sub = subs[0]
+        if list(sub.absolute_path) != path or sub.validator not in ("type",):
             return _format_schema_error(sub)
-        if sub is not None:
-            msg = f"{sub.message} (and no other allowed form matches: {err.message})"
+        msg = f"{err.instance!r} is not valid here: {err.schema.get('description', 'see workflow/schemas/config.schema.yaml')}"
+    if err.validator == "pattern" and err.validator_value == "^-?pi$":
+        msg = f"{err.instance!r} is not an angle: give a number (radians) or 'pi'"
     return f"config key {key}: {msg}"
 
 
