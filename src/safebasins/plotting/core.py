@@ -356,6 +356,9 @@ def draw_fcr(ax, ds, *, color_by="curve", show_branches=False, colors=None, lw=1
     ax.set_ylim(bottom=0)
     if legend:
         handles = mechanism_legend_handles(mechs_seen, by_mechanism_color=(color_by == "mechanism"))
+        if show_branches:
+            handles.append(Line2D([], [], color="0.5", lw=0.9, alpha=0.6,
+                                  label="thin: branch where it is not the minimum"))
         if color_by == "curve" and n > 1:
             handles = curve_handles + [Line2D([], [], ls="none", label="")] + handles
         ax.legend(handles=handles, loc=legend_loc)
@@ -565,9 +568,40 @@ def _safe_fill(ax, x, y, safe, *, color=SB_FACE, zorder=1, alpha=1.0):
                          zorder=zorder, alpha=alpha, rasterized=True, linewidth=0)
 
 
-def draw_rm_portrait(ax, ds, *, n_levels=24, show_saddle=True):
+def _recenter(g, arrays, center):
+    """Shift periodic gamma columns to the window [center - pi, center + pi)."""
+    lo = center - np.pi
+    gg = (g - lo) % (2 * np.pi) + lo
+    keep = np.r_[True, np.abs(np.diff(g)) > 0]
+    if np.isclose(g[-1] - g[0], 2 * np.pi):  # duplicated end point: drop it, re-add on the right
+        keep[-1] = False
+    order = np.argsort(gg[keep], kind="stable")
+    gg = gg[keep][order]
+    out = [a[:, keep][:, order] for a in arrays]
+    # close the window: repeat the first column at +2 pi
+    gg = np.r_[gg, gg[0] + 2 * np.pi]
+    out = [np.concatenate([a, a[:, :1]], axis=1) for a in out]
+    return gg, out
+
+
+def rm_center(ds):
+    """Window centre for gamma: pi when the safe region sits at the seam gamma = +-pi and not
+    at gamma = 0 (island around the MM tangency at gamma* = pi, Fig 5), else 0."""
+    esc = _var(ds, "escapes_rm", required=False)
+    if esc is None:
+        return 0.0
+    gdim = [d for d in esc.dims if "gamma" in d][0]
+    safe = ~np.asarray(esc.transpose(..., gdim)).astype(bool)
+    g = np.asarray(ds[gdim], float)
+    mid = np.abs(g) < 0.15 * np.pi
+    edge = np.abs(g) > 0.85 * np.pi
+    return np.pi if safe[..., edge].any() and not safe[..., mid].any() else 0.0
+
+
+def draw_rm_portrait(ax, ds, *, n_levels=24, show_saddle=True, center="auto"):
     """Left panel of Figs 5-9: level curves of C on (gamma, xi), truncation level dashed,
-    safe basin grey with red boundary."""
+    safe basin grey with red boundary.  ``center``: gamma at the middle of the window
+    (``"auto"``: see :func:`rm_center`)."""
     C = _var(ds, "C", "C_rm")
     gdim = [d for d in C.dims if "gamma" in d][0]
     xdim = [d for d in C.dims if "xi" in d][0]
@@ -577,19 +611,31 @@ def draw_rm_portrait(ax, ds, *, n_levels=24, show_saddle=True):
     Z = np.asarray(C, float)
     xi_max = _attr(ds, "xi_max")
     esc = _var(ds, "escapes_rm", required=False)
-    if esc is not None:
-        safe = ~np.asarray(esc.transpose(xdim, gdim)).astype(bool)
+    safe = None if esc is None else ~np.asarray(esc.transpose(xdim, gdim)).astype(bool)
+    if center == "auto":
+        center = rm_center(ds)
+    if g.max() - g.min() > 1.9 * np.pi:
+        arrays = [Z] + ([safe] if safe is not None else [])
+        g, arrays = _recenter(g, arrays, float(center))
+        Z = arrays[0]
+        safe = arrays[1] if safe is not None else None
+    if safe is not None:
         _safe_fill(ax, g, xi, safe)
     finite = Z[np.isfinite(Z)]
     if finite.size:
         levels = np.linspace(np.percentile(finite, 0.5), np.percentile(finite, 99.5), n_levels)
-        ax.contour(g, xi, Z, levels=levels, colors="k", linewidths=0.5, alpha=0.55, zorder=3)
-    draw_boundaries(ax, ds, "gamma", "xi", periodic=True)
+        ax.contour(g, xi, Z, levels=levels, colors="k", linewidths=0.5, alpha=0.55, zorder=3,
+                   linestyles="solid")
+    lo = g.min()
+    for xs, ys, _kind in _boundary_polylines(ds, "gamma", "xi"):
+        xs = (xs - lo) % (2 * np.pi) + lo
+        xs, ys = _break_wraps(xs, ys)
+        ax.plot(xs, ys, color=SB_EDGE, lw=1.8, zorder=6)
     if xi_max is not None:
         ax.axhline(float(xi_max), color=TRUNC_COLOR, ls="--", lw=2.2, zorder=7)
     sg, sx = _attr(ds, "saddle_gamma"), _attr(ds, "saddle_xi")
     if show_saddle and sg is not None and sx is not None and np.isfinite(sg) and np.isfinite(sx):
-        sg = (float(sg) - g.min()) % (2 * np.pi) + g.min()
+        sg = (float(sg) - lo) % (2 * np.pi) + lo
         ax.plot(sg, sx, "o", mfc="w", mec="k", ms=5, zorder=8)
     ax.set_xlim(g.min(), g.max())
     ax.set_ylim(max(0.0, xi.min()), xi.max())
@@ -642,12 +688,13 @@ def figure_rm_basin(analytic, *, title=None, figsize=(11.5, 4.6)):
     draw_ic_basin(a2, ds)
     sx = _attr(ds, "saddle_xi")
     has_saddle = sx is not None and np.isfinite(float(sx))
+    below = dict(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=8, frameon=False)
     a1.legend(handles=_basin_legend_handles(_attr(ds, "xi_max"), saddle=has_saddle),
-              loc="lower right", fontsize=7.5)
+              ncol=2, **below)
     a2.legend(handles=[Patch(facecolor=SB_FACE, edgecolor=SB_EDGE, lw=1.5, label="safe basin (theory)"),
                        Line2D([], [], color="0.35", ls=(0, (4, 2)), lw=0.9,
                               label=r"well edge $H_0 = \xi_{max}$")],
-              loc="lower right", fontsize=7.5)
+              ncol=2, **below)
     a1.set_title(r"resonance manifold $(\gamma, \xi)$")
     a2.set_title(r"initial conditions $(q_0, p_0)$")
     params = {k: _attr(ds, k) for k in ("F", "Omega", "Psi", "xi_max")}
