@@ -505,3 +505,22 @@ def call_api(fn, *args, **kwargs):
         print(f"note: {fn.__module__}.{fn.__name__} does not accept {k}={kwargs[k]!r}; library default used")
         kwargs.pop(k)
     return fn(*args, **kwargs), dropped
+
+
+def write_params_file(path, params: dict, log_path=None):
+    """Write results/params/{experiment}.yaml atomically (used by the `parameters` rule)."""
+    import tempfile
+
+    path = Path(path)
+    text = (f"# Resolved parameters of {params['experiment']} ({params['kind']}), generated from the\n"
+            "# configuration by the `parameters` rule; edit config/config.yaml, not this file.\n"
+            + dump_params(params))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    with os.fdopen(fd, "w") as fh:
+        fh.write(text)
+    os.chmod(tmp, 0o644)
+    os.replace(tmp, path)
+    if log_path:
+        Path(log_path).parent.mkdir(parents=True, exist_ok=True)
+        Path(log_path).write_text(f"wrote {path} (params sha256 {params_hash(params)})\n")

@@ -179,7 +179,7 @@ def finalize(ds: xr.Dataset, *, title: str, params: dict | None = None, config_h
         attrs["experiment"] = params["experiment"]
     if "fourier" in params:
         attrs.setdefault("fourier", params["fourier"])
-    spc = params.get("steps_per_cycle") or (params.get("numeric") or {}).get("steps_per_cycle")
+    spc = params.get("steps_per_cycle")
     if spc is not None:
         attrs.setdefault("steps_per_cycle", int(spc))
     seeds = _collect_seeds(params)
