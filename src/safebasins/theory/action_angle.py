@@ -68,24 +68,32 @@ def _ell(xi):
         K = special.ellipkm1(m1)      # K(m), accurate as m -> 1
         Kp = special.ellipkm1(m)      # K(1 - m), accurate as m -> 0
     E = special.ellipe(m)
-    return {"mu": mu, "m": m, "m1": m1, "K": K, "Kp": Kp, "E": E}
+    # (K - E)/m = R_D(0, 1-m, 1)/3 (Carlson), used to avoid cancellation in J and dK/dm at small m
+    RD3 = special.elliprd(0.0, m1, 1.0) / 3.0
+    return {"mu": mu, "m": m, "m1": m1, "K": K, "Kp": Kp, "E": E, "RD3": RD3}
 
 
-def _J(xi):
-    e = _ell(xi)
+def _J(xi, e=None):
+    e = _ell(xi) if e is None else e
+    # E - mu K = (1 - mu) K - m (K - E)/m ; both terms O(xi) at the well bottom (no cancellation)
+    mu = e["mu"]
     with np.errstate(invalid="ignore"):
-        muK = np.where(e["mu"] > 0, e["mu"] * e["K"], 0.0)
-    return _C_J * np.sqrt(1.0 + e["mu"]) * (e["E"] - muK)
+        small = mu > 0.5
+        one_m_mu = 4.0 * np.asarray(xi, float) / (1.0 + mu)
+        lo = one_m_mu * e["K"] - e["m"] * e["RD3"]
+        hi = e["E"] - np.where(mu > 0, mu * e["K"], 0.0)
+        d = np.where(small, lo, hi)
+    return _C_J * np.sqrt(1.0 + mu) * d
 
 
-def _omega(xi):
-    e = _ell(xi)
+def _omega(xi, e=None):
+    e = _ell(xi) if e is None else e
     with np.errstate(divide="ignore"):
         return np.pi * np.sqrt(1.0 + e["mu"]) / (2.0 * np.sqrt(2.0) * e["K"])
 
 
-def _G(xi, fourier="paper"):
-    e = _ell(xi)
+def _G(xi, fourier="paper", e=None):
+    e = _ell(xi) if e is None else e
     K, Kp = e["K"], e["Kp"]
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(np.isfinite(K), Kp / K, 0.0)
@@ -97,21 +105,22 @@ def _G(xi, fourier="paper"):
     return g
 
 
-def _dK_dm(K, E, m, m1):
-    return (E - m1 * K) / (2.0 * m * m1)
+def _dK_dm(K, E, m, m1, RD3):
+    # (E - (1-m) K) / (2 m (1-m)) with E = K - m RD3  ->  (K - RD3) / (2 (1-m))
+    return (K - RD3) / (2.0 * m1)
 
 
-def _dG_dxi(xi, fourier="paper"):
+def _dG_dxi(xi, fourier="paper", e=None):
     """dG/dxi for 0 < xi < 1/4 (validated)."""
-    e = _ell(xi)
-    mu, m, m1, K, Kp, E = e["mu"], e["m"], e["m1"], e["K"], e["Kp"], e["E"]
+    e = _ell(xi) if e is None else e
+    mu, m, m1, K, Kp, E, RD3 = e["mu"], e["m"], e["m1"], e["K"], e["Kp"], e["E"], e["RD3"]
     with np.errstate(divide="ignore", invalid="ignore"):
-        g = _G(xi, fourier)
+        g = _G(xi, fourier, e)
         dm_dxi = 4.0 / (mu * (1.0 + mu) ** 2)
         dmu_dxi = -2.0 / mu
         # d ln G / d xi ;  d(K'/K)/dm = -pi / (4 m m1 K^2)  (Legendre relation)
         dlog = 0.5 * dmu_dxi / (1.0 + mu)
-        dlog = dlog + dm_dxi * (-_dK_dm(K, E, m, m1) / K + np.pi ** 2 / (8.0 * m * m1 * K ** 2))
+        dlog = dlog + dm_dxi * (-_dK_dm(K, E, m, m1, RD3) / K + np.pi ** 2 / (8.0 * m * m1 * K ** 2))
         if fourier == "exact":
             q = np.exp(-np.pi * Kp / K)
             dlog = dlog + dm_dxi * q / (1.0 - q) * np.pi ** 2 / (4.0 * m * m1 * K ** 2)

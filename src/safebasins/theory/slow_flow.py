@@ -37,7 +37,7 @@ from scipy import optimize
 
 from .._validate import XI_SEPARATRIX, _arr, check_energy, check_finite, check_nonnegative, \
     check_positive, check_threshold
-from .action_angle import _G, _J, _angle_energy, _dG_dxi, _omega, check_fourier
+from .action_angle import _G, _J, _angle_energy, _dG_dxi, _ell, _omega, check_fourier
 
 __all__ = ["first_integral", "escapes_on_manifold", "slow_flow_escapes", "slow_flow_profile",
            "slow_flow_rhs", "xi_from_J", "saddles"]
@@ -215,6 +215,16 @@ def slow_flow_escapes(q0, p0, F, Omega, Psi, xi_max, fourier="paper"):
 
 
 # ----------------------------------------------------------------------------- Cartesian flow
+_TABLE = []
+
+
+def _J_table():
+    if not _TABLE:
+        tab_x = _xi_grid(0.0, XI_SEPARATRIX, 4001)
+        _TABLE.append((tab_x, _J(tab_x)))
+    return _TABLE[0]
+
+
 def xi_from_J(Jv):
     """Invert eq (19): energy xi with ``J(xi) = Jv`` (0 <= Jv <= 4/(3 pi)), Newton on dJ/dxi = 1/omega."""
     Jv = check_nonnegative("Jv", Jv)
@@ -222,13 +232,13 @@ def xi_from_J(Jv):
     if (Jv > Jmax).any():
         raise ValueError(f"Jv must be <= J(1/4) = {Jmax}")
     # initial guess from a monotone table, then Newton steps
-    tab_x = _xi_grid(0.0, XI_SEPARATRIX, 4001)
-    tab_J = _J(tab_x)
+    tab_x, tab_J = _J_table()
     x = np.interp(Jv, tab_J, tab_x)
-    for _ in range(4):
+    for _ in range(3):
         inner = (x > 0) & (x < XI_SEPARATRIX)
         xs = np.where(inner, x, 0.1)
-        x = np.where(inner, x - (_J(xs) - Jv) * _omega(xs), x)
+        e = _ell(xs)
+        x = np.where(inner, x - (_J(xs, e) - Jv) * _omega(xs, e), x)
         x = np.clip(x, 0.0, XI_SEPARATRIX)
     return x
 
@@ -250,9 +260,10 @@ def slow_flow_rhs(X, Y, F, Omega, fourier="paper"):
     rs = np.where(small, 1.0, r)
     xs = np.where(small, 1e-30, xi)
     c, s = np.where(small, 1.0, X / rs), np.where(small, 0.0, Y / rs)
-    w = _omega(xs)
-    Jdot = -F * _G(xs, fourier) * s
-    gdot = w - Omega - F * w * _dG_dxi(xs, fourier) * c
+    e = _ell(xs)
+    w = _omega(xs, e)
+    Jdot = -F * _G(xs, fourier, e) * s
+    gdot = w - Omega - F * w * _dG_dxi(xs, fourier, e) * c
     dX = Jdot * c / rs - Y * gdot
     dY = Jdot * s / rs + X * gdot
     dX = np.where(small, 0.0, dX)
