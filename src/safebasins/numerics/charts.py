@@ -1,0 +1,178 @@
+"""Escape charts: escape time of every initial condition for many thresholds in one pass."""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from safebasins import _validate as V
+from safebasins.numerics import engine as E
+from safebasins.numerics import kernels as K
+
+_CYC = "1"  # time in forcing cycles (dimensionless)
+
+
+def _ic_arrays(q0, p0, grid):
+    qa = V.check_finite("q0", q0)
+    pa = V.check_finite("p0", p0)
+    if grid is None:
+        grid = qa.ndim == 1 and pa.ndim == 1
+    if grid:
+        if qa.ndim != 1 or pa.ndim != 1:
+            raise ValueError(f"q0 and p0 must be 1-D axes for grid=True, got shapes {qa.shape}, {pa.shape}")
+        if qa.size == 0 or pa.size == 0:
+            raise ValueError("q0 and p0 axes must not be empty")
+        Q, P = np.meshgrid(qa, pa, indexing="ij")
+        return True, qa, pa, Q.ravel(), P.ravel()
+    if qa.shape != pa.shape:
+        raise ValueError(f"q0 and p0 must have the same shape for paired initial conditions (grid=False), "
+                         f"got {qa.shape} and {pa.shape}")
+    return False, qa, pa, qa.ravel(), pa.ravel()
+
+
+def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000,
+                 steps_per_cycle=E.DEFAULT_STEPS_PER_CYCLE, threads=None, grid=None):
+    """Escape time (forcing cycles) of every initial condition, for every threshold.
+
+    Parameters
+    ----------
+    q0, p0 : initial conditions.  grid=None (default): two 1-D arrays are grid AXES -> dims
+        ('q0', 'p0'), ij indexing (first axis q0); anything else is paired.  grid=False: paired
+        ICs of equal shape (e.g. random ICs) -> flat dim 'sample' with coords q0(sample),
+        p0(sample) (C order).  grid=True: require 1-D axes.
+    F, Omega, Psi : forcing amplitude (>= 0), frequency (> 0), phase of eq (1).
+    xi_max : energy thresholds, H0 = p^2/2 + q^2/2 - q^4/4 > xi_max means escape (eq 7).
+        |q| > 1 (beyond the barrier, out of the well) also counts as energy escape.
+    q_max : displacement thresholds, |q| > q_max means escape (q_max(xi_max): eq 4).
+    cycles : horizon in forcing cycles (integer).
+    steps_per_cycle : fixed steps per forcing period (Blanes-Moan SRKN6b, order 4, symplectic).
+    threads : numba threads (None: current setting); results are bitwise independent of it.
+
+    Returns
+    -------
+    xr.Dataset with escape_cycle_energy (xi_max, ...), escape_cycle_displacement (q_max, ...):
+    step of first crossing / steps_per_cycle (exact to one step), 0 if the IC is already beyond,
+    +inf if no crossing within `cycles`.  Safe basin for (threshold, t_eval): escape_cycle > t_eval.
+    One integration serves every threshold and every t_eval <= cycles; a trajectory stops once
+    it has crossed every requested threshold.
+    """
+    is_grid, qa, pa, Q, P = _ic_arrays(q0, p0, grid)
+    F = E.check_scalar("F", F, V.check_nonnegative)
+    Omega = E.check_scalar("Omega", Omega, V.check_positive)
+    Psi = E.check_scalar("Psi", Psi, V.check_finite)
+    xi = E.thresholds("xi_max", xi_max, V.check_threshold)
+    qm = E.thresholds("q_max", q_max, V.check_displacement_threshold)
+    if xi.size == 0 and qm.size == 0:
+        raise ValueError("xi_max and q_max: at least one threshold is required")
+    cycles = E.check_cycles("cycles", cycles)
+    spc = E.check_steps_per_cycle(steps_per_cycle)
+    threads = E.check_threads(threads)
+
+    sE, sQ, _ = E.run_ensemble(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
+                               cycles=cycles, steps_per_cycle=spc, threads=threads)
+    tE = E.steps_to_cycles(sE, spc).T   # (nE, N)
+    tQ = E.steps_to_cycles(sQ, spc).T
+    if is_grid:
+        shape, dims = (qa.size, pa.size), ("q0", "p0")
+        coords = {"q0": ("q0", qa, {"units": "1", "long_name": "initial displacement q(0)"}),
+                  "p0": ("p0", pa, {"units": "1", "long_name": "initial momentum p(0) = dq/dt(0)"})}
+    else:
+        shape, dims = (Q.size,), ("sample",)
+        coords = {"sample": ("sample", np.arange(Q.size), {"long_name": "initial-condition index"}),
+                  "q0": ("sample", Q, {"units": "1", "long_name": "initial displacement q(0)"}),
+                  "p0": ("sample", P, {"units": "1", "long_name": "initial momentum p(0) = dq/dt(0)"})}
+    coords["xi_max"] = ("xi_max", xi, {"units": "1", "long_name": "energy threshold: escape when H0 > xi_max"})
+    coords["q_max"] = ("q_max", qm, {"units": "1", "long_name": "displacement threshold: escape when |q| > q_max"})
+    ds = xr.Dataset(
+        {
+            "escape_cycle_energy": (("xi_max",) + dims, tE.reshape((xi.size,) + shape), {
+                "units": _CYC,
+                "long_name": "escape time in forcing cycles, energy criterion H0 > xi_max (inf: no escape)"}),
+            "escape_cycle_displacement": (("q_max",) + dims, tQ.reshape((qm.size,) + shape), {
+                "units": _CYC,
+                "long_name": "escape time in forcing cycles, displacement criterion |q| > q_max (inf: no escape)"}),
+        },
+        coords=coords,
+    )
+    ds.attrs.update(
+        F=F, Omega=Omega, Psi=Psi, cycles=cycles, steps_per_cycle=spc, integrator=K.INTEGRATOR,
+        grid=int(is_grid),
+        escape_criteria=("energy: H0 = p^2/2 + q^2/2 - q^4/4 > xi_max or |q| > 1; displacement: |q| > q_max; "
+                         "checked after every step; escape_cycle = step / steps_per_cycle"),
+        safe_basin="escape_cycle > t_eval (t_eval <= cycles)",
+    )
+    return ds
+
+
+def _t_eval(chart, t_eval):
+    t = V.check_nonnegative("t_eval", t_eval)
+    if t.ndim > 1:
+        raise ValueError(f"t_eval must be a scalar or 1-D, got shape {t.shape}")
+    cyc = chart.attrs.get("cycles", np.inf)
+    if (t > cyc).any():
+        raise ValueError(f"t_eval must be <= the chart's horizon cycles={cyc}, got max {t.max()!r}")
+    return t
+
+
+def safe_mask(chart, t_eval):
+    """Safe basins of an escape_chart at evaluation time(s) t_eval (cycles, <= chart cycles).
+
+    Returns a Dataset with bool `safe_energy` (xi_max, ...) and `safe_displacement` (q_max, ...):
+    escape_cycle > t_eval.  A 1-D t_eval adds a leading dim 't_eval'; a scalar gives a scalar
+    coordinate.
+    """
+    t = _t_eval(chart, t_eval)
+    tda = xr.DataArray(t, dims=("t_eval",) if t.ndim else (), name="t_eval",
+                       attrs={"units": "1", "long_name": "evaluation time (forcing cycles)"})
+    out = xr.Dataset({
+        "safe_energy": chart["escape_cycle_energy"] > tda,
+        "safe_displacement": chart["escape_cycle_displacement"] > tda,
+    })
+    out = out.assign_coords(t_eval=tda)
+    if "t_eval" in out.dims:
+        out = out.transpose("t_eval", ...)
+    out["safe_energy"].attrs = {"long_name": "safe (no energy escape up to t_eval)"}
+    out["safe_displacement"].attrs = {"long_name": "safe (no displacement escape up to t_eval)"}
+    out.attrs.update({k: chart.attrs[k] for k in ("F", "Omega", "Psi", "cycles", "steps_per_cycle") if k in chart.attrs})
+    return out
+
+
+def _cell_widths(x):
+    x = np.asarray(x, dtype=float)
+    if x.size == 1:
+        return np.array([np.nan])
+    w = np.empty_like(x)
+    w[1:-1] = 0.5 * (x[2:] - x[:-2])
+    w[0] = x[1] - x[0]
+    w[-1] = x[-1] - x[-2]
+    return np.abs(w)
+
+
+def safe_area(chart, t_eval):
+    """Safe-basin area vs evaluation time, vectorised over t_eval.
+
+    Returns a Dataset with `pixels_energy` (t_eval?, xi_max) and `pixels_displacement`
+    (t_eval?, q_max): number of safe ICs; `area_energy`, `area_displacement`: phase-space area
+    (sum of the cells dq0*dp0 of the safe grid points; uniform grid: pixels * dq * dp), NaN for
+    paired ICs; `fraction_*`: pixels / number of ICs.
+    """
+    m = safe_mask(chart, t_eval)
+    is_grid = "q0" in chart.dims and "p0" in chart.dims
+    dims = ("q0", "p0") if is_grid else ("sample",)
+    n = int(np.prod([chart.sizes[d] for d in dims]))
+    out = xr.Dataset(coords={"t_eval": m["t_eval"]})
+    if is_grid:
+        w = xr.DataArray(np.outer(_cell_widths(chart["q0"].values), _cell_widths(chart["p0"].values)), dims=dims)
+    for kind in ("energy", "displacement"):
+        s = m[f"safe_{kind}"]
+        pix = s.sum(dims)
+        out[f"pixels_{kind}"] = pix.astype(np.int64)
+        out[f"pixels_{kind}"].attrs = {"units": "1", "long_name": f"number of safe ICs ({kind} criterion)"}
+        out[f"fraction_{kind}"] = pix / n
+        out[f"fraction_{kind}"].attrs = {"units": "1", "long_name": f"safe fraction of the ICs ({kind} criterion)"}
+        area = (s * w).sum(dims) if is_grid else pix * np.nan
+        out[f"area_{kind}"] = area
+        out[f"area_{kind}"].attrs = {"units": "1", "long_name": f"safe area in the (q0, p0) plane ({kind} criterion)"}
+    if "t_eval" in out.dims:
+        out = out.transpose("t_eval", ...)
+    out.attrs.update(m.attrs)
+    return out

@@ -1,0 +1,109 @@
+"""Python driver of the compiled ensemble kernel (argument checks, thread control, tasks)."""
+from __future__ import annotations
+
+import contextlib
+import math
+
+import numba
+import numpy as np
+
+from safebasins import _validate as V
+from safebasins.numerics import kernels as K
+
+DEFAULT_STEPS_PER_CYCLE = 32
+LANES = 128          # trajectories in flight per task (4 chains x up to 32-lane segments)
+
+
+@contextlib.contextmanager
+def thread_count(threads):
+    """Temporarily run numba parallel regions on `threads` threads (None: leave as is)."""
+    if threads is None:
+        yield numba.get_num_threads()
+        return
+    old = numba.get_num_threads()
+    numba.set_num_threads(int(threads))
+    try:
+        yield int(threads)
+    finally:
+        numba.set_num_threads(old)
+
+
+def check_threads(threads):
+    if threads is None:
+        return None
+    n = V.check_positive_int("threads", threads)
+    if n > numba.config.NUMBA_NUM_THREADS:
+        raise ValueError(f"threads must be <= {numba.config.NUMBA_NUM_THREADS} (numba's thread pool), got {n}")
+    return n
+
+
+def check_steps_per_cycle(steps_per_cycle):
+    n = V.check_positive_int("steps_per_cycle", steps_per_cycle)
+    if n < 4:
+        raise ValueError(f"steps_per_cycle must be >= 4, got {n}")
+    return n
+
+
+def check_cycles(name, cycles):
+    if isinstance(cycles, (float, np.floating)) and float(cycles).is_integer() and cycles >= 1:
+        cycles = int(cycles)
+    return V.check_positive_int(name, cycles)
+
+
+def check_scalar(name, value, check):
+    a = check(name, value)
+    if a.ndim != 0:
+        raise ValueError(f"{name} must be a scalar, got shape {a.shape}")
+    if not np.isfinite(a):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    return float(a)
+
+
+def thresholds(name, values, check):
+    a = np.atleast_1d(check(name, values) if np.size(values) else np.asarray(values, dtype=float)).astype(float)
+    if a.ndim != 1:
+        raise ValueError(f"{name} must be a scalar or a 1-D sequence, got shape {a.shape}")
+    return a
+
+
+def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), cycles, steps_per_cycle,
+                 threads=None, stop_any=False, store=False):
+    """Integrate trajectories i from (q0[i], p0[i]) with Omega[pidx[i]], F[pidx[i]].
+
+    Returns (steps_E (N, nE), steps_Q (N, nQ), store or None): int64 first-crossing steps in the
+    order of the given thresholds (-1: not within `cycles`), and period-map iterates.
+    """
+    q0 = np.ascontiguousarray(q0, dtype=float).ravel()
+    p0 = np.ascontiguousarray(p0, dtype=float).ravel()
+    pidx = np.ascontiguousarray(pidx, dtype=np.int64).ravel()
+    Omega = np.atleast_1d(np.asarray(Omega, dtype=float))
+    F = np.atleast_1d(np.asarray(F, dtype=float))
+    xi = np.asarray(xi_max, dtype=float).ravel()
+    qm = np.asarray(q_max, dtype=float).ravel()
+    N = q0.size
+    oE_sorted = np.argsort(xi, kind="stable")
+    oQ_sorted = np.argsort(qm, kind="stable")
+    outE = np.full((N, xi.size), -1, dtype=np.int64)
+    outQ = np.full((N, qm.size), -1, dtype=np.int64)
+    st = np.full((N, cycles + 1, 2), np.nan) if store else np.empty((0, 0, 2))
+    if N:
+        coef = np.ascontiguousarray(K.lane_coefficients(Omega, steps_per_cycle))
+        sintab = K.sine_table(steps_per_cycle, Psi)
+        with thread_count(threads) as nthreads:
+            n_tasks = max(1, min(math.ceil(N / LANES), 16 * nthreads))
+            K.ensemble(q0, p0, pidx, coef, np.ascontiguousarray(F), sintab,
+                       np.ascontiguousarray(2.0 * xi[oE_sorted]), np.ascontiguousarray(qm[oQ_sorted]),
+                       int(cycles), bool(stop_any), int(n_tasks), LANES, outE, outQ, st, bool(store))
+    # back to the caller's threshold order
+    E = np.empty_like(outE)
+    E[:, oE_sorted] = outE
+    Q = np.empty_like(outQ)
+    Q[:, oQ_sorted] = outQ
+    return E, Q, (st if store else None)
+
+
+def steps_to_cycles(steps, steps_per_cycle):
+    """int64 step counts (-1: none) -> float64 forcing cycles (+inf: none)."""
+    out = steps.astype(float) / steps_per_cycle
+    out[steps < 0] = np.inf
+    return out

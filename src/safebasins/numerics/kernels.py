@@ -1,0 +1,454 @@
+"""Compiled ensemble integrator for eq (1): q'' + q - q^3 = F sin(Omega t + Psi).
+
+Scheme
+------
+Blanes & Moan (2002) symmetric symplectic Runge-Kutta-Nystrom method SRKN_6^b (order 4,
+7 kicks + 6 drifts per step, kick first):
+
+    B(b1) A(a1) B(b2) A(a2) B(b3) A(a3) B(b4) A(a3) B(b3) A(a2) B(b2) A(a1) B(b1)
+
+with A = drift q += a h p (time drifts with q: extended phase space) and B = kick
+p += b h (q^3 - q + F sin(Omega t_k + Psi)) at the current sub-time t_k.  Because
+Omega * t_k = 2 pi (s + c_k) / S for sub-step s of a period of S steps, the table
+sin(Omega t_k + Psi) depends only on (S, Psi): one table serves every Omega and F.
+
+Every lane's arithmetic is written with explicit fused multiply-adds (llvm.fma), no
+fast-math flags: the vector loop and the scalar replay produce bitwise identical numbers
+and a trajectory's result does not depend on which lane, block or thread ran it.
+
+Escape detection
+----------------
+Per step the kernel tracks, per lane, max H0 and max |q| over the current period
+(vectorised, branch free).  At the period boundary a lane whose maxima crossed its next
+uncrossed threshold replays that period from a snapshot (scalar, same arithmetic) and
+records the exact step of first crossing of every threshold crossed in the period.
+A lane whose trajectory is finished (every requested threshold crossed, or the horizon
+reached) takes the next trajectory of its task at the period boundary (lane refill: the
+forcing is periodic, so every lane is always at the same sub-step of the period); when
+the task's queue is empty the active lanes are compacted so the vector loop only runs
+over live trajectories.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange, types
+from numba.extending import intrinsic
+
+# --- Blanes & Moan 2002, SRKN_6^b (Table 3), order 4 -------------------------------------
+_A1 = 0.245298957184271
+_A2 = 0.604872665711080
+_A3 = 0.5 - (_A1 + _A2)
+_B1 = 0.0829844064174052
+_B2 = 0.396309801498368
+_B3 = -0.0390563049223486
+_B4 = 1.0 - 2.0 * (_B1 + _B2 + _B3)
+BM6_DRIFT = np.array([_A1, _A2, _A3, _A3, _A2, _A1])
+BM6_KICK = np.array([_B1, _B2, _B3, _B4, _B3, _B2, _B1])
+# sub-times of the 7 kicks as fractions of a step
+BM6_KICK_TIMES = np.concatenate([[0.0], np.cumsum(BM6_DRIFT)])
+BM6_KICK_TIMES[-1] = 1.0
+INTEGRATOR = "Blanes-Moan SRKN6b (symplectic RKN, order 4, 6 force evaluations/step)"
+N_KICKS = 7
+
+# q beyond the barrier |q| = 1: out of the well.  Counts as crossing every energy threshold
+# (H0 no longer measures the well energy there; the particle runs away).
+Q_BARRIER = 1.0
+# smallest lane segment of the 4-chain vector loop (lanes run: 4 * segment)
+MIN_SEGMENT = 16
+
+
+@intrinsic
+def fma(typingctx, a, b, c):
+    """Correctly rounded a*b + c (llvm.fma.f64): same bits in vector and scalar code."""
+    sig = types.float64(types.float64, types.float64, types.float64)
+
+    def codegen(context, builder, signature, args):
+        return builder.fma(*args)
+
+    return sig, codegen
+
+
+@njit(cache=True, inline="always")
+def force(q, f):
+    """q^3 - q + f, with f = F sin(Omega t_k + Psi) (a product F * table value)."""
+    return fma(q * q, q, f - q)
+
+
+@njit(cache=True, inline="always")
+def bm6_step(q, p, a1, a2, a3, b1, b2, b3, b4, f1, f2, f3, f4, f5, f6, f7):
+    p = fma(b1, force(q, f1), p)
+    q = fma(a1, p, q)
+    p = fma(b2, force(q, f2), p)
+    q = fma(a2, p, q)
+    p = fma(b3, force(q, f3), p)
+    q = fma(a3, p, q)
+    p = fma(b4, force(q, f4), p)
+    q = fma(a3, p, q)
+    p = fma(b3, force(q, f5), p)
+    q = fma(a2, p, q)
+    p = fma(b2, force(q, f6), p)
+    q = fma(a1, p, q)
+    p = fma(b1, force(q, f7), p)
+    return q, p
+
+
+@njit(cache=True, inline="always")
+def energy2(q, p):
+    """2 H0 = p^2 + q^2 - q^4/2 (eq 7, untruncated); compared with 2 xi_max (exact doubling)."""
+    q2 = q * q
+    return fma(q2, fma(-0.5, q2, 1.0), p * p)
+
+
+@njit(cache=True)
+def energy(q, p):
+    return 0.5 * energy2(q, p)
+
+
+def sine_table(steps_per_cycle, Psi):
+    """sin(Omega t + Psi) at the 7 kick sub-times of every step of one period, (S, 7)."""
+    s = np.arange(steps_per_cycle, dtype=float)[:, None] + BM6_KICK_TIMES[None, :]
+    return np.ascontiguousarray(np.sin(2.0 * np.pi * s / steps_per_cycle + Psi))
+
+
+def lane_coefficients(Omega, steps_per_cycle):
+    """Per-parameter-set step coefficients (n, 7): a1 h, a2 h, a3 h, b1 h, ..., b4 h."""
+    Omega = np.atleast_1d(np.asarray(Omega, dtype=float))
+    h = 2.0 * np.pi / (Omega * steps_per_cycle)
+    out = np.empty((Omega.size, 7))
+    out[:, 0:3] = h[:, None] * BM6_DRIFT[None, :3]
+    out[:, 3:7] = h[:, None] * BM6_KICK[None, :4]
+    return out
+
+
+@njit(cache=True)
+def _check_state(i, q, p, step, thrE2, thrQ, iE, iQ, outE, outQ):
+    """Record, at `step`, every next-uncrossed threshold the state (q, p) is beyond."""
+    e = energy2(q, p)
+    aq = abs(q)
+    nE = thrE2.shape[0]
+    nQ = thrQ.shape[0]
+    while iE < nE and (e > thrE2[iE] or aq > Q_BARRIER):
+        outE[i, iE] = step
+        iE += 1
+    while iQ < nQ and aq > thrQ[iQ]:
+        outQ[i, iQ] = step
+        iQ += 1
+    return iE, iQ
+
+
+@njit(cache=True, inline="always")
+def _finished(iE, iQ, nE, nQ, stop_any):
+    return (iE == nE and iQ == nQ) or (stop_any and (iE > 0 or iQ > 0))
+
+
+@njit(cache=True)
+def _replay(i, q, p, period, sintab, c, F, thrE2, thrQ, iE, iQ, outE, outQ, stop_any):
+    """Scalar replay of one period from its start state (same arithmetic as the vector
+    loop); records the step of first crossing of every threshold crossed in the period."""
+    S = sintab.shape[0]
+    nE = thrE2.shape[0]
+    nQ = thrQ.shape[0]
+    base = period * S
+    for s in range(S):
+        q, p = bm6_step(q, p, c[0], c[1], c[2], c[3], c[4], c[5], c[6],
+                        F * sintab[s, 0], F * sintab[s, 1], F * sintab[s, 2], F * sintab[s, 3],
+                        F * sintab[s, 4], F * sintab[s, 5], F * sintab[s, 6])
+        iE, iQ = _check_state(i, q, p, base + s + 1, thrE2, thrQ, iE, iQ, outE, outQ)
+        if _finished(iE, iQ, nE, nQ, stop_any):
+            break
+    return iE, iQ
+
+
+@njit(cache=True)
+def _period_shared(M, Q, P, ME, MQ, c, FS):
+    """One forcing period for lanes [0, 4M), all sharing one parameter set.
+
+    The lane loop (j) vectorises; its body advances 4 independent lanes j, M+j, 2M+j, 3M+j
+    so that 4 dependency chains are in flight (the step is latency bound otherwise).
+    (Generated code: 4 explicit chains.)"""
+    a1 = c[0]; a2 = c[1]; a3 = c[2]; b1 = c[3]; b2 = c[4]; b3 = c[5]; b4 = c[6]
+    for l in range(4 * M):
+        ME[l] = -np.inf
+        MQ[l] = -np.inf
+    for s in range(FS.shape[0]):
+        f1 = FS[s, 0]; f2 = FS[s, 1]; f3 = FS[s, 2]; f4 = FS[s, 3]
+        f5 = FS[s, 4]; f6 = FS[s, 5]; f7 = FS[s, 6]
+        for j in range(M):
+            l0 = 0 * M + j
+            l1 = 1 * M + j
+            l2 = 2 * M + j
+            l3 = 3 * M + j
+            q0, p0 = bm6_step(Q[l0], P[l0], a1, a2, a3, b1, b2, b3, b4,
+                                  f1, f2, f3, f4, f5, f6, f7)
+            q1, p1 = bm6_step(Q[l1], P[l1], a1, a2, a3, b1, b2, b3, b4,
+                                  f1, f2, f3, f4, f5, f6, f7)
+            q2, p2 = bm6_step(Q[l2], P[l2], a1, a2, a3, b1, b2, b3, b4,
+                                  f1, f2, f3, f4, f5, f6, f7)
+            q3, p3 = bm6_step(Q[l3], P[l3], a1, a2, a3, b1, b2, b3, b4,
+                                  f1, f2, f3, f4, f5, f6, f7)
+            Q[l0] = q0
+            P[l0] = p0
+            e0 = energy2(q0, p0)
+            x0 = abs(q0)
+            m = ME[l0]
+            ME[l0] = e0 if e0 > m else m
+            m = MQ[l0]
+            MQ[l0] = x0 if x0 > m else m
+            Q[l1] = q1
+            P[l1] = p1
+            e1 = energy2(q1, p1)
+            x1 = abs(q1)
+            m = ME[l1]
+            ME[l1] = e1 if e1 > m else m
+            m = MQ[l1]
+            MQ[l1] = x1 if x1 > m else m
+            Q[l2] = q2
+            P[l2] = p2
+            e2 = energy2(q2, p2)
+            x2 = abs(q2)
+            m = ME[l2]
+            ME[l2] = e2 if e2 > m else m
+            m = MQ[l2]
+            MQ[l2] = x2 if x2 > m else m
+            Q[l3] = q3
+            P[l3] = p3
+            e3 = energy2(q3, p3)
+            x3 = abs(q3)
+            m = ME[l3]
+            ME[l3] = e3 if e3 > m else m
+            m = MQ[l3]
+            MQ[l3] = x3 if x3 > m else m
+
+
+@njit(cache=True)
+def _period_lanes(M, Q, P, ME, MQ, C, FSL):
+    """As _period_shared with per-lane parameters: C (7, L) step coefficients and
+    FSL (S, 7, L) forcing values F * sin(...) of each lane."""
+    for l in range(4 * M):
+        ME[l] = -np.inf
+        MQ[l] = -np.inf
+    for s in range(FSL.shape[0]):
+        for j in range(M):
+            l0 = 0 * M + j
+            l1 = 1 * M + j
+            l2 = 2 * M + j
+            l3 = 3 * M + j
+            q0, p0 = bm6_step(Q[l0], P[l0], C[0, l0], C[1, l0], C[2, l0], C[3, l0],
+                                  C[4, l0], C[5, l0], C[6, l0], FSL[s, 0, l0], FSL[s, 1, l0],
+                                  FSL[s, 2, l0], FSL[s, 3, l0], FSL[s, 4, l0], FSL[s, 5, l0],
+                                  FSL[s, 6, l0])
+            q1, p1 = bm6_step(Q[l1], P[l1], C[0, l1], C[1, l1], C[2, l1], C[3, l1],
+                                  C[4, l1], C[5, l1], C[6, l1], FSL[s, 0, l1], FSL[s, 1, l1],
+                                  FSL[s, 2, l1], FSL[s, 3, l1], FSL[s, 4, l1], FSL[s, 5, l1],
+                                  FSL[s, 6, l1])
+            q2, p2 = bm6_step(Q[l2], P[l2], C[0, l2], C[1, l2], C[2, l2], C[3, l2],
+                                  C[4, l2], C[5, l2], C[6, l2], FSL[s, 0, l2], FSL[s, 1, l2],
+                                  FSL[s, 2, l2], FSL[s, 3, l2], FSL[s, 4, l2], FSL[s, 5, l2],
+                                  FSL[s, 6, l2])
+            q3, p3 = bm6_step(Q[l3], P[l3], C[0, l3], C[1, l3], C[2, l3], C[3, l3],
+                                  C[4, l3], C[5, l3], C[6, l3], FSL[s, 0, l3], FSL[s, 1, l3],
+                                  FSL[s, 2, l3], FSL[s, 3, l3], FSL[s, 4, l3], FSL[s, 5, l3],
+                                  FSL[s, 6, l3])
+            Q[l0] = q0
+            P[l0] = p0
+            e0 = energy2(q0, p0)
+            x0 = abs(q0)
+            m = ME[l0]
+            ME[l0] = e0 if e0 > m else m
+            m = MQ[l0]
+            MQ[l0] = x0 if x0 > m else m
+            Q[l1] = q1
+            P[l1] = p1
+            e1 = energy2(q1, p1)
+            x1 = abs(q1)
+            m = ME[l1]
+            ME[l1] = e1 if e1 > m else m
+            m = MQ[l1]
+            MQ[l1] = x1 if x1 > m else m
+            Q[l2] = q2
+            P[l2] = p2
+            e2 = energy2(q2, p2)
+            x2 = abs(q2)
+            m = ME[l2]
+            ME[l2] = e2 if e2 > m else m
+            m = MQ[l2]
+            MQ[l2] = x2 if x2 > m else m
+            Q[l3] = q3
+            P[l3] = p3
+            e3 = energy2(q3, p3)
+            x3 = abs(q3)
+            m = ME[l3]
+            ME[l3] = e3 if e3 > m else m
+            m = MQ[l3]
+            MQ[l3] = x3 if x3 > m else m
+
+
+@njit(cache=True)
+def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, Fpar, sintab, thrE2, thrQ, cycles,
+              stop_any, outE, outQ, store, do_store):
+    N = q0.shape[0]
+    S = sintab.shape[0]
+    nE = thrE2.shape[0]
+    nQ = thrQ.shape[0]
+    shared = coef.shape[0] == 1
+    L = np.int64(lanes)
+    Lmem = max(L, 4 * MIN_SEGMENT) + 32       # room for the padded segments
+    Q = np.zeros(Lmem)
+    P = np.zeros(Lmem)
+    ME = np.empty(Lmem)
+    MQ = np.empty(Lmem)
+    QS = np.empty(L)
+    PS = np.empty(L)
+    traj = np.empty(L, np.int64)
+    per = np.empty(L, np.int64)
+    lE = np.empty(L, np.int64)
+    lQ = np.empty(L, np.int64)
+    done = np.zeros(L, np.bool_)
+    tE = np.empty(L)      # next uncrossed 2*xi threshold of the lane (inf: none)
+    tQ = np.empty(L)      # next uncrossed |q| threshold (or the barrier)
+    inf = np.inf
+    if shared:
+        FS = coef.shape[0] * 0.0 + Fpar[0] * sintab        # (S, 7)
+        C = np.empty((7, 1))
+        FSL = np.empty((1, 7, 1))
+    else:
+        FS = np.empty((1, 7))
+        C = np.zeros((7, Lmem))
+        FSL = np.zeros((S, 7, Lmem))
+
+    nxt = np.int64(task)
+    nact = np.int64(0)
+    while True:
+        # ---------------------------------------------------- fill empty / finished lanes
+        l = np.int64(0)
+        while l < nact or (l == nact and nact < L and nxt < N):
+            if l < nact and not done[l]:
+                l += 1
+                continue
+            loaded = False
+            while nxt < N:
+                i = nxt
+                nxt += n_tasks
+                iE, iQ = _check_state(i, q0[i], p0[i], 0, thrE2, thrQ, 0, 0, outE, outQ)
+                if do_store and iE == 0 and iQ == 0:
+                    store[i, 0, 0] = q0[i]
+                    store[i, 0, 1] = p0[i]
+                if _finished(iE, iQ, nE, nQ, stop_any) or cycles == 0:
+                    continue
+                k = pidx[i]
+                Q[l] = q0[i]; P[l] = p0[i]; QS[l] = q0[i]; PS[l] = p0[i]
+                if not shared:
+                    for j in range(7):
+                        C[j, l] = coef[k, j]
+                    Fk = Fpar[k]
+                    for s in range(S):
+                        for j in range(7):
+                            FSL[s, j, l] = Fk * sintab[s, j]
+                traj[l] = i; per[l] = 0; lE[l] = iE; lQ[l] = iQ
+                tE[l] = thrE2[iE] if iE < nE else inf
+                tQ[l] = thrQ[iQ] if iQ < nQ else inf
+                if iE < nE:
+                    tQ[l] = min(tQ[l], Q_BARRIER)
+                done[l] = False
+                loaded = True
+                break
+            if loaded:
+                if l == nact:
+                    nact += 1
+                l += 1
+                continue
+            if l == nact:
+                break
+            # queue empty: move the last active lane into the hole
+            last = nact - 1
+            if last != l:
+                Q[l] = Q[last]; P[l] = P[last]; QS[l] = QS[last]; PS[l] = PS[last]
+                if not shared:
+                    for j in range(7):
+                        C[j, l] = C[j, last]
+                    for s in range(S):
+                        for j in range(7):
+                            FSL[s, j, l] = FSL[s, j, last]
+                traj[l] = traj[last]; per[l] = per[last]; lE[l] = lE[last]; lQ[l] = lQ[last]
+                tE[l] = tE[last]; tQ[l] = tQ[last]; done[l] = done[last]
+            nact -= 1
+        if nact == 0:
+            break
+        # ---------------------------------------------------- one period, vectorised
+        # lanes [0, 4M) with M a multiple of 8 (vector width); idle lanes hold q = p = 0
+        M = max(MIN_SEGMENT, ((nact + 3) // 4 + 7) // 8 * 8)
+        for l in range(nact, 4 * M):
+            Q[l] = 0.0
+            P[l] = 0.0
+        if shared:
+            _period_shared(M, Q, P, ME, MQ, coef[0], FS)
+        else:
+            _period_lanes(M, Q, P, ME, MQ, C, FSL)
+        # ---------------------------------------------------- period boundary
+        for l in range(nact):
+            i = traj[l]
+            iE = lE[l]
+            iQ = lQ[l]
+            if ME[l] > tE[l] or MQ[l] > tQ[l]:
+                k = pidx[i]
+                iE, iQ = _replay(i, QS[l], PS[l], per[l], sintab, coef[k], Fpar[k], thrE2, thrQ,
+                                 iE, iQ, outE, outQ, stop_any)
+                lE[l] = iE
+                lQ[l] = iQ
+                tE[l] = thrE2[iE] if iE < nE else inf
+                tQ[l] = thrQ[iQ] if iQ < nQ else inf
+                if iE < nE:
+                    tQ[l] = min(tQ[l], Q_BARRIER)
+            per[l] += 1
+            fin = _finished(iE, iQ, nE, nQ, stop_any)
+            if do_store and not fin and iE == 0 and iQ == 0:
+                store[i, per[l], 0] = Q[l]
+                store[i, per[l], 1] = P[l]
+            done[l] = fin or per[l] >= cycles
+            QS[l] = Q[l]
+            PS[l] = P[l]
+
+
+@njit(cache=True, parallel=True)
+def ensemble(q0, p0, pidx, coef, Fpar, sintab, thrE2, thrQ, cycles, stop_any, n_tasks, lanes,
+             outE, outQ, store, do_store):
+    """Integrate every trajectory i from (q0[i], p0[i]) with parameter set pidx[i]
+    (coef[pidx[i]] = step coefficients from lane_coefficients, Fpar[pidx[i]] = F) for at most
+    `cycles` forcing periods of S = sintab.shape[0] steps.
+
+    thrE2: sorted ascending 2*xi_max thresholds; thrQ: sorted ascending q_max (either may be
+    empty).  outE (N, nE), outQ (N, nQ): int64 step after which the threshold is first
+    exceeded (0 = the initial condition), pre-filled with -1 (= not within the horizon).
+    A trajectory stops when every threshold is crossed (stop_any: when any is crossed).
+    store (N, cycles+1, 2): period-map iterates when do_store (pre-filled with NaN).
+    Trajectory i is run by task i % n_tasks; the results do not depend on n_tasks, lanes or
+    the thread count (each trajectory is the same sequence of IEEE operations).
+    """
+    for task in prange(n_tasks):
+        _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, Fpar, sintab, thrE2, thrQ, cycles,
+                  stop_any, outE, outQ, store, do_store)
+
+
+@njit(cache=True, parallel=True)
+def final_states(q0, p0, pidx, coef, Fpar, sintab, n_periods):
+    """Plain integration (no escape checks) for n_periods periods; returns (q, p).
+    Scalar per trajectory; used by tests (convergence order, energy drift)."""
+    N = q0.shape[0]
+    S = sintab.shape[0]
+    qo = np.empty(N)
+    po = np.empty(N)
+    for i in prange(N):
+        k = pidx[i]
+        F = Fpar[k]
+        c = coef[k]
+        q = q0[i]
+        p = p0[i]
+        for n in range(n_periods):
+            for s in range(S):
+                q, p = bm6_step(q, p, c[0], c[1], c[2], c[3], c[4], c[5], c[6],
+                                F * sintab[s, 0], F * sintab[s, 1], F * sintab[s, 2],
+                                F * sintab[s, 3], F * sintab[s, 4], F * sintab[s, 5],
+                                F * sintab[s, 6])
+        qo[i] = q
+        po[i] = p
+    return qo, po
