@@ -8,13 +8,10 @@ from .action_angle import (H0, q_max_from_xi, J, omega, G, dJ_dxi, dG_dxi, nome,
 from .slow_flow import (first_integral, escapes_on_manifold, slow_flow_escapes,
                         slow_flow_profile, slow_flow_rhs, xi_from_J, saddles)
 from .critical import critical_forcing, MECHANISMS
+from .basins import safe_basin_boundaries
 
 __all__ = ["H0", "q_max_from_xi", "J", "omega", "G", "dJ_dxi", "dG_dxi", "nome",
            "angle_energy", "phase_point", "initial_condition",
            "first_integral", "escapes_on_manifold", "slow_flow_escapes", "slow_flow_profile",
-           "slow_flow_rhs", "xi_from_J", "saddles", "critical_forcing", "MECHANISMS"]
-try:  # basins is optional until implemented
-    from .basins import safe_basin_boundaries  # noqa: F401
-    __all__.append("safe_basin_boundaries")
-except ImportError:  # pragma: no cover
-    pass
+           "slow_flow_rhs", "xi_from_J", "saddles", "critical_forcing", "MECHANISMS",
+           "safe_basin_boundaries"]
