@@ -23,6 +23,13 @@ Kinds (paper Sec. 2.3):
   through the well bottom, is the special island case);
 * ``"peninsula"`` maximum type whose curve runs from one ray to the other, i.e. wraps around
   the cylinder; the safe region lies between it and the circle xi = 0.
+
+Several boundaries can coexist (Fig 9: a saddle-type boundary on the gamma = 0 side and an
+island on the gamma = pi side) and the basin can be disjoint (Fig 14, e.g. F = 0.01,
+Omega = 0.9, Psi = pi, xi_max = 0.13 ... 0.18).  At ``xi_max = 1/4`` every point is safe in the
+slow flow (G(1/4) = 0); the curves returned there are the measure-zero level ``C = h(1/4)``.
+The paper's text after eq (27) refers to "the curve (28)" for islands/peninsulas; it means the
+SBMT boundary (27).
 """
 from __future__ import annotations
 

@@ -27,6 +27,15 @@ Where the maximum sits names the mechanism:
   ``a'(xi) = 0`` with ``a`` locally maximal, i.e. a saddle.)
 
 For the zero IC this reduces to ``F_cr = max_{0 < xi <= xi_max} |xi - Omega J(xi)| / G(xi)``.
+
+Notes on the paper
+------------------
+* Eq (24) is written with ``C0`` as if it were independent of F; for a nonzero IC
+  ``C0 = h0 - F G0 cos(gamma0)`` depends on F and the explicit solution is the one above.  The
+  "+" sign of eq (24) is the tangency at gamma* = pi, the "-" sign the one at gamma* = 0.
+* At ``xi_max = 1/4`` exactly, ``G(1/4) = 0`` and the tangency point is undefined (as the paper
+  remarks); in the slow flow no level curve except ``C = h(1/4)`` reaches the separatrix, so
+  ``F_cr`` is NaN there.  Use a threshold slightly below 1/4 (the paper uses 0.2499).
 """
 from __future__ import annotations
 
