@@ -129,7 +129,8 @@ def test_bitwise_independent_of_threads_tasks_and_lanes():
         coef = np.repeat(K.lane_coefficients(0.95, S), npar, 0)
         oE = np.full((N, 2), -1, np.int64)
         oQ = np.full((N, 2), -1, np.int64)
-        K.ensemble(Q, P, np.arange(N) % npar, coef, np.full(npar, 0.0876), K.sine_table(S, np.pi),
+        K.ensemble(Q, P, np.arange(N) % npar, coef, np.repeat(K.step_sizes(0.95, S), npar),
+                   np.full(npar, 0.0876), K.sine_table(S, np.pi),
                    2 * np.array([0.2, 0.25]), np.array([0.8, 1.0]), 60, False, n_tasks, lanes, oE, oQ,
                    np.empty((0, 0, 2)), False)
         res.append((oE, oQ))

@@ -91,7 +91,7 @@ def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), cycles, st
         sintab = K.sine_table(steps_per_cycle, Psi)
         with thread_count(threads) as nthreads:
             n_tasks = max(1, min(math.ceil(N / LANES), 16 * nthreads))
-            K.ensemble(q0, p0, pidx, coef, np.ascontiguousarray(F), sintab,
+            K.ensemble(q0, p0, pidx, coef, K.step_sizes(Omega, steps_per_cycle), np.ascontiguousarray(F), sintab,
                        np.ascontiguousarray(2.0 * xi[oE_sorted]), np.ascontiguousarray(qm[oQ_sorted]),
                        int(cycles), bool(stop_any), int(n_tasks), LANES, outE, outQ, st, bool(store))
     # back to the caller's threshold order

@@ -47,6 +47,8 @@ BM6_KICK = np.array([_B1, _B2, _B3, _B4, _B3, _B2, _B1])
 # sub-times of the 7 kicks as fractions of a step
 BM6_KICK_TIMES = np.concatenate([[0.0], np.cumsum(BM6_DRIFT)])
 BM6_KICK_TIMES[-1] = 1.0
+DRIFT1, DRIFT2, DRIFT3 = _A1, _A2, _A3
+KICK1, KICK2, KICK3, KICK4 = _B1, _B2, _B3, _B4
 INTEGRATOR = "Blanes-Moan SRKN6b (symplectic RKN, order 4, 6 force evaluations/step)"
 N_KICKS = 7
 
@@ -118,6 +120,12 @@ def lane_coefficients(Omega, steps_per_cycle):
     out[:, 0:3] = h[:, None] * BM6_DRIFT[None, :3]
     out[:, 3:7] = h[:, None] * BM6_KICK[None, :4]
     return out
+
+
+def step_sizes(Omega, steps_per_cycle):
+    """h = T / S per parameter set (the per-lane path forms h * a_k in the loop)."""
+    Omega = np.atleast_1d(np.asarray(Omega, dtype=float))
+    return 2.0 * np.pi / (Omega * steps_per_cycle)
 
 
 @njit(cache=True)
@@ -221,70 +229,37 @@ def _period_shared(M, Q, P, ME, MQ, c, FS):
 
 
 @njit(cache=True)
-def _period_lanes(M, Q, P, ME, MQ, C, FSL):
-    """As _period_shared with per-lane parameters: C (7, L) step coefficients and
-    FSL (S, 7, L) forcing values F * sin(...) of each lane."""
-    for l in range(4 * M):
+def _period_lanes(M, Q, P, ME, MQ, HL, FL, sintab):
+    """As _period_shared for lanes [0, 4M) with per-lane parameters: step h = HL[l] and
+    amplitude F = FL[l].  The coefficients h*a_k, h*b_k and forcing values F*sin_k are formed
+    in the loop: the same IEEE products as the precomputed ones of the shared path, so both
+    paths give bitwise identical trajectories.  (One chain per iteration: with 4 chains and
+    six arrays LLVM's runtime alias checks exceed its budget and the loop stays scalar.)"""
+    A1 = DRIFT1; A2 = DRIFT2; A3 = DRIFT3; B1 = KICK1; B2 = KICK2; B3 = KICK3; B4 = KICK4
+    n = 4 * M
+    for l in range(n):
         ME[l] = -np.inf
         MQ[l] = -np.inf
-    for s in range(FSL.shape[0]):
-        for j in range(M):
-            l0 = 0 * M + j
-            l1 = 1 * M + j
-            l2 = 2 * M + j
-            l3 = 3 * M + j
-            q0, p0 = bm6_step(Q[l0], P[l0], C[0, l0], C[1, l0], C[2, l0], C[3, l0],
-                                  C[4, l0], C[5, l0], C[6, l0], FSL[s, 0, l0], FSL[s, 1, l0],
-                                  FSL[s, 2, l0], FSL[s, 3, l0], FSL[s, 4, l0], FSL[s, 5, l0],
-                                  FSL[s, 6, l0])
-            q1, p1 = bm6_step(Q[l1], P[l1], C[0, l1], C[1, l1], C[2, l1], C[3, l1],
-                                  C[4, l1], C[5, l1], C[6, l1], FSL[s, 0, l1], FSL[s, 1, l1],
-                                  FSL[s, 2, l1], FSL[s, 3, l1], FSL[s, 4, l1], FSL[s, 5, l1],
-                                  FSL[s, 6, l1])
-            q2, p2 = bm6_step(Q[l2], P[l2], C[0, l2], C[1, l2], C[2, l2], C[3, l2],
-                                  C[4, l2], C[5, l2], C[6, l2], FSL[s, 0, l2], FSL[s, 1, l2],
-                                  FSL[s, 2, l2], FSL[s, 3, l2], FSL[s, 4, l2], FSL[s, 5, l2],
-                                  FSL[s, 6, l2])
-            q3, p3 = bm6_step(Q[l3], P[l3], C[0, l3], C[1, l3], C[2, l3], C[3, l3],
-                                  C[4, l3], C[5, l3], C[6, l3], FSL[s, 0, l3], FSL[s, 1, l3],
-                                  FSL[s, 2, l3], FSL[s, 3, l3], FSL[s, 4, l3], FSL[s, 5, l3],
-                                  FSL[s, 6, l3])
-            Q[l0] = q0
-            P[l0] = p0
-            e0 = energy2(q0, p0)
-            x0 = abs(q0)
-            m = ME[l0]
-            ME[l0] = e0 if e0 > m else m
-            m = MQ[l0]
-            MQ[l0] = x0 if x0 > m else m
-            Q[l1] = q1
-            P[l1] = p1
-            e1 = energy2(q1, p1)
-            x1 = abs(q1)
-            m = ME[l1]
-            ME[l1] = e1 if e1 > m else m
-            m = MQ[l1]
-            MQ[l1] = x1 if x1 > m else m
-            Q[l2] = q2
-            P[l2] = p2
-            e2 = energy2(q2, p2)
-            x2 = abs(q2)
-            m = ME[l2]
-            ME[l2] = e2 if e2 > m else m
-            m = MQ[l2]
-            MQ[l2] = x2 if x2 > m else m
-            Q[l3] = q3
-            P[l3] = p3
-            e3 = energy2(q3, p3)
-            x3 = abs(q3)
-            m = ME[l3]
-            ME[l3] = e3 if e3 > m else m
-            m = MQ[l3]
-            MQ[l3] = x3 if x3 > m else m
+    for s in range(sintab.shape[0]):
+        s1 = sintab[s, 0]; s2 = sintab[s, 1]; s3 = sintab[s, 2]; s4 = sintab[s, 3]
+        s5 = sintab[s, 4]; s6 = sintab[s, 5]; s7 = sintab[s, 6]
+        for l in range(n):
+            h = HL[l]
+            F = FL[l]
+            q, p = bm6_step(Q[l], P[l], h * A1, h * A2, h * A3, h * B1, h * B2, h * B3, h * B4,
+                            F * s1, F * s2, F * s3, F * s4, F * s5, F * s6, F * s7)
+            Q[l] = q
+            P[l] = p
+            e = energy2(q, p)
+            x = abs(q)
+            m = ME[l]
+            ME[l] = e if e > m else m
+            m = MQ[l]
+            MQ[l] = x if x > m else m
 
 
 @njit(cache=True)
-def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, Fpar, sintab, thrE2, thrQ, cycles,
+def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQ, cycles,
               stop_any, outE, outQ, store, do_store):
     N = q0.shape[0]
     S = sintab.shape[0]
@@ -307,14 +282,9 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, Fpar, sintab, thrE2, thr
     tE = np.empty(L)      # next uncrossed 2*xi threshold of the lane (inf: none)
     tQ = np.empty(L)      # next uncrossed |q| threshold (or the barrier)
     inf = np.inf
-    if shared:
-        FS = coef.shape[0] * 0.0 + Fpar[0] * sintab        # (S, 7)
-        C = np.empty((7, 1))
-        FSL = np.empty((1, 7, 1))
-    else:
-        FS = np.empty((1, 7))
-        C = np.zeros((7, Lmem))
-        FSL = np.zeros((S, 7, Lmem))
+    FS = Fpar[0] * sintab        # (S, 7), shared path
+    HL = np.zeros(Lmem)          # per-lane path
+    FL = np.zeros(Lmem)
 
     nxt = np.int64(task)
     nact = np.int64(0)
@@ -337,13 +307,8 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, Fpar, sintab, thrE2, thr
                     continue
                 k = pidx[i]
                 Q[l] = q0[i]; P[l] = p0[i]; QS[l] = q0[i]; PS[l] = p0[i]
-                if not shared:
-                    for j in range(7):
-                        C[j, l] = coef[k, j]
-                    Fk = Fpar[k]
-                    for s in range(S):
-                        for j in range(7):
-                            FSL[s, j, l] = Fk * sintab[s, j]
+                HL[l] = hpar[k]
+                FL[l] = Fpar[k]
                 traj[l] = i; per[l] = 0; lE[l] = iE; lQ[l] = iQ
                 tE[l] = thrE2[iE] if iE < nE else inf
                 tQ[l] = thrQ[iQ] if iQ < nQ else inf
@@ -363,12 +328,8 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, Fpar, sintab, thrE2, thr
             last = nact - 1
             if last != l:
                 Q[l] = Q[last]; P[l] = P[last]; QS[l] = QS[last]; PS[l] = PS[last]
-                if not shared:
-                    for j in range(7):
-                        C[j, l] = C[j, last]
-                    for s in range(S):
-                        for j in range(7):
-                            FSL[s, j, l] = FSL[s, j, last]
+                HL[l] = HL[last]
+                FL[l] = FL[last]
                 traj[l] = traj[last]; per[l] = per[last]; lE[l] = lE[last]; lQ[l] = lQ[last]
                 tE[l] = tE[last]; tQ[l] = tQ[last]; done[l] = done[last]
             nact -= 1
@@ -383,7 +344,7 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, Fpar, sintab, thrE2, thr
         if shared:
             _period_shared(M, Q, P, ME, MQ, coef[0], FS)
         else:
-            _period_lanes(M, Q, P, ME, MQ, C, FSL)
+            _period_lanes(M, Q, P, ME, MQ, HL, FL, sintab)
         # ---------------------------------------------------- period boundary
         for l in range(nact):
             i = traj[l]
@@ -410,10 +371,11 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, Fpar, sintab, thrE2, thr
 
 
 @njit(cache=True, parallel=True)
-def ensemble(q0, p0, pidx, coef, Fpar, sintab, thrE2, thrQ, cycles, stop_any, n_tasks, lanes,
+def ensemble(q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQ, cycles, stop_any, n_tasks, lanes,
              outE, outQ, store, do_store):
     """Integrate every trajectory i from (q0[i], p0[i]) with parameter set pidx[i]
-    (coef[pidx[i]] = step coefficients from lane_coefficients, Fpar[pidx[i]] = F) for at most
+    (coef[pidx[i]] = step coefficients from lane_coefficients, hpar[pidx[i]] = the step h
+    from step_sizes, Fpar[pidx[i]] = F) for at most
     `cycles` forcing periods of S = sintab.shape[0] steps.
 
     thrE2: sorted ascending 2*xi_max thresholds; thrQ: sorted ascending q_max (either may be
@@ -425,7 +387,7 @@ def ensemble(q0, p0, pidx, coef, Fpar, sintab, thrE2, thrQ, cycles, stop_any, n_
     the thread count (each trajectory is the same sequence of IEEE operations).
     """
     for task in prange(n_tasks):
-        _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, Fpar, sintab, thrE2, thrQ, cycles,
+        _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQ, cycles,
                   stop_any, outE, outQ, store, do_store)
 
 
