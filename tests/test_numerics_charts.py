@@ -56,6 +56,13 @@ def test_paired_and_grid_agree(chart):
     assert d2.sizes["sample"] == 200
     np.testing.assert_array_equal(d2["escape_cycle_energy"].values[0], d["escape_cycle_energy"].values[0])
     assert q.shape == (200,) and p.shape == (200,)
+    # grid=None: unsorted 1-D arrays (random ICs) are paired, sorted ones are axes
+    auto = escape_chart(q[:30], p[:30], 0.0876, 0.95, np.pi, xi_max=0.25, cycles=5)
+    assert auto["escape_cycle_energy"].dims == ("xi_max", "sample")
+    axes = escape_chart(np.sort(q[:30]), np.sort(p[:20]), 0.0876, 0.95, np.pi, xi_max=0.25, cycles=5)
+    assert axes["escape_cycle_energy"].dims == ("xi_max", "q0", "p0")
+    forced = escape_chart(np.sort(q[:30]), np.sort(p[:30]), 0.0876, 0.95, np.pi, xi_max=0.25, cycles=5, grid=False)
+    assert forced.sizes["sample"] == 30
     assert np.array_equal(random_initial_conditions(200, 3, box=((-1, 1), (-0.9, 0.9)))[0], q)
 
 

@@ -11,11 +11,16 @@ from safebasins.numerics import kernels as K
 _CYC = "1"  # time in forcing cycles (dimensionless)
 
 
+def _monotone(a):
+    d = np.diff(a)
+    return bool(np.all(d > 0) or np.all(d < 0))
+
+
 def _ic_arrays(q0, p0, grid):
     qa = V.check_finite("q0", q0)
     pa = V.check_finite("p0", p0)
     if grid is None:
-        grid = qa.ndim == 1 and pa.ndim == 1
+        grid = qa.ndim == 1 and pa.ndim == 1 and _monotone(qa) and _monotone(pa)
     if grid:
         if qa.ndim != 1 or pa.ndim != 1:
             raise ValueError(f"q0 and p0 must be 1-D axes for grid=True, got shapes {qa.shape}, {pa.shape}")
@@ -35,10 +40,12 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000
 
     Parameters
     ----------
-    q0, p0 : initial conditions.  grid=None (default): two 1-D arrays are grid AXES -> dims
-        ('q0', 'p0'), ij indexing (first axis q0); anything else is paired.  grid=False: paired
-        ICs of equal shape (e.g. random ICs) -> flat dim 'sample' with coords q0(sample),
-        p0(sample) (C order).  grid=True: require 1-D axes.
+    q0, p0 : initial conditions.  grid=True: 1-D AXES -> dims ('q0', 'p0'), ij indexing (first
+        axis q0).  grid=False: paired ICs of equal shape (e.g. random ICs) -> flat dim 'sample'
+        with coords q0(sample), p0(sample) (C order).  grid=None (default) decides: two 1-D,
+        strictly monotonic arrays are axes (a grid), anything else is paired.  Random ICs are
+        therefore paired automatically; pass grid=False for paired ICs that happen to be sorted
+        (e.g. points on a line) and grid=True/False explicitly in library code.
     F, Omega, Psi : forcing amplitude (>= 0), frequency (> 0), phase of eq (1).
     xi_max : energy thresholds, H0 = p^2/2 + q^2/2 - q^4/4 > xi_max means escape (eq 7).
         |q| > 1 (beyond the barrier, out of the well) also counts as energy escape.

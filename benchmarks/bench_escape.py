@@ -1,0 +1,290 @@
+"""Benchmark and convergence study of safebasins.numerics (see docs/numerics.md).
+
+    python benchmarks/bench_escape.py            # speed: engine vs numpy RK4 vs scipy DOP853
+    python benchmarks/bench_escape.py --study    # convergence study against scipy DOP853
+                                                 # (rtol 1e-10) on the 100x100 chart
+
+Everything runs in ONE process.  The DOP853 reference of the study takes ~10-20 CPU-minutes;
+it is cached in --ref (default: $TMPDIR/safebasins_dop853_chart_ref.npz) and computed with
+--workers processes.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+CHART = dict(F=0.0876, Omega=0.95, Psi=np.pi, xi_max=0.25, cycles=300, n=100)
+
+
+def chart_ics(n=CHART["n"]):
+    q = np.linspace(-1, 1, n)
+    Q, P = np.meshgrid(q, q, indexing="ij")
+    return q, Q.ravel(), P.ravel()
+
+
+# ----------------------------------------------------------------------------- references
+def _dop853_one(args):
+    """Escape time (cycles) of one IC with scipy DOP853 (events: H0 = xi_max, |q| = 1)."""
+    from scipy.integrate import solve_ivp
+    q0, p0, F, Om, Psi, xi_max, cycles, rtol, atol = args
+    H = 0.5 * p0 * p0 + 0.5 * q0 * q0 - 0.25 * q0 ** 4
+    if H > xi_max or abs(q0) > 1:
+        return 0.0
+    T = 2 * math.pi / Om
+
+    def rhs(t, y):
+        q = y[0]
+        return [y[1], q * q * q - q + F * math.sin(Om * t + Psi)]
+
+    def e_energy(t, y):
+        return 0.5 * y[1] * y[1] + 0.5 * y[0] * y[0] - 0.25 * y[0] ** 4 - xi_max
+    e_energy.terminal = True
+    e_energy.direction = 1
+
+    def e_barrier(t, y):
+        return abs(y[0]) - 1.0
+    e_barrier.terminal = True
+    e_barrier.direction = 1
+    sol = solve_ivp(rhs, (0, cycles * T), [q0, p0], method="DOP853", rtol=rtol, atol=atol,
+                    events=(e_energy, e_barrier))
+    hits = [ev[0] for ev in sol.t_events if len(ev)]
+    return min(hits) / T if hits else np.inf
+
+
+def dop853_chart(Q, P, F, Omega, Psi, xi_max, cycles, rtol=1e-10, atol=1e-12, workers=2):
+    from multiprocessing import Pool
+    args = [(float(a), float(b), F, Omega, Psi, xi_max, cycles, rtol, atol) for a, b in zip(Q, P)]
+    if workers > 1:
+        with Pool(workers) as pool:
+            return np.array(pool.map(_dop853_one, args, chunksize=16))
+    return np.array([_dop853_one(a) for a in args])
+
+
+def numpy_rk4_chart(Q, P, F, Omega, Psi, xi_max, cycles, steps_per_cycle):
+    """Vectorised-across-trajectories classic RK4 (numpy), escape checked after every step;
+    escaped trajectories are dropped from the active set at each step."""
+    S = steps_per_cycle
+    h = 2 * np.pi / (Omega * S)
+    q = Q.astype(float).copy()
+    p = P.astype(float).copy()
+    out = np.full(q.size, np.inf)
+    H = 0.5 * p * p + 0.5 * q * q - 0.25 * q ** 4
+    start = (H > xi_max) | (np.abs(q) > 1)
+    out[start] = 0.0
+    idx = np.flatnonzero(~start)
+    q, p = q[idx], p[idx]
+    n_steps = 0
+    for n in range(cycles * S):
+        t = n * h
+        f0 = F * math.sin(Omega * t + Psi)
+        f1 = F * math.sin(Omega * (t + 0.5 * h) + Psi)
+        f2 = F * math.sin(Omega * (t + h) + Psi)
+        k1q = p
+        k1p = q * q * q - q + f0
+        qa = q + 0.5 * h * k1q
+        k2q = p + 0.5 * h * k1p
+        k2p = qa * qa * qa - qa + f1
+        qb = q + 0.5 * h * k2q
+        k3q = p + 0.5 * h * k2p
+        k3p = qb * qb * qb - qb + f1
+        qc = q + h * k3q
+        k4q = p + h * k3p
+        k4p = qc * qc * qc - qc + f2
+        q = q + h / 6 * (k1q + 2 * k2q + 2 * k3q + k4q)
+        p = p + h / 6 * (k1p + 2 * k2p + 2 * k3p + k4p)
+        n_steps += q.size
+        esc = (0.5 * p * p + 0.5 * q * q - 0.25 * q ** 4 > xi_max) | (np.abs(q) > 1)
+        if esc.any():
+            out[idx[esc]] = (n + 1) / S
+            keep = ~esc
+            idx, q, p = idx[keep], q[keep], p[keep]
+            if idx.size == 0:
+                break
+    return out, n_steps
+
+
+# ----------------------------------------------------------------------------- helpers
+def machine_state():
+    la = os.getloadavg()
+    try:
+        model = [line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name")][0]
+    except Exception:  # pragma: no cover
+        model = "?"
+    top = ""
+    try:
+        top = subprocess.run(["top", "-bn1", "-o", "%CPU"], capture_output=True, text=True, timeout=10).stdout
+        top = "\n".join(top.splitlines()[6:12])
+    except Exception:  # pragma: no cover
+        pass
+    return f"{model}, {os.cpu_count()} CPUs, load average {la[0]:.2f} {la[1]:.2f} {la[2]:.2f}\n{top}"
+
+
+def engine_steps(chart_cycles_E, S, cycles):
+    """Trajectory-steps actually integrated by the engine (to the escape step or horizon)."""
+    e = np.where(np.isfinite(chart_cycles_E), chart_cycles_E, cycles)
+    return float(np.round(e * S).sum())
+
+
+def best_time(fn, repeat):
+    best = np.inf
+    out = None
+    for _ in range(repeat):
+        t = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - t)
+    return best, out
+
+
+# ----------------------------------------------------------------------------- benchmark
+def benchmark(args):
+    import numba
+    from safebasins.numerics import escape_chart
+    from safebasins.numerics import engine as E
+    S = args.steps_per_cycle or E.DEFAULT_STEPS_PER_CYCLE
+    print("machine:", machine_state())
+    print(f"numba {numba.__version__}, threads {numba.get_num_threads()}, threading layer "
+          f"{numba.config.THREADING_LAYER}, steps_per_cycle {S}")
+    t = time.perf_counter()
+    escape_chart([0.0], [0.0], 0.01, 1.0, 0.0, cycles=1, steps_per_cycle=S)   # compile / load cache
+    print(f"first call (compile or cache load): {time.perf_counter() - t:.2f} s")
+    rows = []
+
+    # (a1) dense job: F = 0, ICs well inside the well, nothing escapes
+    rng = np.random.default_rng(0)
+    n_dense = args.dense_n
+    r = 0.45 * np.sqrt(rng.uniform(0, 1, n_dense))
+    th = rng.uniform(0, 2 * np.pi, n_dense)
+    qd, pd = r * np.cos(th), r * np.sin(th)
+    dense_cycles = args.dense_cycles
+    tdense, cd = best_time(lambda: escape_chart(qd, pd, 0.0, 1.0, 0.0, xi_max=0.25, cycles=dense_cycles,
+                                                steps_per_cycle=S, grid=False), args.repeat)
+    assert np.isinf(cd["escape_cycle_energy"].values).all()
+    steps = n_dense * dense_cycles * S
+    rows.append(("engine, dense (F=0, no escapes)", steps, tdense))
+
+    # (a2) the 100x100 chart
+    q, Q, P = chart_ics()
+    c = CHART
+    tchart, ch = best_time(lambda: escape_chart(q, q, c["F"], c["Omega"], c["Psi"], xi_max=c["xi_max"],
+                                                cycles=c["cycles"], steps_per_cycle=S), args.repeat)
+    eE = ch["escape_cycle_energy"].values[0].ravel()
+    steps_chart = engine_steps(eE, S, c["cycles"])
+    frac_early = float(np.mean(eE <= 10))
+    rows.append((f"engine, 100x100 chart ({100 * np.mean(np.isfinite(eE)):.1f}% escape, "
+                 f"{100 * frac_early:.1f}% within 10 cycles)", steps_chart, tchart))
+
+    # (b) numpy RK4, vectorised across trajectories, same chart
+    S_rk4 = args.rk4_steps
+    t0 = time.perf_counter()
+    e_rk4, n_rk4 = numpy_rk4_chart(Q, P, c["F"], c["Omega"], c["Psi"], c["xi_max"], c["cycles"], S_rk4)
+    t_rk4 = time.perf_counter() - t0
+    rows.append((f"numpy RK4 ({S_rk4} steps/cycle), same chart", n_rk4, t_rk4))
+
+    # (c) scipy DOP853 on a subset, extrapolated per trajectory-cycle
+    sub = rng.choice(Q.size, args.dop_subset, replace=False)
+    t0 = time.perf_counter()
+    e_dop = dop853_chart(Q[sub], P[sub], c["F"], c["Omega"], c["Psi"], c["xi_max"], c["cycles"],
+                         rtol=1e-10, atol=1e-12, workers=1)
+    t_dop = time.perf_counter() - t0
+    cyc_dop = float(np.where(np.isfinite(e_dop), e_dop, c["cycles"]).sum())
+
+    print(f"\n{'job':62s} {'traj-steps':>12s} {'time [s]':>9s} {'steps/s':>10s} {'cycles/s':>10s}")
+    rate = {}
+    for name, n, t in rows:
+        spc = S_rk4 if name.startswith("numpy") else S
+        rate[name] = (n / t, n / spc / t)
+        print(f"{name:62s} {n:12.4g} {t:9.3f} {n / t:10.3g} {n / spc / t:10.3g}")
+    print(f"{'scipy DOP853 rtol 1e-10, ' + str(args.dop_subset) + ' random ICs of the chart (1 process)':62s} "
+          f"{'-':>12s} {t_dop:9.3f} {'-':>10s} {cyc_dop / t_dop:10.3g}")
+    eng_chart = steps_chart / S / tchart            # trajectory-cycles per second
+    rk4_cyc = n_rk4 / S_rk4 / t_rk4
+    dop_cyc = cyc_dop / t_dop
+    est_dop_chart = float(np.where(np.isfinite(eE), eE, c["cycles"]).sum()) / dop_cyc
+    print(f"\nDOP853 extrapolated to the whole chart (same escape mix, per trajectory-cycle): "
+          f"{est_dop_chart:.0f} s on 1 core")
+    print("ratios on the chart job, per trajectory-cycle (each method at its own steps/cycle):")
+    print(f"  engine / numpy RK4   = {eng_chart / rk4_cyc:8.1f}x   (RK4 at {S_rk4} steps/cycle)")
+    print(f"  engine / scipy DOP853 = {eng_chart / dop_cyc:8.3g}x   (DOP853 measured on {args.dop_subset} ICs, extrapolated)")
+    print("ratio per trajectory-step (engine step = 6 force evaluations, RK4 step = 4):")
+    print(f"  engine / numpy RK4   = {(steps_chart / tchart) / (n_rk4 / t_rk4):8.1f}x")
+    # ceiling: zmm FMA-class ops per step = 7 kicks x 3 + 6 drifts + 3 (energy) = 30 per 8 lanes
+    ghz = args.ghz
+    ceil_steps = 2 * ghz * 1e9 * 8 / 30 if ghz else None
+    if ceil_steps:
+        print(f"ceiling (2 cores x {ghz} GHz x 1 zmm FMA-class op/cycle, 30 ops per 8 lane-steps) "
+              f"= {ceil_steps:.3g} steps/s: dense {steps / tdense / ceil_steps:.0%}, "
+              f"chart {steps_chart / tchart / ceil_steps:.0%}")
+    print("machine after:", machine_state().splitlines()[0])
+
+
+# ----------------------------------------------------------------------------- study
+def study(args):
+    from safebasins.numerics import escape_chart
+    c = CHART
+    q, Q, P = chart_ics()
+    ref_path = args.ref or os.path.join(tempfile.gettempdir(), "safebasins_dop853_chart_ref.npz")
+    if os.path.exists(ref_path):
+        ref = np.load(ref_path)["escape_cycle"]
+        print(f"DOP853 reference loaded from {ref_path}")
+    else:
+        print(f"computing the DOP853 reference (rtol 1e-10, atol 1e-12) with {args.workers} workers ...", flush=True)
+        print("machine:", machine_state().splitlines()[0])
+        t = time.perf_counter()
+        ref = dop853_chart(Q, P, c["F"], c["Omega"], c["Psi"], c["xi_max"], c["cycles"], workers=args.workers)
+        print(f"  done in {time.perf_counter() - t:.0f} s")
+        np.savez(ref_path, escape_cycle=ref)
+    safe_ref = np.isinf(ref)
+    print(f"reference: {safe_ref.sum()} of {ref.size} ICs safe at t_eval = {c['cycles']} "
+          f"({100 * np.mean(np.isfinite(ref)):.1f}% escape)")
+    print(f"\n{'steps/cycle':>11s} {'disagree':>8s} {'agree %':>8s} {'|dt| med':>9s} {'|dt| 99%':>9s} "
+          f"{'dt>1 cyc':>8s} {'t [s]':>6s}")
+    for S in args.steps_list:
+        t = time.perf_counter()
+        ch = escape_chart(q, q, c["F"], c["Omega"], c["Psi"], xi_max=c["xi_max"], cycles=c["cycles"],
+                          steps_per_cycle=S)
+        dt_run = time.perf_counter() - t
+        e = ch["escape_cycle_energy"].values[0].ravel()
+        dis = np.isinf(e) != safe_ref
+        both = np.isfinite(e) & np.isfinite(ref)
+        d = np.abs(e[both] - ref[both])
+        print(f"{S:11d} {dis.sum():8d} {100 * (1 - dis.mean()):8.2f} {np.median(d):9.2g} "
+              f"{np.quantile(d, 0.99):9.2g} {(d > 1).sum():8d} {dt_run:6.2f}")
+    # and the t_eval-resolved agreement at the default
+    from safebasins.numerics import engine as E
+    S = E.DEFAULT_STEPS_PER_CYCLE
+    ch = escape_chart(q, q, c["F"], c["Omega"], c["Psi"], xi_max=c["xi_max"], cycles=c["cycles"], steps_per_cycle=S)
+    e = ch["escape_cycle_energy"].values[0].ravel()
+    print(f"\nagreement of safe(t_eval) at steps_per_cycle={S}:")
+    for te in (1, 10, 50, 100, 200, 300):
+        print(f"  t_eval={te:4d}: {np.sum((e > te) != (ref > te)):4d} pixels differ")
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--study", action="store_true", help="convergence study instead of the speed benchmark")
+    ap.add_argument("--ref", help="DOP853 reference cache (.npz)")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--steps-list", type=int, nargs="+", default=[8, 12, 16, 24, 32, 48, 64, 128])
+    ap.add_argument("--steps-per-cycle", type=int, default=None)
+    ap.add_argument("--dense-n", type=int, default=20000)
+    ap.add_argument("--dense-cycles", type=int, default=300)
+    ap.add_argument("--rk4-steps", type=int, default=64)
+    ap.add_argument("--dop-subset", type=int, default=100)
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--ghz", type=float, default=2.6, help="core clock for the ceiling estimate")
+    args = ap.parse_args(argv)
+    if args.study:
+        study(args)
+    else:
+        benchmark(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
