@@ -41,7 +41,7 @@ from safebasins import _validate as V
 from safebasins._extras_common import (as_1d, fourier_list, mesh, numeric_safe, numerics_fn,
                                        stack_charts, theory_fn)
 from safebasins.erosion import _annotate_axes
-from safebasins.integrity import MEASURE_ATTRS, integrity_measures, unforced_safe_mask
+from safebasins.integrity import H0, MEASURE_ATTRS, integrity_measures, unforced_safe_mask
 
 __all__ = [
     "default_phases",
@@ -120,14 +120,14 @@ def _one_analytic(F, Omega, xi_max, q, p, Psi, fourier, n_gamma):
     return safe, cont, xt, closed_gim, float(np.sqrt(xt / xi_max))
 
 
-def _assemble(safe, true, q, p, Psi, lead_dims, lead_coords, xi_norm):
+def _assemble(safe, q, p, Psi, lead_dims, lead_coords, xi_norm):
     """Common Dataset layout: per-phase masks, true mask, integrity of both."""
     dims_psi = ("Psi",) + lead_dims + ("q0", "p0")
     coords = {"Psi": Psi, "q0": q, "p0": p, **lead_coords}
     da_safe = xr.DataArray(safe, dims=dims_psi, coords=coords,
                            attrs={"long_name": "safe basin for forcing phase Psi", "units": "1"})
     da_true = da_safe.all("Psi").assign_attrs(long_name="phase-invariant safe basin (intersection over Psi)",
-                                              units="1") if true is None else true
+                                              units="1")
     per = integrity_measures(da_safe, xi_max=xi_norm)
     tru = integrity_measures(da_true, xi_max=xi_norm)
     ds = xr.Dataset({"safe": da_safe, "true_safe": da_true})
@@ -135,6 +135,13 @@ def _assemble(safe, true, q, p, Psi, lead_dims, lead_coords, xi_norm):
         ds[k] = per[k]
         ds[f"{k}_true"] = tru[k].assign_attrs(
             units=MEASURE_ATTRS[k]["units"], long_name=MEASURE_ATTRS[k]["long_name"] + " of the true basin")
+    # energy radius of the true basin: largest E with {H0 < E} (inside S0) contained in it, the grid
+    # counterpart of xi_true (compare analytic xi_true with the numeric xi_inscribed_true)
+    Hq = xr.DataArray(H0(*np.meshgrid(q, p, indexing="ij")), dims=("q0", "p0"), coords={"q0": q, "p0": p})
+    s0 = (Hq < xi_norm) & (np.abs(Hq["q0"]) < np.sqrt(1.0 - np.sqrt(1.0 - 4.0 * xi_norm)))
+    bad = s0 & ~da_true
+    ds["xi_inscribed_true"] = Hq.where(bad).min(("q0", "p0")).fillna(xi_norm).assign_attrs(
+        units="1", long_name="largest energy E with {H0 < E} inside the true basin (grid value, one-node accuracy)")
     # containment diagnostic: the true basin lies inside every per-phase basin
     ds["contained"] = (~(da_true & ~da_safe)).all(("q0", "p0")).all("Psi").assign_attrs(
         long_name="true basin contained in every per-phase basin", units="1")
@@ -165,7 +172,9 @@ def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fouri
       ``GIM, LIM, IF, r_local, r_global, area, if_q0, if_p0`` over (Psi, ...) and the
       same with suffix ``_true`` (intersection over Psi_values) and ``_continuous``
       (grid values for {H0 < xi_true}); ``GIM_closed``, ``LIM_closed`` (= IF_closed):
-      the closed forms J(xi_true)/J(xi_max) and sqrt(xi_true/xi_max).
+      the closed forms J(xi_true)/J(xi_max) and sqrt(xi_true/xi_max);
+      ``xi_inscribed_true`` (largest energy disk inside ``true_safe``, grid value) and
+      ``contained`` (true basin inside every per-phase basin).
     """
     F = float(V.check_nonnegative("F", F))
     Omega = float(V.check_positive("Omega", Omega))
@@ -186,7 +195,7 @@ def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fouri
     lead_dims = ("fourier", "xi_max")
     lead_coords = {"fourier": fl, "xi_max": xi}
     xi_norm = xr.DataArray(xi, dims="xi_max", coords={"xi_max": xi})
-    ds = _assemble(safe, None, q, p, Psi, lead_dims, lead_coords, xi_norm)
+    ds = _assemble(safe, q, p, Psi, lead_dims, lead_coords, xi_norm)
     da_cont = xr.DataArray(cont, dims=lead_dims + ("q0", "p0"), coords={**lead_coords, "q0": q, "p0": p},
                            attrs={"long_name": "safe basin for every phase Psi in [0, 2 pi): H0 < xi_true",
                                   "units": "1"})
@@ -211,8 +220,9 @@ def true_safe_basin_from_charts(charts, t_eval=None, *, criterion="energy"):
     """Numeric phase-invariant basin from escape charts stacked over ``Psi`` (or a list of charts).
 
     Returns a Dataset with ``safe(Psi, threshold, t_eval, q0, p0)``, ``true_safe(threshold,
-    t_eval, q0, p0)``, integrity of each (``GIM``... over Psi and ``GIM_true``...) and
-    ``contained``.
+    t_eval, q0, p0)``, integrity of each (``GIM``... over Psi and ``GIM_true``...),
+    ``xi_inscribed_true`` (energy radius of the true basin, to compare with the analytic
+    ``xi_true``) and ``contained``.
     """
     chart = stack_charts(charts, "Psi")
     safe, xi_norm = numeric_safe(chart, t_eval, criterion)
@@ -220,7 +230,7 @@ def true_safe_basin_from_charts(charts, t_eval=None, *, criterion="energy"):
     safe = safe.transpose("Psi", thr, "t_eval", "q0", "p0")
     lead_dims = (thr, "t_eval")
     lead_coords = {thr: safe[thr].values, "t_eval": safe["t_eval"].values}
-    ds = _assemble(safe.values, None, safe["q0"].values, safe["p0"].values, safe["Psi"].values,
+    ds = _assemble(safe.values, safe["q0"].values, safe["p0"].values, safe["Psi"].values,
                    lead_dims, lead_coords, xi_norm)
     ds.attrs.update({k: v for k, v in chart.attrs.items() if k in ("F", "Omega", "cycles", "steps_per_cycle",
                                                                        "integrator")})

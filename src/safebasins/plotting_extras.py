@@ -77,7 +77,8 @@ def figure_erosion(analytic=None, numeric=None, *, measures=("GIM", "LIM", "IF")
                     for k, t in enumerate(ts):
                         frac = 0.35 + 0.65 * (k + 1) / len(ts)
                         y = _sel(numeric[m], xi_max=x, t_eval=t)
-                        ax.plot(y["F"], y.values, ls="none", marker="o", ms=4.2, mfc=shade(col, frac),
+                        ms = 6.5 - 3.0 * k / max(len(ts) - 1, 1)  # early t_eval: big and light, late: small and dark
+                        ax.plot(y["F"], y.values, ls="none", marker="o", ms=ms, mfc=shade(col, frac),
                                 mec=shade(col, min(1.0, frac + 0.2)), mew=0.6, zorder=4)
             ax.set_xlabel(LABELS["F"])
             ax.set_title(MEASURE_LABELS.get(m, m))
@@ -114,9 +115,15 @@ def _draw_basin_panel(ax, ds, sel, label):
     q, p = ds["q0"].values, ds["p0"].values
     ext = [q[0], q[-1], p[0], p[-1]]
     n = safe.sizes["Psi"]
-    frac = safe.transpose("Psi", "q0", "p0").values.mean(axis=0)  # fraction of phases for which safe
-    ax.imshow(np.where(frac > 0, frac, np.nan).T, origin="lower", extent=ext, cmap="Greys", vmin=0, vmax=1.6,
-              alpha=0.55, aspect="auto", interpolation="nearest")
+    sv = safe.transpose("Psi", "q0", "p0").values
+    union = sv.any(axis=0)
+    ax.contourf(q, p, union.T.astype(float), levels=[0.5, 1.5], colors=["0.9"], zorder=0)
+    cmap = plt.get_cmap("twilight")
+    psis = np.asarray(safe["Psi"].values, float)
+    for k in range(n):  # each per-phase basin: a faint outline coloured by its phase
+        if sv[k].any() and not sv[k].all():
+            ax.contour(q, p, sv[k].T.astype(float), levels=[0.5], linewidths=0.5, alpha=0.5,
+                       colors=[cmap((psis[k] % (2 * np.pi)) / (2 * np.pi))], zorder=2)
     tv = true.transpose("q0", "p0").values
     ax.contourf(q, p, tv.T.astype(float), levels=[0.5, 1.5], colors=["tab:green"], alpha=0.75)
     ax.contour(q, p, tv.T.astype(float), levels=[0.5], colors=["darkgreen"], linewidths=0.9)
@@ -127,10 +134,10 @@ def _draw_basin_panel(ax, ds, sel, label):
     rl = float(_sel(ds["r_local_true"], **sel))
     rg = float(_sel(ds["r_global_true"], **sel))
     if rl > 0:
-        ax.add_patch(Circle((0, 0), rl, fill=False, ec="tab:red", lw=1.0, ls="--"))
+        ax.add_patch(Circle((0, 0), rl, fill=False, ec="tab:red", lw=1.0, ls="--", zorder=6))
     if rg > 0:
         c = (float(_sel(ds["if_q0_true"], **sel)), float(_sel(ds["if_p0_true"], **sel)))
-        ax.add_patch(Circle(c, rg, fill=False, ec="tab:purple", lw=1.0))
+        ax.add_patch(Circle(c, rg, fill=False, ec="tab:purple", lw=1.0, zorder=6))
     ax.set_title(f"{label}, {n} phases\ntrue basin: GIM = {g['GIM']:.3f}, LIM = {g['LIM']:.3f}, "
                  f"IF = {g['IF']:.3f}", fontsize=8.5)
     ax.set_xlabel(LABELS["q0"])
@@ -139,8 +146,9 @@ def _draw_basin_panel(ax, ds, sel, label):
 
 def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, fourier="paper", title=None,
                       png=None, pdf=None):
-    """Per-phase safe basins (grey, darker = safe for more phases) and the phase-invariant basin
-    (green) with its LIM (red dashed) and IF (purple) disks; analytic and/or numeric panels."""
+    """Per-phase safe basins (faint outlines coloured by Psi, light grey union) and the
+    phase-invariant basin (green) with its LIM (red dashed) and IF (purple) disks; analytic
+    and/or numeric panels."""
     analytic, numeric = open_dataset(analytic), open_dataset(numeric)
     panels = [(d, lab) for d, lab in ((analytic, "analytic"), (numeric, "numeric")) if d is not None]
     if not panels:
@@ -162,7 +170,9 @@ def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, 
                     draw_well(ax, xt, color="darkgreen", ls=":", lw=0.9)
         axes[0, 0].set_ylabel(LABELS["p0"])
         ref = panels[0][0]
-        handles = [Patch(color="0.6", alpha=0.55, label="safe for some phases"),
+        handles = [Patch(color="0.9", label="safe for some phase"),
+                   Line2D([], [], color=plt.get_cmap("twilight")(0.3), lw=0.8,
+                          label=r"per-phase basins (colour: $\Psi$)"),
                    Patch(color="tab:green", alpha=0.75, label="safe for all phases"),
                    Line2D([], [], color="tab:red", ls="--", label="LIM disk"),
                    Line2D([], [], color="tab:purple", label="IF disk")]
