@@ -212,14 +212,22 @@ def figure_fourier(fcr=None, iou=None, *, title=None, png=None, pdf=None):
             k += 1
             markers = "o^vsD<>p"
             j = 0
+            curve_handles = []
             for ds in fcrs:
                 curves = list(range(ds.sizes["curve"])) if "curve" in ds.dims else [None]
                 for c in curves:
                     d = ds.isel(curve=c) if c is not None else ds
+                    mk = markers[j % len(markers)]
                     for f in d["fourier"].values:
                         y = d["rel_error"].sel(fourier=f)
                         ax.plot(d["Omega"], 100 * y.values, color=FOURIER_COLOR[str(f)],
-                                ls=FOURIER_STYLE[str(f)]["ls"], marker=markers[j % len(markers)], ms=3.5, lw=1.0)
+                                ls=FOURIER_STYLE[str(f)]["ls"], marker=mk, ms=3.5, lw=1.0)
+                    par = []
+                    for key, sym in (("xi_max", r"$\xi_{max}$"), ("xi0", r"$\xi_{ini}$"), ("gamma0", r"$\gamma_{ini}$")):
+                        v = d[key] if key in d.coords else d.attrs.get(key)
+                        if v is not None and (key == "xi_max" or float(v) != 0):
+                            par.append(f"{sym}={float(v):g}")
+                    curve_handles.append(Line2D([], [], color="0.3", ls="none", marker=mk, ms=4, label=", ".join(par)))
                     j += 1
             ax.axhline(0, color="0.5", lw=0.6)
             ax.set_xlabel(LABELS["Omega"])
@@ -233,8 +241,8 @@ def figure_fourier(fcr=None, iou=None, *, title=None, png=None, pdf=None):
             ax.text(0.02, 0.98, "\n".join(txt), transform=ax.transAxes, va="top", fontsize=7.5,
                     bbox=dict(fc="white", ec="0.7", alpha=0.85, lw=0.5))
             ax.legend(handles=[Line2D([], [], color=FOURIER_COLOR[f], ls=FOURIER_STYLE[f]["ls"],
-                                      label=FOURIER_STYLE[f]["label"]) for f in ("paper", "exact")],
-                      loc="lower right", fontsize=7)
+                                      label=FOURIER_STYLE[f]["label"]) for f in ("paper", "exact")] + curve_handles,
+                      loc="best", fontsize=7)
             ax.set_title(r"critical forcing $F_{cr}(\Omega)$")
         if ious:
             ax = axes[0, k]
@@ -246,7 +254,7 @@ def figure_fourier(fcr=None, iou=None, *, title=None, png=None, pdf=None):
                 others = [dd for dd in it.dims if dd != "fourier"]
                 shown = [dd for dd in others if it.sizes[dd] > 1]
                 st = it.stack(_pos=others) if others else it.expand_dims(_pos=[0])
-                head = " ".join(f"{abbr[kk]}={float(ds.attrs[kk]):.3g}" for kk in ("Omega", "F")
+                head = " ".join(f"{abbr[kk]}={float(ds.attrs[kk]):.3g}" for kk in ("Omega", "Psi", "F")
                                 if kk in ds.attrs and kk not in others)
                 for i in range(st.sizes["_pos"]):
                     cell = st.isel(_pos=i)
@@ -263,7 +271,7 @@ def figure_fourier(fcr=None, iou=None, *, title=None, png=None, pdf=None):
             ax.set_xticks(x)
             ax.set_xticklabels(labels, rotation=55, ha="right", fontsize=6.5)
             ax.set_ylabel("IoU, analytic vs numeric")
-            ax.legend(loc="lower right", fontsize=7)
+            ax.legend(loc="lower left", fontsize=7, framealpha=1.0)
             ax.set_title("safe basins")
         fig.suptitle(title or "First harmonic: paper's truncated G vs exact", fontsize=10)
         fig.tight_layout()
