@@ -723,7 +723,7 @@ def safe_from_cycles(ec, t_eval):
 def _stack_param(chart, param, criterion="energy"):
     """-> (values, list of safe-mask DataArrays over (q0, p0)), following the parameter."""
     ec = escape_cycles(chart, criterion)
-    t_eval = _attr(chart, "t_eval", "cycles")
+    t_eval = _attr(chart, "t_eval", "agreement_t_eval", "cycles")
     if t_eval is None:
         t_eval = np.inf
     vals = np.atleast_1d(np.asarray(chart[param], float)) if param in chart.coords else np.array([np.nan])
