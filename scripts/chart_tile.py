@@ -36,7 +36,7 @@ print(f"{p['experiment']} task {k} tile {tile}/{tiles}: F={task['F']} Omega={p['
       flush=True)
 ds, _ = call_api(numerics.escape_chart, q0, p0, task["F"], p["Omega"], p["Psi"], xi_max=tuple(task["xi_max"]),
                  q_max=tuple(task["q_max"]), cycles=p["cycles"], steps_per_cycle=p["steps_per_cycle"],
-                 threads=snakemake.threads)
+                 threads=snakemake.threads, grid=p["kind"] != "criteria")
 if p["kind"] == "criteria":
     ds = ds.assign_coords(sample=np.arange(sl.start, sl.stop))
 ds.attrs.update(task=k, tile=tile, tiles=tiles)

@@ -5,8 +5,8 @@ Every file the pipeline writes goes through :func:`finalize` and :func:`write_ne
 * :func:`annotate` fills ``units`` / ``long_name`` of coordinates and variables from one table;
 * :func:`finalize` adds the CF globals (``Conventions``, ``title``, ``source``, ``history``,
   ``references``, ``institution``, ``date_created``) and provenance (``safebasins_version``,
-  ``git_commit``, ``config_hash``, ``parameters`` as JSON, ``integrator``, ``steps_per_cycle``,
-  ``seeds`` when the parameters have them);
+  ``git_commit``, ``config_hash``, ``parameters`` as JSON, ``seeds`` when the parameters have
+  them; numeric datasets carry ``integrator`` and ``steps_per_cycle`` from safebasins.numerics);
 * :func:`write_netcdf` writes netCDF4 with zlib compression to a temporary file in the target
   directory and renames it over the target (atomic: a killed job never leaves a half file).
 
@@ -179,9 +179,6 @@ def finalize(ds: xr.Dataset, *, title: str, params: dict | None = None, config_h
         attrs["experiment"] = params["experiment"]
     if "fourier" in params:
         attrs.setdefault("fourier", params["fourier"])
-    spc = params.get("steps_per_cycle")
-    if spc is not None:
-        attrs.setdefault("steps_per_cycle", int(spc))
     seeds = _collect_seeds(params)
     if seeds:
         attrs["seeds"] = np.asarray(seeds, dtype=np.int64)
