@@ -860,9 +860,18 @@ def figure_period_map(analytic, numeric, *, title=None, figsize=(7.6, 6.4), s=0.
             qi, pi_ = qi[:max_points], pi_[:max_points]
         ax.scatter(qi, pi_, s=s, color=cmap(i % 20), marker=".", linewidths=0, rasterized=True)
     xi_max = _attr(basin, "xi_max", default=_attr(strobe, "xi_max"))
-    draw_boundaries(ax, basin, "q0", "p0", color="k", ls="--", lw=1.6)
+    blines = draw_boundaries(ax, basin, "q0", "p0", color="k", ls="--", lw=1.6)
     if xi_max is not None:
         draw_well(ax, float(xi_max), color="0.5", lw=0.8, ls=":")
+    # frame the portrait and the predicted boundary (not the whole, mostly empty, well)
+    xs = [q[np.isfinite(q)]] + [np.asarray(b.get_xdata(), float) for b in blines]
+    ys = [p[np.isfinite(p)]] + [np.asarray(b.get_ydata(), float) for b in blines]
+    xs, ys = np.concatenate(xs), np.concatenate(ys)
+    xs, ys = xs[np.isfinite(xs)], ys[np.isfinite(ys)]
+    if xs.size and ys.size:
+        pad = 0.08 * max(np.ptp(xs), np.ptp(ys), 0.1)
+        ax.set_xlim(xs.min() - pad, xs.max() + pad)
+        ax.set_ylim(ys.min() - pad, ys.max() + pad)
     ax.set_aspect("equal")
     ax.set_xlabel(LABELS["q"] + r" at $t = nT$")
     ax.set_ylabel(LABELS["p"] + r" at $t = nT$")
@@ -871,7 +880,7 @@ def figure_period_map(analytic, numeric, *, title=None, figsize=(7.6, 6.4), s=0.
                label=f"{n} non-escaping trajectories ({strobe.sizes.get('iteration', '?')} iterations)"),
         Line2D([], [], color="k", ls="--", lw=1.6, label="theory: SB boundary"),
         Line2D([], [], color="0.5", ls=":", lw=0.8, label=r"well edge $H_0 = \xi_{max}$")],
-        loc="lower right", fontsize=7.5)
+        loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=3, fontsize=8, frameon=False)
     params = {k: _attr(strobe, k, default=_attr(basin, k)) for k in ("F", "Omega", "Psi", "xi_max")}
     seed = _attr(strobe, "seed")
     ax.set_title(title or (r"Period map $(q,p)(t) \mapsto (q,p)(t+2\pi/\Omega)$" + "\n" +
