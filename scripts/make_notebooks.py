@@ -3,6 +3,8 @@
 
     .venv/bin/python scripts/make_notebooks.py            # (re)write notebooks/ and workflow/report/
     .venv/bin/python scripts/make_notebooks.py --check    # exit 1 if any file is out of date
+    .venv/bin/python scripts/make_notebooks.py --gallery results/figures
+                                   # also write small copies of the built PNGs to docs/figures/
 
 Source of truth: ``safebasins.plotting.catalog.FIGURES`` (datasets, options, captions) and
 ``safebasins.plotting.core`` (the drawing).  Every notebook is: a title cell, a ``parameters``
@@ -84,10 +86,36 @@ def outputs():
         yield ROOT / "workflow" / "report" / f"fig{nn}.rst", build_caption(nn)
 
 
+def write_gallery(src: Path, width: int = 800):
+    """docs/figures/figNN.png: downscaled copies of the pipeline's PNGs (+ an index)."""
+    from PIL import Image
+
+    out = ROOT / "docs" / "figures"
+    out.mkdir(parents=True, exist_ok=True)
+    lines = ["# Figure gallery", "",
+             f"Downscaled ({width} px wide) copies of `results/figures/figNN.png` as built by "
+             "`snakemake figures`; regenerate with `scripts/make_notebooks.py --gallery results/figures`.", ""]
+    for nn, f in FIGURES.items():
+        png = src / f"fig{nn}.png"
+        if not png.exists():
+            print(f"gallery: missing {png}")
+            continue
+        im = Image.open(png).convert("RGB")
+        h = round(im.height * width / im.width)
+        im.resize((width, h), Image.LANCZOS).quantize(colors=128).save(out / f"fig{nn}.png", optimize=True)
+        lines += [f"## Figure {int(nn)}", "", f"{f['paper']}", "", f"![fig{nn}](fig{nn}.png)", ""]
+    (out / "README.md").write_text("\n".join(lines))
+    print(f"gallery written to {out.relative_to(ROOT)}")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--check", action="store_true", help="only report files that differ")
+    ap.add_argument("--gallery", type=Path, metavar="FIGURE_DIR",
+                    help="also write downscaled PNGs from FIGURE_DIR to docs/figures/")
     args = ap.parse_args(argv)
+    if args.gallery:
+        write_gallery(args.gallery)
     stale = []
     for path, text in outputs():
         if path.exists() and path.read_text() == text:
