@@ -246,3 +246,14 @@ def test_fmt_and_vertex_names():
 def test_break_wraps():
     x, y = core._break_wraps([3.0, 3.1, -3.1, -3.0], [0, 1, 2, 3])
     assert np.isnan(x[2]) and x.size == 5
+
+
+def test_interior_curves_are_not_drawn_as_boundaries():
+    q0 = np.linspace(-1, 1, 41)
+    p0 = np.linspace(-1, 1, 41)
+    Q, P = np.meshgrid(q0, p0, indexing="ij")
+    safe = xr.DataArray(np.hypot(Q, P) < 0.6, dims=("q0", "p0"), coords=dict(q0=q0, p0=p0))
+    t = np.linspace(0, 2 * np.pi, 80)
+    assert core.separates_mask(0.6 * np.cos(t), 0.6 * np.sin(t), safe)       # the edge
+    assert not core.separates_mask(0.3 * np.cos(t), 0.3 * np.sin(t), safe)   # inside the basin
+    assert not core.separates_mask(0.9 * np.cos(t), 0.9 * np.sin(t), safe)   # in the escape region

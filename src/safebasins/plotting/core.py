@@ -550,15 +550,48 @@ def _boundary_polylines(ds, xname, yname):
     return out
 
 
-def draw_boundaries(ax, ds, xname, yname, *, periodic=False, **kw):
+def separates_mask(xs, ys, safe, *, halo=2, min_fraction=0.5):
+    """True if the polyline (xs, ys) runs along the edge of the boolean DataArray ``safe``
+    (dims q0, p0): at least ``min_fraction`` of its vertices have both safe and escaping
+    pixels within ``halo`` pixels.  Level curves of C through a saddle can lie entirely
+    inside the predicted basin (e.g. a saddle-type region contained in a peninsula): they are
+    not boundaries of the safe basin and are not drawn on the IC plane."""
+    q = np.asarray(safe["q0"], float)
+    p = np.asarray(safe["p0"], float)
+    S = np.asarray(safe.transpose("q0", "p0")).astype(bool)
+    ok = np.isfinite(xs) & np.isfinite(ys)
+    if not ok.any():
+        return False
+    i = np.clip(np.searchsorted(q, xs[ok]), 0, q.size - 1)
+    j = np.clip(np.searchsorted(p, ys[ok]), 0, p.size - 1)
+    edge = np.zeros(i.size, bool)
+    for k, (a, b) in enumerate(zip(i, j)):
+        win = S[max(a - halo, 0):a + halo + 1, max(b - halo, 0):b + halo + 1]
+        edge[k] = win.any() and not win.all()
+    return edge.mean() >= min_fraction
+
+
+def draw_boundaries(ax, ds, xname, yname, *, periodic=False, safe=None, **kw):
+    """Boundary polylines of a safe_basin_boundaries dataset.  With ``safe`` (the analytic
+    safe mask on (q0, p0)), curves that do not border it are skipped (:func:`separates_mask`)."""
     style = dict(color=SB_EDGE, lw=1.8, zorder=6)
     style.update(kw)
     lines = []
     for xs, ys, _kind in _boundary_polylines(ds, xname, yname):
+        if safe is not None and not separates_mask(xs, ys, safe):
+            continue
         if periodic:
             xs, ys = _break_wraps(xs, ys)
         lines += ax.plot(xs, ys, **style)
     return lines
+
+
+def analytic_safe(ds):
+    """Analytic safe mask ``~escapes`` over (q0, p0) of one basin slice, or None."""
+    esc = _var(ds, "escapes", required=False) if ds is not None else None
+    if esc is None or "q0" not in esc.dims or "p0" not in esc.dims or esc.ndim != 2:
+        return None
+    return ~esc.astype(bool)
 
 
 def _safe_fill(ax, x, y, safe, *, color=SB_FACE, zorder=1, alpha=1.0):
@@ -784,9 +817,10 @@ def _agreement(chart, name, param, i):
 
 
 def figure_nested_basins(analytic, numeric, *, param="xi_max", title=None, t_eval=None,
-                         figsize=(9.6, 5.6), theory_colors=None):
+                         figsize=(9.6, 5.6), theory_colors=None, boundary_only=True):
     """Figs 13-17: numeric safe basins shaded by ``param`` (lighter regions include darker
-    ones, white = escape for every value), theory boundaries as curves, IoU in the legend."""
+    ones, white = escape for every value), theory boundaries as curves, IoU in the legend.
+    ``boundary_only``: draw only the theory curves that border the analytic safe mask."""
     chart = open_dataset(numeric)
     basins = open_dataset(analytic)
     if t_eval is not None:
@@ -803,7 +837,8 @@ def figure_nested_basins(analytic, numeric, *, param="xi_max", title=None, t_eva
         col = colors[i % len(colors)]
         ls = LINE_STYLES[i % len(LINE_STYLES)]
         if theory[i] is not None:
-            draw_boundaries(ax, theory[i], "q0", "p0", color=col, ls=ls, lw=1.6)
+            draw_boundaries(ax, theory[i], "q0", "p0", color=col, ls=ls, lw=1.6,
+                            safe=analytic_safe(theory[i]) if boundary_only else None)
         iou = _agreement(chart, "iou", param, i)
         lab = f"{SYMBOLS[param]} = {fmt_value(vals[i])}"
         if iou is not None and np.isfinite(iou):
@@ -860,7 +895,8 @@ def figure_period_map(analytic, numeric, *, title=None, figsize=(7.6, 6.4), s=0.
             qi, pi_ = qi[:max_points], pi_[:max_points]
         ax.scatter(qi, pi_, s=s, color=cmap(i % 20), marker=".", linewidths=0, rasterized=True)
     xi_max = _attr(basin, "xi_max", default=_attr(strobe, "xi_max"))
-    blines = draw_boundaries(ax, basin, "q0", "p0", color="k", ls="--", lw=1.6)
+    blines = draw_boundaries(ax, basin, "q0", "p0", color="k", ls="--", lw=1.6,
+                             safe=analytic_safe(basin))
     if xi_max is not None:
         draw_well(ax, float(xi_max), color="0.5", lw=0.8, ls=":")
     # frame the portrait and the predicted boundary (not the whole, mostly empty, well)
