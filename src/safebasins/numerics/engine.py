@@ -90,7 +90,9 @@ def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), cycles, st
         coef = np.ascontiguousarray(K.lane_coefficients(Omega, steps_per_cycle))
         sintab = K.sine_table(steps_per_cycle, Psi)
         with thread_count(threads) as nthreads:
-            n_tasks = max(1, min(math.ceil(N / LANES), 16 * nthreads))
+            # one task per thread: trajectories are interleaved over tasks (i % n_tasks), so each
+            # task gets a statistically equal share of long-lived ones and its lanes stay full
+            n_tasks = max(1, min(math.ceil(N / LANES), nthreads))
             K.ensemble(q0, p0, pidx, coef, K.step_sizes(Omega, steps_per_cycle), np.ascontiguousarray(F), sintab,
                        np.ascontiguousarray(2.0 * xi[oE_sorted]), np.ascontiguousarray(qm[oQ_sorted]),
                        int(cycles), bool(stop_any), int(n_tasks), LANES, outE, outQ, st, bool(store))
