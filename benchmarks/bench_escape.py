@@ -179,6 +179,19 @@ def benchmark(args):
     frac_early = float(np.mean(eE <= 10))
     rows.append((f"engine, 100x100 chart ({100 * np.mean(np.isfinite(eE)):.1f}% escape, "
                  f"{100 * frac_early:.1f}% within 10 cycles)", steps_chart, tchart))
+    # the same chart, kernel only (no argument checks / meshgrid / xarray)
+    tker, _ = best_time(lambda: E.run_ensemble(Q, P, np.zeros(Q.size, np.int64), [c["Omega"]], [c["F"]], c["Psi"],
+                                               xi_max=(c["xi_max"],), cycles=c["cycles"], steps_per_cycle=S),
+                        args.repeat)
+    rows.append(("  same chart, engine kernel only (run_ensemble)", steps_chart, tker))
+    # 300x300 chart of Fig 21 at 3000 cycles (the paper-scale job)
+    if args.big:
+        qb = np.linspace(-1, 1, 300)
+        tbig, cb = best_time(lambda: escape_chart(qb, qb, c["F"], c["Omega"], c["Psi"], xi_max=c["xi_max"],
+                                                  q_max=1.0, cycles=3000, steps_per_cycle=S), 1)
+        eb = cb["escape_cycle_displacement"].values[0].ravel()
+        rows.append((f"engine, 300x300 chart, 3000 cycles, xi_max=0.25 & q_max=1 "
+                     f"({100 * np.mean(np.isinf(eb)):.1f}% safe)", engine_steps(eb, S, 3000), tbig))
 
     # (b) numpy RK4, vectorised across trajectories, same chart
     S_rk4 = args.rk4_steps
@@ -282,6 +295,7 @@ def main(argv=None):
     ap.add_argument("--dop-subset", type=int, default=100)
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--ghz", type=float, default=2.6, help="core clock for the ceiling estimate")
+    ap.add_argument("--big", action="store_true", help="also the 300x300, 3000-cycle chart")
     args = ap.parse_args(argv)
     if args.study:
         study(args)
