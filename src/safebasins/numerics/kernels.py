@@ -57,6 +57,8 @@ N_KICKS = 7
 Q_BARRIER = 1.0
 # smallest lane segment of the 4-chain vector loop (lanes run: 4 * segment)
 MIN_SEGMENT = 16
+# segments per period for the crossing replay (a crossing is replayed over S / SEGMENTS steps)
+SEGMENTS = 4
 
 
 @intrinsic
@@ -150,14 +152,15 @@ def _finished(iE, iQ, nE, nQ, stop_any):
 
 
 @njit(cache=True)
-def _replay(i, q, p, period, sintab, c, F, thrE2, thrQ, iE, iQ, outE, outQ, stop_any):
-    """Scalar replay of one period from its start state (same arithmetic as the vector
-    loop); records the step of first crossing of every threshold crossed in the period."""
+def _replay(i, q, p, period, s0, s1, sintab, c, F, thrE2, thrQ, iE, iQ, outE, outQ, stop_any):
+    """Scalar replay of steps [s0, s1) of a period from the state before step s0 (same
+    arithmetic as the vector loop); records the step of first crossing of every threshold
+    crossed there."""
     S = sintab.shape[0]
     nE = thrE2.shape[0]
     nQ = thrQ.shape[0]
     base = period * S
-    for s in range(S):
+    for s in range(s0, s1):
         q, p = bm6_step(q, p, c[0], c[1], c[2], c[3], c[4], c[5], c[6],
                         F * sintab[s, 0], F * sintab[s, 1], F * sintab[s, 2], F * sintab[s, 3],
                         F * sintab[s, 4], F * sintab[s, 5], F * sintab[s, 6])
@@ -168,8 +171,9 @@ def _replay(i, q, p, period, sintab, c, F, thrE2, thrQ, iE, iQ, outE, outQ, stop
 
 
 @njit(cache=True)
-def _period_shared(M, Q, P, ME, MQ, c, FS):
-    """One forcing period for lanes [0, 4M), all sharing one parameter set.
+def _period_shared(M, Q, P, ME, MQ, c, FS, s0, s1):
+    """Steps [s0, s1) of the forcing period for lanes [0, 4M), all sharing one parameter set;
+    ME, MQ = max 2*H0 and max |q| over these steps.
 
     The lane loop (j) vectorises; its body advances 4 independent lanes j, M+j, 2M+j, 3M+j
     so that 4 dependency chains are in flight (the step is latency bound otherwise).
@@ -178,7 +182,7 @@ def _period_shared(M, Q, P, ME, MQ, c, FS):
     for l in range(4 * M):
         ME[l] = -np.inf
         MQ[l] = -np.inf
-    for s in range(FS.shape[0]):
+    for s in range(s0, s1):
         f1 = FS[s, 0]; f2 = FS[s, 1]; f3 = FS[s, 2]; f4 = FS[s, 3]
         f5 = FS[s, 4]; f6 = FS[s, 5]; f7 = FS[s, 6]
         for j in range(M):
@@ -229,7 +233,7 @@ def _period_shared(M, Q, P, ME, MQ, c, FS):
 
 
 @njit(cache=True)
-def _period_lanes(M, Q, P, ME, MQ, HL, FL, sintab):
+def _period_lanes(M, Q, P, ME, MQ, HL, FL, sintab, s0, s1):
     """As _period_shared for lanes [0, 4M) with per-lane parameters: step h = HL[l] and
     amplitude F = FL[l].  The coefficients h*a_k, h*b_k and forcing values F*sin_k are formed
     in the loop: the same IEEE products as the precomputed ones of the shared path, so both
@@ -240,14 +244,14 @@ def _period_lanes(M, Q, P, ME, MQ, HL, FL, sintab):
     for l in range(n):
         ME[l] = -np.inf
         MQ[l] = -np.inf
-    for s in range(sintab.shape[0]):
-        s1 = sintab[s, 0]; s2 = sintab[s, 1]; s3 = sintab[s, 2]; s4 = sintab[s, 3]
-        s5 = sintab[s, 4]; s6 = sintab[s, 5]; s7 = sintab[s, 6]
+    for s in range(s0, s1):
+        t1 = sintab[s, 0]; t2 = sintab[s, 1]; t3 = sintab[s, 2]; t4 = sintab[s, 3]
+        t5 = sintab[s, 4]; t6 = sintab[s, 5]; t7 = sintab[s, 6]
         for l in range(n):
             h = HL[l]
             F = FL[l]
             q, p = bm6_step(Q[l], P[l], h * A1, h * A2, h * A3, h * B1, h * B2, h * B3, h * B4,
-                            F * s1, F * s2, F * s3, F * s4, F * s5, F * s6, F * s7)
+                            F * t1, F * t2, F * t3, F * t4, F * t5, F * t6, F * t7)
             Q[l] = q
             P[l] = p
             e = energy2(q, p)
@@ -272,8 +276,16 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
     P = np.zeros(Lmem)
     ME = np.empty(Lmem)
     MQ = np.empty(Lmem)
-    QS = np.empty(L)
-    PS = np.empty(L)
+    # the period is run in G segments; snapshots of (q, p) before each segment and the
+    # segment maxima let a crossing be replayed over one segment only
+    G = SEGMENTS if S >= 4 * SEGMENTS else 1
+    seg = np.empty(G + 1, np.int64)
+    for g in range(G + 1):
+        seg[g] = g * S // G
+    SQ = np.zeros((G, Lmem))
+    SP = np.zeros((G, Lmem))
+    SME = np.empty((G, Lmem))
+    SMQ = np.empty((G, Lmem))
     traj = np.empty(L, np.int64)
     per = np.empty(L, np.int64)
     lE = np.empty(L, np.int64)
@@ -306,7 +318,7 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
                 if _finished(iE, iQ, nE, nQ, stop_any) or cycles == 0:
                     continue
                 k = pidx[i]
-                Q[l] = q0[i]; P[l] = p0[i]; QS[l] = q0[i]; PS[l] = p0[i]
+                Q[l] = q0[i]; P[l] = p0[i]
                 HL[l] = hpar[k]
                 FL[l] = Fpar[k]
                 traj[l] = i; per[l] = 0; lE[l] = iE; lQ[l] = iQ
@@ -327,7 +339,7 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
             # queue empty: move the last active lane into the hole
             last = nact - 1
             if last != l:
-                Q[l] = Q[last]; P[l] = P[last]; QS[l] = QS[last]; PS[l] = PS[last]
+                Q[l] = Q[last]; P[l] = P[last]
                 HL[l] = HL[last]
                 FL[l] = FL[last]
                 traj[l] = traj[last]; per[l] = per[last]; lE[l] = lE[last]; lQ[l] = lQ[last]
@@ -341,33 +353,41 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
         for l in range(nact, 4 * M):
             Q[l] = 0.0
             P[l] = 0.0
-        if shared:
-            _period_shared(M, Q, P, ME, MQ, coef[0], FS)
-        else:
-            _period_lanes(M, Q, P, ME, MQ, HL, FL, sintab)
+        for g in range(G):
+            for l in range(nact):
+                SQ[g, l] = Q[l]
+                SP[g, l] = P[l]
+            if shared:
+                _period_shared(M, Q, P, ME, MQ, coef[0], FS, seg[g], seg[g + 1])
+            else:
+                _period_lanes(M, Q, P, ME, MQ, HL, FL, sintab, seg[g], seg[g + 1])
+            for l in range(nact):
+                SME[g, l] = ME[l]
+                SMQ[g, l] = MQ[l]
         # ---------------------------------------------------- period boundary
         for l in range(nact):
             i = traj[l]
             iE = lE[l]
             iQ = lQ[l]
-            if ME[l] > tE[l] or MQ[l] > tQ[l]:
-                k = pidx[i]
-                iE, iQ = _replay(i, QS[l], PS[l], per[l], sintab, coef[k], Fpar[k], thrE2, thrQ,
-                                 iE, iQ, outE, outQ, stop_any)
-                lE[l] = iE
-                lQ[l] = iQ
-                tE[l] = thrE2[iE] if iE < nE else inf
-                tQ[l] = thrQ[iQ] if iQ < nQ else inf
-                if iE < nE:
-                    tQ[l] = min(tQ[l], Q_BARRIER)
+            for g in range(G):
+                if SME[g, l] > tE[l] or SMQ[g, l] > tQ[l]:
+                    k = pidx[i]
+                    iE, iQ = _replay(i, SQ[g, l], SP[g, l], per[l], seg[g], seg[g + 1], sintab, coef[k],
+                                     Fpar[k], thrE2, thrQ, iE, iQ, outE, outQ, stop_any)
+                    lE[l] = iE
+                    lQ[l] = iQ
+                    tE[l] = thrE2[iE] if iE < nE else inf
+                    tQ[l] = thrQ[iQ] if iQ < nQ else inf
+                    if iE < nE:
+                        tQ[l] = min(tQ[l], Q_BARRIER)
+                    if _finished(iE, iQ, nE, nQ, stop_any):
+                        break
             per[l] += 1
             fin = _finished(iE, iQ, nE, nQ, stop_any)
             if do_store and not fin and iE == 0 and iQ == 0:
                 store[i, per[l], 0] = Q[l]
                 store[i, per[l], 1] = P[l]
             done[l] = fin or per[l] >= cycles
-            QS[l] = Q[l]
-            PS[l] = P[l]
 
 
 @njit(cache=True, parallel=True)
