@@ -19,7 +19,8 @@ cycles = p["cycles"]
 numeric_safe = chart["escape_cycle_energy"] > cycles
 if p["scan"] == "F":
     numeric_safe = numeric_safe.isel(xi_max=0, drop=True)
-analytic_safe = ~basin["escapes"].astype(bool)
+analytic_safe = ~basin["escapes"].astype(bool).reset_coords(drop=True)  # no saddle_* coords in the chart
+numeric_safe = numeric_safe.reset_coords(drop=True)
 for ax in ("q0", "p0"):
     a, n = np.asarray(analytic_safe[ax].values), np.asarray(numeric_safe[ax].values)
     if a.shape != n.shape or not np.allclose(a, n, rtol=0, atol=1e-12):

@@ -48,7 +48,9 @@ elif kind == "basin_chart":
     values = p[scan]
     parts = [one_basin(v if scan == "F" else p["F"], p["Omega"], p["Psi"], v if scan == "xi_max" else p["xi_max"])
              for v in values]
-    out = stack(parts, scan, values)
+    # per-basin saddle point: always a coordinate along the scanned dimension
+    saddle = {k: [float(b.attrs.get(k, np.nan)) for b in parts] for k in ("saddle_gamma", "saddle_xi")}
+    out = stack(parts, scan, values, coords=saddle)
     out.attrs["scan"] = scan
 else:
     raise ValueError(f"analytic_basin: unexpected kind {kind!r}")

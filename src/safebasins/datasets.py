@@ -279,7 +279,10 @@ def pad_dim(ds: xr.Dataset, dim: str, n: int) -> xr.Dataset:
 
 def _same(a, b):
     try:
-        return np.array_equal(np.asarray(a), np.asarray(b))
+        a, b = np.asarray(a), np.asarray(b)
+        if a.dtype.kind in "fc" and b.dtype.kind in "fc":
+            return np.array_equal(a, b, equal_nan=True)
+        return np.array_equal(a, b)
     except Exception:
         return a == b
 
