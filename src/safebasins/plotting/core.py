@@ -1010,19 +1010,23 @@ def _t_evals(chart, params, t_evals, default):
     return list(default)
 
 
-def figure_dsb_esb(numeric, params=None, *, t_evals=None, title=None, figsize=(11.5, 5.6)):
+def figure_dsb_esb(numeric, params=None, *, t_evals=None, title=None, figsize=None):
     """Figs 20-21: DSB grey / ESB black at the first (left) and last (right) t_eval."""
     chart = open_dataset(numeric)
     cycles = float(_attr(chart, "cycles", default=11000))
     t_evals = _t_evals(chart, params, t_evals, (min(500.0, cycles), cycles))
+    if figsize is None:  # panels follow the window's aspect ratio (equal axes)
+        aspect = np.ptp(np.asarray(chart["p0"], float)) / max(np.ptp(np.asarray(chart["q0"], float)), 1e-12)
+        w = 5.6
+        figsize = (w * len(t_evals) + 0.6, min(w * aspect, 7.5) + 1.5)
     fig, axes = plt.subplots(1, len(t_evals), figsize=figsize, layout="constrained", squeeze=False)
     for ax, t in zip(axes[0], t_evals):
         draw_dsb_esb(ax, chart, t)
     xi, qm = chart_thresholds(chart)
-    axes[0][-1].legend(handles=[
-        Patch(facecolor="0.62", label=f"DSB ($q_{{max}}$ = {fmt_value(qm)})"),
-        Patch(facecolor="k", label=rf"ESB ($\xi_{{max}}$ = {fmt_value(xi)})")],
-        loc="lower right", fontsize=8, framealpha=1)
+    fig.legend(handles=[
+        Patch(facecolor="0.62", label=f"DSB: displacement criterion, $q_{{max}}$ = {fmt_value(qm)}"),
+        Patch(facecolor="k", label=rf"ESB: energy criterion, $\xi_{{max}}$ = {fmt_value(xi)}")],
+        loc="outside lower center", ncol=2, fontsize=9, frameon=False)
     params = {k: _attr(chart, k) for k in ("F", "Omega", "Psi")}
     params["xi_max"] = xi
     res = f"{chart.sizes.get('q0', '?')}x{chart.sizes.get('p0', '?')}"
