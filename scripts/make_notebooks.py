@@ -94,7 +94,16 @@ def write_gallery(src: Path, width: int = 800):
     out.mkdir(parents=True, exist_ok=True)
     lines = ["# Figure gallery", "",
              f"Downscaled ({width} px wide) copies of `results/figures/figNN.png` as built by "
-             "`snakemake figures`; regenerate with `scripts/make_notebooks.py --gallery results/figures`.", ""]
+             "`snakemake figures` at paper resolution (config/config.yaml).", "",
+             "How the figures are made:", "",
+             "- drawing: `src/safebasins/plotting/core.py` (shared pieces + one builder per figure family);",
+             "- figure table (datasets, options, paper caption, what to look for): "
+             "`src/safebasins/plotting/catalog.py`;",
+             "- `.venv/bin/python scripts/make_notebooks.py` regenerates `notebooks/figNN_<slug>.ipynb` and the "
+             "report captions `workflow/report/figNN.rst` from the table (`--check` verifies they are current);",
+             "- `snakemake results/figures/figNN.png` runs one notebook with papermill (`-k python3`) and keeps "
+             "the executed copy in `results/notebooks/`; `snakemake figures` builds all 22;",
+             "- `scripts/make_notebooks.py --gallery results/figures` refreshes this page.", ""]
     for nn, f in FIGURES.items():
         png = src / f"fig{nn}.png"
         if not png.exists():
