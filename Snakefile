@@ -2,7 +2,7 @@
 # Karmi, Kravetc & Gendelman, "Analytic exploration of safe basins in a benchmark problem of
 # forced escape", from config/config.yaml.
 #
-#   snakemake -j2                                        # all datasets + figures into results/
+#   snakemake -j2                                        # all datasets, archive, figures into results/
 #   snakemake -j2 --configfile config/quick.yaml         # the same DAG at coarse resolution
 #   snakemake -j2 archive                                # results/archive/*.tar.gz
 #   snakemake --report results/report.html               # HTML report
@@ -28,11 +28,12 @@ include: "workflow/rules/archive.smk"
 
 
 rule all:
-    """Every dataset behind the paper's 22 figures, the figures and the extra products."""
+    """Every dataset behind the paper's 22 figures, their archive, the figures and the extra products."""
     default_target: True
     input:
         PARAM_FILES,
         DATASETS,
+        ARCHIVE,
         FIGURE_TARGETS,
         EXTRA_TARGETS,
 

@@ -2,13 +2,16 @@
 #   snakemake -j2 archive   ->   results/archive/safebasins-results.tar.gz
 
 
+ARCHIVE = "results/archive/safebasins-results.tar.gz"
+
+
 rule archive:
     input:
         datasets=DATASETS,
         params=PARAM_FILES,
         lock="environment.lock",
     output:
-        "results/archive/safebasins-results.tar.gz",
+        ARCHIVE,
     params:
         config=lambda wildcards: json.dumps(config, sort_keys=True),
     log:
