@@ -3,10 +3,8 @@
 Figs 13-15: one chart (thresholds `xi_max`); Figs 16-17: charts stacked over `F`;
 Figs 20-21: one chart with `xi_max` and `q_max` thresholds (+ attribute `t_eval`).
 """
-import xarray as xr
-
 from safebasins.config import load_params, params_hash, redirect_output
-from safebasins.datasets import finalize, load, stack, write_netcdf
+from safebasins.datasets import finalize, stack, task_charts, write_netcdf
 
 redirect_output(snakemake.log[0])
 p = load_params(snakemake.input.params)
@@ -14,18 +12,7 @@ files = list(snakemake.input.tiles)
 ntasks = len(p["tasks"])
 per_task = len(files) // ntasks
 
-
-def gather(paths):
-    parts = [load(f) for f in paths]
-    dim = "sample" if "sample" in parts[0].dims else "q0"
-    ds = xr.concat(parts, dim=dim, data_vars="minimal", coords="minimal", compat="override",
-                   join="exact" if dim == "sample" else "outer", combine_attrs="override")
-    for k in ("task", "tile", "tiles"):
-        ds.attrs.pop(k, None)
-    return ds
-
-
-charts = [gather(files[i * per_task:(i + 1) * per_task]) for i in range(ntasks)]
+charts = task_charts(files, ntasks)
 if p["kind"] == "basin_chart" and p["scan"] == "F":
     out = stack(charts, "F", [t["F"] for t in p["tasks"]], pad=())
     out.attrs["scan"] = "F"

@@ -33,7 +33,7 @@ def resolved_quick():
 
 
 RES = resolved_quick()
-DATASETS = [f for e, p in RES.items() for f in sbc.dataset_files(e, p["kind"])]
+DATASETS = [f for e, p in RES.items() for f in sbc.dataset_files(e, p["kind"], params=p)]
 # small subset used for the determinism checks (numeric chart + agreement, bisection, random ICs)
 SUBSET = ["results/data/numeric/chart_fig13.nc", "results/data/numeric/fcr_fig10.nc",
           "results/data/numeric/criteria_fig19.nc", "results/data/numeric/chart_fig16.nc"]

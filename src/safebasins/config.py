@@ -69,6 +69,17 @@ TITLES = {
     "fig22": "Safe-basin area versus evaluation time (read from the Fig 21 chart)",
 }
 
+#: beyond-the-paper experiments (config block `extras:`), resolved like the figures into
+#: results/params/extra_<name>.yaml; config key -> experiment name
+EXTRA_KEYS = {"erosion": "extra_erosion", "true_basin": "extra_true_basin", "fourier_compare": "extra_fourier"}
+EXTRAS = tuple(EXTRA_KEYS.values())
+KINDS.update({"extra_erosion": "erosion", "extra_true_basin": "true_basin", "extra_fourier": "fourier_compare"})
+TITLES.update({
+    "extra_erosion": "Erosion profiles: GIM, LIM and IF versus F, analytic (paper and exact G) and numeric",
+    "extra_true_basin": "Phase-invariant (true) safe basin: intersection over the forcing phase Psi",
+    "extra_fourier": "First harmonic of the slow flow: paper's G (eq 20) versus the exact one, against the numerics",
+})
+
 # seeds: config `seed` plus a fixed per-experiment offset, so experiments never share streams
 SEED_OFFSET = {"fig18": 18_000, "fig19": 19_000}
 
@@ -215,7 +226,54 @@ def _angle(v):
     return float(v)
 
 
+def _check_extras(config):
+    ext = config.get("extras") or {}
+    tiles = config.get("numerics", {}).get("tiles", 1)
+    figs = config["figures"]
+    for key in ("erosion", "true_basin"):
+        blk = ext.get(key)
+        if blk is None:
+            continue
+        base = f"extras.{key}"
+        _check_grid(f"{base}.grid", blk["grid"])
+        n = blk["grid"]["n"]
+        nq = n if isinstance(n, int) else n[0]
+        if tiles > nq:
+            _fail("numerics.tiles", f"{tiles} tiles but {base}.grid has only {nq} q0 rows")
+        for i, x in enumerate(_as_list(blk["xi_max"])):
+            if x >= 0.25:
+                _fail(f"{base}.xi_max" + (f"[{i}]" if isinstance(blk["xi_max"], list) else ""),
+                      f"the analytic criterion needs xi_max < 0.25 (G(1/4) = 0 is degenerate), got {x}")
+        t = _as_list(blk["t_eval"])
+        if max(t) > blk["cycles"]:
+            _fail(f"{base}.t_eval", f"evaluation time {max(t)} beyond the horizon cycles = {blk['cycles']}")
+    blk = ext.get("erosion")
+    if blk is not None and isinstance(blk["F"], dict):
+        _check_range("extras.erosion.F", blk["F"])
+        if blk["F"]["start"] < 0:
+            _fail("extras.erosion.F.start", f"must be >= 0 (a forcing amplitude), got {blk['F']['start']}")
+    blk = ext.get("fourier_compare")
+    if blk is not None:
+        for key, kinds in (("fcr", ("fcr_compare",)), ("iou", ("basin_chart",))):
+            seen = set()
+            for i, name in enumerate(blk[key]):
+                if KINDS.get(name) not in kinds:
+                    _fail(f"extras.fourier_compare.{key}[{i}]",
+                          f"{name!r} has no {'numeric F_cr' if key == 'fcr' else 'escape chart with analytic counterpart'}"
+                          f" dataset (choose among {', '.join(e for e in EXPERIMENTS if KINDS[e] in kinds)})")
+                if name in seen:
+                    _fail(f"extras.fourier_compare.{key}[{i}]", f"{name!r} listed twice")
+                seen.add(name)
+            if key == "iou" and blk.get("t_eval") is not None:
+                for name in blk[key]:
+                    hor = figs.get(name, {}).get("cycles", 3000)
+                    if blk["t_eval"] > hor:
+                        _fail("extras.fourier_compare.t_eval",
+                              f"{blk['t_eval']} is beyond the horizon of {name} (cycles = {hor})")
+
+
 def _semantic_checks(config):
+    _check_extras(config)
     figs = config["figures"]
     tiles = config.get("numerics", {}).get("tiles", 1)
     for name, blk in figs.items():
@@ -408,6 +466,41 @@ def resolve(config: dict) -> dict[str, dict]:
         elif kind == "area_time":
             p.update(source=blk["source"], t_eval=range_values(blk["t_eval"]))
         out[name] = p
+    out.update(resolve_extras(config))
+    return out
+
+
+def resolve_extras(config: dict) -> dict[str, dict]:
+    """Validated configuration -> {extra experiment: resolved parameters} (block `extras:`)."""
+    ext = config.get("extras") or {}
+    spc = int(config["numerics"]["steps_per_cycle"])
+    out = {}
+    for key, name in EXTRA_KEYS.items():
+        blk = ext.get(key)
+        if blk is None:
+            continue
+        p = {"experiment": name, "kind": KINDS[name], "title": TITLES[name]}
+        if key == "erosion":
+            Fs = range_values(blk["F"]) if isinstance(blk["F"], dict) else [float(f) for f in blk["F"]]
+            xis = [float(x) for x in _as_list(blk["xi_max"])]
+            p.update(fourier=[str(f) for f in _as_list(blk["fourier"])], F=Fs, Omega=float(blk["Omega"]),
+                     Psi=_angle(blk["Psi"]), xi_max=xis, grid=_grid(blk["grid"]), cycles=int(blk["cycles"]),
+                     t_eval=[float(t) for t in _as_list(blk["t_eval"])], level=float(blk["level"]),
+                     steps_per_cycle=spc,
+                     tasks=[{"F": f, "xi_max": xis, "q_max": []} for f in Fs])
+        elif key == "true_basin":
+            xis = [float(x) for x in _as_list(blk["xi_max"])]
+            n = int(blk["n_psi"])
+            psis = [float(np.round(2 * math.pi * k / n, 12)) for k in range(n)]
+            p.update(fourier=[str(f) for f in _as_list(blk["fourier"])], F=float(blk["F"]),
+                     Omega=float(blk["Omega"]), xi_max=xis, Psi=psis, grid=_grid(blk["grid"]),
+                     cycles=int(blk["cycles"]), t_eval=[float(t) for t in _as_list(blk["t_eval"])],
+                     n_gamma=int(blk["n_gamma"]), steps_per_cycle=spc,
+                     tasks=[{"F": float(blk["F"]), "Psi": ps, "xi_max": xis, "q_max": []} for ps in psis])
+        else:
+            p.update(fcr=list(blk["fcr"]), iou=list(blk["iou"]),
+                     t_eval=None if blk.get("t_eval") is None else float(blk["t_eval"]))
+        out[name] = p
     return out
 
 
@@ -431,8 +524,11 @@ def load_params(path) -> dict:
 # --------------------------------------------------------------------------------------
 # what each experiment produces (docs/contracts.md, "Per-figure datasets")
 # --------------------------------------------------------------------------------------
-def dataset_files(experiment: str, kind: str | None = None, root="results/data") -> list[str]:
+def dataset_files(experiment: str, kind: str | None = None, root="results/data", params: dict | None = None
+                  ) -> list[str]:
+    """Datasets of one experiment; the Fourier comparison needs its resolved `params` (sources)."""
     kind = kind or KINDS[experiment]
+    sources = params if kind == "fourier_compare" else None
     a, n = f"{root}/analytic", f"{root}/numeric"
     return {
         "fcr_theory": [f"{a}/fcr_{experiment}.nc"],
@@ -443,6 +539,10 @@ def dataset_files(experiment: str, kind: str | None = None, root="results/data")
         "criteria": [f"{n}/criteria_{experiment}.nc"],
         "chart": [f"{n}/chart_{experiment}.nc"],
         "area_time": [],
+        "erosion": [f"{root}/extras/erosion_analytic.nc", f"{root}/extras/erosion_numeric.nc"],
+        "true_basin": [f"{root}/extras/true_basin_analytic.nc", f"{root}/extras/true_basin_numeric.nc"],
+        "fourier_compare": [f"{root}/extras/fourier_{what}_{e}.nc" for what in ("fcr", "iou")
+                            for e in (sources or {}).get(what, [])],
     }[kind]
 
 

@@ -334,6 +334,28 @@ def stack(datasets, dim: str, values=None, *, coords: dict | None = None,
 # --------------------------------------------------------------------------------------
 # agreement between analytic and numeric safe basins
 # --------------------------------------------------------------------------------------
+def gather_tiles(paths) -> xr.Dataset:
+    """Concatenate the tile files of one chart task (rule `chart_tile`) in order.
+
+    Grid tiles are blocks of q0 rows; random-IC tiles are blocks of ``sample``. The tile
+    bookkeeping attributes (``task``, ``tile``, ``tiles``) are dropped.
+    """
+    parts = [load(f) for f in paths]
+    dim = "sample" if "sample" in parts[0].dims else "q0"
+    ds = xr.concat(parts, dim=dim, data_vars="minimal", coords="minimal", compat="override",
+                   join="exact" if dim == "sample" else "outer", combine_attrs="override")
+    for k in ("task", "tile", "tiles"):
+        ds.attrs.pop(k, None)
+    return ds
+
+
+def task_charts(paths, ntasks: int) -> list[xr.Dataset]:
+    """The gathered chart of every task from the flat tile list (tasks x tiles, task-major)."""
+    paths = list(paths)
+    per_task = len(paths) // ntasks
+    return [gather_tiles(paths[i * per_task:(i + 1) * per_task]) for i in range(ntasks)]
+
+
 def mask_agreement(analytic_safe: xr.DataArray, numeric_safe: xr.DataArray, dims=("q0", "p0")):
     """(iou, pixel_agreement) of two boolean safe masks, reduced over `dims`.
 

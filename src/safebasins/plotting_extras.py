@@ -12,6 +12,8 @@ and :mod:`safebasins.fourier_compare` (or paths to netCDF files holding them).
 """
 from __future__ import annotations
 
+import os
+
 import matplotlib.pyplot as plt
 import numpy as np
 import xarray as xr
@@ -21,7 +23,7 @@ from matplotlib.patches import Circle, Patch
 
 from safebasins.plotting import LABELS, draw_well, open_dataset, save_figure, style
 
-__all__ = ["figure_erosion", "figure_true_basin", "figure_fourier", "shade"]
+__all__ = ["figure_erosion", "figure_true_basin", "figure_fourier", "shade", "describe_extras"]
 
 MEASURE_LABELS = {"GIM": "GIM (safe area)", "LIM": "LIM (disk at the well bottom)", "IF": "IF (largest disk)"}
 FOURIER_STYLE = {"paper": dict(ls="-", marker="o", label="paper G (eq 20)"),
@@ -277,3 +279,34 @@ def figure_fourier(fcr=None, iou=None, *, title=None, png=None, pdf=None):
         fig.tight_layout()
     save_figure(fig, png, pdf)
     return fig
+
+
+#: headline variables printed by :func:`describe_extras` (those present in a dataset)
+HEADLINE = ("F_GIM", "F_LIM", "F_IF", "xi_true", "GIM_true", "LIM_true", "IF_true", "GIM_continuous",
+            "GIM_closed", "LIM_closed", "rms_rel_error", "mean_abs_rel_error", "mean_iou")
+
+
+def describe_extras(**datasets):
+    """Text summary of extra datasets (paths, lists of paths or Datasets): title, the parameters
+    that define them and their headline numbers (level crossings, true-basin integrity, errors)."""
+    lines = []
+    for name, src in datasets.items():
+        for s in (src if isinstance(src, (list, tuple)) else [src]):
+            if s is None:
+                continue
+            ds = open_dataset(s)
+            where = os.fspath(s) if isinstance(s, (str, os.PathLike)) else "<dataset>"
+            lines.append(f"[{name}] {where}: {ds.attrs.get('title', '')}")
+            par = {k: ds.attrs[k] for k in ("F", "Omega", "Psi", "cycles", "steps_per_cycle", "level",
+                                            "source_experiment") if k in ds.attrs}
+            if par:
+                lines.append("  " + ", ".join(f"{k} = {v}" for k, v in par.items()))
+            for v in HEADLINE:
+                if v in ds:
+                    da = ds[v]
+                    dims = ", ".join(f"{d}={np.array2string(np.asarray(da[d].values), precision=4)}"
+                                     for d in da.dims)
+                    vals = np.array2string(np.asarray(da.values), precision=4, suppress_small=True)
+                    lines.append(f"  {v}" + (f" over ({dims})" if dims else "") + f":\n    " +
+                                 vals.replace("\n", "\n    "))
+    return "\n".join(lines)

@@ -35,18 +35,19 @@ FCR_NUMERIC_EXPERIMENTS = experiments("fcr_compare")
 BASIN_EXPERIMENTS = experiments("basin_rm", "basin_chart", "strobe")
 AGREEMENT_EXPERIMENTS = experiments("basin_chart")
 FINAL_CHART_EXPERIMENTS = experiments("chart")
-CHART_EXPERIMENTS = experiments("basin_chart", "chart", "criteria")
+# (the extras erosion / true_basin reuse the chart tiles: one task per F / per Psi)
+CHART_EXPERIMENTS = experiments("basin_chart", "chart", "criteria", "erosion", "true_basin")
 STROBE_EXPERIMENTS = experiments("strobe")
 CRITERIA_EXPERIMENTS = experiments("criteria")
 
 PARAM_FILES = [f"results/params/{e}.yaml" for e in EXP]
-DATASETS = [f for e, p in EXP.items() for f in sbconfig.dataset_files(e, p["kind"])]
+DATASETS = [f for e, p in EXP.items() for f in sbconfig.dataset_files(e, p["kind"], params=p)]
 ANALYTIC_DATASETS = [f for f in DATASETS if "/analytic/" in f]
 NUMERIC_DATASETS = [f for f in DATASETS if "/numeric/" in f]
 
 
 wildcard_constraints:
-    experiment=r"fig\d\d",
+    experiment=r"fig\d\d|extra_[a-z_]+",
     task=r"\d+",
     tile=r"\d+",
     tiles=r"\d+",
@@ -56,11 +57,15 @@ def param_file(wildcards):
     return f"results/params/{wildcards.experiment}.yaml"
 
 
-def chart_tiles(wildcards):
+def tile_files(experiment):
     """Tile files of every task of a chart experiment (tasks x TILES jobs)."""
-    tasks = EXP[wildcards.experiment]["tasks"]
+    tasks = EXP[experiment]["tasks"]
     return [
-        f"results/data/numeric/parts/{wildcards.experiment}/task{k}_tile{t}of{TILES}.nc"
+        f"results/data/numeric/parts/{experiment}/task{k}_tile{t}of{TILES}.nc"
         for k in range(len(tasks))
         for t in range(TILES)
     ]
+
+
+def chart_tiles(wildcards):
+    return tile_files(wildcards.experiment)

@@ -240,3 +240,76 @@ def executed_notebook_path(nn):
 
 def figure_paths(nn):
     return f"{FIGURE_DIR}/fig{nn}.png", f"{FIGURE_DIR}/fig{nn}.pdf"
+
+
+# --------------------------------------------------------------------------------------------
+# beyond the paper (docs/extras.md): three figures drawn by safebasins.plotting_extras from the
+# datasets of workflow/rules/extras.smk. Same fields as above, plus ``title`` (report heading);
+# ``inputs`` values may be lists (passed to papermill as YAML).
+# --------------------------------------------------------------------------------------------
+EXTRAS_DATA = "results/data/extras"
+FCR_SOURCES = ("fig10", "fig11", "fig12")
+IOU_SOURCES = ("fig13", "fig14", "fig15", "fig16", "fig17")
+
+
+def fourier_inputs(fcr=FCR_SOURCES, iou=IOU_SOURCES):
+    """Dataset inputs of the first-harmonic figure for the chosen source figures."""
+    return {"fcr": [f"{EXTRAS_DATA}/fourier_fcr_{e}.nc" for e in fcr],
+            "iou": [f"{EXTRAS_DATA}/fourier_iou_{e}.nc" for e in iou]}
+
+
+EXTRA_FIGURES = {
+    "erosion": dict(
+        builder="figure_erosion",
+        inputs={"analytic": f"{EXTRAS_DATA}/erosion_analytic.nc", "numeric": f"{EXTRAS_DATA}/erosion_numeric.nc"},
+        options=dict(measures=["GIM", "LIM", "IF"], xi_max=None, t_eval=None),
+        title="Erosion profiles: integrity measures versus forcing amplitude",
+        paper="Global (GIM), local (LIM) and integrity-factor (IF) measures of the safe basin versus the "
+              "forcing amplitude F, normalised by the unforced well, for the Figs 16-17 parameters "
+              "(Ω = 0.9, Ψ = π, ξ_max = 0.18 and 0.22).",
+        look="Lines: slow-flow (analytic) profiles with the paper's first harmonic (solid) and the exact "
+             "one (dashed). Markers: numeric profiles from one escape chart per F (energy criterion), one "
+             "shade per evaluation time t_eval (light = early); coinciding markers mean the profile no "
+             "longer depends on t_eval. The dotted line is the 0.5 level whose first crossing F_GIM, "
+             "F_LIM, F_IF is stored in both datasets. LIM collapses when the well bottom escapes "
+             "(near the zero-IC F_cr), IF degrades gradually."),
+    "true_basin": dict(
+        builder="figure_true_basin",
+        inputs={"analytic": f"{EXTRAS_DATA}/true_basin_analytic.nc",
+                "numeric": f"{EXTRAS_DATA}/true_basin_numeric.nc"},
+        options=dict(xi_max=None, t_eval=None, fourier="paper"),
+        title="Phase-invariant (true) safe basin",
+        paper="Initial conditions that are safe whatever the forcing phase Ψ: intersection of the safe "
+              "basins over equispaced phases, slow flow (left) and numerics (right), F = 0.01, Ω = 0.9, "
+              "ξ_max = 0.18.",
+        look="Light grey: safe for at least one phase; thin outlines: the per-phase basins coloured by Ψ; "
+             "green: safe for every sampled phase, with its LIM (red dashed) and IF (purple) disks. The "
+             "dotted oval is the analytic all-phase basin H0 = ξ_true (continuous Ψ). Not knowing the "
+             "phase leaves a small energy disk around the well bottom; the panel titles give its "
+             "integrity measures."),
+    "fourier": dict(
+        builder="figure_fourier",
+        inputs=fourier_inputs(),
+        options={},
+        title="First harmonic: paper versus exact",
+        paper="The paper's G (eq 20, leading term of the sn Fourier series) versus the exact first "
+              "harmonic G/(1 - nome), both against the numerics of the paper figures: relative F_cr "
+              "error on the Figs 10-12 Ω points (left) and IoU of the analytic and numeric safe basins "
+              "of Figs 13-17 (right).",
+        look="Left: (theory - numeric)/numeric for each curve of Figs 10-12, RMS in the box. Right: one "
+             "pair of bars per chart threshold / forcing. Higher bars and smaller errors mean the better "
+             "first harmonic; the gain of the exact one grows with F, since the harmonic enters "
+             "multiplied by F."),
+}
+
+
+def extra_notebook_path(name):
+    return f"notebooks/extra_{name}.ipynb"
+
+
+def extra_executed_notebook_path(name):
+    return f"{NOTEBOOK_DIR}/extra_{name}.ipynb"
+
+
+def extra_figure_paths(name):
+    return f"{FIGURE_DIR}/extra_{name}.png", f"{FIGURE_DIR}/extra_{name}.pdf"
