@@ -28,7 +28,13 @@ def merged(base, override):
 def test_paper_config_valid_and_resolves(base):
     cfg = sbc.validate_config(copy.deepcopy(base))
     res = sbc.resolve(cfg)
-    assert list(res) == list(sbc.EXPERIMENTS)
+    assert list(res) == list(sbc.EXPERIMENTS) + list(sbc.EXTRAS)
+    ero, tb, fo = res["extra_erosion"], res["extra_true_basin"], res["extra_fourier"]
+    assert ero["F"][0] == 0.0 and ero["xi_max"] == [0.18, 0.22] and ero["Psi"] == pytest.approx(math.pi)
+    assert len(ero["tasks"]) == len(ero["F"]) and max(ero["t_eval"]) <= ero["cycles"]
+    assert len(tb["tasks"]) == len(tb["Psi"]) == 16 and tb["tasks"][3]["Psi"] == tb["Psi"][3]
+    assert fo["fcr"] == ["fig10", "fig11", "fig12"] and len(fo["iou"]) == 5
+    assert sbc.dataset_files("extra_fourier", params=fo)[0] == "results/data/extras/fourier_fcr_fig10.nc"
     # paper values survive resolution
     assert res["fig05"]["F"] == 0.0876 and res["fig05"]["Omega"] == 0.92 and res["fig05"]["xi_max"] == 0.24
     assert res["fig13"]["scan"] == "xi_max" and res["fig13"]["Psi"] == pytest.approx(math.pi)
@@ -61,6 +67,15 @@ def test_defaults_filled(base):
     sbc.validate_config(cfg)
     assert cfg["fourier"] == "paper" and cfg["numerics"] == {"steps_per_cycle": 64, "threads": 1, "tiles": 1}
     assert cfg["figures"]["fig13"]["cycles"] == 3000
+
+
+def test_extras_defaults_match_config(base):
+    """Without an `extras:` block the schema defaults give the same parameters as config.yaml."""
+    cfg = copy.deepcopy(base)
+    del cfg["extras"]
+    a = sbc.resolve_extras(sbc.validate_config(cfg))
+    b = sbc.resolve_extras(sbc.validate_config(copy.deepcopy(base)))
+    assert a == b and set(a) == set(sbc.EXTRAS)
 
 
 def test_resolution_is_per_experiment(base):
@@ -118,6 +133,16 @@ BAD = [
     ({"unknown_knob": 1}, "unknown_knob", "unknown key"),
     ({"figures": {"fig13": {"Psi": "tau"}}}, "figures.fig13.Psi", ""),
     ({"figures": {"fig13": {"grid": {"q0": [1.0, -1.0]}}}}, "figures.fig13.grid.q0", "empty interval"),
+    ({"extras": {"erosion": {"t_eval": [10, 5000]}}}, "extras.erosion.t_eval", "beyond the horizon"),
+    ({"extras": {"erosion": {"F": {"start": -0.01, "stop": 0.1, "step": 0.01}}}}, "extras.erosion.F.start", ">= 0"),
+    ({"extras": {"erosion": {"xi_max": [0.18, 0.25]}}}, "extras.erosion.xi_max[1]", "xi_max < 0.25"),
+    ({"extras": {"erosion": {"fourier": ["paper", "truncated"]}}}, "extras.erosion.fourier", ""),
+    ({"extras": {"true_basin": {"n_psi": 0}}}, "extras.true_basin.n_psi", "minimum"),
+    ({"extras": {"true_basin": {"grid": {"p0": [0.5, -0.5]}}}}, "extras.true_basin.grid.p0", "empty interval"),
+    ({"extras": {"fourier_compare": {"iou": ["fig13", "fig20"]}}}, "extras.fourier_compare.iou[1]", "fig20"),
+    ({"extras": {"fourier_compare": {"fcr": ["fig10", "fig10"]}}}, "extras.fourier_compare.fcr[1]", "twice"),
+    ({"extras": {"fourier_compare": {"t_eval": 5000}}}, "extras.fourier_compare.t_eval", "horizon"),
+    ({"extras": {"phase_map": {}}}, "extras.phase_map", "unknown key"),
     ({"figures": {"fig13": {"grid": {"n": 0}}}}, "figures.fig13.grid.n", "minimum"),
     ({"figures": {"fig13": {"grid": {"p0": [0.5]}}}}, "figures.fig13.grid.p0", ""),
     ({"figures": {"fig01": {"xi_ini": [0.1, 0.3]}}}, "figures.fig01.xi_ini[1]", ""),

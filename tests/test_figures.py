@@ -14,7 +14,15 @@ import nbformat
 import numpy as np
 import pytest
 
-from safebasins.plotting.catalog import FIGURES, executed_notebook_path, figure_paths, notebook_path
+from safebasins.plotting.catalog import (
+    EXTRA_FIGURES,
+    FIGURES,
+    executed_notebook_path,
+    extra_figure_paths,
+    extra_notebook_path,
+    figure_paths,
+    notebook_path,
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
@@ -50,6 +58,28 @@ def test_notebook_structure(nn):
     # the drawing lives in safebasins.plotting: the notebook only calls into it
     assert "import safebasins.plotting" in text and "def " not in text
     assert all(not c.get("outputs") for c in code)
+
+
+@pytest.mark.parametrize("name", list(EXTRA_FIGURES))
+def test_extra_notebook_structure(name):
+    nb = nbformat.read(ROOT / extra_notebook_path(name), as_version=4)
+    nbformat.validate(nb)
+    code = [c for c in nb.cells if c.cell_type == "code"]
+    assert "parameters" in code[0].metadata.get("tags", [])
+    params = {}
+    exec(code[0].source, {}, params)
+    assert set(EXTRA_FIGURES[name]["inputs"]) <= set(params)
+    assert (params["png"], params["pdf"]) == extra_figure_paths(name)
+    text = "\n".join(c.source for c in code)
+    assert "import safebasins.plotting_extras" in text and "def " not in text
+    assert (ROOT / "workflow" / "report" / f"extra_{name}.rst").exists()
+
+
+def test_extra_rules_declare_notebook_report_and_log():
+    smk = (ROOT / "workflow" / "rules" / "extras.smk").read_text()
+    for word in ("papermill", "-k python3", 'category="Beyond the paper"', "log:", "EXTRA_TARGETS", "rule extras",
+                 "src/safebasins/plotting_extras.py", "tile_files("):
+        assert word in smk
 
 
 def test_rules_declare_notebook_plotting_and_datasets():

@@ -133,6 +133,50 @@ def test_figures_built(quick):
     assert not missing, missing
 
 
+def test_extras_datasets_and_figures(quick):
+    """Beyond-the-paper products (rule `extras`, built by `all`): layout, invariants, reuse."""
+    wd, _, _ = quick
+    from safebasins.plotting import catalog
+
+    L = lambda f: sd.load(wd / "results" / "data" / "extras" / f)  # noqa: E731
+    ero_p = RES["extra_erosion"]
+    an, nu = L("erosion_analytic.nc"), L("erosion_numeric.nc")
+    assert an["GIM"].dims == ("fourier", "F", "xi_max") and list(an["fourier"].values) == ["paper", "exact"]
+    assert nu["GIM"].dims == ("F", "xi_max", "t_eval") and list(nu["t_eval"].values) == ero_p["t_eval"]
+    assert list(nu["F"].values) == ero_p["F"] and nu.attrs["cycles"] == ero_p["cycles"]
+    for ds in (an, nu):
+        for m in ("GIM", "LIM", "IF"):
+            np.testing.assert_allclose(ds[m].sel(F=0.0).values, 1.0)
+            assert f"F_{m}" in ds
+    # one integration per F: the profile can only shrink with the evaluation time
+    assert (nu["GIM"].diff("t_eval") <= 1e-12).all() and (nu["IF"].diff("t_eval") <= 1e-12).all()
+    assert len(list((wd / "results/data/numeric/parts/extra_erosion").glob("task*_tile*.nc"))) == len(ero_p["F"])
+    ta, tn = L("true_basin_analytic.nc"), L("true_basin_numeric.nc")
+    assert tn["safe"].dims == ("Psi", "xi_max", "t_eval", "q0", "p0") and tn.sizes["Psi"] == len(RES["extra_true_basin"]["Psi"])
+    for ds in (ta, tn):
+        assert bool(ds["contained"].all())
+        assert (ds["GIM_true"] <= ds["GIM"].min("Psi") + 1e-12).all()
+    assert (ta["xi_true"] >= 0).all() and "true_safe_continuous" in ta
+    fo = RES["extra_fourier"]
+    for e in fo["fcr"]:
+        f = L(f"fourier_fcr_{e}.nc")
+        assert f["rel_error"].dims == ("curve", "fourier", "Omega") and "rms_rel_error" in f
+        assert f.attrs["source_config_hash"] == sd.load(wd / f"results/data/numeric/fcr_{e}.nc").attrs["config_hash"]
+    for e in fo["iou"]:
+        f = L(f"fourier_iou_{e}.nc")
+        assert f["iou"].dims[0] == "fourier" and ((f["iou"] >= 0) & (f["iou"] <= 1)).all()
+        assert f.attrs["source_config_hash"] == sd.load(wd / f"results/data/numeric/chart_{e}.nc").attrs["config_hash"]
+    import matplotlib.image as mpimg
+    import json
+
+    for name in catalog.EXTRA_FIGURES:
+        png, pdf = (wd / x for x in catalog.extra_figure_paths(name))
+        assert png.stat().st_size > 20_000 and pdf.stat().st_size > 5_000, name
+        assert float(np.var(mpimg.imread(png)[..., :3])) > 1e-3, f"blank figure {name}"
+        nb = json.loads((wd / catalog.extra_executed_notebook_path(name)).read_text())
+        assert not [o for c in nb["cells"] for o in c.get("outputs", []) if o.get("output_type") == "error"]
+
+
 def test_nothing_to_do_and_param_change_reruns_only_own_chain(quick, tmp_path):
     wd, r, _ = quick
     if r.returncode != 0:
