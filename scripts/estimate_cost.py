@@ -24,7 +24,7 @@ def costs(resolved):
             lo, hi = n["F_bracket"]
             levels = math.ceil(math.log2((hi - lo) / n["tol"]))
             out[e] = len(p["curves"]) * len(n["Omega"]) * (levels + n["n_scan"]) * n["cycles"] * n["steps_per_cycle"]
-        elif k in ("basin_chart", "chart"):
+        elif k in ("basin_chart", "chart", "erosion", "true_basin"):  # extras: one chart per F / per Psi
             nq, np_ = p["grid"]["n"]
             out[e] = len(p["tasks"]) * nq * np_ * p["cycles"] * p["steps_per_cycle"]
         elif k == "criteria":

@@ -242,9 +242,12 @@ def figure_fourier(fcr=None, iou=None, *, title=None, png=None, pdf=None):
                     txt.append(f"{f}: RMS {100 * np.sqrt(np.mean(vals ** 2)):.2f}%")
             ax.text(0.02, 0.98, "\n".join(txt), transform=ax.transAxes, va="top", fontsize=7.5,
                     bbox=dict(fc="white", ec="0.7", alpha=0.85, lw=0.5))
-            ax.legend(handles=[Line2D([], [], color=FOURIER_COLOR[f], ls=FOURIER_STYLE[f]["ls"],
-                                      label=FOURIER_STYLE[f]["label"]) for f in ("paper", "exact")] + curve_handles,
-                      loc="best", fontsize=7)
+            lh = [Line2D([], [], color=FOURIER_COLOR[f], ls=FOURIER_STYLE[f]["ls"],
+                         label=FOURIER_STYLE[f]["label"]) for f in ("paper", "exact")] + curve_handles
+            if len(curve_handles) > 4:  # many curves (Figs 10-12 together): legend below the axes
+                ax.legend(handles=lh, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, fontsize=6.5)
+            else:
+                ax.legend(handles=lh, loc="best", fontsize=7)
             ax.set_title(r"critical forcing $F_{cr}(\Omega)$")
         if ious:
             ax = axes[0, k]
