@@ -18,10 +18,11 @@ and a trajectory's result does not depend on which lane, block or thread ran it.
 
 Escape detection
 ----------------
-Per step the kernel tracks, per lane, max H0 and max |q| over the current period
-(vectorised, branch free).  At the period boundary a lane whose maxima crossed its next
-uncrossed threshold replays that period from a snapshot (scalar, same arithmetic) and
-records the exact step of first crossing of every threshold crossed in the period.
+Per step the kernel tracks, per lane, max 2*H0 and max |q| over the current quarter period
+(vectorised, branch free; the period runs in SEGMENTS = 4 segments with a (q, p) snapshot
+before each).  At the period boundary a lane whose segment maxima crossed its next
+uncrossed threshold replays that segment from its snapshot (scalar, same arithmetic) and
+records the exact step of first crossing of every threshold crossed there.
 A lane whose trajectory is finished (every requested threshold crossed, or the horizon
 reached) takes the next trajectory of its task at the period boundary (lane refill: the
 forcing is periodic, so every lane is always at the same sub-step of the period); when
