@@ -4,7 +4,8 @@
     .venv/bin/python scripts/make_notebooks.py            # (re)write notebooks/ and workflow/report/
     .venv/bin/python scripts/make_notebooks.py --check    # exit 1 if any file is out of date
     .venv/bin/python scripts/make_notebooks.py --gallery results/figures
-                                   # also write small copies of the built PNGs to docs/figures/
+                                   # also write small copies of the built PNGs (paper + extra)
+                                   # to docs/figures/
 
 Source of truth: ``safebasins.plotting.catalog.FIGURES`` (datasets, options, captions) and
 ``safebasins.plotting.core`` (the drawing).  Every notebook is: a title cell, a ``parameters``
@@ -124,33 +125,50 @@ def outputs():
         yield ROOT / "workflow" / "report" / f"extra_{name}.rst", build_extra_caption(name)
 
 
+def gallery_entries(src: Path):
+    """(section, heading, stem, caption) of every gallery image: the 22 paper figures, then the
+    beyond-the-paper ones (``catalog.EXTRA_FIGURES``)."""
+    for nn, f in FIGURES.items():
+        yield None, f"Figure {int(nn)}", f"fig{nn}", f["paper"]
+    for name, f in EXTRA_FIGURES.items():
+        yield "Beyond the paper", f["title"], f"extra_{name}", f["paper"]
+
+
 def write_gallery(src: Path, width: int = 800):
-    """docs/figures/figNN.png: downscaled copies of the pipeline's PNGs (+ an index)."""
+    """docs/figures/<stem>.png: downscaled copies of the pipeline's PNGs (+ an index)."""
     from PIL import Image
 
     out = ROOT / "docs" / "figures"
     out.mkdir(parents=True, exist_ok=True)
     lines = ["# Figure gallery", "",
-             f"Downscaled ({width} px wide) copies of `results/figures/figNN.png` as built by "
-             "`snakemake figures` at paper resolution (config/config.yaml).", "",
+             f"Downscaled ({width} px wide) copies of `results/figures/figNN.png` and "
+             "`results/figures/extra_<name>.png` as built by `snakemake figures` and `snakemake extras` at "
+             "paper resolution (config/config.yaml).", "",
              "How the figures are made:", "",
-             "- drawing: `src/safebasins/plotting/core.py` (shared pieces + one builder per figure family);",
+             "- drawing: `src/safebasins/plotting/core.py` (shared pieces + one builder per figure family), "
+             "`src/safebasins/plotting_extras.py` for the beyond-the-paper figures (docs/extras.md);",
              "- figure table (datasets, options, paper caption, what to look for): "
-             "`src/safebasins/plotting/catalog.py`;",
-             "- `.venv/bin/python scripts/make_notebooks.py` regenerates `notebooks/figNN_<slug>.ipynb` and the "
-             "report captions `workflow/report/figNN.rst` from the table (`--check` verifies they are current);",
+             "`src/safebasins/plotting/catalog.py` (`FIGURES`, `EXTRA_FIGURES`);",
+             "- `.venv/bin/python scripts/make_notebooks.py` regenerates `notebooks/figNN_<slug>.ipynb`, "
+             "`notebooks/extra_<name>.ipynb` and the report captions `workflow/report/*.rst` from the table "
+             "(`--check` verifies they are current);",
              "- `snakemake results/figures/figNN.png` runs one notebook with papermill (`-k python3`) and keeps "
-             "the executed copy in `results/notebooks/`; `snakemake figures` builds all 22;",
+             "the executed copy in `results/notebooks/`; `snakemake figures` builds all 22, `snakemake extras` "
+             "the three extra ones;",
              "- `scripts/make_notebooks.py --gallery results/figures` refreshes this page.", ""]
-    for nn, f in FIGURES.items():
-        png = src / f"fig{nn}.png"
+    section = None
+    for sec, heading, stem, caption in gallery_entries(src):
+        png = src / f"{stem}.png"
         if not png.exists():
             print(f"gallery: missing {png}")
             continue
+        if sec != section:
+            lines += [f"# {sec}", ""]
+            section = sec
         im = Image.open(png).convert("RGB")
         h = round(im.height * width / im.width)
-        im.resize((width, h), Image.LANCZOS).quantize(colors=128).save(out / f"fig{nn}.png", optimize=True)
-        lines += [f"## Figure {int(nn)}", "", f"{f['paper']}", "", f"![fig{nn}](fig{nn}.png)", ""]
+        im.resize((width, h), Image.LANCZOS).quantize(colors=128).save(out / f"{stem}.png", optimize=True)
+        lines += [f"## {heading}", "", caption, "", f"![{stem}]({stem}.png)", ""]
     (out / "README.md").write_text("\n".join(lines))
     print(f"gallery written to {out.relative_to(ROOT)}")
 

@@ -13,6 +13,7 @@ and :mod:`safebasins.fourier_compare` (or paths to netCDF files holding them).
 from __future__ import annotations
 
 import os
+import re
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -21,7 +22,8 @@ from matplotlib.colors import to_rgb
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Patch
 
-from safebasins.plotting import LABELS, draw_well, open_dataset, save_figure, style
+from safebasins.plotting import LABELS, curve_labels, draw_well, open_dataset, param_text, save_figure, style
+from safebasins.plotting.core import ic_text
 
 __all__ = ["figure_erosion", "figure_true_basin", "figure_fourier", "shade", "describe_extras"]
 
@@ -29,6 +31,7 @@ MEASURE_LABELS = {"GIM": "GIM (safe area)", "LIM": "LIM (disk at the well bottom
 FOURIER_STYLE = {"paper": dict(ls="-", marker="o", label="paper G (eq 20)"),
                  "exact": dict(ls="--", marker="s", label="exact first harmonic")}
 FOURIER_COLOR = {"paper": "tab:blue", "exact": "tab:orange"}
+LIM_COLOR, IF_COLOR, XI_TRUE_COLOR = "crimson", "#7b3fa0", "black"
 
 
 def shade(color, frac):
@@ -62,7 +65,7 @@ def figure_erosion(analytic=None, numeric=None, *, measures=("GIM", "LIM", "IF")
     xis = list(np.atleast_1d(xi_max)) if xi_max is not None else _values(ref, "xi_max")
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     with style():
-        fig, axes = plt.subplots(1, len(measures), figsize=(4.0 * len(measures), 3.4), sharey=True,
+        fig, axes = plt.subplots(1, len(measures), figsize=(4.0 * len(measures), 3.9), sharey=True,
                                  squeeze=False)
         handles = []
         for a, m in enumerate(measures):
@@ -102,11 +105,12 @@ def figure_erosion(analytic=None, numeric=None, *, measures=("GIM", "LIM", "IF")
                 lab = "numeric" + (f", $t_{{eval}}$ = {float(t):g} EC" if t is not None else "")
                 handles.append(Line2D([], [], ls="none", marker="o", mfc=shade("0.2", frac), mec="0.2", mew=0.6,
                                       label=lab))
-        axes[0, -1].legend(handles=handles, loc="upper right", fontsize=7)
+        ncol = len(handles) if len(handles) <= 4 else (len(handles) + 1) // 2
+        fig.legend(handles=handles, loc="lower center", ncol=ncol, fontsize=7.5, frameon=False,
+                   bbox_to_anchor=(0.5, 0.0), columnspacing=1.5)
         par = {k: ref.attrs.get(k) for k in ("Omega", "Psi") if ref.attrs.get(k) is not None}
-        fig.suptitle(title or "Erosion profiles: " + ", ".join(
-            rf"$\{k}$ = {float(v):.3g}" for k, v in par.items()), fontsize=10)
-        fig.tight_layout()
+        fig.suptitle(title or "Erosion profiles: " + param_text(par), fontsize=10)
+        fig.tight_layout(rect=(0, 0.04 + 0.045 * -(-len(handles) // ncol), 1, 1))
     save_figure(fig, png, pdf)
     return fig
 
@@ -127,19 +131,20 @@ def _draw_basin_panel(ax, ds, sel, label):
             ax.contour(q, p, sv[k].T.astype(float), levels=[0.5], linewidths=0.5, alpha=0.5,
                        colors=[cmap((psis[k] % (2 * np.pi)) / (2 * np.pi))], zorder=2)
     tv = true.transpose("q0", "p0").values
-    ax.contourf(q, p, tv.T.astype(float), levels=[0.5, 1.5], colors=["tab:green"], alpha=0.75)
-    ax.contour(q, p, tv.T.astype(float), levels=[0.5], colors=["darkgreen"], linewidths=0.9)
+    ax.contourf(q, p, tv.T.astype(float), levels=[0.5, 1.5], colors=["tab:green"], alpha=0.55)
     xi = sel.get("xi_max", ds.attrs.get("xi_max"))
     if xi is not None:
         draw_well(ax, float(xi))
     g = {k: float(_sel(ds[f"{k}_true"], **sel)) for k in ("GIM", "LIM", "IF")}
     rl = float(_sel(ds["r_local_true"], **sel))
     rg = float(_sel(ds["r_global_true"], **sel))
-    if rl > 0:
-        ax.add_patch(Circle((0, 0), rl, fill=False, ec="tab:red", lw=1.0, ls="--", zorder=6))
+    # IF below (wide, solid), LIM on top (thin, dashed): both stay visible when they coincide
     if rg > 0:
         c = (float(_sel(ds["if_q0_true"], **sel)), float(_sel(ds["if_p0_true"], **sel)))
-        ax.add_patch(Circle(c, rg, fill=False, ec="tab:purple", lw=1.0, zorder=6))
+        ax.add_patch(Circle(c, rg, fill=False, ec=IF_COLOR, lw=2.2, zorder=6))
+        ax.plot(*c, marker="+", color=IF_COLOR, ms=6, mew=1.2, zorder=7)
+    if rl > 0:
+        ax.add_patch(Circle((0, 0), rl, fill=False, ec=LIM_COLOR, lw=1.1, ls=(0, (3, 2)), zorder=7))
     ax.set_title(f"{label}, {n} phases\ntrue basin: GIM = {g['GIM']:.3f}, LIM = {g['LIM']:.3f}, "
                  f"IF = {g['IF']:.3f}", fontsize=8.5)
     ax.set_xlabel(LABELS["q0"])
@@ -156,7 +161,7 @@ def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, 
     if not panels:
         raise ValueError("give at least one of analytic, numeric")
     with style():
-        fig, axes = plt.subplots(1, len(panels), figsize=(4.3 * len(panels), 3.9), squeeze=False)
+        fig, axes = plt.subplots(1, len(panels), figsize=(4.3 * len(panels), 4.5), squeeze=False)
         for ax, (ds, lab) in zip(axes[0], panels):
             x = xi_max if xi_max is not None else (float(ds["xi_max"][0]) if "xi_max" in ds.dims else None)
             sel = {"xi_max": x, "fourier": fourier}
@@ -169,119 +174,201 @@ def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, 
             if "xi_true" in ds:
                 xt = float(_sel(ds["xi_true"], **sel))
                 if xt > 0:
-                    draw_well(ax, xt, color="darkgreen", ls=":", lw=0.9)
+                    draw_well(ax, xt, color=XI_TRUE_COLOR, ls=":", lw=1.0, zorder=8)
         axes[0, 0].set_ylabel(LABELS["p0"])
         ref = panels[0][0]
         handles = [Patch(color="0.9", label="safe for some phase"),
                    Line2D([], [], color=plt.get_cmap("twilight")(0.3), lw=0.8,
                           label=r"per-phase basins (colour: $\Psi$)"),
-                   Patch(color="tab:green", alpha=0.75, label="safe for all phases"),
-                   Line2D([], [], color="tab:red", ls="--", label="LIM disk"),
-                   Line2D([], [], color="tab:purple", label="IF disk")]
+                   Patch(color="tab:green", alpha=0.55, label="safe for all sampled phases"),
+                   Line2D([], [], color=IF_COLOR, lw=2.2, marker="+", ms=6, label="IF disk (+ centre)"),
+                   Line2D([], [], color=LIM_COLOR, lw=1.1, ls=(0, (3, 2)), label="LIM disk")]
         if "xi_true" in ref:
-            handles.append(Line2D([], [], color="darkgreen", ls=":", label=r"$H_0 = \xi_{true}$ (all $\Psi$)"))
-        fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=7, frameon=False,
-                   bbox_to_anchor=(0.5, -0.02))
+            handles.append(Line2D([], [], color=XI_TRUE_COLOR, ls=":", lw=1.0,
+                                  label=r"$H_0 = \xi_{true}$ (all $\Psi$)"))
+        fig.legend(handles=handles, loc="lower center", ncol=3, fontsize=7.5, frameon=False,
+                   bbox_to_anchor=(0.5, 0.0), columnspacing=1.5)
         F, Om = ref.attrs.get("F"), ref.attrs.get("Omega")
-        head = "Phase-invariant safe basin"
-        if F is not None and Om is not None:
-            head += rf": $F$ = {float(F):g}, $\Omega$ = {float(Om):g}"
+        par = {"F": ref.attrs.get("F"), "Omega": ref.attrs.get("Omega")}
         if xi_max is not None or "xi_max" in ref.dims:
-            head += rf", $\xi_{{max}}$ = {float(xi_max if xi_max is not None else ref['xi_max'][0]):g}"
+            par["xi_max"] = float(xi_max if xi_max is not None else ref["xi_max"][0])
+        head = "Phase-invariant safe basin" + (": " + param_text(par) if any(v is not None for v in par.values()) else "")
         fig.suptitle(title or head, fontsize=10)
-        fig.tight_layout(rect=(0, 0.06, 1, 1))
+        fig.subplots_adjust(left=0.08, right=0.98, top=0.84, bottom=0.2, wspace=0.22)
     save_figure(fig, png, pdf)
     return fig
 
 
+def _source_name(ds, k):
+    """"Fig 10" from the dataset's ``source_experiment`` attribute (else "set k+1")."""
+    src = str(ds.attrs.get("source_experiment", ""))
+    m = re.fullmatch(r"fig(\d+)", src)
+    return f"Fig {int(m.group(1))}" if m else (src or f"set {k + 1}")
+
+
+def _compact(txt):
+    return txt.replace(" = ", "=")
+
+
+def _curve_labels(ds):
+    """Short label per curve of an F_cr comparison (the parameters that vary between its curves,
+    e.g. "ξini=0.05") and the title text of the constant ones."""
+    if "curve" in ds.dims:
+        labels, const = curve_labels(ds)
+    else:
+        labels, const = [], {k: ds[k].values if k in ds.coords else ds.attrs[k]
+                             for k in ("xi_max", "xi0", "gamma0", "Psi") if k in ds.coords or k in ds.attrs}
+        labels = [param_text({"xi_max": const.pop("xi_max")})] if "xi_max" in const else ["theory"]
+    return [_compact(t) for t in labels], _compact(ic_text(const))
+
+
+def _curves(ds):
+    return [ds.isel(curve=c) for c in range(ds.sizes["curve"])] if "curve" in ds.dims else [ds]
+
+
+def _rms(x):
+    x = np.ravel(np.asarray(x, float))
+    x = x[np.isfinite(x)]
+    return float(np.sqrt(np.mean(x ** 2))) if x.size else np.nan
+
+
+def _grouped_bars(ax, groups, ylabel, *, ymax, fmt="{:.2f}"):
+    """Paired bars (paper, exact) grouped by source figure: ``groups`` = [(title, [(tick, paper,
+    exact), ...]), ...]. Group titles sit inside the axes above ``ymax``, dotted separators
+    between groups. Returns the (paper, exact) values."""
+    w, x0, ticks, labels = 0.4, 0, [], []
+    allv = {"paper": [], "exact": []}
+    for g, (head, bars) in enumerate(groups):
+        x = x0 + np.arange(len(bars))
+        for s, f, i in ((-1, "paper", 1), (1, "exact", 2)):
+            v = [b[i] for b in bars]
+            allv[f] += v
+            ax.bar(x + s * w / 2, v, width=w, color=FOURIER_COLOR[f], label=FOURIER_STYLE[f]["label"] if g == 0 else None)
+        ticks += list(x)
+        labels += [b[0] for b in bars]
+        ax.text(x.mean(), 0.985, head, transform=ax.get_xaxis_transform(), ha="center", va="top", fontsize=7.5)
+        if g:
+            ax.axvline(x0 - 0.75, color="0.6", lw=0.7, ls=":")
+        x0 += len(bars) + 0.5
+    ax.set_xlim(-0.6, x0 - 0.9)
+    ax.set_ylim(0, ymax)
+    ax.set_xticks(ticks)
+    ax.set_xticklabels(labels, rotation=60, ha="right", rotation_mode="anchor", fontsize=7)
+    ax.tick_params(axis="x", which="both", top=False, length=2)
+    ax.set_ylabel(ylabel)
+    return allv
+
+
 def figure_fourier(fcr=None, iou=None, *, title=None, png=None, pdf=None):
-    """Paper vs exact first harmonic: relative F_cr error vs Omega (left) and IoU per chart (right).
+    """Paper vs exact first harmonic against the numerics.
+
+    Top row: relative F_cr error versus Omega, one panel per F_cr dataset (source figure), paper G
+    solid, exact dashed, one colour per curve. Bottom row: RMS relative F_cr error per curve and
+    IoU of the analytic and numeric safe basins per chart, paired bars grouped by source figure.
+    The overall RMS error and mean IoU are in the title.
 
     fcr : Dataset(s) of ``fcr_fourier_comparison`` (optionally with a ``curve`` dim), or a list.
     iou : Dataset(s) of ``iou_fourier_comparison``, or a list (one per chart file); each
-          (chart, threshold, t_eval) combination becomes one x position.
+          combination of its non-singleton dims becomes one pair of bars.
     """
     fcrs = [open_dataset(d) for d in (fcr if isinstance(fcr, (list, tuple)) else [fcr]) if d is not None]
     ious = [open_dataset(d) for d in (iou if isinstance(iou, (list, tuple)) else [iou]) if d is not None]
     if not fcrs and not ious:
         raise ValueError("give at least one of fcr, iou")
-    n = int(bool(fcrs)) + int(bool(ious))
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    summary = []
     with style():
-        fig, axes = plt.subplots(1, n, figsize=(5.4 * n, 4.2), squeeze=False)
-        k = 0
+        nf = len(fcrs)
+        fig = plt.figure(figsize=(max(11.0, 3.7 * nf), 3.3 * (bool(fcrs) + bool(ious or fcrs)) + 0.9))
+        rows = int(bool(fcrs)) + 1
+        gs = fig.add_gridspec(rows, 1, height_ratios=[1.0] * rows, hspace=0.45)
         if fcrs:
-            ax = axes[0, k]
-            k += 1
-            markers = "o^vsD<>p"
-            j = 0
-            curve_handles = []
-            for ds in fcrs:
-                curves = list(range(ds.sizes["curve"])) if "curve" in ds.dims else [None]
-                for c in curves:
-                    d = ds.isel(curve=c) if c is not None else ds
-                    mk = markers[j % len(markers)]
-                    for f in d["fourier"].values:
-                        y = d["rel_error"].sel(fourier=f)
-                        ax.plot(d["Omega"], 100 * y.values, color=FOURIER_COLOR[str(f)],
-                                ls=FOURIER_STYLE[str(f)]["ls"], marker=mk, ms=3.5, lw=1.0)
-                    par = []
-                    for key, sym in (("xi_max", r"$\xi_{max}$"), ("xi0", r"$\xi_{ini}$"), ("gamma0", r"$\gamma_{ini}$")):
-                        v = d[key] if key in d.coords else d.attrs.get(key)
-                        if v is not None and (key == "xi_max" or float(v) != 0):
-                            par.append(f"{sym}={float(v):g}")
-                    curve_handles.append(Line2D([], [], color="0.3", ls="none", marker=mk, ms=4, label=", ".join(par)))
-                    j += 1
-            ax.axhline(0, color="0.5", lw=0.6)
-            ax.set_xlabel(LABELS["Omega"])
-            ax.set_ylabel(r"relative $F_{cr}$ error, theory vs numeric (%)")
-            txt = []
-            for f in ("paper", "exact"):
-                vals = np.concatenate([np.ravel(ds["rel_error"].sel(fourier=f).values) for ds in fcrs])
-                vals = vals[np.isfinite(vals)]
-                if vals.size:
-                    txt.append(f"{f}: RMS {100 * np.sqrt(np.mean(vals ** 2)):.2f}%")
-            ax.text(0.02, 0.98, "\n".join(txt), transform=ax.transAxes, va="top", fontsize=7.5,
-                    bbox=dict(fc="white", ec="0.7", alpha=0.85, lw=0.5))
-            lh = [Line2D([], [], color=FOURIER_COLOR[f], ls=FOURIER_STYLE[f]["ls"],
-                         label=FOURIER_STYLE[f]["label"]) for f in ("paper", "exact")] + curve_handles
-            if len(curve_handles) > 4:  # many curves (Figs 10-12 together): legend below the axes
-                ax.legend(handles=lh, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2, fontsize=6.5)
-            else:
-                ax.legend(handles=lh, loc="best", fontsize=7)
-            ax.set_title(r"critical forcing $F_{cr}(\Omega)$")
+            top = gs[0].subgridspec(1, nf, wspace=0.08)
+            ax0 = None
+            for k, ds in enumerate(fcrs):
+                ax = fig.add_subplot(top[0, k], sharey=ax0)
+                ax0 = ax0 or ax
+                labs, const = _curve_labels(ds)
+                for c, (d, lab) in enumerate(zip(_curves(ds), labs)):
+                    col = colors[c % len(colors)]
+                    for f in ("paper", "exact"):
+                        if f in d["fourier"].values:
+                            ax.plot(d["Omega"], 100 * d["rel_error"].sel(fourier=f).values, color=col,
+                                    ls=FOURIER_STYLE[f]["ls"], lw=1.1, marker="o", ms=2.2,
+                                    label=lab if f == "paper" else None)
+                ax.axhline(0, color="0.5", lw=0.6, zorder=0)
+                ax.set_xlabel(LABELS["Omega"])
+                ax.set_title(_source_name(ds, k) + (f": {const}" if const else ""), fontsize=8.5)
+                if k == 0:
+                    ax.set_ylabel(r"rel. $F_{cr}$ error vs numeric (%)")
+                else:
+                    ax.tick_params(labelleft=False)
+                ax.legend(loc="upper center", bbox_to_anchor=(0.56, 1.0), fontsize=6.5, ncol=2 if len(labs) > 3 else 1, handlelength=1.4,
+                          columnspacing=0.8, labelspacing=0.25, framealpha=0.9)
+            style_h = [Line2D([], [], color="0.25", ls=FOURIER_STYLE[f]["ls"], label=FOURIER_STYLE[f]["label"])
+                       for f in ("paper", "exact")]
+            fig.legend(handles=style_h, loc="center", bbox_to_anchor=(0.5, 0.925), ncol=2, fontsize=8,
+                       frameon=False, handlelength=2.5)
+            rms = {f: _rms(np.concatenate([np.ravel(ds["rel_error"].sel(fourier=f).values) for ds in fcrs]))
+                   for f in ("paper", "exact")}
+            summary.append(rf"RMS rel. $F_{{cr}}$ error: paper {100 * rms['paper']:.1f}%, "
+                           rf"exact {100 * rms['exact']:.1f}%")
+        bottom = gs[rows - 1].subgridspec(1, 2, width_ratios=[max(sum(len(_curves(d)) for d in fcrs), 1) + 2,
+                                                              max(sum(_n_iou(d) for d in ious), 1) + 2] if fcrs and ious
+                                          else [1, 0.0001], wspace=0.12)
+        bi = 0
+        if fcrs:
+            ax = fig.add_subplot(bottom[0, bi])
+            bi += 1
+            groups = []
+            for k, ds in enumerate(fcrs):
+                bars = []
+                for d, lab in zip(_curves(ds), _curve_labels(ds)[0]):
+                    r = {f: _rms(d["rel_error"].sel(fourier=f).values) if f in d["fourier"].values else np.nan
+                         for f in ("paper", "exact")}
+                    bars.append((lab, 100 * r["paper"], 100 * r["exact"]))
+                groups.append((_source_name(ds, k), bars))
+            allv = [v for g in groups for b in g[1] for v in b[1:] if np.isfinite(v)]
+            _grouped_bars(ax, groups, r"RMS rel. $F_{cr}$ error (%)", ymax=1.18 * max(allv or [1.0]))
+            ax.legend(loc="upper left", bbox_to_anchor=(0.0, 0.9), fontsize=7, framealpha=0.9)
+            ax.set_title(r"critical forcing: RMS error per curve over $\Omega$", fontsize=9)
         if ious:
-            ax = axes[0, k]
-            labels, vals = [], {"paper": [], "exact": []}
-            abbr = {"F": "F", "xi_max": r"$\xi$", "t_eval": "t", "Omega": r"$\Omega$", "Psi": r"$\Psi$",
-                    "q_max": "q"}
-            for ds in ious:
+            ax = fig.add_subplot(bottom[0, bi])
+            groups = []
+            for k, ds in enumerate(ious):
                 it = ds["iou"]
                 others = [dd for dd in it.dims if dd != "fourier"]
                 shown = [dd for dd in others if it.sizes[dd] > 1]
                 st = it.stack(_pos=others) if others else it.expand_dims(_pos=[0])
-                head = " ".join(f"{abbr[kk]}={float(ds.attrs[kk]):.3g}" for kk in ("Omega", "Psi", "F")
-                                if kk in ds.attrs and kk not in others)
+                fixed = {kk: ds.attrs[kk] for kk in ("Omega", "Psi", "F") if kk in ds.attrs and kk not in shown}
+                fixed.update({dd: float(it[dd][0]) for dd in others if dd not in shown and dd in ("xi_max", "F")})
+                bars = []
                 for i in range(st.sizes["_pos"]):
                     cell = st.isel(_pos=i)
-                    lab = " ".join(f"{abbr.get(dd, dd)}={float(cell[dd]):.3g}" for dd in shown)
-                    labels.append((head + " " + lab).strip())
-                    for f in ("paper", "exact"):
-                        vals[f].append(float(cell.sel(fourier=f)) if f in cell["fourier"].values else np.nan)
-            x = np.arange(len(labels))
-            w = 0.38
-            for s, f in ((-1, "paper"), (1, "exact")):
-                ax.bar(x + s * w / 2, vals[f], width=w, color=FOURIER_COLOR[f], label=FOURIER_STYLE[f]["label"])
-            lo = np.nanmin([np.nanmin(vals["paper"] or [1]), np.nanmin(vals["exact"] or [1])])
-            ax.set_ylim(max(0.0, lo - 0.05), 1.0)
-            ax.set_xticks(x)
-            ax.set_xticklabels(labels, rotation=55, ha="right", fontsize=6.5)
-            ax.set_ylabel("IoU, analytic vs numeric")
-            ax.legend(loc="lower left", fontsize=7, framealpha=1.0)
-            ax.set_title("safe basins")
-        fig.suptitle(title or "First harmonic: paper's truncated G vs exact", fontsize=10)
-        fig.tight_layout()
+                    lab = _compact(param_text({dd: float(cell[dd]) for dd in shown}))
+                    v = {f: float(cell.sel(fourier=f)) if f in cell["fourier"].values else np.nan
+                         for f in ("paper", "exact")}
+                    bars.append((lab or _source_name(ds, k), v["paper"], v["exact"]))
+                head = _source_name(ds, k) + "\n" + _compact(param_text(fixed, sep="\n"))
+                groups.append((head, bars))
+            allv = _grouped_bars(ax, groups, "IoU, analytic vs numeric", ymax=1.45)
+            ax.set_yticks(np.arange(0, 1.01, 0.2))
+            ax.axhline(1.0, color="0.6", lw=0.6, ls="-", zorder=0)
+            ax.set_title("safe basins: IoU per chart", fontsize=9)
+            if not fcrs:
+                ax.legend(loc="lower left", fontsize=7, framealpha=0.9)
+            summary.append("mean IoU: paper {:.3f}, exact {:.3f}".format(np.nanmean(allv["paper"]),
+                                                                        np.nanmean(allv["exact"])))
+        head = title or "First harmonic: paper's truncated G (eq 20) vs exact, against the numerics"
+        fig.suptitle(head + ("\n" + "; ".join(summary) if summary and not title else ""), fontsize=10, y=0.995)
+        fig.subplots_adjust(left=0.06, right=0.99, top=0.87 if fcrs else 0.8, bottom=0.12 if fcrs else 0.3)
     save_figure(fig, png, pdf)
     return fig
+
+
+def _n_iou(ds):
+    it = ds["iou"]
+    return int(np.prod([it.sizes[d] for d in it.dims if d != "fourier"]))
 
 
 #: headline variables printed by :func:`describe_extras` (those present in a dataset)

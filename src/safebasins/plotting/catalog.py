@@ -283,8 +283,9 @@ EXTRA_FIGURES = {
               "basins over equispaced phases, slow flow (left) and numerics (right), F = 0.01, Ω = 0.9, "
               "ξ_max = 0.18.",
         look="Light grey: safe for at least one phase; thin outlines: the per-phase basins coloured by Ψ; "
-             "green: safe for every sampled phase, with its LIM (red dashed) and IF (purple) disks. The "
-             "dotted oval is the analytic all-phase basin H0 = ξ_true (continuous Ψ). Not knowing the "
+             "green: safe for every sampled phase, with its IF disk (thick purple, + at the centre) and LIM "
+             "disk (red dashed, drawn on top: where the two coincide the outline is purple and red). The "
+             "dotted black oval is the analytic all-phase basin H0 = ξ_true (continuous Ψ). Not knowing the "
              "phase leaves a small energy disk around the well bottom; the panel titles give its "
              "integrity measures."),
     "fourier": dict(
@@ -294,12 +295,13 @@ EXTRA_FIGURES = {
         title="First harmonic: paper versus exact",
         paper="The paper's G (eq 20, leading term of the sn Fourier series) versus the exact first "
               "harmonic G/(1 - nome), both against the numerics of the paper figures: relative F_cr "
-              "error on the Figs 10-12 Ω points (left) and IoU of the analytic and numeric safe basins "
-              "of Figs 13-17 (right).",
-        look="Left: (theory - numeric)/numeric for each curve of Figs 10-12, RMS in the box. Right: one "
-             "pair of bars per chart threshold / forcing. Higher bars and smaller errors mean the better "
-             "first harmonic; the gain of the exact one grows with F, since the harmonic enters "
-             "multiplied by F."),
+              "error on the Figs 10-12 Ω points (top row, one panel per figure) and its RMS per curve, "
+              "and IoU of the analytic and numeric safe basins of Figs 13-17 (bottom row).",
+        look="Top: (theory - numeric)/numeric versus Ω, one colour per curve, paper G solid, exact "
+             "dashed. Bottom left: RMS of that error per curve; bottom right: IoU per chart threshold / "
+             "forcing; paired bars (paper blue, exact orange) grouped by source figure. The title gives "
+             "the overall RMS error and mean IoU. Lower errors and higher IoU mean the better first "
+             "harmonic; the gain of the exact one grows with F, since the harmonic enters multiplied by F."),
 }
 
 
