@@ -11,6 +11,7 @@ from safebasins import _validate as V
 from safebasins.numerics import kernels as K
 
 DEFAULT_STEPS_PER_CYCLE = 32
+DEFAULT_INTEGRATOR = "srkn6b"
 LANES = 128          # trajectories in flight per task (4 chains x up to 32-lane segments)
 
 
@@ -67,12 +68,14 @@ def thresholds(name, values, check):
 
 
 def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), cycles, steps_per_cycle,
-                 threads=None, stop_any=False, store=False):
+                 threads=None, stop_any=False, store=False, integrator=DEFAULT_INTEGRATOR):
     """Integrate trajectories i from (q0[i], p0[i]) with Omega[pidx[i]], F[pidx[i]].
 
     Returns (steps_E (N, nE), steps_Q (N, nQ), store or None): int64 first-crossing steps in the
     order of the given thresholds (-1: not within `cycles`), and period-map iterates.
+    integrator: "srkn6b" (default) or "rk4" (kernels.INTEGRATORS).
     """
+    K.check_integrator(integrator)
     q0 = np.ascontiguousarray(q0, dtype=float).ravel()
     p0 = np.ascontiguousarray(p0, dtype=float).ravel()
     pidx = np.ascontiguousarray(pidx, dtype=np.int64).ravel()
@@ -87,8 +90,8 @@ def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), cycles, st
     outQ = np.full((N, qm.size), -1, dtype=np.int64)
     st = np.full((N, cycles + 1, 2), np.nan) if store else np.empty((0, 0, 2))
     if N:
-        coef = np.ascontiguousarray(K.lane_coefficients(Omega, steps_per_cycle))
-        sintab = K.sine_table(steps_per_cycle, Psi)
+        coef = np.ascontiguousarray(K.lane_coefficients(Omega, steps_per_cycle, integrator))
+        sintab = K.sine_table(steps_per_cycle, Psi, integrator)
         with thread_count(threads) as nthreads:
             # one task per thread: trajectories are interleaved over tasks (i % n_tasks), so each
             # task gets a statistically equal share of long-lived ones and its lanes stay full

@@ -10,7 +10,7 @@ from safebasins.numerics import kernels as K
 
 
 def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=None,
-                     steps_per_cycle=E.DEFAULT_STEPS_PER_CYCLE, threads=None):
+                     steps_per_cycle=E.DEFAULT_STEPS_PER_CYCLE, threads=None, integrator=E.DEFAULT_INTEGRATOR):
     """Period-map iterates (q(nT), p(nT)), T = 2 pi / Omega, n = 0..n_iter, of paired ICs.
 
     q0, p0 : paired initial conditions of equal shape (flattened in C order to dim 'sample').
@@ -18,6 +18,7 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
         (None: none).  A trajectory has escaped once it crosses ANY given threshold (energy:
         H0 > xi_max or |q| > 1; displacement: |q| > q_max); its iterates from that period on
         are NaN and it is no longer integrated.
+    integrator : "srkn6b" (default) or "rk4" (see escape_chart).
 
     Returns xr.Dataset with q, p (sample, iteration) (iteration 0 = the IC), escaped (sample,
     bool), escape_cycle (sample; step / steps_per_cycle, +inf = not within n_iter cycles),
@@ -38,10 +39,11 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
         raise ValueError("xi_max and q_max: at least one escape threshold is required")
     spc = E.check_steps_per_cycle(steps_per_cycle)
     threads = E.check_threads(threads)
+    K.check_integrator(integrator)
 
     sE, sQ, st = E.run_ensemble(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
                                 cycles=n_iter, steps_per_cycle=spc, threads=threads, stop_any=True,
-                                store=True)
+                                store=True, integrator=integrator)
     steps = np.concatenate([sE, sQ], axis=1).astype(float)
     steps[steps < 0] = np.inf
     first = steps.min(axis=1)
@@ -62,6 +64,6 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
         },
     )
     ds.attrs.update(F=F, Omega=Omega, Psi=Psi, xi_max=xi[0] if xi else np.nan, q_max=qm[0] if qm else np.nan,
-                    n_iter=n_iter, steps_per_cycle=spc, integrator=K.INTEGRATOR,
+                    n_iter=n_iter, steps_per_cycle=spc, integrator=K.INTEGRATORS[integrator],
                     map="eq (29): (q(t), p(t)) -> (q(t + T), p(t + T)), T = 2 pi / Omega; NaN after escape")
     return ds
