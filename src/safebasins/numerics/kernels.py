@@ -340,15 +340,20 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
     Q = np.zeros(Lmem)
     P = np.zeros(Lmem)
     # the period is run in G segments; snapshots of (q, p) before each segment and the
-    # segment maxima let a crossing be replayed over one segment only
-    G = SEGMENTS if S >= 4 * SEGMENTS else 1
-    seg = np.empty(G + 1, np.int64)
-    for g in range(G + 1):
-        seg[g] = g * S // G
-    SQ = np.zeros((G, Lmem))
-    SP = np.zeros((G, Lmem))
-    SME = np.empty((G, Lmem))
-    SMQ = np.empty((G, Lmem))
+    # segment maxima let a crossing be replayed over one segment only.  Segments cost a
+    # snapshot per lane each; they pay off only while lanes cross thresholds, so a period
+    # after one without any crossing runs as ONE segment (a crossing there is replayed over
+    # the whole period; the recorded steps are the same either way)
+    Gmax = SEGMENTS if S >= 4 * SEGMENTS else 1
+    segs = np.empty((2, Gmax + 1), np.int64)
+    for g in range(Gmax + 1):
+        segs[0, g] = g * S // Gmax
+        segs[1, g] = S if g > 0 else 0
+    SQ = np.zeros((Gmax, Lmem))
+    SP = np.zeros((Gmax, Lmem))
+    SME = np.empty((Gmax, Lmem))
+    SMQ = np.empty((Gmax, Lmem))
+    nhit = np.int64(1)         # crossings at the last period boundary (first period: segmented)
     traj = np.empty(L, np.int64)
     per = np.empty(L, np.int64)
     lE = np.empty(L, np.int64)
@@ -364,9 +369,12 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
 
     nxt = np.int64(task)
     nact = np.int64(0)
+    ndone = np.int64(0)        # lanes finished at the last period boundary
     while True:
         # ---------------------------------------------------- fill empty / finished lanes
         l = np.int64(0)
+        if ndone == 0 and (nact == L or nxt >= N):
+            l = nact           # nothing to refill or compact: skip the scan
         while l < nact or (l == nact and nact < L and nxt < N):
             if l < nact and not done[l]:
                 l += 1
@@ -417,6 +425,8 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
         for l in range(nact, 4 * M):
             Q[l] = 0.0
             P[l] = 0.0
+        G = Gmax if nhit > 0 else 1
+        seg = segs[0] if nhit > 0 else segs[1]
         for g in range(G):
             for l in range(nact):
                 SQ[g, l] = Q[l]
@@ -434,10 +444,18 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
         for g in range(G):
             for l in range(nact):
                 hit[l] = hit[l] | (SME[g, l] > tE[l]) | (SMQ[g, l] > tQ[l])
+        nhit = np.int64(0)
+        for l in range(nact):
+            nhit += hit[l]
+        ndone = np.int64(0)
         for l in range(nact):
             per[l] += 1
-            done[l] = per[l] >= cycles
+            d = per[l] >= cycles
+            done[l] = d
+            ndone += d
         for l in range(nact):
+            if nhit == 0 and not do_store:
+                break
             if not (hit[l] or do_store):
                 continue
             i = traj[l]
@@ -461,7 +479,9 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
             if do_store and not fin and iE == 0 and iQ == 0:
                 store[i, per[l], 0] = Q[l]
                 store[i, per[l], 1] = P[l]
-            done[l] = fin or per[l] >= cycles
+            d = fin or per[l] >= cycles
+            ndone += d and not done[l]
+            done[l] = d
 
 
 @njit(cache=True, parallel=True)
