@@ -1,6 +1,7 @@
 """Benchmark and convergence study of safebasins.numerics (see docs/numerics.md).
 
-    python benchmarks/bench_escape.py            # speed: engine vs numpy RK4 vs scipy DOP853
+    python benchmarks/bench_escape.py            # speed: engine (SRKN6b and RK4) vs numpy RK4 vs
+                                                 # scipy DOP853, ceilings, equal-accuracy comparison
     python benchmarks/bench_escape.py --study    # convergence study against scipy DOP853
                                                  # (rtol 1e-10) on the 100x100 chart
 
@@ -246,7 +247,138 @@ def benchmark(args):
         print(f"ceiling (2 cores x {ghz} GHz x 1 zmm FMA-class op/cycle, 30 ops per 8 lane-steps) "
               f"= {ceil_steps:.3g} steps/s: dense {steps / tdense / ceil_steps:.0%}, "
               f"chart {steps_chart / tchart / ceil_steps:.0%}")
+    if not args.no_integrators:
+        integrators_section(args)
     print("machine after:", machine_state().splitlines()[0])
+
+
+# ----------------------------------------------------------------------------- RK4 in the engine
+E_LEVELS = np.array([0.01, 0.1, 0.2, 0.24, 0.249])   # H0 of the ICs at rest (F = 0, Omega = 1)
+
+
+def energy_error(integrator, S, cycles):
+    """Max relative |H0(t) - H0(0)| / H0(0) over the steps of cycle `cycles` + 1 (F = 0,
+    Omega = 1), ICs at rest at H0 = E_LEVELS, with the engine's own step (kernels.final_states)."""
+    from safebasins.numerics import kernels as K
+    q0 = np.sqrt(1 - np.sqrt(1 - 4 * E_LEVELS))
+    q, p = K.final_states(q0, np.zeros_like(q0), np.zeros(q0.size, np.int64),
+                          K.lane_coefficients(1.0, S, integrator), np.array([0.0]),
+                          K.sine_table(S, 0.0, integrator), cycles)
+    # then one more cycle step by step: the max over the steps of that cycle (a symplectic
+    # scheme's error oscillates within the period; the period-end value can be far smaller)
+    c = K.lane_coefficients(1.0, S, integrator)[0]
+    worst = np.zeros(q0.size)
+    for s in range(S + 1):
+        H = 0.5 * p * p + 0.5 * q * q - 0.25 * q ** 4
+        rel = (H - E_LEVELS) / E_LEVELS
+        worst = np.where(np.abs(rel) > np.abs(worst), rel, worst)
+        if s < S:
+            for j in range(q0.size):
+                if integrator == "rk4":
+                    q[j], p[j] = K.rk4_step(q[j], p[j], c[0], c[1], c[2], 0.0, 0.0, 0.0)
+                else:
+                    q[j], p[j] = K.bm6_step(q[j], p[j], *c, *np.zeros(7))
+    return float(np.abs(worst).max()), float(worst[np.argmax(np.abs(worst))])
+
+
+def dense_ics(n, seed=0):
+    rng = np.random.default_rng(seed)
+    r = 0.45 * np.sqrt(rng.uniform(0, 1, n))
+    th = rng.uniform(0, 2 * np.pi, n)
+    return r * np.cos(th), r * np.sin(th)
+
+
+def kernel_rate(integrator, Q, P, F, Omega, Psi, cycles, S, repeat, reps=1):
+    """Best wall time of `reps` back-to-back engine.run_ensemble calls (kernel only);
+    returns (time, useful trajectory-steps, CPU time of the best run)."""
+    from safebasins.numerics import engine as E
+    def job():
+        for _ in range(reps):
+            sE, _, _ = E.run_ensemble(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=(0.25,),
+                                      cycles=cycles, steps_per_cycle=S, integrator=integrator)
+        return sE
+    key = f"{integrator}-{S}-{cycles}-{reps}"
+    t, sE = best_time(job, repeat, key)
+    steps = float(np.where(sE[:, 0] < 0, cycles * S, sE[:, 0]).sum()) * reps
+    return t, steps, CPU_TIMES[key]
+
+
+def integrators_section(args):
+    """RK4 vs SRKN6b in the same compiled engine: steps/s on the dense job and the 100x100 chart,
+    fractions of the RK4 ceilings, and the equal-accuracy comparison (trajectory-cycles/s at the
+    steps/cycle each needs for the 11,000-cycle energy bound)."""
+    import numba
+    from safebasins.numerics import engine as E
+    nthr = numba.get_num_threads()
+    c = CHART
+    S0 = E.DEFAULT_STEPS_PER_CYCLE
+    qd, pd = dense_ics(args.dense_n)
+    _, Q, P = chart_ics()
+    for integ in ("srkn6b", "rk4"):     # compile / cache load outside the timings
+        E.run_ensemble([0.1], [0.0], [0], [1.0], [0.0], 0.0, xi_max=(0.25,), cycles=1, steps_per_cycle=S0,
+                       integrator=integ)
+    print(f"\n=== SRKN6b vs RK4 in the same compiled engine ({nthr} threads, kernel only, best of {args.repeat}) ===")
+    print(f"dense: {args.dense_n} ICs inside the well, F = 0, {args.dense_cycles_long} cycles (no escapes); "
+          f"chart: 100x100, {c['cycles']} cycles, the whole chart job repeated {args.chart_reps}x back to back "
+          f"(one chart is ~5 ms of work)")
+    print(f"{'job':40s} {'S':>4s} {'traj-steps':>11s} {'wall [s]':>9s} {'steps/s':>9s} {'traj-cyc/s':>10s} "
+          f"{'steps/CPU-s x thr':>17s}")
+    rates = {}
+    for integ in ("srkn6b", "rk4"):
+        for job, (QQ, PP, F, Om, Psi, cyc, reps) in (
+                ("dense", (qd, pd, 0.0, 1.0, 0.0, args.dense_cycles_long, 1)),
+                ("chart", (Q, P, c["F"], c["Omega"], c["Psi"], c["cycles"], args.chart_reps))):
+            t, n, cpu = kernel_rate(integ, QQ, PP, F, Om, Psi, cyc, S0, args.repeat, reps)
+            rates[integ, job] = n / t
+            print(f"{integ + ' ' + job:40s} {S0:4d} {n:11.4g} {t:9.3f} {n / t:9.3g} {n / S0 / t:10.3g} "
+                  f"{n / cpu * nthr:17.3g}")
+    # ceilings for RK4 (brief: 46 flops/step, 16 FP64 flops/cycle/core)
+    ncores = os.cpu_count()
+    ceil_brief = 2.8e9
+    ceil_nom = ncores * 2.6e9 * 16 / 46
+    ceil_boost = ncores * 3.65e9 * 16 / 46
+    # instruction-level: 20 zmm FMA-pipe ops (mul/FMA) per 8 lane-steps (asm of the RK4 loop:
+    # 14 FMA + 6 MUL per chain; the 11 add/sub/cmp go to the FADD pipes), 1 zmm FMA-pipe op per
+    # cycle per core (Zen 4 double-pumps 512-bit ops over its two 256-bit FMA pipes)
+    ceil_isa = ncores * 2.6e9 * 8 / 20
+    print(f"\nRK4 ceilings ({ncores} cores): brief's 2.8e9; 46 flops/step x 16 flops/cycle/core: "
+          f"{ceil_nom:.3g} at 2.6 GHz nominal, {ceil_boost:.3g} at 3.65 GHz boost; "
+          f"FMA-pipe bound of this code (20 zmm mul/FMA per 8 lane-steps) {ceil_isa:.3g} at 2.6 GHz")
+    for job in ("dense", "chart"):
+        r = rates["rk4", job]
+        print(f"  RK4 {job}: {r:.3g} steps/s = {r / ceil_brief:.0%} of 2.8e9, {r / ceil_nom:.0%} of the 2.6 GHz "
+              f"46-flop ceiling ({r * 46 / 1e9:.0f} GFlop/s), {r / ceil_isa:.0%} of the FMA-pipe bound; "
+              f"target {'2e9' if job == 'dense' else '1.5e9'}: "
+              f"{'met' if r >= (2e9 if job == 'dense' else 1.5e9) else 'NOT met'}")
+    # equal accuracy: relative energy error after 11,000 free cycles
+    cyc = args.energy_cycles
+    bound = 1e-5
+    print(f"\nequal accuracy: max relative energy error over the steps of free cycle {cyc} + 1 (F = 0, Omega = 1, ICs at rest "
+          f"at H0 = {', '.join(f'{x:g}' for x in E_LEVELS)}); requirement {bound:g}")
+    err = {}
+    for integ, Ss in (("srkn6b", (16, 32)), ("rk4", (64, 128, 192, 224, 256, 320))):
+        for S in Ss:
+            err[integ, S] = energy_error(integ, S, cyc)
+            print(f"  {integ:7s} S = {S:4d}: {err[integ, S][0]:.2e} (signed {err[integ, S][1]:+.2e})")
+    S_rk4 = min(S for (i, S) in err if i == "rk4" and err[i, S][0] <= bound)
+    # RK4 error ~ S^-4: steps/cycle RK4 needs to match SRKN6b at its default
+    e_ref = err["srkn6b", S0][0]
+    S_match = 256 * (err["rk4", 256][0] / e_ref) ** 0.25
+    # trajectory-cycles/s measured on the dense job at each scheme's steps/cycle
+    print(f"trajectory-cycles/s on the dense job ({args.dense_n} ICs, steps/cycle as given, >= 0.5 s of work):")
+    tc = {}
+    for integ, S in (("srkn6b", S0), ("srkn6b", 16), ("rk4", S_rk4)):
+        cyc_d = max(20, int(args.dense_cycles_long * S0 / S))
+        t, n, _ = kernel_rate(integ, qd, pd, 0.0, 1.0, 0.0, cyc_d, S, args.repeat)
+        tc[integ, S] = n / S / t
+        print(f"  {integ:7s} S = {S:4d} ({cyc_d} cycles): {n / t:.3g} steps/s, {n / S / t:.3g} traj-cycles/s, "
+              f"energy error {err[integ, S][0]:.1e}")
+    print(f"=> at the requirement ({bound:g}): SRKN6b at its default {S0} steps/cycle does "
+          f"{tc['srkn6b', S0] / tc['rk4', S_rk4]:.1f}x the trajectory-cycles/s of RK4 at the {S_rk4} steps/cycle "
+          f"RK4 needs, with a {err['rk4', S_rk4][0] / e_ref:.0f}x smaller energy error; at 16 steps/cycle "
+          f"(error {err['srkn6b', 16][0]:.1e}, still within the bound) {tc['srkn6b', 16] / tc['rk4', S_rk4]:.1f}x")
+    print(f"=> RK4 would need ~{S_match:.0f} steps/cycle to match SRKN6b's {e_ref:.1e} at {S0} steps/cycle "
+          f"(error ~ S^-4 from S = 256): ~{tc['rk4', S_rk4] * S_rk4 / S_match / tc['srkn6b', S0]:.3f}x SRKN6b's rate")
 
 
 # ----------------------------------------------------------------------------- study
@@ -303,6 +435,13 @@ def main(argv=None):
     ap.add_argument("--steps-per-cycle", type=int, default=None)
     ap.add_argument("--dense-n", type=int, default=20000)
     ap.add_argument("--dense-cycles", type=int, default=300)
+    ap.add_argument("--dense-cycles-long", type=int, default=2000,
+                    help="cycles of the dense job in the SRKN6b-vs-RK4 section (>= 0.5 s of work)")
+    ap.add_argument("--chart-reps", type=int, default=150,
+                    help="back-to-back repetitions of the 100x100 chart job in the SRKN6b-vs-RK4 section")
+    ap.add_argument("--energy-cycles", type=int, default=11000)
+    ap.add_argument("--no-integrators", action="store_true", help="skip the SRKN6b-vs-RK4 section")
+    ap.add_argument("--only-integrators", action="store_true", help="only the SRKN6b-vs-RK4 section")
     ap.add_argument("--rk4-steps", type=int, default=64)
     ap.add_argument("--dop-subset", type=int, default=100)
     ap.add_argument("--repeat", type=int, default=5)
@@ -311,6 +450,10 @@ def main(argv=None):
     args = ap.parse_args(argv)
     if args.study:
         study(args)
+    elif args.only_integrators:
+        print("machine:", machine_state())
+        integrators_section(args)
+        print("machine after:", machine_state().splitlines()[0])
     else:
         benchmark(args)
 
