@@ -28,7 +28,9 @@ Per step the kernel tracks, per lane, max 2*H0 and max |q| over the current quar
 (vectorised, branch free; the period runs in SEGMENTS = 4 segments with a (q, p) snapshot
 before each).  At the period boundary a lane whose segment maxima crossed its next
 uncrossed threshold replays that segment from its snapshot (scalar, same arithmetic) and
-records the exact step of first crossing of every threshold crossed there.
+records the exact step of first crossing of every threshold crossed there.  A period that
+follows a boundary without any crossing runs as one segment (its crossings are replayed over
+the whole period): the snapshots are only paid for while lanes are crossing thresholds.
 A lane whose trajectory is finished (every requested threshold crossed, or the horizon
 reached) takes the next trajectory of its task at the period boundary (lane refill: the
 forcing is periodic, so every lane is always at the same sub-step of the period); when
