@@ -21,6 +21,8 @@ import time
 
 import numpy as np
 
+from _reference import ivp_escape  # noqa: E402  (benchmarks/ is on sys.path)
+
 CHART = dict(F=0.0876, Omega=0.95, Psi=np.pi, xi_max=0.25, cycles=300, n=100)
 
 
@@ -33,30 +35,8 @@ def chart_ics(n=CHART["n"]):
 # ----------------------------------------------------------------------------- references
 def _dop853_one(args):
     """Escape time (cycles) of one IC with scipy DOP853 (events: H0 = xi_max, |q| = 1)."""
-    from scipy.integrate import solve_ivp
     q0, p0, F, Om, Psi, xi_max, cycles, rtol, atol = args
-    H = 0.5 * p0 * p0 + 0.5 * q0 * q0 - 0.25 * q0 ** 4
-    if H > xi_max or abs(q0) > 1:
-        return 0.0
-    T = 2 * math.pi / Om
-
-    def rhs(t, y):
-        q = y[0]
-        return [y[1], q * q * q - q + F * math.sin(Om * t + Psi)]
-
-    def e_energy(t, y):
-        return 0.5 * y[1] * y[1] + 0.5 * y[0] * y[0] - 0.25 * y[0] ** 4 - xi_max
-    e_energy.terminal = True
-    e_energy.direction = 1
-
-    def e_barrier(t, y):
-        return abs(y[0]) - 1.0
-    e_barrier.terminal = True
-    e_barrier.direction = 1
-    sol = solve_ivp(rhs, (0, cycles * T), [q0, p0], method="DOP853", rtol=rtol, atol=atol,
-                    events=(e_energy, e_barrier))
-    hits = [ev[0] for ev in sol.t_events if len(ev)]
-    return min(hits) / T if hits else np.inf
+    return ivp_escape((q0, p0, F, Om, Psi, xi_max, cycles, "DOP853", rtol, atol))[0]
 
 
 def dop853_chart(Q, P, F, Omega, Psi, xi_max, cycles, rtol=1e-10, atol=1e-12, workers=2):
