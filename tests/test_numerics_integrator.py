@@ -110,13 +110,16 @@ def test_initial_condition_beyond_threshold_is_zero():
     assert (sE[2] == 0).all() and (sQ[2] == 0).all()        # beyond the barrier: out of the well
 
 
-def test_bitwise_independent_of_threads_tasks_and_lanes():
+@pytest.mark.parametrize("integrator", ["srkn6b", "rk4"])
+def test_bitwise_independent_of_threads_tasks_and_lanes(integrator):
     import numba
     from safebasins.numerics import escape_chart
     q = np.linspace(-1, 1, 40)
-    kw = dict(xi_max=(0.2, 0.25), q_max=(0.8, 1.0), cycles=60)
+    kw = dict(xi_max=(0.2, 0.25), q_max=(0.8, 1.0), cycles=60, integrator=integrator)
     a = escape_chart(q, q, 0.0876, 0.95, np.pi, threads=1, **kw)
     b = escape_chart(q, q, 0.0876, 0.95, np.pi, threads=min(2, numba.config.NUMBA_NUM_THREADS), **kw)
+    assert a.attrs["integrator"] == K.INTEGRATORS[integrator]
+    assert ("RK4" in a.attrs["integrator"]) == (integrator == "rk4")
     for v in ("escape_cycle_energy", "escape_cycle_displacement"):
         np.testing.assert_array_equal(a[v].values, b[v].values)
     # different task partition / lane count / per-lane parameter path
@@ -125,12 +128,12 @@ def test_bitwise_independent_of_threads_tasks_and_lanes():
     N = Q.size
     S = 32
     res = []
-    for n_tasks, lanes, npar in ((1, 128, 1), (7, 64, 1), (3, 128, 2)):
-        coef = np.repeat(K.lane_coefficients(0.95, S), npar, 0)
+    for n_tasks, lanes, npar in ((1, 128, 1), (7, 64, 1), (3, 128, 2)):   # npar 2: per-lane path
+        coef = np.repeat(K.lane_coefficients(0.95, S, integrator), npar, 0)
         oE = np.full((N, 2), -1, np.int64)
         oQ = np.full((N, 2), -1, np.int64)
         K.ensemble(Q, P, np.arange(N) % npar, coef, np.repeat(K.step_sizes(0.95, S), npar),
-                   np.full(npar, 0.0876), K.sine_table(S, np.pi),
+                   np.full(npar, 0.0876), K.sine_table(S, np.pi, integrator),
                    2 * np.array([0.2, 0.25]), np.array([0.8, 1.0]), 60, False, n_tasks, lanes, oE, oQ,
                    np.empty((0, 0, 2)), False)
         res.append((oE, oQ))

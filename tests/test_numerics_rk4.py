@@ -1,6 +1,5 @@
 """Classic RK4 in the compiled lane engine (integrator="rk4"): order, DOP853 agreement, known
 energy loss, bitwise thread/lane/path independence, chart agreement with SRKN6b."""
-import numba
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -64,32 +63,6 @@ def test_rk4_energy_loss_known_figures():
         rel = (H0(q, p) - E0) / E0
         assert (rel < 0).all(), rel                      # loss, not gain
         assert lo < -rel.min() < hi, (S, rel)
-
-
-def test_rk4_bitwise_independent_of_threads_tasks_lanes_and_path():
-    q = np.linspace(-1, 1, 40)
-    kw = dict(xi_max=(0.2, 0.25), q_max=(0.8, 1.0), cycles=60, integrator="rk4")
-    a = escape_chart(q, q, 0.0876, 0.95, np.pi, threads=1, **kw)
-    b = escape_chart(q, q, 0.0876, 0.95, np.pi, threads=min(2, numba.config.NUMBA_NUM_THREADS), **kw)
-    assert a.attrs["integrator"] == K.INTEGRATORS["rk4"] and "RK4" in a.attrs["integrator"]
-    for v in ("escape_cycle_energy", "escape_cycle_displacement"):
-        np.testing.assert_array_equal(a[v].values, b[v].values)
-    Q, P = np.meshgrid(q, q, indexing="ij")
-    Q, P = Q.ravel(), P.ravel()
-    N, S = Q.size, 32
-    res = []
-    for n_tasks, lanes, npar in ((1, 128, 1), (7, 64, 1), (3, 128, 2)):   # npar 2: per-lane path
-        oE = np.full((N, 2), -1, np.int64)
-        oQ = np.full((N, 2), -1, np.int64)
-        K.ensemble(Q, P, np.arange(N) % npar, np.repeat(K.lane_coefficients(0.95, S, "rk4"), npar, 0),
-                   np.repeat(K.step_sizes(0.95, S), npar), np.full(npar, 0.0876), K.sine_table(S, np.pi, "rk4"),
-                   2 * np.array([0.2, 0.25]), np.array([0.8, 1.0]), 60, False, n_tasks, lanes, oE, oQ,
-                   np.empty((0, 0, 2)), False)
-        res.append((oE, oQ))
-    for oE, oQ in res[1:]:
-        np.testing.assert_array_equal(oE, res[0][0])
-        np.testing.assert_array_equal(oQ, res[0][1])
-    np.testing.assert_array_equal(E.steps_to_cycles(res[0][0], S), a["escape_cycle_energy"].values.reshape(2, -1).T)
 
 
 def test_rk4_escape_step_is_first_step_beyond_threshold():
