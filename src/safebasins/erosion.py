@@ -27,6 +27,7 @@ import xarray as xr
 from safebasins import _validate as V
 from safebasins._extras_common import (as_1d, chart_param, fourier_list, mesh, numeric_safe,
                                        numerics_fn, stack_charts, theory_fn)
+from safebasins.datasets import annotate
 from safebasins.integrity import integrity_measures, unforced_safe_mask
 
 __all__ = [
@@ -92,7 +93,7 @@ def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier="pape
                      "method": "safebasins.theory.slow_flow_escapes on the grid"})
     if isinstance(fourier, str):
         ds.attrs["fourier"] = fourier
-    return _annotate_axes(ds)
+    return annotate(ds)
 
 
 # --------------------------------------------------------------------------- numeric
@@ -126,7 +127,7 @@ def profile_from_charts(charts, t_eval=None, *, criterion="energy", stack_dim="F
                                                                        "steps_per_cycle", "integrator")})
     ds.attrs.update({"kind": "numeric", "criterion": criterion,
                      "method": "safe = escape_cycle > t_eval from safebasins.numerics.escape_chart"})
-    return _annotate_axes(ds)
+    return annotate(ds)
 
 
 def erosion_profile_numeric(F_values, Omega, Psi, xi_max, q0, p0, t_eval=None, cycles=3000, *,
@@ -213,20 +214,3 @@ def compare_profiles(analytic, numeric, level=0.5):
         out[f"F_{k}_numeric"] = level_crossing(numeric[k], level)
     out.attrs.update(level=float(level), Omega=analytic.attrs.get("Omega"), Psi=analytic.attrs.get("Psi"))
     return out
-
-
-def _annotate_axes(ds):
-    meta = {
-        "F": ("1", "forcing amplitude"),
-        "xi_max": ("1", "energy escape threshold"),
-        "q_max": ("1", "displacement escape threshold"),
-        "t_eval": ("forcing cycles", "evaluation time"),
-        "Psi": ("rad", "forcing phase"),
-        "q0": ("1", "initial displacement"),
-        "p0": ("1", "initial momentum"),
-    }
-    for k, (u, ln) in meta.items():
-        if k in ds.coords:
-            ds[k].attrs.setdefault("units", u)
-            ds[k].attrs.setdefault("long_name", ln)
-    return ds

@@ -22,7 +22,7 @@ import xarray as xr
 from safebasins import _validate as V
 from safebasins._extras_common import (FOURIER_CHOICES, as_1d, chart_param, mesh, numeric_safe,
                                        numerics_fn, theory_fn)
-from safebasins.erosion import _annotate_axes
+from safebasins.datasets import annotate
 from safebasins.integrity import integrity_measures, iou, pixel_agreement, unforced_safe_mask
 
 __all__ = ["fcr_fourier_comparison", "fcr_fourier_comparison_from_numeric", "iou_fourier_comparison"]
@@ -202,4 +202,4 @@ def iou_fourier_comparison(chart, t_eval=None, *, criterion="energy"):
     m = ds["mean_iou"].values
     if np.isfinite(m).all():
         ds.attrs["closer_overall"] = _FOURIER[int(np.argmax(m))]
-    return _annotate_axes(ds)
+    return annotate(ds)

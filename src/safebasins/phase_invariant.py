@@ -40,7 +40,7 @@ import xarray as xr
 from safebasins import _validate as V
 from safebasins._extras_common import (as_1d, fourier_list, mesh, numeric_safe, numerics_fn,
                                        stack_charts, theory_fn)
-from safebasins.erosion import _annotate_axes
+from safebasins.datasets import annotate
 from safebasins.integrity import H0, MEASURE_ATTRS, integrity_measures, unforced_safe_mask
 
 __all__ = [
@@ -213,7 +213,7 @@ def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fouri
         ds = ds.isel(fourier=0)
     ds.attrs.update({"kind": "analytic", "F": F, "Omega": Omega, "n_gamma": int(n_gamma),
                      "method": "rotation of the Psi = 0 manifold classification: gamma0 = theta0 - Psi"})
-    return _annotate_axes(ds)
+    return annotate(ds)
 
 
 def true_safe_basin_from_charts(charts, t_eval=None, *, criterion="energy"):
@@ -236,7 +236,7 @@ def true_safe_basin_from_charts(charts, t_eval=None, *, criterion="energy"):
                                                                        "integrator")})
     ds.attrs.update({"kind": "numeric", "criterion": criterion,
                      "method": "intersection over Psi of escape_cycle > t_eval, one escape_chart per Psi"})
-    return _annotate_axes(ds)
+    return annotate(ds)
 
 
 def true_safe_basin_numeric(F, Omega, xi_max, q0, p0, Psi_values=None, t_eval=None, cycles=3000, *,
