@@ -11,20 +11,20 @@ from safebasins import erosion, fourier_compare, integrity, phase_invariant
 from safebasins._extras_common import numerics_fn, theory_fn
 
 
-def need_theory(*names):
+def _need(lookup, package, names):
     for n in names:
         try:
-            theory_fn(n)
+            lookup(n)
         except ImportError as exc:
-            pytest.skip(f"theory not landed yet: {exc}")
+            pytest.skip(f"{package} not landed yet: {exc}")
+
+
+def need_theory(*names):
+    _need(theory_fn, "theory", names)
 
 
 def need_numerics(*names):
-    for n in names:
-        try:
-            numerics_fn(n)
-        except ImportError as exc:
-            pytest.skip(f"numerics not landed yet: {exc}")
+    _need(numerics_fn, "numerics", names)
 
 
 Q = np.linspace(-1, 1, 41)
