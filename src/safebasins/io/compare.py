@@ -1,0 +1,130 @@
+"""Value-by-value comparison of datasets and of whole ``results/data`` trees.
+
+Used to prove that a refactor keeps results (``scripts/compare_results.py``) and by the tests
+(-j1 vs -j2, tiles, cluster, GPU). Provenance attributes (who/when/which commit/which
+parameter text made the file) are reported but never fail a comparison; everything else must
+be identical: names, dims, dtypes, values (NaN == NaN) and the attributes of every variable.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+#: global attributes that describe how a file was made, not what it holds
+PROVENANCE_ATTRS = ("date_created", "git_commit", "safebasins_version", "config_hash", "parameters",
+                    "history", "source", "seeds")
+
+
+def _same_array(a: np.ndarray, b: np.ndarray) -> bool:
+    if a.shape != b.shape or a.dtype != b.dtype:
+        return False
+    if a.dtype.kind in "fc":
+        return bool(np.array_equal(a, b, equal_nan=True))
+    return bool(np.array_equal(a, b))
+
+
+def _same_attr(a, b) -> bool:
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        a, b = np.asarray(a), np.asarray(b)
+        return a.shape == b.shape and (np.array_equal(a, b, equal_nan=a.dtype.kind in "fc"
+                                                      and b.dtype.kind in "fc"))
+    if isinstance(a, float) and isinstance(b, float) and np.isnan(a) and np.isnan(b):
+        return True
+    return type(a) is type(b) and a == b
+
+
+def _attr_diffs(where: str, a: dict, b: dict, ignore=()) -> list[str]:
+    out = []
+    for k in sorted(set(a) | set(b)):
+        if k in ignore:
+            continue
+        if k not in a or k not in b:
+            out.append(f"{where}: attribute {k!r} only in {'new' if k in b else 'old'}")
+        elif not _same_attr(a[k], b[k]):
+            out.append(f"{where}: attribute {k!r} differs: {a[k]!r} vs {b[k]!r}")
+    return out
+
+
+def dataset_differences(old: xr.Dataset, new: xr.Dataset, *, ignore_attrs=PROVENANCE_ATTRS) -> list[str]:
+    """Every difference between two datasets except the ignored global attributes."""
+    out = []
+    names_old, names_new = set(map(str, old.variables)), set(map(str, new.variables))
+    for n in sorted(names_old - names_new):
+        out.append(f"variable {n!r} only in old")
+    for n in sorted(names_new - names_old):
+        out.append(f"variable {n!r} only in new")
+    for n in sorted(names_old & names_new):
+        a, b = old[n].variable, new[n].variable
+        kind_a = "coord" if n in old.coords else "data"
+        kind_b = "coord" if n in new.coords else "data"
+        if kind_a != kind_b:
+            out.append(f"{n}: {kind_a} variable in old, {kind_b} variable in new")
+        if a.dims != b.dims:
+            out.append(f"{n}: dims {a.dims} vs {b.dims}")
+            continue
+        va, vb = np.asarray(a.values), np.asarray(b.values)
+        if not _same_array(va, vb):
+            if va.shape != vb.shape or va.dtype != vb.dtype:
+                out.append(f"{n}: shape/dtype {va.shape} {va.dtype} vs {vb.shape} {vb.dtype}")
+            else:
+                neq = ~((va == vb) | ((va != va) & (vb != vb))) if va.dtype.kind in "fc" else (va != vb)
+                out.append(f"{n}: {int(np.count_nonzero(neq))} of {va.size} values differ")
+        out.extend(_attr_diffs(n, dict(a.attrs), dict(b.attrs)))
+    out.extend(_attr_diffs("<global>", dict(old.attrs), dict(new.attrs), ignore=ignore_attrs))
+    return out
+
+
+@dataclass
+class TreeReport:
+    compared: list[str] = field(default_factory=list)
+    only_old: list[str] = field(default_factory=list)
+    only_new: list[str] = field(default_factory=list)
+    differences: dict[str, list[str]] = field(default_factory=dict)
+    provenance: dict[str, list[str]] = field(default_factory=dict)
+
+    @property
+    def identical(self) -> bool:
+        return not (self.only_old or self.only_new or self.differences)
+
+    def lines(self, verbose=True):
+        for f in self.only_old:
+            yield f"MISSING in new: {f}"
+        for f in self.only_new:
+            yield f"EXTRA in new: {f}"
+        for f in self.compared:
+            if f in self.differences:
+                yield f"DIFFERENT {f}"
+                for d in self.differences[f]:
+                    yield f"    {d}"
+            elif verbose:
+                note = f" (provenance differs: {', '.join(self.provenance[f])})" if f in self.provenance else ""
+                yield f"identical {f}{note}"
+        yield (f"{len(self.compared)} datasets compared: {len(self.differences)} different, "
+               f"{len(self.only_old)} missing, {len(self.only_new)} extra -> "
+               + ("IDENTICAL" if self.identical else "DIFFERENT"))
+
+
+def _datasets(root: Path, parts: bool) -> set[str]:
+    return {str(p.relative_to(root)) for p in root.rglob("*.nc")
+            if parts or "parts" not in p.relative_to(root).parts}
+
+
+def compare_trees(old_root, new_root, *, parts=False) -> TreeReport:
+    """Compare every dataset of two ``results/data`` trees (see the module docstring)."""
+    old_root, new_root = Path(old_root), Path(new_root)
+    a, b = _datasets(old_root, parts), _datasets(new_root, parts)
+    rep = TreeReport(only_old=sorted(a - b), only_new=sorted(b - a))
+    for f in sorted(a & b):
+        rep.compared.append(f)
+        old, new = xr.load_dataset(old_root / f), xr.load_dataset(new_root / f)
+        diffs = dataset_differences(old, new)
+        if diffs:
+            rep.differences[f] = diffs
+        prov = [k for k in PROVENANCE_ATTRS
+                if not _same_attr(old.attrs.get(k), new.attrs.get(k))]
+        if prov:
+            rep.provenance[f] = prov
+    return rep
