@@ -1,0 +1,103 @@
+"""The potential well: the one home of V, dV, H0, turning points, barriers and the unforced
+motion's action-angle variables (paper Sec. 2.1, generalised to any well).
+
+A well is a potential ``V(q)`` with its minimum at ``q = 0``: ``V(0) = V'(0) = 0``,
+``V''(0) > 0``.  On each side the well ends at a barrier (a local maximum of V, i.e. a saddle
+of H0) or nowhere (``V -> inf``).  The escape energy is the lowest barrier, ``barrier_energy``;
+below it every energy level ``0 <= E < barrier_energy`` carries one periodic orbit around the
+well bottom with turning points ``q_minus(E) < 0 < q_plus(E)``.
+
+Conventions shared by every well (they reproduce eqs (13)-(17), (20) for the quartic):
+
+* ``H0(q, p) = p^2 / 2 + V(q)`` (eq 7 for the quartic); energies ``xi``/``E`` are H0 values.
+* the angle ``theta`` advances at ``omega(E) = dE/dJ`` along the free motion ``q' = p,
+  p' = -V'(q)``, and ``theta = 0`` where the orbit crosses the well bottom ``q = 0`` with
+  ``p > 0``;
+* ``q(theta) = sum_k q_k e^{i k theta}``; ``first_harmonic(E)`` is the complex ``q_1``
+  (paper eq (12)); for a symmetric well ``q(theta)`` is odd and ``q_1 = -i G`` with ``G`` real
+  (eq 20 for the quartic).
+
+Escape criteria (one definition, used by theory, numerics, integrity and plotting):
+
+* energy: ``H0(q, p) > xi_max``, or ``q`` beyond a barrier (there H0 no longer measures the
+  well energy);
+* displacement: ``q < q_minus(xi_max)`` or ``q > q_plus(xi_max)`` (eq (4) for the quartic,
+  where ``q_plus = -q_minus = q_max(xi_max)``);
+* the unforced safe set of a threshold: ``S0(xi_max) = {H0 < xi_max, q_minus < q < q_plus}``.
+"""
+from __future__ import annotations
+
+import abc
+
+import numpy as np
+
+__all__ = ["Well"]
+
+
+class Well(abc.ABC):
+    """Abstract potential well; subclasses give V, dV, the barriers and the action-angle data.
+
+    Array arguments broadcast; every method raises ``ValueError`` naming the argument for
+    input outside its domain (an energy outside ``[0, barrier_energy)``, a point outside the
+    well, NaN).
+    """
+
+    #: short name used in datasets and configs ("quartic", "cubic", "polynomial", ...)
+    name: str = "well"
+
+    # ------------------------------------------------------------------ the potential
+    @abc.abstractmethod
+    def V(self, q):
+        """Potential energy V(q)."""
+
+    @abc.abstractmethod
+    def dV(self, q):
+        """V'(q) (the restoring force is -V'(q))."""
+
+    @property
+    @abc.abstractmethod
+    def barriers(self) -> tuple[float, float]:
+        """Positions ``(q_left, q_right)`` of the barrier maxima of V on each side of the well
+        bottom; ``-inf`` / ``+inf`` on a side where ``V -> inf`` (no escape that way)."""
+
+    @property
+    def barrier_energy(self) -> float:
+        """Escape energy: the lowest barrier ``min V(q_left), V(q_right)``."""
+        lo, hi = self.barriers
+        vals = [float(self.V(q)) for q in (lo, hi) if np.isfinite(q)]
+        if not vals:
+            raise ValueError(f"well {self.name!r} has no barrier: nothing can escape")
+        return min(vals)
+
+    def H0(self, q, p):
+        """Unforced energy ``p^2 / 2 + V(q)`` (eq 7, untruncated)."""
+        q = np.asarray(q, dtype=float)
+        p = np.asarray(p, dtype=float)
+        return 0.5 * p * p + self.V(q)
+
+    @abc.abstractmethod
+    def turning_points(self, E):
+        """``(q_minus(E), q_plus(E))``: the orbit's turning points, ``q_minus <= 0 <= q_plus``,
+        for ``0 <= E <= barrier_energy``."""
+
+    # ------------------------------------------------------------------ action-angle
+    @abc.abstractmethod
+    def J(self, E):
+        """Action ``J(E) = (1 / 2 pi) oint p dq`` (eq 13 / 19 for the quartic)."""
+
+    @abc.abstractmethod
+    def omega(self, E):
+        """Frequency ``omega(E) = dE/dJ = 2 pi / period`` (eq 16)."""
+
+    @abc.abstractmethod
+    def angle_energy(self, q, p):
+        """``(theta, E)`` of phase points inside the well (eqs 7, 14); theta in [0, 2 pi)."""
+
+    @abc.abstractmethod
+    def phase_point(self, theta, E):
+        """``(q, p)`` at angle theta on the orbit of energy E (eqs 15, 17); inverse of
+        :meth:`angle_energy`."""
+
+    @abc.abstractmethod
+    def first_harmonic(self, E):
+        """Complex first Fourier coefficient ``q_1(E)`` of ``q(theta)`` (eq 12)."""
