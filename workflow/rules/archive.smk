@@ -1,8 +1,12 @@
-# Stage 7: archive of every dataset + resolved configuration + environment + SHA-256 manifest.
+# Stage 7: the results archive, a Workflow Run RO-Crate (safebasins.io.archive): every dataset,
+# the resolved parameter files and configuration, environment.lock, installed package versions,
+# CITATION.cff, the workflow (Snakefile + rule files), ro-crate-metadata.json and a SHA-256 manifest.
 #   snakemake -j2 archive   ->   results/archive/safebasins-results.tar.gz
 
 
 ARCHIVE = "results/archive/safebasins-results.tar.gz"
+# the workflow's source tree (where the real Snakefile lives, also when it is run through a symlink)
+WORKFLOW_SRC = Path(workflow.main_snakefile).resolve().parent
 
 
 rule archive:
@@ -10,6 +14,9 @@ rule archive:
         datasets=DATASETS,
         params=PARAM_FILES,
         lock="environment.lock",
+        workflow=str(WORKFLOW_SRC / "Snakefile"),
+        rules=sorted(str(p) for p in (WORKFLOW_SRC / "workflow" / "rules").glob("*.smk")),
+        citation=str(WORKFLOW_SRC / "CITATION.cff"),
     output:
         ARCHIVE,
     params:
