@@ -1,0 +1,346 @@
+"""CUDA kernels (numba-cuda) for the escape ensembles of eq (1): q'' + q - q^3 = F sin(Omega t + Psi).
+
+The GPU twin of kernels.py: same schemes (Blanes-Moan SRKN6b by default, classic RK4), same
+forcing tables, same escape criteria, and the SAME SEQUENCE OF IEEE OPERATIONS per trajectory,
+so the recorded first-crossing steps are bitwise equal to the CPU engine's.
+
+Bitwise equality: fused multiply-adds and contraction
+------------------------------------------------------
+The CPU lanes write every fused multiply-add explicitly (llvm.fma) and keep every other product
+as a separate, rounded multiply (numba's CPU target never contracts).  NVVM, in contrast,
+contracts a*b + c into one fma by default (-fma=1; numba-cuda turns it off for no option but
+fastmath, which would also flush denormals and relax division), and ptxas may do the same with
+PTX mul/add pairs that carry no rounding modifier.  Contraction needs an add or subtract whose
+operand is the result of a multiply; this module leaves no such pair:
+
+* every product the CPU forms OUTSIDE an fma is computed on the host instead, with numpy, in
+  exactly the CPU's form: the forcing values F * sin(Omega t_k + Psi) are the table
+  FS[k, s, j] = F[k] * sine_table[s, j] (the CPU's shared path precomputes the same products,
+  its replay and per-lane paths form the same IEEE products in the loop), and the step
+  coefficients h * a_k, h * b_k are kernels.lane_coefficients (the CPU's replay uses the same
+  array);
+* the products that remain in the kernel, q*q in the force and q*q, p*p in the energy, feed
+  only explicit fma instructions (as a multiplicand or as the addend), never an add: an fma
+  cannot absorb a further product, so nothing can be fused;
+* RK4's sums (p2 + p3 etc.) contain no product.  LLVM may rewrite s + s as s * 2.0 and NVVM
+  then fuse that into fma(s, 2, x): doubling is exact, so round(x + 2 s) is the same number
+  either way (short of overflow, long after escape).
+No fast-math anywhere, no division, no transcendental in the kernel (sin is in the host table).
+FP64 has no flush-to-zero on the GPU.  benchmarks/bench_gpu.py counts the PTX f64 instructions
+of the compiled kernel (each step must show exactly the CPU's multiplies) and compares the
+escape steps with the CPU engine.
+
+The simulator (NUMBA_ENABLE_CUDASIM=1) implements cuda.fma as a*b + c (two roundings); under
+the simulator `fma` is therefore the CPU's correctly rounded kernels.fma (llvm.fma), called
+from Python, so the simulator runs the same arithmetic as the GPU.
+
+Kernel organisation (one thread = one trajectory at a time)
+-----------------------------------------------------------
+* Escape check after every step, as on the CPU but without the CPU's segment maxima and
+  replay: the step of first crossing is recorded directly.  A branch-free filter (2 H0 > next
+  uncrossed 2 xi_max, or |q| > next uncrossed q_max or the barrier) guards the exact scalar
+  bookkeeping, which is kernels._check_state line for line.
+* Persistent threads: the grid holds no more blocks than the GPU keeps resident; a thread
+  whose trajectory is finished (every threshold crossed, any with stop_any, or the horizon
+  reached) takes the next one from a global atomic counter at the period boundary.  The
+  forcing is periodic, so every thread of a block stays at the same sub-step of the period
+  and reads the same table row (a broadcast from shared memory).  The counter hands
+  trajectories out in a scrambled order i = c * A mod N (A coprime to N): escape times are
+  spatially clustered in an initial-condition grid, and the scrambling spreads the long-lived
+  ones evenly over blocks and SMs.
+* Compaction: once the queue is empty, finished trajectories leave holes that would keep
+  half-empty warps running at full cost (a chart where 90% escape in 10 cycles would run at
+  the speed of its slowest trajectory in every warp).  At a period boundary where the live
+  trajectories of a block fit in fewer warps than they occupy, the block packs them into its
+  first lanes (state through shared memory); the freed warps exit.  Moving a trajectory to
+  another lane does not change its arithmetic.
+* Forcing table in shared memory when it fits (one parameter set: S * 7 doubles); many
+  parameter sets (bisection) read it from global memory (cached).
+* The force is a device function force(q, f) handed to the kernel factory: other wells
+  (a polynomial -V'(q) evaluated by Horner with fma) plug in there.  The escape criteria
+  (energy2, the barrier |q| = 1) are those of the quartic well, as in kernels.py.
+"""
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+from numba import cuda, float64, int32, int64, njit
+from numba.cuda.core import config as cuda_config
+
+from safebasins.numerics import kernels
+
+SIMULATOR = bool(cuda_config.ENABLE_CUDASIM)
+Q_BARRIER = kernels.Q_BARRIER
+WIDTHS = {"srkn6b": 7, "rk4": 3}     # forcing values per step (the scheme of a table)
+BLOCK = 128                          # threads per block on a GPU
+WARP = 32
+# forcing tables up to this size go to shared memory (48 KiB needs no opt-in; leave room for
+# the compaction buffers and for several blocks per SM)
+SHARED_TABLE_BYTES = 16 * 1024
+
+
+def _device(fn):
+    return cuda.jit(device=True)(fn)
+
+
+if SIMULATOR:
+    @njit(cache=True)
+    def _fma_cpu(a, b, c):
+        return kernels.fma(a, b, c)
+
+    def fma(a, b, c):
+        """Correctly rounded a*b + c: the CPU's llvm.fma (the simulator's cuda.fma rounds twice)."""
+        return _fma_cpu(a, b, c)
+else:
+    @_device
+    def fma(a, b, c):
+        """Correctly rounded a*b + c (llvm.fma -> fma.rn.f64)."""
+        return cuda.fma(a, b, c)
+
+
+# ------------------------------------------------------------------------------- the well
+def make_force_quartic():
+    """force(q, f) = q^3 - q + f for V = q^2/2 - q^4/4, as kernels.force: fma(q*q, q, f - q)."""
+    @_device
+    def force(q, f):
+        return fma(q * q, q, f - q)
+    return force
+
+
+@_device
+def energy2(q, p):
+    """2 H0 = p^2 + q^2 - q^4/2, as kernels.energy2."""
+    q2 = q * q
+    return fma(q2, fma(-0.5, q2, 1.0), p * p)
+
+
+# ------------------------------------------------------------------------------- schemes
+def make_steps(force):
+    """Device steps for a force(q, f): (bm6_step, rk4_step), each
+    step(q, p, c1, ..., c7, tab, o) -> (q, p) with the forcing values tab[o], tab[o+1], ...
+    (already multiplied by F) and c1..c7 as kernels.lane_coefficients.  Same operations in the
+    same order as kernels.bm6_step / kernels.rk4_step."""
+    @_device
+    def bm6_step(q, p, a1, a2, a3, b1, b2, b3, b4, tab, o):
+        p = fma(b1, force(q, tab[o]), p)
+        q = fma(a1, p, q)
+        p = fma(b2, force(q, tab[o + 1]), p)
+        q = fma(a2, p, q)
+        p = fma(b3, force(q, tab[o + 2]), p)
+        q = fma(a3, p, q)
+        p = fma(b4, force(q, tab[o + 3]), p)
+        q = fma(a3, p, q)
+        p = fma(b3, force(q, tab[o + 4]), p)
+        q = fma(a2, p, q)
+        p = fma(b2, force(q, tab[o + 5]), p)
+        q = fma(a1, p, q)
+        p = fma(b1, force(q, tab[o + 6]), p)
+        return q, p
+
+    @_device
+    def rk4_step(q, p, hh, h, h6, c4, c5, c6, c7, tab, o):
+        f2 = tab[o + 1]
+        k1 = force(q, tab[o])
+        q2 = fma(hh, p, q)
+        p2 = fma(hh, k1, p)
+        k2 = force(q2, f2)
+        q3 = fma(hh, p2, q)
+        p3 = fma(hh, k2, p)
+        k3 = force(q3, f2)
+        q4 = fma(h, p3, q)
+        p4 = fma(h, k3, p)
+        k4 = force(q4, tab[o + 2])
+        sq = p2 + p3
+        sp = k2 + k3
+        q = fma(h6, (p + p4) + (sq + sq), q)
+        p = fma(h6, (k1 + k4) + (sp + sp), p)
+        return q, p
+
+    return bm6_step, rk4_step
+
+
+# ------------------------------------------------------------------------------- escape bookkeeping
+@_device
+def check_state(i, e, aq, step, thrE2, nE, thrQ, nQ, iE, iQ, outE, outQ):
+    """kernels._check_state with e = energy2(q, p), aq = |q|: record `step` for every next
+    uncrossed threshold the state is beyond (outE, outQ flat, row i)."""
+    while iE < nE and (e > thrE2[iE] or aq > Q_BARRIER):
+        outE[i * nE + iE] = step
+        iE += 1
+    while iQ < nQ and aq > thrQ[iQ]:
+        outQ[i * nQ + iQ] = step
+        iQ += 1
+    return iE, iQ
+
+
+@_device
+def finished(iE, iQ, nE, nQ, stop_any):
+    return (iE == nE and iQ == nQ) or (stop_any and (iE > 0 or iQ > 0))
+
+
+@_device
+def next_filters(iE, iQ, thrE2, nE, thrQ, nQ):
+    """(tE, tQ): the next uncrossed 2 xi_max (inf: none) and the next uncrossed q_max, or the
+    barrier while an energy threshold is uncrossed (|q| > 1 crosses them all)."""
+    tE = math.inf
+    tQ = math.inf
+    if iQ < nQ:
+        tQ = thrQ[iQ]
+    if iE < nE:
+        tE = thrE2[iE]
+        if Q_BARRIER < tQ:
+            tQ = Q_BARRIER
+    return tE, tQ
+
+
+# ------------------------------------------------------------------------------- the kernel
+@functools.lru_cache(maxsize=None)
+def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WARP, force=None):
+    """The compiled ensemble kernel for one scheme (cached per argument set).
+
+    integrator: "srkn6b" | "rk4"; shared_table: copy the forcing table into dynamic shared
+    memory (launch with its size in bytes); block: threads per block (static shared buffers);
+    warp: compaction granularity (32 on a GPU; smaller values exercise compaction in the
+    simulator); force: a device function force(q, f) (None: the quartic well).
+
+    Launch: kernel[grid, block, 0, table_bytes if shared_table else 0](
+        q0, p0, pidx, coef, FS, thrE2, nE, thrQ, nQ, N, S, cycles, stop_any, A, counter, outE, outQ)
+    q0, p0 (N,) float64; pidx (N,) int64; coef (P*7,) lane_coefficients; FS (P*S*W,) the
+    forcing products F[k] * sine_table (W = 7 or 3); thrE2 (>= max(nE, 1),) sorted 2*xi_max;
+    thrQ (>= max(nQ, 1),) sorted q_max; A: scrambling multiplier (coprime to N); counter (1,)
+    int64 = 0; outE (N*nE,), outQ (N*nQ,) int64 pre-filled with -1.
+    """
+    W = WIDTHS[kernels.check_integrator(integrator)]
+    bm6_step, rk4_step = make_steps(make_force_quartic() if force is None else force)
+    step = rk4_step if integrator == "rk4" else bm6_step
+    SHARED = bool(shared_table)
+    BLK = int(block)
+    WRP = int(warp)
+    if BLK % WRP:
+        raise ValueError(f"block ({BLK}) must be a multiple of warp ({WRP})")
+
+    def ensemble(q0, p0, pidx, coef, FS, thrE2, nE, thrQ, nQ, N, S, cycles, stop_any, A, counter,
+                 outE, outQ):
+        tid = cuda.threadIdx.x
+        # compaction buffers (one slot per lane) and the slot counter
+        bq = cuda.shared.array(BLK, float64)
+        bp = cuda.shared.array(BLK, float64)
+        bi = cuda.shared.array(BLK, int64)
+        bk = cuda.shared.array(BLK, int64)
+        bper = cuda.shared.array(BLK, int64)
+        bE = cuda.shared.array(BLK, int32)
+        bQ = cuda.shared.array(BLK, int32)
+        cnt = cuda.shared.array(1, int32)
+        if SHARED:
+            tab = cuda.shared.array(0, float64)
+            for j in range(tid, FS.shape[0], BLK):
+                tab[j] = FS[j]
+        else:
+            tab = FS
+        if tid == 0:
+            cnt[0] = 0
+        cuda.syncthreads()
+
+        SW = S * W
+        live = False
+        empty = False
+        nlive_c = BLK             # live lanes lie in [0, nlive_c) (after the last compaction)
+        i = int64(0)
+        k = int64(0)
+        per = int64(0)
+        iE = int64(0)
+        iQ = int64(0)
+        q = 0.0
+        p = 0.0
+        tE = math.inf
+        tQ = math.inf
+        c1 = c2 = c3 = c4 = c5 = c6 = c7 = 0.0
+        reload = False
+        while True:
+            # ---------------------------------------------- take the next trajectory
+            if not live and not empty:
+                while True:
+                    c = cuda.atomic.add(counter, 0, 1)
+                    if c >= N:
+                        empty = True
+                        break
+                    i = (c * A) % N
+                    q = q0[i]
+                    p = p0[i]
+                    iE, iQ = check_state(i, energy2(q, p), abs(q), 0, thrE2, nE, thrQ, nQ, 0, 0,
+                                         outE, outQ)
+                    if finished(iE, iQ, nE, nQ, stop_any):
+                        continue
+                    k = pidx[i]
+                    per = 0
+                    live = True
+                    reload = True
+                    break
+            nlive = cuda.syncthreads_count(1 if live else 0)
+            if nlive == 0:
+                break             # every lane idle and the queue empty: uniform exit
+            # ---------------------------------------------- compaction (queue exhausted)
+            if cuda.syncthreads_or(1 if empty else 0) and (nlive + WRP - 1) // WRP < (nlive_c + WRP - 1) // WRP:
+                if live:
+                    slot = cuda.atomic.add(cnt, 0, 1)
+                    bq[slot] = q
+                    bp[slot] = p
+                    bi[slot] = i
+                    bk[slot] = k
+                    bper[slot] = per
+                    bE[slot] = iE
+                    bQ[slot] = iQ
+                cuda.syncthreads()
+                live = tid < nlive
+                if live:
+                    q = bq[tid]
+                    p = bp[tid]
+                    i = bi[tid]
+                    k = bk[tid]
+                    per = bper[tid]
+                    iE = int64(bE[tid])
+                    iQ = int64(bQ[tid])
+                    reload = True
+                if tid == 0:
+                    cnt[0] = 0
+                nlive_c = nlive
+                cuda.syncthreads()
+            if not live:
+                # idle lanes stay in the loop (every lane must reach the block barriers); a warp
+                # of idle lanes issues no arithmetic and only waits at the barriers
+                continue
+            if reload:
+                o = k * 7
+                c1 = coef[o]
+                c2 = coef[o + 1]
+                c3 = coef[o + 2]
+                c4 = coef[o + 3]
+                c5 = coef[o + 4]
+                c6 = coef[o + 5]
+                c7 = coef[o + 6]
+                tE, tQ = next_filters(iE, iQ, thrE2, nE, thrQ, nQ)
+                reload = False
+            # ---------------------------------------------- one forcing period
+            o = k * SW
+            base = per * S
+            for s in range(S):
+                q, p = step(q, p, c1, c2, c3, c4, c5, c6, c7, tab, o)
+                o += W
+                e = energy2(q, p)
+                aq = abs(q)
+                if e > tE or aq > tQ:
+                    iE, iQ = check_state(i, e, aq, base + s + 1, thrE2, nE, thrQ, nQ, iE, iQ, outE, outQ)
+                    if finished(iE, iQ, nE, nQ, stop_any):
+                        live = False
+                        break
+                    tE, tQ = next_filters(iE, iQ, thrE2, nE, thrQ, nQ)
+            if live:
+                per += 1
+                if per >= cycles:
+                    live = False
+
+    sig = ("void(float64[::1], float64[::1], int64[::1], float64[::1], float64[::1], float64[::1], int64, "
+           "float64[::1], int64, int64, int64, int64, boolean, int64, int64[::1], int64[::1], int64[::1])")
+    return cuda.jit(sig)(ensemble)
