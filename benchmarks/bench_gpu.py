@@ -95,18 +95,25 @@ def compare(a, b):
     return dict(bitwise_equal=bool(np.array_equal(a, b)), mismatches=int((a != b).sum()), compared=int(a.size))
 
 
-def dense(n, cycles, S=32, seed=1, run_cpu=True):
+def dense(n, cycles, S=32, seed=1, run_cpu=True, integrator="srkn6b", blocks=()):
     rng = np.random.default_rng(seed)
     q = rng.uniform(-0.3, 0.3, n)
     p = rng.uniform(-0.3, 0.3, n)          # H0 < 0.09: never reaches xi_max = 0.25 with F = 0
     pidx = np.zeros(n, np.int64)
-    kw = dict(xi_max=[0.25], q_max=[1.0], cycles=cycles, steps_per_cycle=S)
+    kw = dict(xi_max=[0.25], q_max=[1.0], cycles=cycles, steps_per_cycle=S, integrator=integrator)
     steps = n * cycles * S
     cuda_engine.run_ensemble_cuda(q[:256], p[:256], pidx[:256], [0.95], [0.0], np.pi, **dict(kw, cycles=2))
     tm = {}
     gE, gQ = cuda_engine.run_ensemble_cuda(q, p, pidx, [0.95], [0.0], np.pi, timing=tm, **kw)
-    out = dict(n=n, cycles=cycles, steps_per_cycle=S, trajectory_steps=steps, gpu=dict(tm),
-               gpu_steps_per_s=steps / tm["kernel_s"], escaped=int((gE >= 0).sum() + (gQ >= 0).sum()))
+    out = dict(integrator=integrator, n=n, cycles=cycles, steps_per_cycle=S, trajectory_steps=steps, gpu=dict(tm),
+               gpu_steps_per_s=steps / tm["kernel_s"], escaped=int((gE >= 0).sum() + (gQ >= 0).sum()), block_sweep={})
+    for b in blocks:                         # GPU only: threads per block (results must not change)
+        cuda_engine.run_ensemble_cuda(q[:256], p[:256], pidx[:256], [0.95], [0.0], np.pi, block=b, **dict(kw, cycles=2))
+        tb = {}
+        bE, bQ = cuda_engine.run_ensemble_cuda(q, p, pidx, [0.95], [0.0], np.pi, timing=tb, block=b, **kw)
+        out["block_sweep"][b] = dict(kernel_s=tb["kernel_s"], steps_per_s=steps / tb["kernel_s"], grid=tb["grid"],
+                                     regs=tb.get("regs_per_thread"),
+                                     same_as_default=bool(np.array_equal(bE, gE) and np.array_equal(bQ, gQ)))
     if run_cpu:
         engine.run_ensemble(q[:256], p[:256], pidx[:256], [0.95], [0.0], np.pi, **dict(kw, cycles=2))
         t = time.perf_counter()
@@ -124,13 +131,14 @@ def work_steps(sE, sQ, cycles, S):
     return int(np.where(done, allc.max(axis=1), cycles * S).sum())
 
 
-def fig21(n=300, cpu_sample=None, cpu_result=None, cycles=FIG21["cycles"]):
+def fig21(n=300, cpu_sample=None, cpu_result=None, cycles=FIG21["cycles"], integrator="srkn6b"):
     qa = np.linspace(-1.0, 1.0, n)
     pa = np.linspace(-0.75, 0.75, n)
     Q, P = np.meshgrid(qa, pa, indexing="ij")
     Q, P = Q.ravel(), P.ravel()
     pidx = np.zeros(Q.size, np.int64)
-    kw = dict(xi_max=FIG21["xi_max"], q_max=FIG21["q_max"], cycles=cycles, steps_per_cycle=FIG21["steps_per_cycle"])
+    kw = dict(xi_max=FIG21["xi_max"], q_max=FIG21["q_max"], cycles=cycles, steps_per_cycle=FIG21["steps_per_cycle"],
+              integrator=integrator)
     args = ([FIG21["Omega"]], [FIG21["F"]], FIG21["Psi"])
     runs = []
     for _ in range(2):                      # the first run pays for nothing but the transfers
@@ -139,7 +147,7 @@ def fig21(n=300, cpu_sample=None, cpu_result=None, cycles=FIG21["cycles"]):
         runs.append(tm)
     S = FIG21["steps_per_cycle"]
     work = work_steps(gE, gQ, cycles, S)
-    out = dict(n=n, cycles=cycles, gpu_runs=runs, kernel_s=min(r["kernel_s"] for r in runs),
+    out = dict(integrator=integrator, n=n, cycles=cycles, gpu_runs=runs, kernel_s=min(r["kernel_s"] for r in runs),
                wall_s=min(r["wall_s"] for r in runs), trajectory_steps=work,
                gpu_steps_per_s=work / min(r["kernel_s"] for r in runs),
                safe_fraction={f"t{t}": dict(E=float(((gE[:, 0] < 0) | (gE[:, 0] > t * S)).mean()),
@@ -150,7 +158,8 @@ def fig21(n=300, cpu_sample=None, cpu_result=None, cycles=FIG21["cycles"]):
     cached = None
     if cpu_result and os.path.exists(cpu_result):
         z = np.load(cpu_result)
-        if int(z["n"]) == n and int(z["cycles"]) == cycles and np.array_equal(z["rows"], rows):
+        if (int(z["n"]) == n and int(z["cycles"]) == cycles and np.array_equal(z["rows"], rows)
+                and str(z.get("integrator", "srkn6b")) == integrator):
             cached = z
         else:
             print(f"  {cpu_result}: made for other rows/n/cycles: recomputing")
@@ -163,7 +172,8 @@ def fig21(n=300, cpu_sample=None, cpu_result=None, cycles=FIG21["cycles"]):
         cE, cQ, _ = engine.run_ensemble(Q[sel], P[sel], pidx[sel], *args, **kw)
         cpu_s = time.perf_counter() - t
         if cpu_result:
-            np.savez(cpu_result, steps_E=cE, steps_Q=cQ, rows=rows, n=n, cycles=cycles, cpu_s=cpu_s)
+            np.savez(cpu_result, steps_E=cE, steps_Q=cQ, rows=rows, n=n, cycles=cycles, cpu_s=cpu_s,
+                     integrator=integrator)
     out.update(cpu_rows=int(rows.size), cpu_s=cpu_s, cpu_s_full_estimate=cpu_s * n / rows.size,
                E=compare(cE, gE[sel]), Q=compare(cQ, gQ[sel]))
     return out
@@ -177,7 +187,10 @@ def main():
     ap.add_argument("--chart-n", type=int, default=300)
     ap.add_argument("--chart-cycles", type=int, default=FIG21["cycles"])
     ap.add_argument("--cpu-sample", type=int, default=None, help="compare Fig 21 on this many rows of q0")
-    ap.add_argument("--cpu-result", default=None, help="npz of CPU Fig 21 steps: reused if it fits, else written")
+    ap.add_argument("--cpu-result", default=None, help="npz of CPU Fig 21 steps: reused if it fits, else written "
+                    "(srkn6b; other integrators get the suffix _<integrator>)")
+    ap.add_argument("--integrators", default="srkn6b", help="comma-separated: srkn6b,rk4")
+    ap.add_argument("--blocks", default="", help="comma-separated threads per block to sweep on the dense job (GPU)")
     ap.add_argument("--json", default=None)
     a = ap.parse_args()
     if not cuda_engine.cuda_available():
@@ -191,25 +204,35 @@ def main():
     for r in res["ptx"]:
         print(f"kernel {r['integrator']}: PTX f64 ops {r['ptx_f64_ops']}; contractible mul->add/sub pairs: "
               f"{r['contractible_pairs']}; SASS {r['sass']}")
-    d = dense(a.dense_n, a.dense_cycles, run_cpu=bool(a.dense_cpu))
-    res["dense"] = d
-    print(f"(a) dense: {d['n']} trajectories x {d['cycles']} cycles x {d['steps_per_cycle']} steps = "
-          f"{d['trajectory_steps']:.3g} trajectory-steps, none escapes ({d['escaped']} crossings)")
-    print(f"    GPU kernel {d['gpu']['kernel_s']:.4f} s -> {d['gpu_steps_per_s']:.3g} steps/s "
-          f"(grid {d['gpu']['grid']} x {d['gpu']['block']}, {d['gpu'].get('regs_per_thread')} regs, "
-          f"wall {d['gpu']['wall_s']:.3f} s)")
-    if "cpu_s" in d:
-        print(f"    CPU {d['cpu_s']:.3f} s -> {d['cpu_steps_per_s']:.3g} steps/s; GPU/CPU "
-              f"{d['gpu_steps_per_s'] / d['cpu_steps_per_s']:.1f}x; steps E {d['E']}, Q {d['Q']}")
-    f = fig21(a.chart_n, a.cpu_sample, a.cpu_result, a.chart_cycles)
-    res["fig21"] = f
-    print(f"(b) Fig 21 chart {f['n']}x{f['n']}, {f['cycles']} cycles: GPU kernel {f['kernel_s']:.4f} s, wall "
-          f"{f['wall_s']:.4f} s (runs: {[round(r['kernel_s'], 4) for r in f['gpu_runs']]} s kernel); "
-          f"{f['trajectory_steps']:.3g} trajectory-steps -> {f['gpu_steps_per_s']:.3g} steps/s")
-    print(f"    safe fractions {f['safe_fraction']}")
-    print(f"    CPU {f['cpu_s']:.2f} s on {f['cpu_rows']} of {f['n']} rows (full chart ~{f['cpu_s_full_estimate']:.1f} s)"
-          f"{' [from ' + f['cpu_from'] + ']' if 'cpu_from' in f else ''}; "
-          f"CPU vs GPU steps: E {f['E']}, Q {f['Q']}")
+    blocks = [int(b) for b in a.blocks.split(",") if b]
+    res["dense"], res["fig21"] = [], []
+    for integrator in a.integrators.split(","):
+        d = dense(a.dense_n, a.dense_cycles, run_cpu=bool(a.dense_cpu), integrator=integrator, blocks=blocks)
+        res["dense"].append(d)
+        print(f"(a) dense [{integrator}]: {d['n']} trajectories x {d['cycles']} cycles x {d['steps_per_cycle']} steps = "
+              f"{d['trajectory_steps']:.3g} trajectory-steps, none escapes ({d['escaped']} crossings)")
+        print(f"    GPU kernel {d['gpu']['kernel_s']:.4f} s -> {d['gpu_steps_per_s']:.3g} steps/s "
+              f"(grid {d['gpu']['grid']} x {d['gpu']['block']}, {d['gpu'].get('regs_per_thread')} regs, "
+              f"wall {d['gpu']['wall_s']:.3f} s)")
+        for b, r in d["block_sweep"].items():
+            print(f"    block {b}: grid {r['grid']}, {r['regs']} regs, kernel {r['kernel_s']:.4f} s -> "
+                  f"{r['steps_per_s']:.3g} steps/s, steps identical to block {d['gpu']['block']}: {r['same_as_default']}")
+        if "cpu_s" in d:
+            print(f"    CPU {d['cpu_s']:.3f} s -> {d['cpu_steps_per_s']:.3g} steps/s; GPU/CPU "
+                  f"{d['gpu_steps_per_s'] / d['cpu_steps_per_s']:.1f}x; steps E {d['E']}, Q {d['Q']}")
+        cpu_result = a.cpu_result
+        if cpu_result and integrator != "srkn6b":
+            root, ext = os.path.splitext(cpu_result)
+            cpu_result = f"{root}_{integrator}{ext}"
+        f = fig21(a.chart_n, a.cpu_sample, cpu_result, a.chart_cycles, integrator)
+        res["fig21"].append(f)
+        print(f"(b) Fig 21 chart [{integrator}] {f['n']}x{f['n']}, {f['cycles']} cycles: GPU kernel {f['kernel_s']:.4f} s, "
+              f"wall {f['wall_s']:.4f} s (runs: {[round(r['kernel_s'], 4) for r in f['gpu_runs']]} s kernel); "
+              f"{f['trajectory_steps']:.3g} trajectory-steps -> {f['gpu_steps_per_s']:.3g} steps/s")
+        print(f"    safe fractions {f['safe_fraction']}")
+        print(f"    CPU {f['cpu_s']:.2f} s on {f['cpu_rows']} of {f['n']} rows (full chart ~{f['cpu_s_full_estimate']:.1f} s)"
+              f"{' [from ' + f['cpu_from'] + ']' if 'cpu_from' in f else ''}; "
+              f"CPU vs GPU steps: E {f['E']}, Q {f['Q']}")
     if a.json:
         with open(a.json, "w") as fh:
             json.dump(res, fh, indent=1, default=str)

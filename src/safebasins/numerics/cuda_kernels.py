@@ -66,7 +66,7 @@ import functools
 import math
 
 import numpy as np
-from numba import cuda, float64, int32, int64, njit
+from numba import cuda, float64, int32, int64, njit, uint64
 from numba.cuda.core import config as cuda_config
 
 from safebasins.numerics import kernels
@@ -76,6 +76,11 @@ Q_BARRIER = kernels.Q_BARRIER
 WIDTHS = {"srkn6b": 7, "rk4": 3}     # forcing values per step (the scheme of a table)
 BLOCK = 128                          # threads per block on a GPU
 WARP = 32
+# forcing-table offsets are unsigned: numba wraps negative signed indices around (a compare,
+# select and add per load, five 64-bit integer instructions on each of the 7 loads of a step,
+# which made the step issue-bound); unsigned + unsigned stays unsigned (unsigned + signed would
+# be float64 in numba's typing)
+U1, U2, U3, U4, U5, U6 = (np.uint64(j) for j in range(1, 7))
 # forcing tables up to this size go to shared memory (48 KiB needs no opt-in; leave room for
 # the compaction buffers and for several blocks per SM)
 SHARED_TABLE_BYTES = 16 * 1024
@@ -120,28 +125,28 @@ def energy2(q, p):
 def make_steps(force):
     """Device steps for a force(q, f): (bm6_step, rk4_step), each
     step(q, p, c1, ..., c7, tab, o) -> (q, p) with the forcing values tab[o], tab[o+1], ...
-    (already multiplied by F) and c1..c7 as kernels.lane_coefficients.  Same operations in the
+    (already multiplied by F; o unsigned) and c1..c7 as kernels.lane_coefficients.  Same operations in the
     same order as kernels.bm6_step / kernels.rk4_step."""
     @_device
     def bm6_step(q, p, a1, a2, a3, b1, b2, b3, b4, tab, o):
         p = fma(b1, force(q, tab[o]), p)
         q = fma(a1, p, q)
-        p = fma(b2, force(q, tab[o + 1]), p)
+        p = fma(b2, force(q, tab[o + U1]), p)
         q = fma(a2, p, q)
-        p = fma(b3, force(q, tab[o + 2]), p)
+        p = fma(b3, force(q, tab[o + U2]), p)
         q = fma(a3, p, q)
-        p = fma(b4, force(q, tab[o + 3]), p)
+        p = fma(b4, force(q, tab[o + U3]), p)
         q = fma(a3, p, q)
-        p = fma(b3, force(q, tab[o + 4]), p)
+        p = fma(b3, force(q, tab[o + U4]), p)
         q = fma(a2, p, q)
-        p = fma(b2, force(q, tab[o + 5]), p)
+        p = fma(b2, force(q, tab[o + U5]), p)
         q = fma(a1, p, q)
-        p = fma(b1, force(q, tab[o + 6]), p)
+        p = fma(b1, force(q, tab[o + U6]), p)
         return q, p
 
     @_device
     def rk4_step(q, p, hh, h, h6, c4, c5, c6, c7, tab, o):
-        f2 = tab[o + 1]
+        f2 = tab[o + U1]
         k1 = force(q, tab[o])
         q2 = fma(hh, p, q)
         p2 = fma(hh, k1, p)
@@ -151,7 +156,7 @@ def make_steps(force):
         k3 = force(q3, f2)
         q4 = fma(h, p3, q)
         p4 = fma(h, k3, p)
-        k4 = force(q4, tab[o + 2])
+        k4 = force(q4, tab[o + U2])
         sq = p2 + p3
         sp = k2 + k3
         q = fma(h6, (p + p4) + (sq + sq), q)
@@ -213,6 +218,7 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
     int64 = 0; outE (N*nE,), outQ (N*nQ,) int64 pre-filled with -1.
     """
     W = WIDTHS[kernels.check_integrator(integrator)]
+    UW = np.uint64(W)
     bm6_step, rk4_step = make_steps(make_force_quartic() if force is None else force)
     step = rk4_step if integrator == "rk4" else bm6_step
     SHARED = bool(shared_table)
@@ -243,7 +249,7 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
             cnt[0] = 0
         cuda.syncthreads()
 
-        SW = S * W
+        uSW = uint64(S) * UW
         live = False
         empty = False
         nlive_c = BLK             # live lanes lie in [0, nlive_c) (after the last compaction)
@@ -323,11 +329,11 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
                 tE, tQ = next_filters(iE, iQ, thrE2, nE, thrQ, nQ)
                 reload = False
             # ---------------------------------------------- one forcing period
-            o = k * SW
+            o = uint64(k) * uSW
             base = per * S
             for s in range(S):
                 q, p = step(q, p, c1, c2, c3, c4, c5, c6, c7, tab, o)
-                o += W
+                o += UW
                 e = energy2(q, p)
                 aq = abs(q)
                 if e > tE or aq > tQ:
