@@ -26,9 +26,11 @@ operand is the result of a multiply; this module leaves no such pair:
   then fuse that into fma(s, 2, x): doubling is exact, so round(x + 2 s) is the same number
   either way (short of overflow, long after escape).
 No fast-math anywhere, no division, no transcendental in the kernel (sin is in the host table).
-FP64 has no flush-to-zero on the GPU.  benchmarks/bench_gpu.py counts the PTX f64 instructions
-of the compiled kernel (each step must show exactly the CPU's multiplies) and compares the
-escape steps with the CPU engine.
+FP64 has no flush-to-zero on the GPU.  benchmarks/bench_gpu.py counts the f64 instructions of
+the compiled kernel and the multiplies that feed an add (must be none), and compares the escape
+steps with the CPU engine.  On an H100 (numba-cuda 0.30.4) the SASS has exactly the PTX's DFMA
+and DMUL counts (nothing fused) and the Fig 21 chart (90,000 ICs, 11,000 cycles) and a dense
+1e5-trajectory job gave 0 differing escape steps for both schemes.
 
 The simulator (NUMBA_ENABLE_CUDASIM=1) implements cuda.fma as a*b + c (two roundings); under
 the simulator `fma` is therefore the CPU's correctly rounded kernels.fma (llvm.fma), called
