@@ -1,8 +1,8 @@
-# safebasins: every dataset (and, via workflow/rules/figures.smk, every figure) of
-# Karmi, Kravetc & Gendelman, "Analytic exploration of safe basins in a benchmark problem of
-# forced escape", from config/config.yaml.
+# safebasins: every dataset and figure of Karmi, Kravetc & Gendelman, "Analytic exploration of
+# safe basins in a benchmark problem of forced escape", and the beyond-the-paper products, from
+# config/config.yaml through the registry of experiment kinds (safebasins.pipeline).
 #
-#   snakemake -j2                                        # all datasets, archive, figures into results/
+#   snakemake -j2                                        # all datasets, figures, archive
 #   snakemake -j2 --configfile config/quick.yaml         # the same DAG at coarse resolution
 #   snakemake -j2 archive                                # results/archive/*.tar.gz
 #   snakemake --report results/report.html               # HTML report
@@ -21,21 +21,19 @@ include: "workflow/rules/common.smk"
 include: "workflow/rules/parameters.smk"
 include: "workflow/rules/analytic.smk"
 include: "workflow/rules/numeric.smk"
-include: "workflow/rules/agreement.smk"
-include: "workflow/rules/figures.smk"
 include: "workflow/rules/extras.smk"
+include: "workflow/rules/figures.smk"
 include: "workflow/rules/archive.smk"
 
 
 rule all:
-    """Every dataset behind the paper's 22 figures, their archive, the figures and the extra products."""
+    """Every dataset, figure and the archive."""
     default_target: True
     input:
         PARAM_FILES,
         DATASETS,
         ARCHIVE,
-        FIGURE_TARGETS,
-        EXTRA_TARGETS,
+        [p for f in FIGURES for p in (f.png, f.pdf)],
 
 
 rule datasets:
@@ -43,3 +41,10 @@ rule datasets:
     input:
         PARAM_FILES,
         DATASETS,
+
+
+rule experiments:
+    """The datasets and figures of the experiments declared in the config under `experiments:`."""
+    input:
+        [p for e in RUN.experiments.values() if e.key.startswith("experiments.") for p in e.dataset_files()],
+        figure_targets("Experiments"),

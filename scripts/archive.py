@@ -4,7 +4,7 @@ installed package versions, CITATION.cff, the workflow and a SHA-256 manifest
 (see safebasins.io.archive)."""
 import json
 
-from safebasins.config import redirect_output
+from safebasins.pipeline.runtime import redirect_output
 from safebasins.io.archive import write_archive
 
 redirect_output(snakemake.log[0])

@@ -1,6 +1,4 @@
-"""Rule `parameters`: write one experiment's resolved parameters (results/params/{experiment}.yaml)."""
-import json
+"""Rule `parameters`: one experiment's resolved parameters (results/params/{experiment}.yaml)."""
+from safebasins.pipeline.runtime import write_params
 
-from safebasins.config import write_params_file
-
-write_params_file(snakemake.output[0], json.loads(snakemake.params.spec), snakemake.log[0])
+write_params(snakemake)

@@ -1,30 +1,20 @@
-# Stages 2-3: analytic products (safebasins.theory): F_cr curves and safe basins.
+# Stages 2-3: analytic products (safebasins.theory, the slow flow of the isolated resonance):
+# F_cr curves, safe-basin boundaries and per-IC masks. One rule for every kind: the registry
+# names the library call of each dataset (safebasins.pipeline.kinds).
 
 
-rule analytic_fcr:
-    """Analytic F_cr(Omega) curves (Figs 1-4 and the theory lines of Figs 10-12)."""
+rule analytic_dataset:
+    """An analytic dataset of the registry: results/data/analytic/<name>.nc."""
     input:
-        params=param_file,
+        unpack(dataset_inputs("analytic")),
     output:
-        "results/data/analytic/fcr_{experiment}.nc",
+        "results/data/analytic/{name}.nc",
     log:
-        "results/logs/analytic_fcr/{experiment}.log",
+        "results/logs/analytic/{name}.log",
     wildcard_constraints:
-        experiment=alternatives(FCR_EXPERIMENTS),
+        name=alternatives(dataset_names("analytic")),
+    params:
+        extensions=EXTENSIONS,
+    threads: dataset_threads("analytic")
     script:
-        "../../scripts/analytic_fcr.py"
-
-
-rule analytic_basin:
-    """Analytic safe basins: boundaries + per-IC escape masks on the numeric grid (Figs 5-9, 13-18);
-    for Figs 5-9 also C and the escape mask on the (gamma_rm, xi_rm) resonance-manifold grid."""
-    input:
-        params=param_file,
-    output:
-        "results/data/analytic/basin_{experiment}.nc",
-    log:
-        "results/logs/analytic_basin/{experiment}.log",
-    wildcard_constraints:
-        experiment=alternatives(BASIN_EXPERIMENTS),
-    script:
-        "../../scripts/analytic_basin.py"
+        "../../scripts/dataset.py"

@@ -1,53 +1,49 @@
-# Shared set-up: configuration validation, resolution into per-experiment parameters,
-# target lists and input functions used by every other rule file.
+# Shared set-up: the run's plan (safebasins.pipeline.plan: config validated before any job,
+# naming the offending key; every experiment resolved through the registry of kinds) and the
+# target lists and input functions every other rule file uses.
 import json
 from pathlib import Path
 
-from snakemake.utils import validate
+from safebasins.pipeline.plan import plan as _plan
+from safebasins.pipeline.registry import STAGES
 
-from safebasins import config as sbconfig
+RUN = _plan(config)
+PARAMS_JSON = {e: json.dumps(p, sort_keys=True) for e, p in RUN.params().items()}
+NUM_THREADS = RUN.threads
+EXTENSIONS = config["extensions"]
 
-
-# ---------------------------------------------------------------- validation (before any job)
-# safebasins.config.validate_config gives one message naming the offending key (and adds the
-# checks JSON Schema cannot express); snakemake.utils.validate then fills the schema defaults.
-sbconfig.validate_config(config, Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml")
-validate(config, "../schemas/config.schema.yaml")
-
-# ---------------------------------------------------------------- resolution
-EXP = sbconfig.resolve(config)  # experiment -> resolved parameters (results/params/{e}.yaml)
-PARAMS_JSON = {e: json.dumps(p, sort_keys=True) for e, p in EXP.items()}
-NUM_THREADS = int(config["numerics"]["threads"])
-TILES = int(config["numerics"]["tiles"])
-
-
-def experiments(*kinds):
-    return [e for e, p in EXP.items() if p["kind"] in kinds]
+PARAM_FILES = RUN.param_files()
+DATASETS = RUN.datasets()
+FIGURES = RUN.figures()
 
 
 def alternatives(names):
-    """Regex matching exactly the given experiment names (never matches if empty)."""
-    return "|".join(names) if names else "(?!x)x"
+    """Regex matching exactly the given names (never matches if empty)."""
+    return "|".join(sorted(names)) if names else "(?!x)x"
 
 
-FCR_EXPERIMENTS = experiments("fcr_theory", "fcr_compare")
-FCR_NUMERIC_EXPERIMENTS = experiments("fcr_compare")
-BASIN_EXPERIMENTS = experiments("basin_rm", "basin_chart", "strobe")
-AGREEMENT_EXPERIMENTS = experiments("basin_chart")
-FINAL_CHART_EXPERIMENTS = experiments("chart")
-# (the extras erosion / true_basin reuse the chart tiles: one task per F / per Psi)
-CHART_EXPERIMENTS = experiments("basin_chart", "chart", "criteria", "erosion", "true_basin")
-STROBE_EXPERIMENTS = experiments("strobe")
-CRITERIA_EXPERIMENTS = experiments("criteria")
+def dataset_names(stage):
+    return [p.rsplit("/", 1)[1].removesuffix(".nc") for p in RUN.datasets(stage)]
 
-PARAM_FILES = [f"results/params/{e}.yaml" for e in EXP]
-DATASETS = [f for e, p in EXP.items() for f in sbconfig.dataset_files(e, p["kind"], params=p)]
-ANALYTIC_DATASETS = [f for f in DATASETS if "/analytic/" in f]
-NUMERIC_DATASETS = [f for f in DATASETS if "/numeric/" in f]
+
+def dataset_path(stage, wildcards):
+    return f"{STAGES[stage]}/{wildcards.name}.nc"
+
+
+def dataset_inputs(stage):
+    return lambda wildcards: RUN.product_inputs(dataset_path(stage, wildcards))
+
+
+def dataset_threads(stage):
+    return lambda wildcards: NUM_THREADS if RUN.product(dataset_path(stage, wildcards)).heavy else 1
+
+
+def figure_targets(category):
+    return [p for f in FIGURES if f.category == category for p in (f.png, f.pdf)]
 
 
 wildcard_constraints:
-    experiment=r"fig\d\d|extra_[a-z_]+",
+    experiment=alternatives(RUN.experiments),
     task=r"\d+",
     tile=r"\d+",
     tiles=r"\d+",
@@ -55,17 +51,3 @@ wildcard_constraints:
 
 def param_file(wildcards):
     return f"results/params/{wildcards.experiment}.yaml"
-
-
-def tile_files(experiment):
-    """Tile files of every task of a chart experiment (tasks x TILES jobs)."""
-    tasks = EXP[experiment]["tasks"]
-    return [
-        f"results/data/numeric/parts/{experiment}/task{k}_tile{t}of{TILES}.nc"
-        for k in range(len(tasks))
-        for t in range(TILES)
-    ]
-
-
-def chart_tiles(wildcards):
-    return tile_files(wildcards.experiment)

@@ -1,62 +1,70 @@
-# Figure rules: one rule per paper figure (fig01 ... fig22), each executing its papermill
-# notebook (kernel python3) from the repository root.
+# Figure rules: one per figure of the plan (the paper's 22, the beyond-the-paper ones and those
+# of experiments declared in the config), each executing its papermill notebook (kernel python3)
+# from the repository root.
 #
-# Inputs  = the figure's datasets (written by the analytic / numeric rules) + its notebook +
-#           the shared plotting code, so a plot change never reruns a simulation and the
-#           notebooks never recompute physics.
-# Outputs = results/figures/figNN.png (in the report, category "Figures") and .pdf, and the
-#           executed notebook under results/notebooks/.
-#
-# The table of figures (datasets, options, captions) is safebasins.plotting.catalog; the
-# notebooks and workflow/report/figNN.rst are generated from it by scripts/make_notebooks.py.
+# Inputs  = the figure's datasets + its notebook + the plotting code, so a plot change never
+#           reruns a simulation and the notebooks never recompute physics.
+# Outputs = results/figures/<name>.png (in the report) and .pdf, and the executed notebook
+#           under results/notebooks/.
+# Notebooks of the package's figures are generated into notebooks/ by scripts/make_notebooks.py
+# (committed, checked by the tests); those of config experiments by the rule figure_notebook.
+import glob as _fig_glob
+import shlex as _fig_shlex
 import sys as _fig_sys
 
-from safebasins.plotting import catalog as _figcat
-
-_FIG_PLOTTING = ["src/safebasins/plotting/core.py", "src/safebasins/plotting/__init__.py"]
+_FIG_PLOTTING = sorted(_fig_glob.glob(f"{workflow.basedir}/src/safebasins/plotting/*.py"))
 _FIG_DPI = 180  # PNG resolution (the PDF is vector, rasters inside it embedded at this dpi)
 
-FIGURE_TARGETS = [p for nn in _figcat.FIGURES for p in _figcat.figure_paths(nn)]
-
-
-def _fig_params(inputs):
-    """`-p name path` for every dataset input of a figure (bound now, not at job time:
-    the shell string of a rule defined in a loop would see the loop's last value)."""
-    return " ".join(f"-p {name} {path}" for name, path in inputs.items())
-
-
-for _nn, _fig in _figcat.FIGURES.items():
-    _png, _pdf = _figcat.figure_paths(_nn)
+for _fig in FIGURES:
 
     rule:
         name:
-            f"fig{_nn}"
+            _fig.name
         input:
-            notebook=_figcat.notebook_path(_nn),
+            notebook=_fig.notebook,
             plotting=_FIG_PLOTTING,
-            **_fig["inputs"],
+            **_fig.inputs,
         output:
             png=report(
-                _png,
-                caption=f"../report/fig{_nn}.rst",
-                category="Figures",
-                labels={"figure": f"Fig. {int(_nn)}", "slug": _fig["slug"]},
+                _fig.png,
+                caption=f"../report/{_fig.name}.rst" if _fig.packaged else "../report/experiment.rst",
+                category=_fig.category,
+                labels={"figure": _fig.label, "slug": _fig.stem},
             ),
-            pdf=_pdf,
-            notebook=_figcat.executed_notebook_path(_nn),
+            pdf=_fig.pdf,
+            notebook=_fig.executed_notebook,
         log:
-            f"{_figcat.LOG_DIR}/fig{_nn}.log",
+            f"results/logs/figures/{_fig.name}.log",
         params:
             python=_fig_sys.executable,
             dpi=_FIG_DPI,
-            data=_fig_params(_fig["inputs"]),
+            # bound now (a rule defined in a loop); YAML (here JSON) because some inputs are lists
+            data=_fig_shlex.quote(json.dumps(dict(_fig.inputs))),
         threads: 1
         shell:
             "{params.python} -m papermill --no-progress-bar -k python3 "
-            "{input.notebook} {output.notebook} {params.data} "
+            "{input.notebook} {output.notebook} -y {params.data} "
             "-p png {output.png} -p pdf {output.pdf} -p dpi {params.dpi} > {log} 2>&1"
 
 
+rule figure_notebook:
+    """Papermill template of a figure of an experiment declared in the config."""
+    output:
+        "results/notebooks/templates/{stem}.ipynb",
+    log:
+        "results/logs/figure_notebook/{stem}.log",
+    wildcard_constraints:
+        stem=alternatives([f.stem for f in FIGURES if not f.packaged]),
+    params:
+        figure=lambda wildcards: next(f.name for f in FIGURES if f.stem == wildcards.stem),
+        extensions=EXTENSIONS,
+        configfiles=lambda wildcards: json.dumps(config),
+    localrule: True
+    script:
+        "../../scripts/figure_notebook.py"
+
+
 rule figures:
+    """The paper's figures."""
     input:
-        FIGURE_TARGETS,
+        figure_targets("Figures"),

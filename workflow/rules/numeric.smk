@@ -1,22 +1,7 @@
-# Stages 4-5: numeric products (safebasins.numerics). Every job here uses `threads:` numba
-# threads (config numerics.threads), so `-j2` never oversubscribes the cores.
-
-
-rule numeric_fcr:
-    """Numeric F_cr(Omega) by bisection + scan (dots of Figs 10-12)."""
-    input:
-        params=param_file,
-    output:
-        "results/data/numeric/fcr_{experiment}.nc",
-    log:
-        "results/logs/numeric_fcr/{experiment}.log",
-    benchmark:
-        "results/benchmarks/numeric_fcr/{experiment}.tsv"
-    wildcard_constraints:
-        experiment=alternatives(FCR_NUMERIC_EXPERIMENTS),
-    threads: NUM_THREADS
-    script:
-        "../../scripts/numeric_fcr.py"
+# Stages 4-6: numeric products (safebasins.numerics). Heavy jobs use `threads:` numba threads
+# (config numerics.threads), so `-j2` never oversubscribes the cores. Escape charts are split
+# into `numerics.tiles` independent tile jobs per task and gathered by the dataset that reads
+# them (with the analytic/numeric agreement where the kind has an analytic counterpart).
 
 
 rule chart_tile:
@@ -31,70 +16,29 @@ rule chart_tile:
     benchmark:
         "results/benchmarks/chart_tile/{experiment}/task{task}_tile{tile}of{tiles}.tsv"
     wildcard_constraints:
-        experiment=alternatives(CHART_EXPERIMENTS),
+        experiment=alternatives(RUN.chart_experiments()),
+    params:
+        extensions=EXTENSIONS,
     threads: NUM_THREADS
     script:
         "../../scripts/chart_tile.py"
 
 
-rule chart_gather:
-    """Gather the tiles of a chart with an analytic counterpart (Figs 13-17; stacked over F for
-    16-17); the agreement rule turns it into results/data/numeric/chart_{experiment}.nc."""
+rule numeric_dataset:
+    """A numeric dataset of the registry: results/data/numeric/<name>.nc (numeric F_cr, gathered
+    escape charts with their agreement, criteria counts, stroboscopic maps)."""
     input:
-        params=param_file,
-        tiles=chart_tiles,
+        unpack(dataset_inputs("numeric")),
     output:
-        "results/data/numeric/parts/{experiment}/chart.nc",
+        "results/data/numeric/{name}.nc",
     log:
-        "results/logs/chart_gather/{experiment}.log",
-    wildcard_constraints:
-        experiment=alternatives(AGREEMENT_EXPERIMENTS),
-    script:
-        "../../scripts/chart_gather.py"
-
-
-rule chart_final:
-    """Gather the tiles of a chart without analytic counterpart (Figs 20-21, read by 20-22)."""
-    input:
-        params=param_file,
-        tiles=chart_tiles,
-    output:
-        "results/data/numeric/chart_{experiment}.nc",
-    log:
-        "results/logs/chart_final/{experiment}.log",
-    wildcard_constraints:
-        experiment=alternatives(FINAL_CHART_EXPERIMENTS),
-    script:
-        "../../scripts/chart_gather.py"
-
-
-rule criteria:
-    """Energy versus displacement criterion on random ICs (Fig 19): A_E, A_q per (F, repeat)."""
-    input:
-        params=param_file,
-        tiles=chart_tiles,
-    output:
-        "results/data/numeric/criteria_{experiment}.nc",
-    log:
-        "results/logs/criteria/{experiment}.log",
-    wildcard_constraints:
-        experiment=alternatives(CRITERIA_EXPERIMENTS),
-    script:
-        "../../scripts/criteria_gather.py"
-
-
-rule strobe:
-    """Stroboscopic map of non-escaping trajectories from seeded random ICs (Fig 18)."""
-    input:
-        params=param_file,
-    output:
-        "results/data/numeric/strobe_{experiment}.nc",
-    log:
-        "results/logs/strobe/{experiment}.log",
+        "results/logs/numeric/{name}.log",
     benchmark:
-        "results/benchmarks/strobe/{experiment}.tsv"
+        "results/benchmarks/numeric/{name}.tsv"
     wildcard_constraints:
-        experiment=alternatives(STROBE_EXPERIMENTS),
-    threads: NUM_THREADS
+        name=alternatives(dataset_names("numeric")),
+    params:
+        extensions=EXTENSIONS,
+    threads: dataset_threads("numeric")
     script:
-        "../../scripts/strobe.py"
+        "../../scripts/dataset.py"

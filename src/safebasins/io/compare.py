@@ -77,6 +77,13 @@ def dataset_differences(old: xr.Dataset, new: xr.Dataset, *, ignore_attrs=PROVEN
     return out
 
 
+def assert_same_content(old: xr.Dataset, new: xr.Dataset, *, ignore_attrs=PROVENANCE_ATTRS):
+    """AssertionError listing every difference (provenance attributes aside)."""
+    diffs = dataset_differences(old, new, ignore_attrs=ignore_attrs)
+    if diffs:
+        raise AssertionError("datasets differ:\n  " + "\n  ".join(diffs))
+
+
 @dataclass
 class TreeReport:
     compared: list[str] = field(default_factory=list)

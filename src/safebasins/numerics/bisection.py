@@ -4,9 +4,10 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from safebasins import _validate as V
-from safebasins.numerics import engine as E
-from safebasins.numerics import kernels as K
+from safebasins import checks
+from safebasins.wells.quartic import QUARTIC
+from safebasins.numerics import engine
+from safebasins.numerics import kernels
 
 DEFAULT_N_SCAN = 301
 
@@ -14,7 +15,7 @@ DEFAULT_N_SCAN = 301
 def _escapes(q0, p0, Omega, F, Psi, thr_kw, cycles, spc, threads, integrator):
     """One compiled ensemble: trajectory k with (Omega[k], F[k]); True where it escapes."""
     n = Omega.size
-    sE, sQ, _ = E.run_ensemble(np.full(n, q0), np.full(n, p0), np.arange(n), Omega, F, Psi, cycles=cycles,
+    sE, sQ, _ = engine.run_ensemble(np.full(n, q0), np.full(n, p0), np.arange(n), Omega, F, Psi, cycles=cycles,
                                steps_per_cycle=spc, threads=threads, stop_any=True, integrator=integrator,
                                **thr_kw)
     return ((sE >= 0).any(axis=1)) | ((sQ >= 0).any(axis=1))
@@ -22,8 +23,8 @@ def _escapes(q0, p0, Omega, F, Psi, thr_kw, cycles, spc, threads, integrator):
 
 def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3000, tol=5e-5,
                              F_bracket=(0.0, 0.3), criterion="energy", n_scan=DEFAULT_N_SCAN,
-                             steps_per_cycle=E.DEFAULT_STEPS_PER_CYCLE, threads=None,
-                             integrator=E.DEFAULT_INTEGRATOR):
+                             steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None,
+                             integrator=engine.DEFAULT_INTEGRATOR):
     """Numeric escape threshold F_cr(Omega) for the IC (q0, p0) (Section 3.1, Figs 10-12).
 
     Bisection: all Omega points advance together, one compiled ensemble per bisection level,
@@ -40,27 +41,27 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     F_escape_all, non_monotone; attrs xi_max, q0, p0, Psi, cycles, tol, criterion, F_bracket,
     n_scan, steps_per_cycle, integrator, bisection_levels.
     """
-    Om = np.atleast_1d(V.check_positive("Omega", Omega)).astype(float)
+    Om = np.atleast_1d(checks.check_positive("Omega", Omega)).astype(float)
     if Om.ndim != 1:
         raise ValueError(f"Omega must be a scalar or 1-D, got shape {Om.shape}")
     if not np.isfinite(Om).all():
         raise ValueError("Omega must be finite")
-    xi = E.check_scalar("xi_max", xi_max, V.check_threshold)
-    q0 = E.check_scalar("q0", q0, V.check_finite)
-    p0 = E.check_scalar("p0", p0, V.check_finite)
-    Psi = E.check_scalar("Psi", Psi, V.check_finite)
-    cycles = E.check_cycles("cycles", cycles)
-    tol = E.check_scalar("tol", tol, V.check_positive)
-    br = V.check_nonnegative("F_bracket", F_bracket)
+    xi = checks.check_scalar("xi_max", xi_max, QUARTIC.check_threshold)
+    q0 = checks.check_scalar("q0", q0, checks.check_finite)
+    p0 = checks.check_scalar("p0", p0, checks.check_finite)
+    Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
+    cycles = engine.check_cycles("cycles", cycles)
+    tol = checks.check_scalar("tol", tol, checks.check_positive)
+    br = checks.check_nonnegative("F_bracket", F_bracket)
     if br.shape != (2,) or not np.isfinite(br).all() or not br[1] > br[0]:
         raise ValueError(f"F_bracket must be (F_lo, F_hi) with 0 <= F_lo < F_hi, got {F_bracket!r}")
     if criterion not in ("energy", "displacement"):
         raise ValueError(f"criterion must be 'energy' or 'displacement', got {criterion!r}")
     if isinstance(n_scan, bool) or not isinstance(n_scan, (int, np.integer)) or n_scan < 0 or n_scan == 1:
         raise ValueError(f"n_scan must be 0 (no scan) or an integer >= 2, got {n_scan!r}")
-    spc = E.check_steps_per_cycle(steps_per_cycle)
-    threads = E.check_threads(threads)
-    K.check_integrator(integrator)
+    spc = engine.check_steps_per_cycle(steps_per_cycle)
+    threads = engine.check_threads(threads)
+    kernels.check_integrator(integrator)
     if criterion == "energy":
         thr_kw = {"xi_max": (xi,), "q_max": ()}
     else:
@@ -117,7 +118,7 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
         coords={"Omega": ("Omega", Om, {**u, "long_name": "forcing frequency"})},
     )
     ds.attrs.update(xi_max=xi, q0=q0, p0=p0, Psi=Psi, cycles=cycles, tol=tol, criterion=criterion,
-                    F_bracket=br, n_scan=int(n_scan), steps_per_cycle=spc, integrator=K.INTEGRATORS[integrator],
+                    F_bracket=br, n_scan=int(n_scan), steps_per_cycle=spc, integrator=kernels.INTEGRATORS[integrator],
                     bisection_levels=levels,
                     F_scan_step=float((br[1] - br[0]) / (n_scan - 1)) if n_scan else np.nan)
     return ds

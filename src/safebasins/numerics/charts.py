@@ -4,9 +4,10 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from safebasins import _validate as V
-from safebasins.numerics import engine as E
-from safebasins.numerics import kernels as K
+from safebasins import checks
+from safebasins.wells.quartic import QUARTIC
+from safebasins.numerics import engine
+from safebasins.numerics import kernels
 
 _CYC = "1"  # time in forcing cycles (dimensionless)
 
@@ -17,8 +18,8 @@ def _monotone(a):
 
 
 def _ic_arrays(q0, p0, grid):
-    qa = V.check_finite("q0", q0)
-    pa = V.check_finite("p0", p0)
+    qa = checks.check_finite("q0", q0)
+    pa = checks.check_finite("p0", p0)
     if grid is None:
         grid = qa.ndim == 1 and pa.ndim == 1 and _monotone(qa) and _monotone(pa)
     if grid:
@@ -35,8 +36,8 @@ def _ic_arrays(q0, p0, grid):
 
 
 def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000,
-                 steps_per_cycle=E.DEFAULT_STEPS_PER_CYCLE, threads=None, grid=None,
-                 integrator=E.DEFAULT_INTEGRATOR):
+                 steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None, grid=None,
+                 integrator=engine.DEFAULT_INTEGRATOR):
     """Escape time (forcing cycles) of every initial condition, for every threshold.
 
     Parameters
@@ -67,22 +68,22 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000
     it has crossed every requested threshold.
     """
     is_grid, qa, pa, Q, P = _ic_arrays(q0, p0, grid)
-    F = E.check_scalar("F", F, V.check_nonnegative)
-    Omega = E.check_scalar("Omega", Omega, V.check_positive)
-    Psi = E.check_scalar("Psi", Psi, V.check_finite)
-    xi = E.thresholds("xi_max", xi_max, V.check_threshold)
-    qm = E.thresholds("q_max", q_max, V.check_displacement_threshold)
+    F = checks.check_scalar("F", F, checks.check_nonnegative)
+    Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
+    Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
+    xi = engine.thresholds("xi_max", xi_max, QUARTIC.check_threshold)
+    qm = engine.thresholds("q_max", q_max, QUARTIC.check_displacement)
     if xi.size == 0 and qm.size == 0:
         raise ValueError("xi_max and q_max: at least one threshold is required")
-    cycles = E.check_cycles("cycles", cycles)
-    spc = E.check_steps_per_cycle(steps_per_cycle)
-    threads = E.check_threads(threads)
-    K.check_integrator(integrator)
+    cycles = engine.check_cycles("cycles", cycles)
+    spc = engine.check_steps_per_cycle(steps_per_cycle)
+    threads = engine.check_threads(threads)
+    kernels.check_integrator(integrator)
 
-    sE, sQ, _ = E.run_ensemble(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
+    sE, sQ, _ = engine.run_ensemble(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
                                cycles=cycles, steps_per_cycle=spc, threads=threads, integrator=integrator)
-    tE = E.steps_to_cycles(sE, spc).T   # (nE, N)
-    tQ = E.steps_to_cycles(sQ, spc).T
+    tE = engine.steps_to_cycles(sE, spc).T   # (nE, N)
+    tQ = engine.steps_to_cycles(sQ, spc).T
     if is_grid:
         shape, dims = (qa.size, pa.size), ("q0", "p0")
         coords = {"q0": ("q0", qa, {"units": "1", "long_name": "initial displacement q(0)"}),
@@ -106,85 +107,10 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000
         coords=coords,
     )
     ds.attrs.update(
-        F=F, Omega=Omega, Psi=Psi, cycles=cycles, steps_per_cycle=spc, integrator=K.INTEGRATORS[integrator],
+        F=F, Omega=Omega, Psi=Psi, cycles=cycles, steps_per_cycle=spc, integrator=kernels.INTEGRATORS[integrator],
         grid=int(is_grid),
         escape_criteria=("energy: H0 = p^2/2 + q^2/2 - q^4/4 > xi_max or |q| > 1; displacement: |q| > q_max; "
                          "checked after every step; escape_cycle = step / steps_per_cycle"),
         safe_basin="escape_cycle > t_eval (t_eval <= cycles)",
     )
     return ds
-
-
-def _t_eval(chart, t_eval):
-    t = V.check_nonnegative("t_eval", t_eval)
-    if t.ndim > 1:
-        raise ValueError(f"t_eval must be a scalar or 1-D, got shape {t.shape}")
-    cyc = chart.attrs.get("cycles", np.inf)
-    if (t > cyc).any():
-        raise ValueError(f"t_eval must be <= the chart's horizon cycles={cyc}, got max {t.max()!r}")
-    return t
-
-
-def safe_mask(chart, t_eval):
-    """Safe basins of an escape_chart at evaluation time(s) t_eval (cycles, <= chart cycles).
-
-    Returns a Dataset with bool `safe_energy` (xi_max, ...) and `safe_displacement` (q_max, ...):
-    escape_cycle > t_eval.  A 1-D t_eval adds a leading dim 't_eval'; a scalar gives a scalar
-    coordinate.
-    """
-    t = _t_eval(chart, t_eval)
-    tda = xr.DataArray(t, dims=("t_eval",) if t.ndim else (), name="t_eval",
-                       attrs={"units": "1", "long_name": "evaluation time (forcing cycles)"})
-    out = xr.Dataset({
-        "safe_energy": chart["escape_cycle_energy"] > tda,
-        "safe_displacement": chart["escape_cycle_displacement"] > tda,
-    })
-    out = out.assign_coords(t_eval=tda)
-    if "t_eval" in out.dims:
-        out = out.transpose("t_eval", ...)
-    out["safe_energy"].attrs = {"long_name": "safe (no energy escape up to t_eval)"}
-    out["safe_displacement"].attrs = {"long_name": "safe (no displacement escape up to t_eval)"}
-    out.attrs.update({k: chart.attrs[k] for k in ("F", "Omega", "Psi", "cycles", "steps_per_cycle") if k in chart.attrs})
-    return out
-
-
-def _cell_widths(x):
-    x = np.asarray(x, dtype=float)
-    if x.size == 1:
-        return np.array([np.nan])
-    w = np.empty_like(x)
-    w[1:-1] = 0.5 * (x[2:] - x[:-2])
-    w[0] = x[1] - x[0]
-    w[-1] = x[-1] - x[-2]
-    return np.abs(w)
-
-
-def safe_area(chart, t_eval):
-    """Safe-basin area vs evaluation time, vectorised over t_eval.
-
-    Returns a Dataset with `pixels_energy` (t_eval?, xi_max) and `pixels_displacement`
-    (t_eval?, q_max): number of safe ICs; `area_energy`, `area_displacement`: phase-space area
-    (sum of the cells dq0*dp0 of the safe grid points; uniform grid: pixels * dq * dp), NaN for
-    paired ICs; `fraction_*`: pixels / number of ICs.
-    """
-    m = safe_mask(chart, t_eval)
-    is_grid = "q0" in chart.dims and "p0" in chart.dims
-    dims = ("q0", "p0") if is_grid else ("sample",)
-    n = int(np.prod([chart.sizes[d] for d in dims]))
-    out = xr.Dataset(coords={"t_eval": m["t_eval"]})
-    if is_grid:
-        w = xr.DataArray(np.outer(_cell_widths(chart["q0"].values), _cell_widths(chart["p0"].values)), dims=dims)
-    for kind in ("energy", "displacement"):
-        s = m[f"safe_{kind}"]
-        pix = s.sum(dims)
-        out[f"pixels_{kind}"] = pix.astype(np.int64)
-        out[f"pixels_{kind}"].attrs = {"units": "1", "long_name": f"number of safe ICs ({kind} criterion)"}
-        out[f"fraction_{kind}"] = pix / n
-        out[f"fraction_{kind}"].attrs = {"units": "1", "long_name": f"safe fraction of the ICs ({kind} criterion)"}
-        area = (s * w).sum(dims) if is_grid else pix * np.nan
-        out[f"area_{kind}"] = area
-        out[f"area_{kind}"].attrs = {"units": "1", "long_name": f"safe area in the (q0, p0) plane ({kind} criterion)"}
-    if "t_eval" in out.dims:
-        out = out.transpose("t_eval", ...)
-    out.attrs.update(m.attrs)
-    return out

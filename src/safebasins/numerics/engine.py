@@ -7,8 +7,8 @@ import math
 import numba
 import numpy as np
 
-from safebasins import _validate as V
-from safebasins.numerics import kernels as K
+from safebasins import checks
+from safebasins.numerics import kernels
 
 DEFAULT_STEPS_PER_CYCLE = 32
 DEFAULT_INTEGRATOR = "srkn6b"
@@ -32,14 +32,14 @@ def thread_count(threads):
 def check_threads(threads):
     if threads is None:
         return None
-    n = V.check_positive_int("threads", threads)
+    n = checks.check_positive_int("threads", threads)
     if n > numba.config.NUMBA_NUM_THREADS:
         raise ValueError(f"threads must be <= {numba.config.NUMBA_NUM_THREADS} (numba's thread pool), got {n}")
     return n
 
 
 def check_steps_per_cycle(steps_per_cycle):
-    n = V.check_positive_int("steps_per_cycle", steps_per_cycle)
+    n = checks.check_positive_int("steps_per_cycle", steps_per_cycle)
     if n < 4:
         raise ValueError(f"steps_per_cycle must be >= 4, got {n}")
     return n
@@ -48,16 +48,7 @@ def check_steps_per_cycle(steps_per_cycle):
 def check_cycles(name, cycles):
     if isinstance(cycles, (float, np.floating)) and float(cycles).is_integer() and cycles >= 1:
         cycles = int(cycles)
-    return V.check_positive_int(name, cycles)
-
-
-def check_scalar(name, value, check):
-    a = check(name, value)
-    if a.ndim != 0:
-        raise ValueError(f"{name} must be a scalar, got shape {a.shape}")
-    if not np.isfinite(a):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return float(a)
+    return checks.check_positive_int(name, cycles)
 
 
 def thresholds(name, values, check):
@@ -75,7 +66,7 @@ def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), cycles, st
     order of the given thresholds (-1: not within `cycles`), and period-map iterates.
     integrator: "srkn6b" (default) or "rk4" (kernels.INTEGRATORS).
     """
-    K.check_integrator(integrator)
+    kernels.check_integrator(integrator)
     q0 = np.ascontiguousarray(q0, dtype=float).ravel()
     p0 = np.ascontiguousarray(p0, dtype=float).ravel()
     pidx = np.ascontiguousarray(pidx, dtype=np.int64).ravel()
@@ -90,21 +81,21 @@ def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), cycles, st
     outQ = np.full((N, qm.size), -1, dtype=np.int64)
     st = np.full((N, cycles + 1, 2), np.nan) if store else np.empty((0, 0, 2))
     if N:
-        coef = np.ascontiguousarray(K.lane_coefficients(Omega, steps_per_cycle, integrator))
-        sintab = K.sine_table(steps_per_cycle, Psi, integrator)
+        coef = np.ascontiguousarray(kernels.lane_coefficients(Omega, steps_per_cycle, integrator))
+        sintab = kernels.sine_table(steps_per_cycle, Psi, integrator)
         with thread_count(threads) as nthreads:
             # one task per thread: trajectories are interleaved over tasks (i % n_tasks), so each
             # task gets a statistically equal share of long-lived ones and its lanes stay full
             n_tasks = max(1, min(math.ceil(N / LANES), nthreads))
-            K.ensemble(q0, p0, pidx, coef, K.step_sizes(Omega, steps_per_cycle), np.ascontiguousarray(F), sintab,
+            kernels.ensemble(q0, p0, pidx, coef, kernels.step_sizes(Omega, steps_per_cycle), np.ascontiguousarray(F), sintab,
                        np.ascontiguousarray(2.0 * xi[oE_sorted]), np.ascontiguousarray(qm[oQ_sorted]),
                        int(cycles), bool(stop_any), int(n_tasks), LANES, outE, outQ, st, bool(store))
     # back to the caller's threshold order
-    E = np.empty_like(outE)
-    E[:, oE_sorted] = outE
-    Q = np.empty_like(outQ)
-    Q[:, oQ_sorted] = outQ
-    return E, Q, (st if store else None)
+    steps_E = np.empty_like(outE)
+    steps_E[:, oE_sorted] = outE
+    steps_Q = np.empty_like(outQ)
+    steps_Q[:, oQ_sorted] = outQ
+    return steps_E, steps_Q, (st if store else None)
 
 
 def steps_to_cycles(steps, steps_per_cycle):

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from safebasins import _validate as V
+from safebasins import checks
 
 
 def random_initial_conditions(n, seed, box=((-1, 1), (-1, 1))):
@@ -12,10 +12,10 @@ def random_initial_conditions(n, seed, box=((-1, 1), (-1, 1))):
     Returns (q0, p0), 1-D arrays of length n (q0 drawn first, then p0).  Pass them to
     escape_chart with grid=False (paired ICs -> dim 'sample').
     """
-    n = V.check_positive_int("n", n)
+    n = checks.check_positive_int("n", n)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
-    b = V.check_finite("box", box)
+    b = checks.check_finite("box", box)
     if b.shape != (2, 2) or not (b[:, 1] > b[:, 0]).all():
         raise ValueError(f"box must be ((q_lo, q_hi), (p_lo, p_hi)) with lo < hi, got {box!r}")
     rng = np.random.default_rng(int(seed))

@@ -4,13 +4,14 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from safebasins import _validate as V
-from safebasins.numerics import engine as E
-from safebasins.numerics import kernels as K
+from safebasins import checks
+from safebasins.wells.quartic import QUARTIC
+from safebasins.numerics import engine
+from safebasins.numerics import kernels
 
 
 def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=None,
-                     steps_per_cycle=E.DEFAULT_STEPS_PER_CYCLE, threads=None, integrator=E.DEFAULT_INTEGRATOR):
+                     steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None, integrator=engine.DEFAULT_INTEGRATOR):
     """Period-map iterates (q(nT), p(nT)), T = 2 pi / Omega, n = 0..n_iter, of paired ICs.
 
     q0, p0 : paired initial conditions of equal shape (flattened in C order to dim 'sample').
@@ -24,24 +25,24 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
     bool), escape_cycle (sample; step / steps_per_cycle, +inf = not within n_iter cycles),
     q0, p0 (sample); attrs F, Omega, Psi, xi_max, q_max, n_iter, steps_per_cycle, integrator.
     """
-    qa = V.check_finite("q0", q0)
-    pa = V.check_finite("p0", p0)
+    qa = checks.check_finite("q0", q0)
+    pa = checks.check_finite("p0", p0)
     if qa.shape != pa.shape:
         raise ValueError(f"q0 and p0 must have the same shape, got {qa.shape} and {pa.shape}")
     Q, P = qa.ravel(), pa.ravel()
-    F = E.check_scalar("F", F, V.check_nonnegative)
-    Omega = E.check_scalar("Omega", Omega, V.check_positive)
-    Psi = E.check_scalar("Psi", Psi, V.check_finite)
-    n_iter = E.check_cycles("n_iter", n_iter)
-    xi = () if xi_max is None else (E.check_scalar("xi_max", xi_max, V.check_threshold),)
-    qm = () if q_max is None else (E.check_scalar("q_max", q_max, V.check_displacement_threshold),)
+    F = checks.check_scalar("F", F, checks.check_nonnegative)
+    Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
+    Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
+    n_iter = engine.check_cycles("n_iter", n_iter)
+    xi = () if xi_max is None else (checks.check_scalar("xi_max", xi_max, QUARTIC.check_threshold),)
+    qm = () if q_max is None else (checks.check_scalar("q_max", q_max, QUARTIC.check_displacement),)
     if not xi and not qm:
         raise ValueError("xi_max and q_max: at least one escape threshold is required")
-    spc = E.check_steps_per_cycle(steps_per_cycle)
-    threads = E.check_threads(threads)
-    K.check_integrator(integrator)
+    spc = engine.check_steps_per_cycle(steps_per_cycle)
+    threads = engine.check_threads(threads)
+    kernels.check_integrator(integrator)
 
-    sE, sQ, st = E.run_ensemble(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
+    sE, sQ, st = engine.run_ensemble(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
                                 cycles=n_iter, steps_per_cycle=spc, threads=threads, stop_any=True,
                                 store=True, integrator=integrator)
     steps = np.concatenate([sE, sQ], axis=1).astype(float)
@@ -64,6 +65,6 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
         },
     )
     ds.attrs.update(F=F, Omega=Omega, Psi=Psi, xi_max=xi[0] if xi else np.nan, q_max=qm[0] if qm else np.nan,
-                    n_iter=n_iter, steps_per_cycle=spc, integrator=K.INTEGRATORS[integrator],
+                    n_iter=n_iter, steps_per_cycle=spc, integrator=kernels.INTEGRATORS[integrator],
                     map="eq (29): (q(t), p(t)) -> (q(t + T), p(t + T)), T = 2 pi / Omega; NaN after escape")
     return ds

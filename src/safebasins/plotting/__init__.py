@@ -1,37 +1,11 @@
-"""Shared plotting for the paper's figures (see :mod:`safebasins.plotting.core`).
+"""Figures: one module per figure family, each builder reading datasets by exact names.
 
-The figure table (datasets, options, captions) is :mod:`safebasins.plotting.catalog`;
-notebooks are generated from it by ``scripts/make_notebooks.py``.
+style      rcParams, labels, number formatting, saving
+data       reading datasets (exact names), summaries for the notebooks
+fcr        F_cr(Omega): Figs 1-4, 10-12
+basins     slow-flow safe basins on the manifold and the IC plane: Figs 5-9 (+ shared pieces)
+charts     escape charts: Figs 13-17, 19, 20-22
+maps       the period map: Fig 18
+extras     beyond the paper: erosion, phase-invariant basin, first harmonic
+notebooks  the papermill notebook of a figure (scripts/make_notebooks.py, rule figure_notebook)
 """
-from .core import (  # noqa: F401
-    DEFAULT_DPI,
-    LABELS,
-    MECHANISMS,
-    apply_style,
-    curve_labels,
-    describe,
-    draw_boundaries,
-    draw_dsb_esb,
-    draw_fcr,
-    draw_fcr_curve,
-    draw_fcr_numeric,
-    draw_ic_basin,
-    draw_nested_safe,
-    draw_rm_portrait,
-    draw_well,
-    figure_area_vs_time,
-    figure_criteria,
-    figure_dsb_esb,
-    figure_fcr,
-    figure_fcr_comparison,
-    figure_nested_basins,
-    figure_period_map,
-    figure_rm_basin,
-    fmt_value,
-    open_dataset,
-    param_text,
-    safe_area_curve,
-    safe_from_cycles,
-    save_figure,
-    style,
-)

@@ -37,10 +37,9 @@ import numpy as np
 import xarray as xr
 from scipy import optimize
 
-from .._validate import _arr, check_finite, check_nonnegative, check_positive, \
-    check_positive_int, check_threshold
-from .action_angle import _G, _J, _phase_point, check_fourier
-from .slow_flow import SlowFlowProfile, _scalar
+from safebasins.checks import check_finite, check_nonnegative, check_positive, check_positive_int
+from safebasins.theory.slow_flow import SlowFlowProfile, _scalar
+from safebasins.wells.quartic import _G, _J, _phase_point, check_fourier, QUARTIC
 
 __all__ = ["safe_basin_boundaries"]
 
@@ -159,8 +158,9 @@ def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier="paper", n_points=400):
       on the curve), ``ray`` (0 or pi: the ray of its tangency / saddle point), ``xi_top``
       (energy of that point: xi_max for maximum type, xi of the saddle for saddle type),
       ``safe_sign`` (-1: the safe side is C < C_level, i.e. towards gamma = 0; +1: C > C_level);
-      dim ``vertex``: ``gamma`` (in [-pi, pi]), ``xi``, ``q0``, ``p0`` (IC plane, via eqs 15, 17
-      with theta0 = gamma + Psi), ``curve_index`` (int; consecutive vertices of one curve form a
+      dim ``vertex``: ``gamma`` (in [-pi, pi]), ``xi``, ``q0_vertex``, ``p0_vertex`` (the vertex in
+      the IC plane, via eqs 15, 17 with theta0 = gamma + Psi; named apart from the grid axes
+      ``q0``, ``p0`` of the masks stored beside them), ``curve_index`` (int; consecutive vertices of one curve form a
       polyline; NaN rows split it where it crosses gamma = +-pi).
       attrs: F, Omega, Psi, xi_max, fourier, saddle_gamma, saddle_xi (the saddle below xi_max
       whose level bounds the basin, else the lowest saddle below xi_max, else NaN; located by
@@ -170,7 +170,7 @@ def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier="paper", n_points=400):
     F = _scalar("F", F, check_nonnegative)
     Om = _scalar("Omega", Omega, check_positive)
     Psi = _scalar("Psi", Psi, check_finite)
-    xm = _scalar("xi_max", xi_max, check_threshold)
+    xm = _scalar("xi_max", xi_max, QUARTIC.check_threshold)
     n_points = check_positive_int("n_points", n_points)
     if n_points < 3:
         raise ValueError("n_points must be >= 3")
@@ -225,8 +225,8 @@ def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier="paper", n_points=400):
                           {"long_name": "safe side: -1 where C < C_level, +1 where C > C_level"}),
             "gamma": ("vertex", gam, {"units": "rad", "long_name": "slow phase gamma = theta - Psi - Omega tau"}),
             "xi": ("vertex", xis, {"units": "1", "long_name": "averaged energy"}),
-            "q0": ("vertex", q0, {"units": "1", "long_name": "initial displacement"}),
-            "p0": ("vertex", p0, {"units": "1", "long_name": "initial momentum"}),
+            "q0_vertex": ("vertex", q0, {"units": "1", "long_name": "initial displacement"}),
+            "p0_vertex": ("vertex", p0, {"units": "1", "long_name": "initial momentum"}),
             "curve_index": ("vertex", idx, {"long_name": "index of the curve a vertex belongs to"}),
         },
         attrs={"F": F, "Omega": Om, "Psi": Psi, "xi_max": xm, "fourier": fourier,

@@ -42,10 +42,9 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from .._validate import XI_SEPARATRIX, _arr, check_energy, check_finite, check_positive, \
-    check_threshold
-from .action_angle import _G, _J, _dG_dxi, _omega, check_fourier
-from .slow_flow import _scalar, _xi_grid
+from safebasins.checks import check_finite, check_positive
+from safebasins.theory.slow_flow import _scalar, _xi_grid
+from safebasins.wells.quartic import QUARTIC, XI_SEPARATRIX, _G, _J, _dG_dxi, _omega, check_fourier
 
 __all__ = ["critical_forcing", "MECHANISMS"]
 
@@ -136,8 +135,8 @@ def critical_forcing(Omega, xi_max, xi0=0.0, gamma0=0.0, fourier="paper", n_grid
     Om = np.atleast_1d(check_positive("Omega", Omega)).astype(float)
     if Om.ndim != 1:
         raise ValueError("Omega must be a scalar or 1-D array")
-    xm = _scalar("xi_max", xi_max, check_threshold)
-    x0 = _scalar("xi0", xi0, lambda n, v: check_energy(n, v))
+    xm = _scalar("xi_max", xi_max, QUARTIC.check_threshold)
+    x0 = _scalar("xi0", xi0, QUARTIC.check_energy)
     if x0 >= xm:
         raise ValueError(f"xi0 must be < xi_max ({xm}), got {x0}")
     g0 = _scalar("gamma0", gamma0, check_finite)

@@ -35,9 +35,9 @@ from __future__ import annotations
 import numpy as np
 from scipy import optimize
 
-from .._validate import XI_SEPARATRIX, _arr, check_energy, check_finite, check_nonnegative, \
-    check_positive, check_threshold
-from .action_angle import _G, _J, _angle_energy, _dG_dxi, _ell, _omega, check_fourier
+from safebasins.checks import check_finite, check_nonnegative, check_positive
+from safebasins.wells.quartic import (QUARTIC, XI_SEPARATRIX, _G, _H0, _J, _angle_energy, _dG_dxi,
+                                      _ell, _omega, check_fourier)
 
 __all__ = ["first_integral", "escapes_on_manifold", "slow_flow_escapes", "slow_flow_profile",
            "slow_flow_rhs", "xi_from_J", "saddles"]
@@ -58,7 +58,7 @@ def first_integral(gamma, xi, F, Omega, fourier="paper"):
     """
     check_fourier(fourier)
     gamma = check_finite("gamma", gamma)
-    xi = check_energy("xi", xi, allow_separatrix=True)
+    xi = QUARTIC.check_energy("xi", xi, allow_separatrix=True)
     F = check_nonnegative("F", F)
     Omega = check_positive("Omega", Omega)
     return xi - Omega * _J(xi) - F * _G(xi, fourier) * np.cos(gamma)
@@ -145,7 +145,7 @@ def slow_flow_profile(F, Omega, xi_max, fourier="paper", n=1500):
     check_fourier(fourier)
     F = _scalar("F", F, check_nonnegative)
     Omega = _scalar("Omega", Omega, check_positive)
-    xi_max = _scalar("xi_max", xi_max, check_threshold)
+    xi_max = _scalar("xi_max", xi_max, QUARTIC.check_threshold)
     return SlowFlowProfile(F, Omega, xi_max, fourier, n)
 
 
@@ -187,7 +187,7 @@ def escapes_on_manifold(gamma, xi, F, Omega, xi_max, fourier="paper"):
     """
     check_fourier(fourier)
     gamma = check_finite("gamma", gamma)
-    xi = check_energy("xi", xi, allow_separatrix=True)
+    xi = QUARTIC.check_energy("xi", xi, allow_separatrix=True)
     prof = slow_flow_profile(F, Omega, xi_max, fourier)
     return _escapes_rm(gamma, xi, prof)
 
@@ -206,7 +206,7 @@ def slow_flow_escapes(q0, p0, F, Omega, Psi, xi_max, fourier="paper"):
     _scalar("Psi", Psi, check_finite)
     prof = slow_flow_profile(F, Omega, xi_max, fourier)
     q0, p0 = np.broadcast_arrays(q0, p0)
-    H = 0.5 * p0 * p0 + 0.5 * q0 * q0 - 0.25 * q0 ** 4
+    H = _H0(q0, p0)
     inside = (np.abs(q0) < 1.0) & (H < prof.xi_max)
     out = np.ones(q0.shape, dtype=bool)
     theta, xi = _angle_energy(q0[inside], p0[inside])

@@ -1,0 +1,9 @@
+"""Analyses of analytic and numeric safe basins.
+
+safe             the one definition ``safe = escape_cycle > t_eval``; safe masks and areas of charts
+agreement        IoU, pixel agreement, energy vs displacement criterion counts (Fig 19)
+integrity        GIM, LIM, IF of safe masks
+erosion          integrity profiles versus the forcing amplitude
+phase_invariant  the safe basin for every forcing phase
+fourier_compare  the paper's first harmonic (eq 20) versus the exact one
+"""

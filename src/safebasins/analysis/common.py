@@ -1,0 +1,67 @@
+"""Small helpers shared by the analysis modules (erosion, phase-invariant basins, first harmonic)."""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from safebasins import checks
+from safebasins.analysis.integrity import grid_spacing
+from safebasins.wells.quartic import FOURIER_VARIANTS
+
+
+def fourier_list(fourier):
+    """Normalise ``fourier`` to (list_of_variants, is_scalar)."""
+    scalar = isinstance(fourier, str)
+    items = [fourier] if scalar else list(fourier)
+    if not items:
+        raise ValueError("fourier must name at least one variant")
+    for f in items:
+        if f not in FOURIER_VARIANTS:
+            raise ValueError(f"fourier must be one of {FOURIER_VARIANTS} (or a list of them), got {f!r}")
+    return items, scalar
+
+
+def as_1d(name, values, check=checks.as_array):
+    """``check(name, values)`` as a 1-D float array."""
+    return checks.check_1d(name, values, check)
+
+
+def mesh(q0, p0):
+    """Validated uniform grid axes and their ``ij`` mesh: ``(q, p, Q, P)``."""
+    q, p, _, _ = grid_spacing(q0, p0)
+    Q, P = np.meshgrid(q, p, indexing="ij")
+    return q, p, Q, P
+
+
+def chart_param(ds, name):
+    """A parameter of an escape chart: coordinate if stacked over it, else the attribute."""
+    if name in ds.coords:
+        return ds[name]
+    if name in ds.attrs:
+        return ds.attrs[name]
+    raise ValueError(f"chart has neither a coordinate nor an attribute {name!r}")
+
+
+def stack_charts(charts, dim):
+    """Accept one Dataset (possibly already stacked over ``dim``) or a sequence of charts.
+
+    A sequence is concatenated along ``dim`` using each chart's attribute ``dim``.
+    """
+    if isinstance(charts, xr.Dataset):
+        return charts
+    charts = list(charts)
+    if not charts:
+        raise ValueError("charts must not be empty")
+    vals = []
+    for c in charts:
+        if dim in c.coords:
+            vals.append(float(c[dim]))
+        elif dim in c.attrs:
+            vals.append(float(c.attrs[dim]))
+        else:
+            raise ValueError(f"every chart needs an attribute or scalar coordinate {dim!r} to be stacked")
+    out = xr.concat([c.drop_vars(dim, errors="ignore") for c in charts], dim=dim,
+                    combine_attrs="drop_conflicts")
+    out = out.assign_coords({dim: vals})
+    out.attrs.pop(dim, None)
+    return out

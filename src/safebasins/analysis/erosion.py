@@ -1,0 +1,217 @@
+"""Erosion profiles: GIM, LIM and IF of the safe basin versus the forcing amplitude F.
+
+Analytic profiles classify every grid IC with the isolated-resonance slow flow
+(``theory.slow_flow_escapes``) for each F; numeric profiles integrate eq (1) with ONE
+``numerics.escape_chart`` per F carrying all thresholds, and read the safe set
+``escape_cycle > t_eval`` for every evaluation time from the same escape cycles, so
+the numeric profile is a function of ``(F, xi_max, t_eval)`` at the cost of a
+function of F.  :func:`profile_from_charts` does the reading for charts that
+already exist (the pipeline's ``chart_fig16/17.nc``, or any stack over F).
+
+All results are ``xarray.Dataset`` objects with the variables of
+:func:`safebasins.analysis.integrity.integrity_measures` (``GIM``, ``LIM``, ``IF`` plus raw
+radii/areas), ``units``/``long_name`` attributes, and the parameters as attributes.
+
+Monotonicity that holds exactly: for a fixed chart the safe set shrinks as t_eval
+grows, so GIM, LIM and IF are non-increasing in ``t_eval`` (LIM/IF because the
+distance to the unsafe set can only shrink when the unsafe set grows).  In F
+neither the analytic nor the numeric profile is monotone in general (secondary
+resonances, the non-monotone escape near the resonance minimum); the analytic
+profile starts at 1 at F = 0 where the slow flow is xi = const.
+"""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from safebasins import checks
+from safebasins.analysis.common import as_1d, fourier_list, mesh, stack_charts
+from safebasins.analysis.integrity import integrity_measures, unforced_safe_mask
+from safebasins.analysis.safe import safe_stack
+from safebasins.io.cf import annotate
+from safebasins.numerics import escape_chart
+from safebasins.theory import slow_flow_escapes
+from safebasins.wells.quartic import QUARTIC
+
+__all__ = [
+    "analytic_safe_masks",
+    "erosion_profile_analytic",
+    "erosion_profile_numeric",
+    "profile_from_charts",
+    "level_crossing",
+    "compare_profiles",
+]
+
+
+# --------------------------------------------------------------------------- analytic
+def analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier="paper"):
+    """Analytic safe masks ``~slow_flow_escapes`` stacked as DataArray (fourier?, F, xi_max, q0, p0).
+
+    ``fourier`` may be a string (scalar coordinate) or a list (dimension ``fourier``).
+    Points outside the unforced set S0 are never safe (theory returns True there; the
+    mask is intersected with S0 anyway so that GIM <= 1 exactly).
+    """
+    F = as_1d("F_values", F_values, checks.check_nonnegative)
+    xi = as_1d("xi_max", xi_max, QUARTIC.check_threshold)
+    Omega = float(checks.check_positive("Omega", Omega))
+    Psi = float(checks.check_finite("Psi", Psi))
+    fl, scalar = fourier_list(fourier)
+    q, p, Q, P = mesh(q0, p0)
+    S0 = unforced_safe_mask(q, p, xi)
+    out = np.zeros((len(fl), F.size, xi.size, q.size, p.size), dtype=bool)
+    for a, f in enumerate(fl):
+        for i, Fi in enumerate(F):
+            for j, x in enumerate(xi):
+                e = np.asarray(slow_flow_escapes(Q, P, float(Fi), Omega, Psi, float(x), fourier=f), dtype=bool)
+                out[a, i, j] = ~e & S0[j]
+    da = xr.DataArray(out, dims=("fourier", "F", "xi_max", "q0", "p0"),
+                      coords={"fourier": fl, "F": F, "xi_max": xi, "q0": q, "p0": p},
+                      attrs={"long_name": "analytic safe basin (isolated 1:1 resonance)", "units": "1"})
+    return da.isel(fourier=0) if scalar else da
+
+
+def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier="paper", *, keep_masks=False):
+    """Analytic erosion profile: GIM/LIM/IF versus F from the slow flow on the (q0, p0) grid.
+
+    Parameters
+    ----------
+    F_values : 1-D forcing amplitudes (include 0 for the unforced reference point).
+    Omega, Psi : forcing frequency and phase.
+    xi_max : energy threshold(s) (dimension ``xi_max``).
+    q0, p0 : 1-D uniform grid axes (cover the well: |q0| <= 1, |p0| <= 1/sqrt(2)).
+    fourier : "paper" | "exact" | list of both (adds dimension ``fourier``).
+    keep_masks : also return the masks as variable ``safe`` (..., q0, p0).
+
+    Returns
+    -------
+    xr.Dataset over (fourier?, F, xi_max) with ``GIM``, ``LIM``, ``IF`` and the raw
+    measures (see :func:`safebasins.analysis.integrity.integrity_measures`).
+    """
+    masks = analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier)
+    ds = integrity_measures(masks)
+    if keep_masks:
+        ds["safe"] = masks
+    ds.attrs.update({"kind": "analytic", "Omega": float(Omega), "Psi": float(Psi),
+                     "method": "safebasins.theory.slow_flow_escapes on the grid"})
+    if isinstance(fourier, str):
+        ds.attrs["fourier"] = fourier
+    return annotate(ds)
+
+
+# --------------------------------------------------------------------------- numeric
+def profile_from_charts(charts, t_eval=None, *, criterion="energy", stack_dim="F"):
+    """Integrity profile from existing escape charts (no integration).
+
+    Parameters
+    ----------
+    charts : one ``escape_chart`` Dataset (optionally stacked over ``stack_dim``, e.g.
+        the pipeline's ``chart_fig16.nc``) or a sequence of charts, concatenated along
+        ``stack_dim`` using each chart's attribute of that name.
+    t_eval : evaluation times in forcing cycles (default: the chart horizon
+        ``cycles``); each <= ``cycles``.  Adds dimension ``t_eval``.
+    criterion : "energy" (``escape_cycle_energy``, thresholds ``xi_max``) or
+        "displacement" (``escape_cycle_displacement``, thresholds ``q_max``,
+        normalised by the unforced set of energy V(q_max)).
+
+    Returns
+    -------
+    xr.Dataset over (stack_dim?, threshold, t_eval) with the integrity variables.
+    """
+    chart = stack_charts(charts, stack_dim)
+    safe, xi_norm = safe_stack(chart, t_eval, criterion)
+    parts = [integrity_measures(safe.isel(t_eval=k), xi_max=xi_norm) for k in range(safe.sizes["t_eval"])]
+    ds = xr.concat(parts, dim="t_eval", coords="minimal", compat="override", join="override")
+    thr = "xi_max" if criterion == "energy" else "q_max"
+    lead = [d for d in (stack_dim, thr) if d in ds.dims]
+    ds = ds.transpose(*lead, "t_eval", ...)
+    ds["t_eval"].attrs.update(units="forcing cycles", long_name="evaluation time")
+    ds.attrs.update({k: v for k, v in chart.attrs.items() if k in ("Omega", "Psi", "F", "cycles",
+                                                                       "steps_per_cycle", "integrator")})
+    ds.attrs.update({"kind": "numeric", "criterion": criterion,
+                     "method": "safe = escape_cycle > t_eval from safebasins.numerics.escape_chart"})
+    return annotate(ds)
+
+
+def erosion_profile_numeric(F_values, Omega, Psi, xi_max, q0, p0, t_eval=None, cycles=3000, *,
+                            q_max=(), keep_charts=False, **chart_kwargs):
+    """Numeric erosion profile: ONE escape chart per F, all thresholds and t_eval read from it.
+
+    Parameters
+    ----------
+    F_values, Omega, Psi, xi_max, q0, p0 : as in :func:`erosion_profile_analytic`.
+    t_eval : evaluation time(s) in forcing cycles, each <= ``cycles`` (default ``cycles``).
+    cycles : integration horizon of each chart.
+    q_max : displacement thresholds also integrated (profile variables for them are
+        not returned here; use :func:`profile_from_charts` on the kept charts).
+    keep_charts : return the stacked charts too: ``(profile, charts)``.
+    chart_kwargs : passed to ``numerics.escape_chart`` (``steps_per_cycle``, ``threads``).
+
+    Returns
+    -------
+    xr.Dataset over (F, xi_max, t_eval) (and the charts stacked over F if ``keep_charts``).
+    """
+    F = as_1d("F_values", F_values, checks.check_nonnegative)
+    xi = as_1d("xi_max", xi_max, QUARTIC.check_threshold)
+    checks.check_positive_int("cycles", cycles)
+    q, p, _, _ = mesh(q0, p0)
+    charts = []
+    for Fi in F:
+        c = escape_chart(q, p, float(Fi), float(Omega), float(Psi), xi_max=tuple(xi.tolist()),
+                         q_max=tuple(np.atleast_1d(q_max).tolist()), cycles=cycles, **chart_kwargs)
+        charts.append(c.assign_attrs(F=float(Fi)))
+    stacked = stack_charts(charts, "F")
+    prof = profile_from_charts(stacked, t_eval)
+    return (prof, stacked) if keep_charts else prof
+
+
+# --------------------------------------------------------------------------- summaries
+def level_crossing(profile, level=0.5, dim="F"):
+    """First value of ``dim`` at which a profile falls below ``level`` (linear interpolation).
+
+    ``profile`` is a DataArray (e.g. ``ds["GIM"]``) or a Dataset (applied to GIM, LIM,
+    IF).  NaN where the profile never drops below ``level``; the first coordinate if it
+    starts below.  Vectorised over all other dims.
+    """
+    if isinstance(profile, xr.Dataset):
+        out = xr.Dataset({k: level_crossing(profile[k], level, dim) for k in ("GIM", "LIM", "IF")
+                          if k in profile})
+        return out.assign_attrs(level=float(level), dim=dim)
+    x = profile[dim].values.astype(float)
+    if x.size > 1 and (np.diff(x) <= 0).any():
+        raise ValueError(f"{dim} must be increasing along the profile")
+
+    def _first(y):
+        y = np.asarray(y, float)
+        below = np.flatnonzero(y < level)
+        if below.size == 0:
+            return np.nan
+        k = below[0]
+        if k == 0:
+            return x[0]
+        y0, y1 = y[k - 1], y[k]
+        if not np.isfinite(y0) or y0 == y1:
+            return x[k]
+        return x[k - 1] + (y0 - level) / (y0 - y1) * (x[k] - x[k - 1])
+
+    res = xr.apply_ufunc(lambda a: np.apply_along_axis(_first, -1, a), profile,
+                         input_core_dims=[[dim]], output_core_dims=[[]])
+    return res.assign_attrs(units=profile[dim].attrs.get("units", "1"),
+                            long_name=f"first {dim} at which {profile.name or 'the measure'} < {level}")
+
+
+def compare_profiles(analytic, numeric, level=0.5):
+    """Side-by-side Dataset: ``<measure>_analytic``, ``<measure>_numeric`` and the F at which
+    each falls below ``level`` (``F_<measure>_analytic``, ``F_<measure>_numeric``).
+
+    The two profiles must share the F and xi_max coordinates (as produced by
+    :func:`erosion_profile_analytic` and :func:`erosion_profile_numeric` with the same
+    arguments).
+    """
+    out = xr.Dataset()
+    for k in ("GIM", "LIM", "IF"):
+        out[f"{k}_analytic"] = analytic[k]
+        out[f"{k}_numeric"] = numeric[k]
+        out[f"F_{k}_analytic"] = level_crossing(analytic[k], level)
+        out[f"F_{k}_numeric"] = level_crossing(numeric[k], level)
+    out.attrs.update(level=float(level), Omega=analytic.attrs.get("Omega"), Psi=analytic.attrs.get("Psi"))
+    return out

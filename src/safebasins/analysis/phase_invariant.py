@@ -1,0 +1,260 @@
+"""Phase-invariant ("true") safe basin: the intersection over forcing phases Psi.
+
+An engineer rarely knows the forcing phase at the moment the disturbance starts; the
+set of initial conditions that is safe *whatever* the phase is the intersection of
+the safe basins over Psi.
+
+Analytic (isolated 1:1 resonance)
+---------------------------------
+The slow phase is ``gamma = theta - Psi - Omega tau``, so the basin for phase Psi is
+the Psi = 0 basin rotated in the slow angle: an IC ``(theta0, xi0)`` is safe for Psi
+iff ``(gamma0, xi0) = (theta0 - Psi, xi0)`` is safe on the resonance manifold.  One
+``angle_energy`` evaluation of the grid therefore serves every phase
+(``escapes_on_manifold(theta0 - Psi, xi0, ...)``).
+
+Over a *continuum* of phases the intersection is a sub-level set of the energy:
+an IC is safe for every Psi iff the whole circle ``xi = xi0`` of the manifold is safe.
+If a point of the circle ``xi1`` lies on a level curve of C that reaches xi_max,
+that curve crosses every circle ``xi1 < xi < xi_max`` on its way, so the set of
+all-safe circles is an interval ``[0, xi_true)``.  Hence
+
+    true basin (all phases) = {H0(q0, p0) < xi_true(F, Omega, xi_max)}
+
+and its integrity has a closed form: ``GIM = J(xi_true) / J(xi_max)`` (area = 2 pi J),
+``LIM = IF = sqrt(xi_true / xi_max)`` (inscribed radius sqrt(2 xi)).  ``xi_true`` is
+found by nested grid refinement of "some gamma of the circle escapes" (monotone in xi
+by the same argument) with a fine gamma grid; if the LPT through the well bottom escapes,
+``xi_true = 0``.  A finite set of phases gives a superset of this disk.
+
+Numeric
+-------
+One escape chart per phase (eq (1) is not rotation invariant); the true basin for a
+threshold and an evaluation time is the intersection of ``escape_cycle > t_eval``
+over the phases.
+"""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from safebasins import checks
+from safebasins.analysis.common import as_1d, fourier_list, mesh, stack_charts
+from safebasins.analysis.integrity import MEASURE_ATTRS, integrity_measures, unforced_safe_mask
+from safebasins.analysis.safe import safe_stack
+from safebasins.io.cf import annotate
+from safebasins.numerics import escape_chart
+from safebasins.theory import J, angle_energy, escapes_on_manifold
+from safebasins.wells.quartic import QUARTIC
+
+__all__ = [
+    "default_phases",
+    "xi_true_analytic",
+    "true_safe_basin_analytic",
+    "true_safe_basin_numeric",
+    "true_safe_basin_from_charts",
+]
+
+_KEEP = ("GIM", "LIM", "IF", "r_local", "r_global", "area", "if_q0", "if_p0")
+
+
+def default_phases(n_psi=16):
+    """``n_psi`` phases uniformly covering [0, 2 pi)."""
+    n = checks.check_positive_int("n_psi", n_psi)
+    return 2 * np.pi * np.arange(n) / n
+
+
+def _first_escaping_circle(lo, hi, n_xi, F, Omega, xi_max, fourier, gamma):
+    """Grid search on [lo, hi]: (last all-safe xi, first xi with an escaping point) or None."""
+    xs = np.linspace(lo, hi, n_xi)
+    e = np.asarray(escapes_on_manifold(gamma[:, None], xs[None, :], F, Omega, xi_max, fourier=fourier), dtype=bool).any(axis=0)
+    k = np.flatnonzero(e)
+    if k.size == 0:
+        return None
+    k = int(k[0])
+    return (xs[k - 1] if k > 0 else None), xs[k]
+
+
+def xi_true_analytic(F, Omega, xi_max, fourier="paper", *, n_gamma=512, n_xi=400, levels=3):
+    """Largest xi such that every circle ``xi' < xi`` of the resonance manifold is safe.
+
+    The predicate "some point of the circle escapes" is monotone in xi (module
+    docstring); it is tested on ``n_gamma`` equally spaced gamma (even, so the rays
+    gamma = 0 and pi where the level curves turn are included) and refined ``levels``
+    times on ``n_xi``-point xi grids, giving a resolution of about
+    ``xi_max / (n_xi - 1)**levels``.  Returns 0 if the well bottom (the limiting phase
+    trajectory) escapes and ``xi_max`` if nothing below xi_max escapes.
+    """
+    F = float(checks.check_nonnegative("F", F))
+    Omega = float(checks.check_positive("Omega", Omega))
+    xi_max = float(QUARTIC.check_threshold("xi_max", xi_max))
+    fourier_list(fourier)
+    n_gamma = checks.check_positive_int("n_gamma", n_gamma)
+    n_gamma += n_gamma % 2
+    gamma = 2 * np.pi * np.arange(n_gamma) / n_gamma
+    lo, hi = 0.0, xi_max * (1 - 1e-12)
+    for _ in range(checks.check_positive_int("levels", levels)):
+        r = _first_escaping_circle(lo, hi, checks.check_positive_int("n_xi", n_xi), F, Omega, xi_max, fourier, gamma)
+        if r is None:
+            return hi if hi >= xi_max * (1 - 1e-9) else lo
+        if r[0] is None:
+            return lo
+        lo, hi = r
+    return lo
+
+
+def _one_analytic(F, Omega, xi_max, q, p, Psi, fourier, n_gamma):
+    Q, P = np.meshgrid(q, p, indexing="ij")
+    S0 = unforced_safe_mask(q, p, xi_max)
+    theta = np.zeros(Q.shape)
+    xi0 = np.zeros(Q.shape)
+    th, x = angle_energy(Q[S0], P[S0])
+    theta[S0], xi0[S0] = th, x
+    safe = np.zeros((Psi.size,) + Q.shape, dtype=bool)
+    for k, ps in enumerate(Psi):
+        gamma = np.mod(theta[S0] - ps, 2 * np.pi)
+        safe[k][S0] = ~np.asarray(escapes_on_manifold(gamma, xi0[S0], F, Omega, xi_max, fourier=fourier), dtype=bool)
+    xt = xi_true_analytic(F, Omega, xi_max, fourier, n_gamma=n_gamma)
+    cont = S0 & (xi0 < xt)
+    closed_gim = float(J(xt) / J(xi_max)) if xt > 0 else 0.0
+    return safe, cont, xt, closed_gim, float(np.sqrt(xt / xi_max))
+
+
+def _assemble(safe, q, p, Psi, lead_dims, lead_coords, xi_norm):
+    """Common Dataset layout: per-phase masks, true mask, integrity of both."""
+    dims_psi = ("Psi",) + lead_dims + ("q0", "p0")
+    coords = {"Psi": Psi, "q0": q, "p0": p, **lead_coords}
+    da_safe = xr.DataArray(safe, dims=dims_psi, coords=coords,
+                           attrs={"long_name": "safe basin for forcing phase Psi", "units": "1"})
+    da_true = da_safe.all("Psi").assign_attrs(long_name="phase-invariant safe basin (intersection over Psi)",
+                                              units="1")
+    per = integrity_measures(da_safe, xi_max=xi_norm)
+    tru = integrity_measures(da_true, xi_max=xi_norm)
+    ds = xr.Dataset({"safe": da_safe, "true_safe": da_true})
+    for k in _KEEP:
+        ds[k] = per[k]
+        ds[f"{k}_true"] = tru[k].assign_attrs(
+            units=MEASURE_ATTRS[k]["units"], long_name=MEASURE_ATTRS[k]["long_name"] + " of the true basin")
+    # energy radius of the true basin: largest E with {H0 < E} (inside S0) contained in it, the grid
+    # counterpart of xi_true (compare analytic xi_true with the numeric xi_inscribed_true)
+    Hq = xr.DataArray(QUARTIC.H0(*np.meshgrid(q, p, indexing="ij")), dims=("q0", "p0"), coords={"q0": q, "p0": p})
+    s0 = QUARTIC.unforced_safe(Hq["q0"], Hq["p0"], xi_norm)
+    bad = s0 & ~da_true
+    ds["xi_inscribed_true"] = Hq.where(bad).min(("q0", "p0")).fillna(xi_norm).assign_attrs(
+        units="1", long_name="largest energy E with {H0 < E} inside the true basin (grid value, one-node accuracy)")
+    # containment diagnostic: the true basin lies inside every per-phase basin
+    ds["contained"] = (~(da_true & ~da_safe)).all(("q0", "p0")).all("Psi").assign_attrs(
+        long_name="true basin contained in every per-phase basin", units="1")
+    ds["Psi"].attrs.update(units="rad", long_name="forcing phase")
+    return ds
+
+
+def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fourier="paper", n_psi=16,
+                             n_gamma=512):
+    """Analytic phase-invariant safe basin and its integrity.
+
+    Parameters
+    ----------
+    F, Omega : forcing amplitude and frequency.
+    xi_max : energy threshold(s) (dimension ``xi_max``).
+    q0, p0 : 1-D uniform grid axes.
+    Psi_values : phases to intersect over (default ``default_phases(n_psi)``).
+    fourier : "paper" | "exact" | list (dimension ``fourier``).
+    n_gamma : gamma resolution of the continuous-phase limit ``xi_true``.
+
+    Returns
+    -------
+    xr.Dataset with
+      ``safe(Psi, [fourier,] xi_max, q0, p0)``     per-phase basins (rotations of Psi = 0),
+      ``true_safe([fourier,] xi_max, q0, p0)``     intersection over ``Psi_values``,
+      ``true_safe_continuous(...)``                 all phases: {H0 < xi_true},
+      ``xi_true([fourier,] xi_max)``                energy radius of the all-phase basin,
+      ``GIM, LIM, IF, r_local, r_global, area, if_q0, if_p0`` over (Psi, ...) and the
+      same with suffix ``_true`` (intersection over Psi_values) and ``_continuous``
+      (grid values for {H0 < xi_true}); ``GIM_closed``, ``LIM_closed`` (= IF_closed):
+      the closed forms J(xi_true)/J(xi_max) and sqrt(xi_true/xi_max);
+      ``xi_inscribed_true`` (largest energy disk inside ``true_safe``, grid value) and
+      ``contained`` (true basin inside every per-phase basin).
+    """
+    F = float(checks.check_nonnegative("F", F))
+    Omega = float(checks.check_positive("Omega", Omega))
+    xi = as_1d("xi_max", xi_max, QUARTIC.check_threshold)
+    Psi = default_phases(n_psi) if Psi_values is None else as_1d("Psi_values", Psi_values, checks.check_finite)
+    fl, scalar = fourier_list(fourier)
+    q, p, _, _ = mesh(q0, p0)
+    nf, nx = len(fl), xi.size
+    safe = np.zeros((Psi.size, nf, nx, q.size, p.size), bool)
+    cont = np.zeros((nf, nx, q.size, p.size), bool)
+    xt = np.zeros((nf, nx))
+    gim_c = np.zeros((nf, nx))
+    lim_c = np.zeros((nf, nx))
+    for a, f in enumerate(fl):
+        for j, x in enumerate(xi):
+            s, c, t, g, l = _one_analytic(F, Omega, float(x), q, p, Psi, f, n_gamma)
+            safe[:, a, j], cont[a, j], xt[a, j], gim_c[a, j], lim_c[a, j] = s, c, t, g, l
+    lead_dims = ("fourier", "xi_max")
+    lead_coords = {"fourier": fl, "xi_max": xi}
+    xi_norm = xr.DataArray(xi, dims="xi_max", coords={"xi_max": xi})
+    ds = _assemble(safe, q, p, Psi, lead_dims, lead_coords, xi_norm)
+    da_cont = xr.DataArray(cont, dims=lead_dims + ("q0", "p0"), coords={**lead_coords, "q0": q, "p0": p},
+                           attrs={"long_name": "safe basin for every phase Psi in [0, 2 pi): H0 < xi_true",
+                                  "units": "1"})
+    ds["true_safe_continuous"] = da_cont
+    cm = integrity_measures(da_cont, xi_max=xi_norm)
+    for k in _KEEP:
+        ds[f"{k}_continuous"] = cm[k]
+    ds["xi_true"] = xr.DataArray(xt, dims=lead_dims, attrs={
+        "units": "1", "long_name": "largest energy whose whole manifold circle is safe (all-phase basin H0 < xi_true)"})
+    ds["GIM_closed"] = xr.DataArray(gim_c, dims=lead_dims, attrs={
+        "units": "1", "long_name": "closed-form GIM of the all-phase basin, J(xi_true)/J(xi_max)"})
+    ds["LIM_closed"] = xr.DataArray(lim_c, dims=lead_dims, attrs={
+        "units": "1", "long_name": "closed-form LIM = IF of the all-phase basin, sqrt(xi_true/xi_max)"})
+    if scalar:
+        ds = ds.isel(fourier=0)
+    ds.attrs.update({"kind": "analytic", "F": F, "Omega": Omega, "n_gamma": int(n_gamma),
+                     "method": "rotation of the Psi = 0 manifold classification: gamma0 = theta0 - Psi"})
+    return annotate(ds)
+
+
+def true_safe_basin_from_charts(charts, t_eval=None, *, criterion="energy"):
+    """Numeric phase-invariant basin from escape charts stacked over ``Psi`` (or a list of charts).
+
+    Returns a Dataset with ``safe(Psi, threshold, t_eval, q0, p0)``, ``true_safe(threshold,
+    t_eval, q0, p0)``, integrity of each (``GIM``... over Psi and ``GIM_true``...),
+    ``xi_inscribed_true`` (energy radius of the true basin, to compare with the analytic
+    ``xi_true``) and ``contained``.
+    """
+    chart = stack_charts(charts, "Psi")
+    safe, xi_norm = safe_stack(chart, t_eval, criterion)
+    thr = "xi_max" if criterion == "energy" else "q_max"
+    safe = safe.transpose("Psi", thr, "t_eval", "q0", "p0")
+    lead_dims = (thr, "t_eval")
+    lead_coords = {thr: safe[thr].values, "t_eval": safe["t_eval"].values}
+    ds = _assemble(safe.values, safe["q0"].values, safe["p0"].values, safe["Psi"].values,
+                   lead_dims, lead_coords, xi_norm)
+    ds.attrs.update({k: v for k, v in chart.attrs.items() if k in ("F", "Omega", "cycles", "steps_per_cycle",
+                                                                       "integrator")})
+    ds.attrs.update({"kind": "numeric", "criterion": criterion,
+                     "method": "intersection over Psi of escape_cycle > t_eval, one escape_chart per Psi"})
+    return annotate(ds)
+
+
+def true_safe_basin_numeric(F, Omega, xi_max, q0, p0, Psi_values=None, t_eval=None, cycles=3000, *,
+                            n_psi=16, keep_charts=False, **chart_kwargs):
+    """Numeric phase-invariant safe basin: one ``numerics.escape_chart`` per phase.
+
+    Parameters as in :func:`true_safe_basin_analytic`, plus ``t_eval`` (cycles, each <=
+    ``cycles``; dimension ``t_eval``), ``cycles`` and ``chart_kwargs`` for escape_chart.
+    Returns the Dataset of :func:`true_safe_basin_from_charts` (and the charts if
+    ``keep_charts``).
+    """
+    F = float(checks.check_nonnegative("F", F))
+    Omega = float(checks.check_positive("Omega", Omega))
+    xi = as_1d("xi_max", xi_max, QUARTIC.check_threshold)
+    Psi = default_phases(n_psi) if Psi_values is None else as_1d("Psi_values", Psi_values, checks.check_finite)
+    checks.check_positive_int("cycles", cycles)
+    q, p, _, _ = mesh(q0, p0)
+    charts = [escape_chart(q, p, F, Omega, float(ps), xi_max=tuple(xi.tolist()), cycles=cycles,
+                           **chart_kwargs).assign_attrs(Psi=float(ps)) for ps in Psi]
+    stacked = stack_charts(charts, "Psi")
+    ds = true_safe_basin_from_charts(stacked, t_eval)
+    return (ds, stacked) if keep_charts else ds

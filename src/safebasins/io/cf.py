@@ -1,0 +1,86 @@
+"""CF metadata: the one table of units and long names of every shared variable name.
+
+Names follow docs/contracts.md and the paper (dimensionless units; times in forcing cycles).
+:func:`annotate` fills ``units`` / ``long_name`` of coordinates and data variables that do not
+carry their own.
+"""
+from __future__ import annotations
+
+import xarray as xr
+
+REFERENCE = ("G. Karmi, P. Kravetc, O. Gendelman, Analytic exploration of safe basins in a "
+             "benchmark problem of forced escape")
+INSTITUTION = "safebasins reproduction"
+
+# name -> (units, long_name). Dimensionless units are "1"; time in forcing cycles.
+VARIABLES = {
+    "q0": ("1", "initial displacement q(0)"),
+    "p0": ("1", "initial momentum p(0)"),
+    "q": ("1", "displacement at the stroboscopic instants"),
+    "p": ("1", "momentum at the stroboscopic instants"),
+    "sample": ("1", "initial-condition index"),
+    "iteration": ("1", "stroboscopic-map iteration (forcing cycles)"),
+    "Omega": ("1", "forcing frequency Omega"),
+    "F": ("1", "forcing amplitude F"),
+    "Psi": ("rad", "forcing phase Psi"),
+    "xi_max": ("1", "energy truncation level xi_max (escape threshold on H0)"),
+    "q_max": ("1", "displacement escape threshold q_max"),
+    "t_eval": ("forcing cycles", "evaluation time"),
+    "gamma": ("rad", "slow phase gamma = theta - Psi - Omega tau"),
+    "xi": ("1", "averaged energy xi"),
+    "gamma_rm": ("rad", "slow phase gamma on the resonance-manifold grid"),
+    "xi_rm": ("1", "averaged energy xi on the resonance-manifold grid"),
+    "repeat": ("1", "random repetition index"),
+    "seed": ("1", "random seed of the repetition"),
+    "xi_ini": ("1", "initial averaged energy xi_ini"),
+    "gamma_ini": ("rad", "initial slow phase gamma_ini"),
+    "xi0": ("1", "initial averaged energy xi_ini"),
+    "gamma0": ("rad", "initial slow phase gamma_ini"),
+    "curve": ("1", "curve index"),
+    "label": ("", "curve label"),
+    "vertex": ("1", "boundary vertex index"),
+    "curve_index": ("1", "index of the boundary curve a vertex belongs to (-1 = padding)"),
+    "kind": ("", "boundary kind (island | peninsula | saddle)"),
+    "C_level": ("1", "level of the first integral C on the boundary curve"),
+    "C": ("1", "first integral C(gamma, xi) of the slow flow, eq (18)"),
+    "escapes": ("1", "analytic (slow-flow) escape: True = the IC escapes"),
+    "escapes_rm": ("1", "analytic escape of the resonance-manifold point: True = escapes"),
+    "escape_cycle_energy": ("forcing cycles", "first cycle with H0 > xi_max (+inf = none within the horizon)"),
+    "escape_cycle_displacement": ("forcing cycles", "first cycle with |q| > q_max (+inf = none within the horizon)"),
+    "escape_cycle": ("forcing cycles", "escape time (+inf = none within the horizon)"),
+    "escaped": ("1", "trajectory escaped within the horizon"),
+    "F_cr": ("1", "critical forcing amplitude"),
+    "F_MM_0": ("1", "critical forcing, maximum mechanism through gamma* = 0"),
+    "F_MM_pi": ("1", "critical forcing, maximum mechanism through gamma* = pi"),
+    "F_SM": ("1", "critical forcing, saddle mechanism"),
+    "F_SMM": ("1", "critical forcing, saddle maximum mechanism"),
+    "F_escape_low": ("1", "lowest escaping F on the scan"),
+    "F_escape_all": ("1", "F above which every scanned F escapes"),
+    "non_monotone": ("1", "escape is not monotone in F on the scan"),
+    "mechanism": ("1", "escape mechanism of the overall F_cr"),
+    "xi_saddle": ("1", "averaged energy of the saddle point"),
+    "gamma_saddle": ("rad", "slow phase of the saddle point"),
+    "saddle_gamma": ("rad", "slow phase of the saddle point"),
+    "saddle_xi": ("1", "averaged energy of the saddle point"),
+    "iou": ("1", "intersection over union of the analytic and numeric safe basins"),
+    "pixel_agreement": ("1", "fraction of grid points where the analytic and numeric safe/escape labels agree"),
+    "safe_analytic": ("1", "number of grid points in the analytic safe basin"),
+    "safe_numeric": ("1", "number of grid points in the numeric safe basin"),
+    "A_E": ("1", "number of ICs in the energy-criterion safe basin (ESB)"),
+    "A_q": ("1", "number of ICs in the displacement-criterion safe basin (DSB)"),
+    "rel_diff": ("1", "(A_q - A_E) / A_E"),
+}
+
+
+def annotate(ds: xr.Dataset) -> xr.Dataset:
+    """Fill missing `units` / `long_name` of coordinates and data variables (in place, returned)."""
+    for name in list(ds.variables):
+        entry = VARIABLES.get(str(name))
+        if entry is None:
+            continue
+        units, long_name = entry
+        attrs = ds[name].attrs
+        if units and "units" not in attrs and ds[name].dtype.kind in "fiub":
+            attrs["units"] = units
+        attrs.setdefault("long_name", long_name)
+    return ds

@@ -1,0 +1,290 @@
+"""The experiments the package declares: the paper's 22 figures and the beyond-the-paper products.
+
+Pure data: which config block holds each experiment, its kind (:mod:`safebasins.pipeline.registry`),
+title, seed offset, and its figure's texts (the paper's caption, what to look for) and plotting
+options.  Read by the registry's :func:`~safebasins.pipeline.plan.plan` (Snakefile, scripts,
+notebooks, report captions, cost estimate); experiments declared in the config under
+``experiments:`` take their figure texts from their kind.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+
+@dataclass(frozen=True)
+class Declaration:
+    name: str                 # experiment name: results/params/<name>.yaml, results/figures/<name>.png
+    kind: str
+    key: tuple[str, str]      # config block: config[key[0]][key[1]]
+    title: str
+    stem: str                 # notebook stem (notebooks/<stem>.ipynb)
+    label: str                # report label
+    category: str             # report category
+    caption: str
+    look: str
+    options: dict = field(default_factory=dict)
+    seed_offset: int = 0      # experiments never share random streams: seed = config seed + offset
+
+
+_SB_LEFT_RIGHT = ('Left: level curves of the first integral C(γ, ξ) of eq. (18) on the resonance-manifold '
+     'cylinder, the truncation level ξ = ξ_max (thick blue dashed line) and the safe basin (grey '
+     'region with red boundary). Right: the same safe basin mapped to the plane of initial '
+     'conditions (q0, p0) with eqs. (15), (17); the thin dashed oval is the edge of the unforced '
+     'well H0 = ξ_max.')
+
+_NESTED = ('Grey regions: numeric safe basins (escape chart of eq. (1), energy criterion, t_eval = the '
+     'integration horizon) shaded by the scanned parameter; the shading is painted from the '
+     'largest basin (lightest) to the smallest (darkest), so lighter regions contain the darker '
+     'ones and white is escape common to all values. Coloured curves: analytic boundaries '
+     '(isolated-resonance approximation) for the same parameter values, matched by colour and line '
+     'style in the legend, which also gives the stored analytic/numeric intersection over union '
+     '(IoU).')
+
+DECLARATIONS = (
+    Declaration(
+        name="fig01", kind="fcr_theory", key=("figures", "fig01"), stem="fig01_fcr_xi_ini",
+        label="Fig. 1", category="Figures", options={'color_by': 'curve', 'show_branches': False, 'F_max': None},
+        title=('Critical forcing F_cr(Omega) for several initial energies xi_ini (gamma_ini = '
+               '0.25, xi_max = 0.242)'),
+        caption=('Escape threshold versus excitation frequency for various values of ξ_ini and '
+                 'γ_ini = 0.25, ξ_max = 0.242.'),
+        look=('Theoretical F_cr(Ω) for several initial energies ξ_ini (one colour each); the line '
+              'style gives the mechanism (solid SM, dashed MM through γ* = π, dash-dot MM through '
+              'γ* = 0, dotted SMM). Higher ξ_ini generally lowers F_cr, but the ξ_ini = 0 curve '
+              'lies below some higher-energy curves on its SM part.')),
+    Declaration(
+        name="fig02", kind="fcr_theory", key=("figures", "fig02"), stem="fig02_fcr_gamma_ini",
+        label="Fig. 2", category="Figures", options={'color_by': 'curve', 'show_branches': False, 'F_max': None},
+        title=('Critical forcing F_cr(Omega) for several initial angles gamma_ini (xi_ini = 0.15, '
+               'xi_max = 0.242)'),
+        caption=('Escape threshold versus excitation frequency for various values of γ_ini and '
+                 'ξ_ini = 0.15, ξ_max = 0.242.'),
+        look=('Theoretical F_cr(Ω) for several initial slow phases γ_ini (one colour each), line '
+              'style = mechanism. Increasing γ_ini lowers the SM part of the curve and raises the '
+              'MM part.')),
+    Declaration(
+        name="fig03", kind="fcr_theory", key=("figures", "fig03"), stem="fig03_fcr_mechanisms",
+        label="Fig. 3", category="Figures", options={'color_by': 'mechanism', 'show_branches': True, 'F_max': None},
+        title=('Critical forcing F_cr(Omega) for the zero IC, xi_max = 0.15: SMM, SM and MM '
+               'branches'),
+        caption=('Escape threshold versus excitation frequency for the zero IC and the truncation '
+                 'energy level ξ_max = 0.15. Dotted, solid and dashed lines correspond to SMM, SM '
+                 'and MM, respectively.'),
+        look=('The overall threshold (thick) is coloured and styled by the mechanism that sets it: '
+              'green dashed MM through the tangent point (γ = π, ξ = 0.15), blue solid SM, red '
+              'dotted SMM (MM through γ = 0 where the saddle energy ξ† exceeds ξ_max). Thin faint '
+              'lines continue each branch where it is not the smallest.')),
+    Declaration(
+        name="fig04", kind="fcr_theory", key=("figures", "fig04"), stem="fig04_fcr_xi_max",
+        label="Fig. 4", category="Figures", options={'color_by': 'curve', 'show_branches': False, 'F_max': None},
+        title='Critical forcing F_cr(Omega) for the zero IC and several truncation levels xi_max',
+        caption=('Escape threshold versus excitation frequency for the zero IC for various values '
+                 'of the threshold energy level ξ_max.'),
+        look=('Shallower wells (smaller ξ_max) need less forcing and their resonance minimum moves '
+              'towards Ω = 1 (nearly linear oscillator).')),
+    Declaration(
+        name="fig05", kind="basin_rm", key=("figures", "fig05"), stem="fig05_sbmt_island",
+        label="Fig. 5", category="Figures", options={},
+        title='Safe basin of maximum type, island kind (F = 0.0876, Omega = 0.92, xi_max = 0.24)',
+        caption=('Grey region is SBMT of island kind on the (γ, ξ) cylinder (left) and on the (q0, '
+                 'p0) plane (right). Thick dashed line corresponds to truncation level ξ_max = '
+                 '0.24. The parameters of external forcing are F = 0.0876; Ω = 0.92.'),
+        look=_SB_LEFT_RIGHT + " " + ('The boundary is the level curve of C tangent to ξ = ξ_max; the safe region is '
+              'enclosed by it (island: it does not wrap around the cylinder).')),
+    Declaration(
+        name="fig06", kind="basin_rm", key=("figures", "fig06"), stem="fig06_sbmt_peninsula_a",
+        label="Fig. 6", category="Figures", options={},
+        title=('Safe basin of maximum type, peninsula kind (F = 0.0876, Omega = 1.04, xi_max = '
+               '0.249)'),
+        caption=('Peninsula SBMT for the parameters F = 0.0876, Ω = 1.04. Thick dashed line '
+                 'corresponds to truncation level ξ_max = 0.249.'),
+        look=_SB_LEFT_RIGHT + " " + ('Peninsula: the tangent level curve wraps around the cylinder and the safe region '
+              'lies between it and ξ = 0 (all γ).')),
+    Declaration(
+        name="fig07", kind="basin_rm", key=("figures", "fig07"), stem="fig07_sbmt_peninsula_b",
+        label="Fig. 7", category="Figures", options={},
+        title=('Safe basin of maximum type, peninsula kind (F = 0.0876, Omega = 0.57, xi_max = '
+               '0.21)'),
+        caption=('Peninsula SBMT for the parameters F = 0.0876, Ω = 0.57. Thick dashed line '
+                 'corresponds to truncation level ξ_max = 0.21.'),
+        look=_SB_LEFT_RIGHT + " " + 'Peninsula far below resonance (Ω = 0.57).'),
+    Declaration(
+        name="fig08", kind="basin_rm", key=("figures", "fig08"), stem="fig08_sbst",
+        label="Fig. 8", category="Figures", options={},
+        title='Safe basin of saddle type (F = 0.0876, Omega = 0.57, xi_max = 0.2499)',
+        caption=('SBST for the parameters F = 0.0876, Ω = 0.57. Thick dashed line corresponds to '
+                 'truncation level ξ_max = 0.2499.'),
+        look=_SB_LEFT_RIGHT + " " + ('Saddle type: the boundary passes through the saddle (open circle) of C; the safe '
+              'region lies between it and ξ = 0.')),
+    Declaration(
+        name="fig09", kind="basin_rm", key=("figures", "fig09"), stem="fig09_sb_coexisting",
+        label="Fig. 9", category="Figures", options={},
+        title='Coexisting safe basins of both types (F = 0.0478, Omega = 0.76, xi_max = 0.235)',
+        caption=('Co-existence of two types of SB with parameters F = 0.0478, Ω = 0.76. Thick '
+                 'dashed line corresponds to truncation level ξ_max = 0.235.'),
+        look=_SB_LEFT_RIGHT + " " + ('Both a maximum-type and a saddle-type region exist, so the safe basin on (q0, p0) '
+              'is made of two disjoint parts.')),
+    Declaration(
+        name="fig10", kind="fcr_compare", key=("figures", "fig10"), stem="fig10_fcr_numeric_zero_ic",
+        label="Fig. 10", category="Figures", options={'layout': 'panels', 'bracket': True, 'F_max': None},
+        title='Analytic versus numeric F_cr(Omega), zero IC, three truncation levels',
+        caption=('Escape threshold versus excitation frequency for different energy truncation '
+                 'levels ξ_max and the zero IC. Dots represent values obtained numerically, while '
+                 'solid curves correspond to the theoretical prediction.'),
+        look=('One panel per ξ_max. Dots: bisection F_cr (tolerance 5e-5, 3000 EC horizon). Where '
+              'escape is not monotone in F (near the resonance dip), a vertical bar spans the '
+              'lowest escaping F on the scan (F_escape_low) to the F above which every scanned F '
+              'escapes (F_escape_all). Agreement is best near the dip and weaker far from '
+              'resonance, especially on the MM branches.')),
+    Declaration(
+        name="fig11", kind="fcr_compare", key=("figures", "fig11"), stem="fig11_fcr_numeric_xi_ini",
+        label="Fig. 11", category="Figures", options={'layout': 'overlay', 'bracket': True, 'F_max': None},
+        title=('Analytic versus numeric F_cr(Omega), several xi_ini (gamma_ini = 0.25, Psi = pi, '
+               'xi_max = 0.242)'),
+        caption=('Escape threshold versus excitation frequency for various values of ξ_ini and '
+                 'ξ_max = 0.242, γ_ini = 0.25, Ψ = π. The notation is the same as in Figure 10.'),
+        look=('Theory lines and numeric dots share a colour per ξ_ini; bars mark the non-monotone '
+              'escape bracket where it exists.')),
+    Declaration(
+        name="fig12", kind="fcr_compare", key=("figures", "fig12"), stem="fig12_fcr_numeric_gamma_ini",
+        label="Fig. 12", category="Figures", options={'layout': 'overlay', 'bracket': True, 'F_max': None},
+        title=('Analytic versus numeric F_cr(Omega), several gamma_ini (xi_ini = 0.15, Psi = pi, '
+               'xi_max = 0.242)'),
+        caption=('Escape threshold versus excitation frequency for various values of γ_ini and '
+                 'ξ_max = 0.242, ξ_ini = 0.15, Ψ = π. The notation is the same as in Figure 10.'),
+        look=('Theory lines and numeric dots share a colour per γ_ini; bars mark the non-monotone '
+              'escape bracket where it exists.')),
+    Declaration(
+        name="fig13", kind="basin_chart", key=("figures", "fig13"), stem="fig13_sb_xi_max_a",
+        label="Fig. 13", category="Figures", options={},
+        title=('Safe basins versus xi_max, analytic and numeric (F = 0.015, Omega = 1.04, Psi = '
+               'pi)'),
+        caption=('Transformation of the SB with increasing energy truncation level ξ_max. Grey '
+                 'regions represent the numerically obtained SBs, curves correspond to the '
+                 'theoretical predictions. The other parameters are F = 0.015, Ω = 1.04, Ψ = π.'),
+        look=_NESTED + " " + ("Same topology for every ξ_max; very good agreement. Note: the paper's text says "
+              'lighter = smaller ξ_max, but the basin grows with ξ_max (a larger threshold is '
+              'harder to exceed), so containment puts the larger ξ_max lighter.')),
+    Declaration(
+        name="fig14", kind="basin_chart", key=("figures", "fig14"), stem="fig14_sb_xi_max_b",
+        label="Fig. 14", category="Figures", options={},
+        title='Safe basins versus xi_max, analytic and numeric (F = 0.01, Omega = 0.9, Psi = pi)',
+        caption='Same as Figure 13 but for F = 0.01; Ω = 0.9; Ψ = π.',
+        look=_NESTED + " " + 'For the smaller ξ_max the basin splits into disjoint parts (cf. Fig 9).'),
+    Declaration(
+        name="fig15", kind="basin_chart", key=("figures", "fig15"), stem="fig15_sb_xi_max_psi1",
+        label="Fig. 15", category="Figures", options={},
+        title='Safe basins versus xi_max, analytic and numeric (F = 0.01, Omega = 0.9, Psi = 1)',
+        caption='Same as Figure 14 but for Ψ = 1.',
+        look=_NESTED + " " + 'The forcing phase Ψ = 1 distorts and rotates the basins of Figure 14.'),
+    Declaration(
+        name="fig16", kind="basin_chart", key=("figures", "fig16"), stem="fig16_sb_forcing_a",
+        label="Fig. 16", category="Figures", options={},
+        title='Safe basins versus F, analytic and numeric (xi_max = 0.18, Omega = 0.9, Psi = pi)',
+        caption=('Transformation of the SB with increasing external forcing amplitude F. Other '
+                 'parameters are ξ_max = 0.18, Ω = 0.9, Ψ = π.'),
+        look=_NESTED + " " + 'Small forcing: numeric basins follow the theoretical boundaries.'),
+    Declaration(
+        name="fig17", kind="basin_chart", key=("figures", "fig17"), stem="fig17_sb_forcing_b",
+        label="Fig. 17", category="Figures", options={},
+        title='Safe basins versus F, analytic and numeric (xi_max = 0.22, Omega = 0.9, Psi = pi)',
+        caption='Same as Figure 16 but for ξ_max = 0.22, Ω = 0.9, Ψ = π.',
+        look=_NESTED + " " + ('Larger forcing: erosion by secondary resonances makes the numeric basins depart '
+              'from the theory (lower IoU for the larger F).')),
+    Declaration(
+        name="fig18", kind="strobe", key=("figures", "fig18"), stem="fig18_period_map",
+        label="Fig. 18", category="Figures", options={}, seed_offset=18000,
+        title=('Stroboscopic map of non-escaping trajectories (F = 0.0876, Omega = 0.99, Psi = pi, '
+               'xi_max = 0.24)'),
+        caption=('Phase portrait of 100 non-escaping trajectories of the period map for the '
+                 'following set of parameters: F = 0.0876, Ψ = π, Ω = 0.99, ξ_max = 0.24. Each '
+                 'trajectory runs for 3000 iterations. Dashed curve corresponds to the '
+                 'theoretically predicted boundary of the SB.'),
+        look=('Stroboscopic points (one colour per trajectory): a large island of invariant tori '
+              'around a fixed point, chains of smaller islands (e.g. a 1:6 chain) and a stochastic '
+              'layer between them. The dashed theoretical boundary is a reasonable first guess of '
+              'the safe region but does not capture the erosion.')),
+    Declaration(
+        name="fig19", kind="criteria", key=("figures", "fig19"), stem="fig19_criteria_rel_diff",
+        label="Fig. 19", category="Figures", options={}, seed_offset=19000,
+        title='Energy versus displacement escape criterion: safe-basin areas of random ICs',
+        caption=('Comparison of SB areas for different values of the external force amplitude F. '
+                 'Blue, orange and green markers correspond to the minimum, the mean, and the '
+                 'maximum of 5 experiments. Other parameters are the following: Ω = 0.9, Ψ = 0, '
+                 'ξ_max = 0.25.'),
+        look=('Relative difference (A_q − A_E)/A_E between the displacement-criterion (DSB) and '
+              'energy-criterion (ESB) safe counts from 10,000 random ICs in [−1, 1]², F = 0.001 … '
+              '0.071. Near zero for small F, growing with F.')),
+    Declaration(
+        name="fig20", kind="chart", key=("figures", "fig20"), stem="fig20_dsb_esb_zoom",
+        label="Fig. 20", category="Figures", options={'t_evals': None},
+        title='Escape chart, zoomed window (F = 0.0876, Omega = 0.95, Psi = pi, xi_max = 0.25)',
+        caption=('Zoomed SB Escape Chart simulation for F = 0.0876, Ω = 0.95, Ψ = π, ξ_max = 0.25, '
+                 'the resolution is 300×300. Left: t_eval = 500 EC. Right: t_eval = 11,000 EC, DSB '
+                 '(grey) and ESB (black).'),
+        look=('DSB (grey) always contains ESB (black). At 500 EC both boundaries are irregular '
+              '(transients); at 11,000 EC they are smoother and the energy criterion gives the '
+              'smoother boundary.')),
+    Declaration(
+        name="fig21", kind="chart", key=("figures", "fig21"), stem="fig21_dsb_esb_full",
+        label="Fig. 21", category="Figures", options={'t_evals': None},
+        title='Escape chart, entire window (F = 0.0876, Omega = 0.95, Psi = pi, xi_max = 0.25)',
+        caption=('Entire SB Escape Chart simulation for F = 0.0876, Ω = 0.95, Ψ = π, ξ_max = 0.25, '
+                 'the resolution is 300×300. Left: t_eval = 500 EC. Right: t_eval = 11,000 EC, DSB '
+                 '(grey) and ESB (black).'),
+        look='Full view of the basins of Figure 20.'),
+    Declaration(
+        name="fig22", kind="area_time", key=("figures", "fig22"), stem="fig22_sb_area_vs_time",
+        label="Fig. 22", category="Figures", options={'t_evals': None},
+        title='Safe-basin area versus evaluation time (read from the Fig 21 chart)',
+        caption=('Log of SB area in pixels fading with t_eval for DSB (dashed) and ESB (solid), F '
+                 '= 0.0876, Ω = 0.95, Ψ = π, ξ_max = 0.25, the resolution is 300×300.'),
+        look=('Natural log of the number of safe pixels of the Figure 21 chart as a function of '
+              'the evaluation time: rapid shrinking for about 2000 EC, then almost constant.')),
+    Declaration(
+        name="extra_erosion", kind="erosion", key=("extras", "erosion"), stem="extra_erosion",
+        label='Erosion profiles: integrity measures versus forcing amplitude', category="Beyond the paper", options={'measures': ['GIM', 'LIM', 'IF'], 'xi_max': None, 't_eval': None},
+        title=('Erosion profiles: GIM, LIM and IF versus F, analytic (paper and exact G) and '
+               'numeric'),
+        caption=('Global (GIM), local (LIM) and integrity-factor (IF) measures of the safe basin '
+                 'versus the forcing amplitude F, normalised by the unforced well, for the Figs '
+                 '16-17 parameters (Ω = 0.9, Ψ = π, ξ_max = 0.18 and 0.22).'),
+        look=("Lines: slow-flow (analytic) profiles with the paper's first harmonic (solid) and "
+              'the exact one (dashed). Markers: numeric profiles from one escape chart per F '
+              '(energy criterion), one shade per evaluation time t_eval (light = early); '
+              'coinciding markers mean the profile no longer depends on t_eval. The dotted line is '
+              'the 0.5 level whose first crossing F_GIM, F_LIM, F_IF is stored in both datasets. '
+              'LIM collapses when the well bottom escapes (near the zero-IC F_cr), IF degrades '
+              'gradually.')),
+    Declaration(
+        name="extra_true_basin", kind="true_basin", key=("extras", "true_basin"), stem="extra_true_basin",
+        label='Phase-invariant (true) safe basin', category="Beyond the paper", options={'xi_max': None, 't_eval': None, 'fourier': 'paper'},
+        title='Phase-invariant (true) safe basin: intersection over the forcing phase Psi',
+        caption=('Initial conditions that are safe whatever the forcing phase Ψ: intersection of '
+                 'the safe basins over equispaced phases, slow flow (left) and numerics (right), F '
+                 '= 0.01, Ω = 0.9, ξ_max = 0.18.'),
+        look=('Light grey: safe for at least one phase; thin outlines: the per-phase basins '
+              'coloured by Ψ; green: safe for every sampled phase, with its IF disk (thick purple, '
+              '+ at the centre) and LIM disk (red dashed, drawn on top: where the two coincide the '
+              'outline is purple and red). The dotted black oval is the analytic all-phase basin '
+              'H0 = ξ_true (continuous Ψ). Not knowing the phase leaves a small energy disk around '
+              'the well bottom; the panel titles give its integrity measures.')),
+    Declaration(
+        name="extra_fourier", kind="fourier_compare", key=("extras", "fourier_compare"), stem="extra_fourier",
+        label='First harmonic: paper versus exact', category="Beyond the paper", options={},
+        title=("First harmonic of the slow flow: paper's G (eq 20) versus the exact one, against "
+               'the numerics'),
+        caption=("The paper's G (eq 20, leading term of the sn Fourier series) versus the exact "
+                 'first harmonic G/(1 - nome), both against the numerics of the paper figures: '
+                 'relative F_cr error on the Figs 10-12 Ω points (top row, one panel per figure) '
+                 'and its RMS per curve, and IoU of the analytic and numeric safe basins of Figs '
+                 '13-17 (bottom row).'),
+        look=('Top: (theory - numeric)/numeric versus Ω, one colour per curve, paper G solid, '
+              'exact dashed. Bottom left: RMS of that error per curve; bottom right: IoU per chart '
+              'threshold / forcing; paired bars (paper blue, exact orange) grouped by source '
+              'figure. The title gives the overall RMS error and mean IoU. Lower errors and higher '
+              'IoU mean the better first harmonic; the gain of the exact one grows with F, since '
+              'the harmonic enters multiplied by F.')),
+)
+
+BY_NAME = {d.name: d for d in DECLARATIONS}

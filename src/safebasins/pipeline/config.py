@@ -1,0 +1,179 @@
+"""Configuration: loading, the schema assembled from the registry, validation naming the key.
+
+The schema is ``workflow/schemas/config.schema.yaml`` (global knobs and shared building blocks
+under ``$defs``) plus one ``$defs`` entry per registered kind (its ``schema``): the paper's
+figures (block ``figures``) and the beyond-the-paper products (block ``extras``) refer to
+their kind's definition, and blocks under ``experiments`` name theirs with ``kind:``.  Every
+config default lives in that schema and is filled in by :func:`validate_config`, which then
+runs each kind's ``check``; every failure is a :class:`ConfigError` starting with the dotted
+key, e.g. ``config key figures.fig13.xi_max[2]: ...``.
+
+Nothing here imports the theory or numerics code, so a bad configuration is rejected (and the
+DAG built) without compiling anything.
+"""
+from __future__ import annotations
+
+import copy
+import importlib
+from pathlib import Path
+
+import yaml
+
+from safebasins.pipeline import catalog
+from safebasins.pipeline.registry import KINDS
+from safebasins.pipeline.validation import CheckContext, ConfigError, fail, key_path
+
+REPO_ROOT = Path(__file__).resolve().parents[3]
+SCHEMA_PATH = REPO_ROOT / "workflow" / "schemas" / "config.schema.yaml"
+#: the kind modules of the package (importing them registers the kinds)
+KIND_MODULES = ("safebasins.pipeline.kinds.fcr", "safebasins.pipeline.kinds.basins",
+                "safebasins.pipeline.kinds.charts", "safebasins.pipeline.kinds.extras")
+
+__all__ = ["ConfigError", "load_yaml", "build_schema", "validate_config", "experiment_blocks", "SCHEMA_PATH"]
+
+
+def load_yaml(path):
+    with open(path) as fh:
+        return yaml.safe_load(fh)
+
+
+def load_kinds(extensions=()):
+    """Import the package's kind modules and the config's ``extensions`` (modules registering
+    further kinds)."""
+    for mod in (*KIND_MODULES, *extensions):
+        importlib.import_module(mod)
+
+
+def build_schema(base=None) -> dict:
+    """The full JSON schema: the base file plus one ``$defs`` entry per registered kind."""
+    schema = copy.deepcopy(load_yaml(SCHEMA_PATH) if base is None else base)
+    defs = schema.setdefault("$defs", {})
+    for name, kind in KINDS.items():
+        defs[name] = copy.deepcopy(kind.schema)
+    props = schema["properties"]
+    for d in catalog.DECLARATIONS:
+        block, key = d.key
+        ref = {"$ref": f"#/$defs/{d.kind}"}
+        if block == "extras":
+            ref["default"] = {}
+        props[block].setdefault("properties", {})[key] = ref
+        if block == "figures":
+            props[block].setdefault("required", []).append(key)
+    props["experiments"]["additionalProperties"] = {
+        "type": "object", "required": ["kind"],
+        "properties": {"kind": {"enum": sorted(KINDS)}},
+    }
+    return schema
+
+
+# --------------------------------------------------------------------------------------
+# JSON-schema errors in plain words
+# --------------------------------------------------------------------------------------
+def _default_filling_validator(schema):
+    from jsonschema import Draft202012Validator, validators
+
+    base = Draft202012Validator
+    validate_properties = base.VALIDATORS["properties"]
+
+    def set_defaults(validator, properties, instance, schema_):
+        if isinstance(instance, dict):
+            for prop, sub in properties.items():
+                if isinstance(sub, dict) and "default" in sub:
+                    instance.setdefault(prop, copy.deepcopy(sub["default"]))
+        yield from validate_properties(validator, properties, instance, schema_)
+
+    return validators.extend(base, {"properties": set_defaults})(schema)
+
+
+def _flatten(errors):
+    for e in errors:
+        if e.context:
+            yield from _flatten(e.context)
+        else:
+            yield e
+
+
+def _format_schema_error(err, prefix=()) -> str:
+    path = list(prefix) + list(err.absolute_path)
+    key = key_path(path)
+    msg = err.message
+    if err.validator == "additionalProperties":
+        # name the unknown key itself
+        extra = [k for k in err.instance if k not in err.schema.get("properties", {})]
+        if extra:
+            key = key_path(path + [extra[0]])
+            if path == ["figures"]:
+                names = [d.key[1] for d in catalog.DECLARATIONS if d.key[0] == "figures"]
+                msg = f"unknown figure name {extra[0]!r} (expected one of {names[0]} ... {names[-1]})"
+            else:
+                msg = f"unknown key {extra[0]!r}"
+    elif err.validator == "required":
+        missing = [k for k in err.validator_value if k not in err.instance]
+        if missing:
+            key = key_path(path + [missing[0]])
+            msg = f"missing required key {missing[0]!r}"
+    elif err.validator in ("oneOf", "anyOf") and err.context:
+        # report the most specific failure inside the alternatives: the deepest one, and
+        # rather a value error (maximum, minimum, ...) than "wrong type" of another branch
+        subs = list(_flatten(err.context))
+        subs.sort(key=lambda e: (-len(list(e.absolute_path)), e.validator in ("type", "oneOf", "anyOf", "required")))
+        sub = subs[0]
+        if list(sub.absolute_path) != list(err.absolute_path) or sub.validator not in ("type",):
+            return _format_schema_error(sub, prefix)
+        msg = f"{err.instance!r} is not valid here: {err.schema.get('description', 'see workflow/schemas/config.schema.yaml')}"
+    if err.validator == "pattern" and err.validator_value == "^-?pi$":
+        msg = f"{err.instance!r} is not an angle: give a number (radians) or 'pi'"
+    return f"config key {key}: {msg}"
+
+
+def _schema_check(validator, instance, prefix=()):
+    errors = list(validator.iter_errors(instance))
+    if errors:
+        # report the error closest to the offending value (deepest path first)
+        errors.sort(key=lambda e: (-len(list(e.absolute_path)), str(e.message)))
+        raise ConfigError(_format_schema_error(errors[0], prefix))
+
+
+# --------------------------------------------------------------------------------------
+# validation
+# --------------------------------------------------------------------------------------
+def experiment_blocks(config: dict):
+    """``(name, kind name, dotted key, block, declaration or None)`` of every experiment of a
+    validated config: the catalog's, then the config's ``experiments``."""
+    out = []
+    for d in catalog.DECLARATIONS:
+        block, key = d.key
+        out.append((d.name, d.kind, f"{block}.{key}", config[block][key], d))
+    for name, blk in (config.get("experiments") or {}).items():
+        out.append((name, blk["kind"], f"experiments.{name}", blk, None))
+    return out
+
+
+def validate_config(config: dict) -> dict:
+    """Validate ``config`` in place (filling schema defaults); raise ConfigError naming the key."""
+    if not isinstance(config, dict):
+        raise ConfigError(f"config key <config>: the configuration must be a mapping, got {type(config).__name__}")
+    ext = config.get("extensions", [])
+    if not isinstance(ext, list) or not all(isinstance(m, str) for m in ext):
+        fail("extensions", "must be a list of importable module names that register experiment kinds")
+    for i, mod in enumerate(ext):
+        try:
+            importlib.import_module(mod)
+        except ImportError as exc:
+            fail(f"extensions[{i}]", f"cannot import {mod!r}: {exc}")
+    load_kinds()
+    schema = build_schema()
+    _schema_check(_default_filling_validator(schema), config)
+    # experiments declared in the config: their kind's schema (plus `kind` and `title`)
+    for name, blk in (config.get("experiments") or {}).items():
+        if name in catalog.BY_NAME:
+            fail(f"experiments.{name}", f"{name!r} is already an experiment of the package; choose another name")
+        sub = copy.deepcopy(schema["$defs"][blk["kind"]])
+        sub["properties"] = {"kind": {"enum": [blk["kind"]]}, "title": {"type": "string"}, **sub.get("properties", {})}
+        sub["$defs"] = schema["$defs"]
+        _schema_check(_default_filling_validator(sub), blk, ("experiments", name))
+    exps = experiment_blocks(config)
+    ctx = CheckContext(config, kinds={n: k for n, k, *_ in exps}, blocks={n: b for n, _, _, b, _ in exps})
+    for name, kind, key, blk, _ in exps:
+        KINDS[kind].check(blk, key, ctx)
+    return config

@@ -1,0 +1,1 @@
+"""The package's experiment kinds (each module registers its kinds on import)."""

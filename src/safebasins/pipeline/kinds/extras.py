@@ -1,0 +1,299 @@
+"""Beyond-the-paper kinds (docs/extras.md): ``erosion`` (integrity versus F), ``true_basin``
+(phase-invariant safe basin) and ``fourier_compare`` (paper versus exact first harmonic).
+
+Their datasets are ``results/data/extras/<experiment>_<product>.nc``.  Their numerics reuse the chart tiles (one escape chart per F, per Psi); every threshold and
+evaluation time is read from the same integration.  ``fourier_compare`` integrates nothing:
+it re-reads the numeric datasets of other experiments.
+"""
+from __future__ import annotations
+
+from functools import partial
+
+from safebasins.pipeline import values
+from safebasins.pipeline.registry import Kind, Product, dataset_path, register
+
+FOURIER_LIST = {"description": "first-harmonic variants of the analytic products (\"paper\", \"exact\")",
+                "oneOf": [{"enum": ["paper", "exact"]},
+                          {"type": "array", "minItems": 1, "uniqueItems": True, "items": {"enum": ["paper", "exact"]}}]}
+T_EVAL_LIST = {"description": "evaluation times in forcing cycles (each <= cycles), read from one integration",
+               "oneOf": [{"type": "number", "minimum": 0},
+                         {"type": "array", "minItems": 1, "items": {"type": "number", "minimum": 0}}]}
+
+
+def _grid_charts(params, tiles, attr):
+    """The chart of every task, each tagged with its task value ``attr`` (F or Psi) and cycles."""
+    from safebasins.io.gather import task_charts
+
+    charts = task_charts(tiles, len(params["tasks"]))
+    for c, t in zip(charts, params["tasks"]):
+        c.attrs.update({attr: t[attr], "cycles": params["cycles"]})
+    return charts
+
+
+def _level_crossings(ds, level):
+    from safebasins.analysis.erosion import level_crossing
+
+    cross = level_crossing(ds, level)
+    for m in ("GIM", "LIM", "IF"):
+        ds[f"F_{m}"] = cross[m].assign_attrs(units="1", long_name=f"first F at which {m} falls below {level:g}")
+    return ds
+
+
+def build_erosion_analytic(params, inputs, threads):
+    """GIM / LIM / IF versus F from the slow flow on the chart grid, per first-harmonic variant."""
+    from safebasins.analysis.erosion import erosion_profile_analytic
+
+    q0, p0 = values.grid_axes(params["grid"])
+    print(f"{params['experiment']}: {len(params['F'])} F x {len(params['xi_max'])} xi_max x {params['fourier']}")
+    ds = erosion_profile_analytic(params["F"], params["Omega"], params["Psi"], params["xi_max"], q0, p0,
+                                  fourier=params["fourier"])
+    ds = _level_crossings(ds, params["level"])
+    ds.attrs.update(level=params["level"], xi_max=params["xi_max"])
+    return ds
+
+
+def build_erosion_numeric(params, inputs, threads):
+    """GIM / LIM / IF versus (F, xi_max, t_eval) from one escape chart per F."""
+    from safebasins.analysis.erosion import profile_from_charts
+
+    ds = profile_from_charts(_grid_charts(params, inputs["tiles"], "F"), params["t_eval"], stack_dim="F")
+    ds = _level_crossings(ds, params["level"])
+    ds.attrs.update(level=params["level"], xi_max=params["xi_max"], cycles=params["cycles"])
+    return ds
+
+
+def build_true_basin_analytic(params, inputs, threads):
+    """Per-phase analytic basins, their intersection and the all-phase basin H0 < xi_true."""
+    from safebasins.analysis.phase_invariant import true_safe_basin_analytic
+
+    q0, p0 = values.grid_axes(params["grid"])
+    print(f"{params['experiment']}: F={params['F']} Omega={params['Omega']} xi_max={params['xi_max']} "
+          f"{len(params['Psi'])} phases {params['fourier']}")
+    return true_safe_basin_analytic(params["F"], params["Omega"], params["xi_max"], q0, p0, params["Psi"],
+                                    fourier=params["fourier"], n_gamma=params["n_gamma"])
+
+
+def build_true_basin_numeric(params, inputs, threads):
+    """Intersection over Psi of the numeric safe basins (one escape chart per Psi)."""
+    from safebasins.analysis.phase_invariant import true_safe_basin_from_charts
+
+    return true_safe_basin_from_charts(_grid_charts(params, inputs["tiles"], "Psi"), params["t_eval"])
+
+
+def build_fourier(params, inputs, threads, *, what, source):
+    """Paper vs exact first harmonic against the numerics of experiment ``source``."""
+    from safebasins.analysis import fourier_compare as fc
+    from safebasins.io.datasets import load
+
+    src = load(inputs["source"])
+    if what == "fcr":
+        ds = fc.fcr_fourier_comparison_from_numeric(src)
+        if "curve" in ds.dims:  # per-curve parameters of the source (attributes would conflict across curves)
+            ds = ds.assign_coords({c: ("curve", src[c].values) for c in ("label", "xi_max", "xi0", "gamma0", "Psi")
+                                   if c in src.coords and src[c].dims == ("curve",)})
+    else:
+        ds = fc.iou_fourier_comparison(src, params["t_eval"])
+    ds.attrs.update(source_experiment=source, source_file=str(inputs["source"]),
+                    source_config_hash=src.attrs.get("config_hash", "none"))
+    return ds
+
+
+def _check_grid_block(block, key, ctx):
+    ctx.check_grid(f"{key}.grid", block["grid"])
+    ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "the analytic criterion")
+    ctx.check_t_eval_within(f"{key}.t_eval", block["t_eval"], block["cycles"])
+
+
+def _chart_cost(params):
+    nq, np_ = params["grid"]["n"]
+    return len(params["tasks"]) * nq * np_ * params["cycles"] * params["steps_per_cycle"]
+
+
+def _grid_ics(params):
+    q0, p0 = values.grid_axes(params["grid"])
+    return q0, p0, True
+
+
+@register
+class Erosion(Kind):
+    name = "erosion"
+    description = "GIM / LIM / IF versus F; one escape chart per F serves every xi_max and t_eval"
+    builder = "safebasins.plotting.extras:figure_erosion"
+    schema = {
+        "description": description,
+        "type": "object", "additionalProperties": False, "default": {},
+        "properties": {
+            "F": {"default": {"start": 0.0, "stop": 0.15, "step": 0.005},
+                  "oneOf": [{"$ref": "#/$defs/range"},
+                            {"type": "array", "minItems": 2, "items": {"$ref": "#/$defs/forcing"}}]},
+            "Omega": {"$ref": "#/$defs/frequency", "default": 0.9},
+            "Psi": {"$ref": "#/$defs/angle", "default": "pi"},
+            "xi_max": {"$ref": "#/$defs/threshold_list", "default": [0.18, 0.22]},
+            "grid": {"$ref": "#/$defs/grid", "default": {"q0": [-0.85, 0.85], "p0": [-0.70, 0.70], "n": 121}},
+            "cycles": {"$ref": "#/$defs/cycles", "default": 1000},
+            "t_eval": {**T_EVAL_LIST, "default": [10, 50, 200, 1000]},
+            "fourier": {**FOURIER_LIST, "default": ["paper", "exact"]},
+            "level": {"description": "integrity level whose first crossing in F is reported (F at GIM = level, ...)",
+                      "type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1, "default": 0.5},
+        },
+    }
+
+    def check(self, block, key, ctx):
+        _check_grid_block(block, key, ctx)
+        if isinstance(block["F"], dict):
+            ctx.check_range(f"{key}.F", block["F"])
+            if block["F"]["start"] < 0:
+                ctx.fail(f"{key}.F.start", f"must be >= 0 (a forcing amplitude), got {block['F']['start']}")
+
+    def resolve(self, block, ctx):
+        Fs = values.values(block["F"])
+        xis = [float(x) for x in values.as_list(block["xi_max"])]
+        return dict(fourier=[str(f) for f in values.as_list(block["fourier"])], F=Fs, Omega=float(block["Omega"]),
+                    Psi=values.angle(block["Psi"]), xi_max=xis, grid=values.grid(block["grid"]),
+                    cycles=int(block["cycles"]), t_eval=[float(t) for t in values.as_list(block["t_eval"])],
+                    level=float(block["level"]), steps_per_cycle=ctx.steps_per_cycle,
+                    tasks=[{"F": f, "xi_max": xis, "q_max": []} for f in Fs])
+
+    chart_ics = staticmethod(_grid_ics)
+    cost = staticmethod(_chart_cost)
+
+    def products(self, experiment, params):
+        return [
+            Product(dataset_path("extras", f"{experiment}_analytic"), "extras", build_erosion_analytic, heavy=True,
+                    title=params["title"] + " (analytic)",
+                    contract={**{m: ("fourier", "F", "xi_max") for m in ("GIM", "LIM", "IF")},
+                              **{f"F_{m}": ("fourier", "xi_max") for m in ("GIM", "LIM", "IF")}},
+                    history=f"safebasins.analysis.erosion.erosion_profile_analytic ({experiment})"),
+            Product(dataset_path("extras", f"{experiment}_numeric"), "extras", build_erosion_numeric, tiles=True,
+                    title=params["title"] + " (numeric)",
+                    contract={**{m: ("F", "xi_max", "t_eval") for m in ("GIM", "LIM", "IF")},
+                              **{f"F_{m}": ("xi_max", "t_eval") for m in ("GIM", "LIM", "IF")}},
+                    history=(f"safebasins.numerics.escape_chart per F + safebasins.analysis.erosion."
+                             f"profile_from_charts ({experiment})")),
+        ]
+
+    def figure_inputs(self, experiment, params):
+        return {"analytic": dataset_path("extras", f"{experiment}_analytic"),
+                "numeric": dataset_path("extras", f"{experiment}_numeric")}
+
+
+@register
+class TrueBasin(Kind):
+    name = "true_basin"
+    description = "intersection over n_psi equispaced forcing phases of the safe basins (one chart per phase)"
+    builder = "safebasins.plotting.extras:figure_true_basin"
+    schema = {
+        "description": description,
+        "type": "object", "additionalProperties": False, "default": {},
+        "properties": {
+            "F": {"$ref": "#/$defs/forcing", "default": 0.01},
+            "Omega": {"$ref": "#/$defs/frequency", "default": 0.9},
+            "xi_max": {"$ref": "#/$defs/threshold_list", "default": 0.18},
+            "n_psi": {"type": "integer", "minimum": 1, "default": 16},
+            "grid": {"$ref": "#/$defs/grid", "default": {"q0": [-0.72, 0.72], "p0": [-0.63, 0.63], "n": 121}},
+            "cycles": {"$ref": "#/$defs/cycles", "default": 1000},
+            "t_eval": {**T_EVAL_LIST, "default": [50, 1000]},
+            "fourier": {**FOURIER_LIST, "default": ["paper", "exact"]},
+            "n_gamma": {"description": "gamma resolution of the continuous-phase energy radius xi_true",
+                        "type": "integer", "minimum": 8, "default": 512},
+        },
+    }
+
+    def check(self, block, key, ctx):
+        _check_grid_block(block, key, ctx)
+
+    def resolve(self, block, ctx):
+        import math
+
+        import numpy as np
+
+        xis = [float(x) for x in values.as_list(block["xi_max"])]
+        n = int(block["n_psi"])
+        psis = [float(np.round(2 * math.pi * k / n, 12)) for k in range(n)]
+        return dict(fourier=[str(f) for f in values.as_list(block["fourier"])], F=float(block["F"]),
+                    Omega=float(block["Omega"]), xi_max=xis, Psi=psis, grid=values.grid(block["grid"]),
+                    cycles=int(block["cycles"]), t_eval=[float(t) for t in values.as_list(block["t_eval"])],
+                    n_gamma=int(block["n_gamma"]), steps_per_cycle=ctx.steps_per_cycle,
+                    tasks=[{"F": float(block["F"]), "Psi": ps, "xi_max": xis, "q_max": []} for ps in psis])
+
+    chart_ics = staticmethod(_grid_ics)
+    cost = staticmethod(_chart_cost)
+
+    def products(self, experiment, params):
+        return [
+            Product(dataset_path("extras", f"{experiment}_analytic"), "extras", build_true_basin_analytic, heavy=True,
+                    title=params["title"] + " (analytic)",
+                    contract={"safe": ("Psi", "fourier", "xi_max", "q0", "p0"),
+                              "true_safe": ("fourier", "xi_max", "q0", "p0"), "xi_true": ("fourier", "xi_max"),
+                              "GIM_true": ("fourier", "xi_max"), "contained": ("fourier", "xi_max")},
+                    history=f"safebasins.analysis.phase_invariant.true_safe_basin_analytic ({experiment})"),
+            Product(dataset_path("extras", f"{experiment}_numeric"), "extras", build_true_basin_numeric, tiles=True,
+                    title=params["title"] + " (numeric)",
+                    contract={"safe": ("Psi", "xi_max", "t_eval", "q0", "p0"),
+                              "true_safe": ("xi_max", "t_eval", "q0", "p0"), "GIM_true": ("xi_max", "t_eval"),
+                              "contained": ("xi_max", "t_eval")},
+                    history=(f"safebasins.numerics.escape_chart per Psi + safebasins.analysis.phase_invariant."
+                             f"true_safe_basin_from_charts ({experiment})")),
+        ]
+
+    def figure_inputs(self, experiment, params):
+        return {"analytic": dataset_path("extras", f"{experiment}_analytic"),
+                "numeric": dataset_path("extras", f"{experiment}_numeric")}
+
+
+@register
+class FourierCompare(Kind):
+    name = "fourier_compare"
+    description = ("paper vs exact first harmonic against existing numerics (nothing is re-integrated): "
+                   "F_cr of the listed fcr_compare experiments, safe-basin IoU of the listed basin_chart ones")
+    builder = "safebasins.plotting.extras:figure_fourier"
+    SOURCES = {"fcr": ("fcr_compare", "numeric F_cr"), "iou": ("basin_chart", "escape chart with analytic counterpart")}
+    schema = {
+        "description": description,
+        "type": "object", "additionalProperties": False, "default": {},
+        "properties": {
+            "fcr": {"type": "array", "items": {"type": "string"}, "default": ["fig10", "fig11", "fig12"]},
+            "iou": {"type": "array", "items": {"type": "string"},
+                    "default": ["fig13", "fig14", "fig15", "fig16", "fig17"]},
+            "t_eval": {"description": "evaluation time of the numeric basins (null = each chart's horizon)",
+                       "oneOf": [{"type": "null"}, {"type": "number", "exclusiveMinimum": 0}], "default": None},
+        },
+    }
+
+    def check(self, block, key, ctx):
+        for what, (kind, label) in self.SOURCES.items():
+            seen = set()
+            for i, name in enumerate(block[what]):
+                if ctx.kinds.get(name) != kind:
+                    choices = ", ".join(sorted(e for e, k in ctx.kinds.items() if k == kind))
+                    ctx.fail(f"{key}.{what}[{i}]", f"{name!r} has no {label} dataset (choose among {choices})")
+                if name in seen:
+                    ctx.fail(f"{key}.{what}[{i}]", f"{name!r} listed twice")
+                seen.add(name)
+        if block["t_eval"] is not None:
+            for name in block["iou"]:
+                horizon = ctx.block(name)["cycles"]
+                if block["t_eval"] > horizon:
+                    ctx.fail(f"{key}.t_eval", f"{block['t_eval']} is beyond the horizon of {name} (cycles = {horizon})")
+
+    def resolve(self, block, ctx):
+        return dict(fcr=list(block["fcr"]), iou=list(block["iou"]),
+                    t_eval=None if block["t_eval"] is None else float(block["t_eval"]))
+
+    def products(self, experiment, params):
+        out = []
+        for what, label, src_name in (("fcr", "F_cr", "fcr"), ("iou", "safe-basin IoU", "chart")):
+            for source in params[what]:
+                out.append(Product(
+                    dataset_path("extras", f"{experiment}_{what}_{source}"), "extras",
+                    partial(build_fourier, what=what, source=source), heavy=True,
+                    title=f"{params['title']}: {label} of {source}",
+                    inputs={"source": dataset_path("numeric", f"{src_name}_{source}")},
+                    contract=({"rel_error": ("curve", "fourier", "Omega"), "rms_rel_error": ("curve", "fourier")}
+                              if what == "fcr" else {"mean_iou": ("fourier",)}),
+                    history=f"safebasins.analysis.fourier_compare on the numerics of {source} ({experiment})"))
+        return out
+
+    def figure_inputs(self, experiment, params):
+        return {"fcr": [dataset_path("extras", f"{experiment}_fcr_{e}") for e in params["fcr"]],
+                "iou": [dataset_path("extras", f"{experiment}_iou_{e}") for e in params["iou"]]}

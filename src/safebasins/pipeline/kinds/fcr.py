@@ -1,0 +1,178 @@
+"""Kinds ``fcr_theory`` (Figs 1-4) and ``fcr_compare`` (Figs 10-12): critical forcing F_cr(Omega).
+
+Curves come from list-valued ``xi_max`` / ``xi_ini`` / ``gamma_ini`` (equal lengths or length
+1); the analytic product stacks :func:`safebasins.theory.critical_forcing` over ``curve``, the
+numeric one :func:`safebasins.numerics.critical_forcing_numeric` (bisection + F scan) for the
+IC ``theory.initial_condition(xi_ini, gamma_ini, Psi)``.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from safebasins.pipeline import values
+from safebasins.pipeline.registry import Kind, Product, dataset_path, register
+
+_CO = ("curve", "Omega")
+ANALYTIC_CONTRACT = {**{v: _CO for v in ("F_cr", "mechanism", "F_MM_0", "F_MM_pi", "F_SM", "F_SMM")},
+                     **{c: ("curve",) for c in ("xi_max", "xi0", "gamma0", "label")}}
+NUMERIC_CONTRACT = {**{v: _CO for v in ("F_cr", "F_cr_low", "F_cr_high", "F_escape_low", "F_escape_all",
+                                         "non_monotone")},
+                    **{c: ("curve",) for c in ("xi_max", "xi0", "gamma0", "Psi", "label", "q0", "p0")}}
+
+CURVES_SCHEMA = {
+    "Omega": {"$ref": "#/$defs/omega_range"},
+    "xi_max": {"$ref": "#/$defs/threshold_list"},
+    "xi_ini": {"$ref": "#/$defs/energy_list", "default": 0.0},
+    "gamma_ini": {"$ref": "#/$defs/angle_list", "default": 0.0},
+}
+
+
+def _check_curves(block, key, ctx):
+    ctx.check_range(f"{key}.Omega", block["Omega"], positive=True)
+    lens = {k: len(values.as_list(block[k])) for k in ("xi_max", "xi_ini", "gamma_ini")}
+    n = max(lens.values())
+    for k, m in lens.items():
+        if m not in (1, n):
+            ctx.fail(f"{key}.{k}", f"has {m} values but another curve list has {n}: lists must have equal length")
+    ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "analytic F_cr")
+    xm = values.as_list(block["xi_max"]) * (n // lens["xi_max"])
+    xi = values.as_list(block["xi_ini"]) * (n // lens["xi_ini"])
+    for i, (a, b) in enumerate(zip(xm, xi)):
+        if b >= a:
+            ctx.fail(f"{key}.xi_ini" + (f"[{i}]" if lens["xi_ini"] > 1 else ""),
+                     f"initial energy {b} must be below the truncation level xi_max = {a}")
+
+
+def build_fcr_analytic(params, inputs, threads):
+    """One theory.critical_forcing per curve, stacked over ``curve``."""
+    from safebasins.io.datasets import stack
+    from safebasins.theory import critical_forcing
+
+    Omega = np.asarray(params["Omega"], dtype=float)
+    curves = params["curves"]
+    parts = []
+    for c in curves:
+        print(f"{params['experiment']}: critical_forcing for {c['label']}")
+        parts.append(critical_forcing(Omega, c["xi_max"], xi0=c["xi0"], gamma0=c["gamma0"],
+                                      fourier=params["fourier"]))
+    coords = {k: [c[k] for c in curves] for k in ("xi_max", "xi0", "gamma0", "label")}
+    if all("Psi" in c for c in curves):
+        coords["Psi"] = [c["Psi"] for c in curves]
+    out = stack(parts, "curve", coords=coords)
+    out.attrs["fourier"] = params["fourier"]
+    return out
+
+
+def build_fcr_numeric(params, inputs, threads):
+    """One numerics.critical_forcing_numeric per curve (IC from (xi_ini, gamma_ini, Psi))."""
+    from safebasins.io.datasets import stack
+    from safebasins.numerics import critical_forcing_numeric
+    from safebasins.theory import initial_condition
+
+    num = params["numeric"]
+    Omega = np.asarray(num["Omega"], dtype=float)
+    parts, q0s, p0s = [], [], []
+    for c in params["curves"]:
+        q0, p0 = (float(v) for v in initial_condition(c["xi0"], c["gamma0"], c["Psi"]))
+        q0s.append(q0)
+        p0s.append(p0)
+        print(f"{params['experiment']}: {c['label']}: IC (q0, p0) = ({q0:.6f}, {p0:.6f})", flush=True)
+        parts.append(critical_forcing_numeric(
+            Omega, c["xi_max"], q0=q0, p0=p0, Psi=c["Psi"], cycles=num["cycles"], tol=num["tol"],
+            F_bracket=tuple(num["F_bracket"]), criterion=num["criterion"], n_scan=num["n_scan"],
+            steps_per_cycle=num["steps_per_cycle"], threads=threads))
+    coords = {k: [c[k] for c in params["curves"]] for k in ("xi_max", "xi0", "gamma0", "Psi", "label")}
+    coords.update(q0=q0s, p0=p0s)
+    return stack(parts, "curve", coords=coords)
+
+
+@register
+class FcrTheory(Kind):
+    name = "fcr_theory"
+    description = "analytic F_cr(Omega) curves; list-valued xi_max / xi_ini / gamma_ini give the curves"
+    builder = "safebasins.plotting.fcr:figure_fcr"
+    schema = {
+        "description": description,
+        "type": "object", "additionalProperties": False, "required": ["Omega", "xi_max"],
+        "properties": dict(CURVES_SCHEMA),
+    }
+
+    def check(self, block, key, ctx):
+        _check_curves(block, key, ctx)
+
+    def resolve(self, block, ctx):
+        return dict(fourier=ctx.fourier, Omega=values.range_values(block["Omega"]),
+                    curves=values.curves(block, False))
+
+    def products(self, experiment, params):
+        return [Product(dataset_path("analytic", f"fcr_{experiment}"), "analytic", build_fcr_analytic,
+                        title=params["title"], contract=ANALYTIC_CONTRACT,
+                        history=f"safebasins.theory.critical_forcing per curve ({experiment})")]
+
+    def figure_inputs(self, experiment, params):
+        return {"analytic": dataset_path("analytic", f"fcr_{experiment}")}
+
+
+@register
+class FcrCompare(Kind):
+    name = "fcr_compare"
+    description = "analytic F_cr curves (fine Omega) and their numeric counterparts (coarse Omega)"
+    builder = "safebasins.plotting.fcr:figure_fcr_comparison"
+    schema = {
+        "description": description,
+        "type": "object", "additionalProperties": False, "required": ["Omega", "xi_max", "numeric"],
+        "properties": {
+            **CURVES_SCHEMA,
+            "Psi": {"$ref": "#/$defs/angle", "default": 0.0},
+            "numeric": {
+                "type": "object", "additionalProperties": False, "required": ["Omega"],
+                "properties": {
+                    "Omega": {"$ref": "#/$defs/omega_range"},
+                    "cycles": {"$ref": "#/$defs/cycles", "default": 3000},
+                    "tol": {"type": "number", "exclusiveMinimum": 0, "default": 5.0e-5},
+                    "F_bracket": {"type": "array", "minItems": 2, "maxItems": 2,
+                                  "items": {"type": "number", "minimum": 0}, "default": [0.0, 0.3]},
+                    "n_scan": {"type": "integer", "minimum": 0, "default": 60},
+                    "criterion": {"enum": ["energy", "displacement"], "default": "energy"},
+                },
+            },
+        },
+    }
+
+    def check(self, block, key, ctx):
+        _check_curves(block, key, ctx)
+        num = block["numeric"]
+        ctx.check_range(f"{key}.numeric.Omega", num["Omega"], positive=True)
+        lo, hi = num["F_bracket"]
+        if not hi > lo:
+            ctx.fail(f"{key}.numeric.F_bracket", f"empty bracket [{lo}, {hi}]")
+
+    def resolve(self, block, ctx):
+        nb = block["numeric"]
+        return dict(fourier=ctx.fourier, Omega=values.range_values(block["Omega"]), curves=values.curves(block, True),
+                    numeric={"Omega": values.range_values(nb["Omega"]), "cycles": int(nb["cycles"]),
+                             "tol": float(nb["tol"]), "F_bracket": [float(x) for x in nb["F_bracket"]],
+                             "n_scan": int(nb["n_scan"]), "criterion": nb["criterion"],
+                             "steps_per_cycle": ctx.steps_per_cycle})
+
+    def products(self, experiment, params):
+        return [
+            Product(dataset_path("analytic", f"fcr_{experiment}"), "analytic", build_fcr_analytic,
+                    title=params["title"], contract={**ANALYTIC_CONTRACT, "Psi": ("curve",)}, history=f"safebasins.theory.critical_forcing per curve ({experiment})"),
+            Product(dataset_path("numeric", f"fcr_{experiment}"), "numeric", build_fcr_numeric, heavy=True,
+                    title=params["title"], contract=NUMERIC_CONTRACT,
+                    history=f"safebasins.numerics.critical_forcing_numeric per curve ({experiment})"),
+        ]
+
+    def cost(self, params):
+        n = params["numeric"]
+        lo, hi = n["F_bracket"]
+        levels = math.ceil(math.log2((hi - lo) / n["tol"]))
+        return (len(params["curves"]) * len(n["Omega"]) * (levels + n["n_scan"]) * n["cycles"]
+                * n["steps_per_cycle"])
+
+    def figure_inputs(self, experiment, params):
+        return {"analytic": dataset_path("analytic", f"fcr_{experiment}"),
+                "numeric": dataset_path("numeric", f"fcr_{experiment}")}

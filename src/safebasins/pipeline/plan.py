@@ -1,0 +1,134 @@
+"""A run's plan: every experiment of a validated config with its resolved parameters, datasets,
+chart tasks and figure -- what the Snakefile, the rule scripts, the notebook generator, the
+report and the cost estimate read.
+
+    from safebasins.pipeline.plan import plan
+    run = plan(config)                    # validates (filling defaults), then resolves
+    run.experiments["fig13"].params       # = results/params/fig13.yaml
+    run.product("results/data/numeric/chart_fig13.nc").build(...)
+"""
+from __future__ import annotations
+
+import zlib
+from dataclasses import dataclass
+from pathlib import Path
+
+from safebasins.pipeline.config import experiment_blocks, load_yaml, validate_config
+from safebasins.pipeline.registry import (KINDS, PARTS_DIR, Experiment, FigureSpec, Product, params_path)
+
+__all__ = ["Plan", "ResolveContext", "plan", "tile_path", "load_config"]
+
+
+@dataclass(frozen=True)
+class ResolveContext:
+    """Global settings a kind's ``resolve`` may use."""
+
+    fourier: str
+    steps_per_cycle: int
+    seed: int            # the config seed plus this experiment's offset
+
+
+def tile_path(experiment: str, task: int, tile: int, tiles: int) -> str:
+    return f"{PARTS_DIR}/{experiment}/task{task}_tile{tile}of{tiles}.nc"
+
+
+def _seed_offset(name, decl):
+    if decl is not None:
+        return decl.seed_offset
+    # experiments declared in the config get a stable offset of their own (never a catalog one)
+    return 1_000_000 + 1000 * (zlib.crc32(name.encode()) % 100_000)
+
+
+def _figure(name, kind, params, decl):
+    if kind.builder is None:
+        return None
+    if decl is not None:
+        return FigureSpec(name=name, stem=decl.stem, builder=kind.builder, inputs=kind.figure_inputs(name, params),
+                          options=dict(decl.options), caption=decl.caption, look=decl.look, label=decl.label,
+                          category=decl.category, packaged=True)
+    caption, look = kind.default_figure_text(name, params)
+    return FigureSpec(name=name, stem=name, builder=kind.builder, inputs=kind.figure_inputs(name, params),
+                      options={}, caption=caption, look=look, label=params["title"], category="Experiments",
+                      packaged=False)
+
+
+class Plan:
+    """Experiments of one validated config, in catalog order then config order."""
+
+    def __init__(self, config: dict):
+        self.config = config
+        num = config["numerics"]
+        self.threads = int(num["threads"])
+        self.tiles = int(num["tiles"])
+        self.experiments: dict[str, Experiment] = {}
+        self._products: dict[str, tuple[Experiment, Product]] = {}
+        for name, kind_name, key, blk, decl in experiment_blocks(config):
+            kind = KINDS[kind_name]
+            ctx = ResolveContext(fourier=config["fourier"], steps_per_cycle=int(num["steps_per_cycle"]),
+                                 seed=int(config["seed"]) + _seed_offset(name, decl))
+            title = decl.title if decl is not None else blk.get("title", f"{name} ({kind_name})")
+            params = {"experiment": name, "kind": kind_name, "title": title, **kind.resolve(blk, ctx)}
+            exp = Experiment(name=name, kind=kind, key=key, params=params, figure=_figure(name, kind, params, decl),
+                             products=tuple(kind.products(name, params)), tasks=tuple(kind.tasks(params)))
+            self.experiments[name] = exp
+            for prod in exp.products:
+                if prod.path in self._products:
+                    other = self._products[prod.path][0].name
+                    raise ValueError(f"experiments {other!r} and {name!r} both write {prod.path}")
+                self._products[prod.path] = (exp, prod)
+
+    # ------------------------------------------------------------------ lookups
+    def params(self) -> dict[str, dict]:
+        return {n: e.params for n, e in self.experiments.items()}
+
+    def product(self, path) -> Product:
+        return self._products[str(path)][1]
+
+    def experiment_of(self, path) -> Experiment:
+        return self._products[str(path)][0]
+
+    def datasets(self, stage: str | None = None) -> list[str]:
+        return [p for p, (_, prod) in self._products.items() if stage is None or prod.stage == stage]
+
+    def param_files(self) -> list[str]:
+        return [params_path(n) for n in self.experiments]
+
+    def tile_files(self, experiment: str) -> list[str]:
+        """Tile files of every task of a chart experiment (tasks x tiles, task-major)."""
+        exp = self.experiments[experiment]
+        return [tile_path(experiment, k, t, self.tiles) for k in range(len(exp.tasks)) for t in range(self.tiles)]
+
+    def chart_experiments(self) -> list[str]:
+        return [n for n, e in self.experiments.items() if e.tasks]
+
+    def product_inputs(self, path) -> dict:
+        """Snakemake inputs of a dataset: its experiment's parameter file, its tiles (chart kinds
+        whose product gathers them) and the files the product names."""
+        exp, prod = self._products[str(path)]
+        inputs = {"params": exp.params_file, **prod.inputs}
+        if prod.tiles:
+            inputs["tiles"] = self.tile_files(exp.name)
+        return inputs
+
+    def figures(self) -> list[FigureSpec]:
+        return [e.figure for e in self.experiments.values() if e.figure is not None]
+
+
+def load_config(paths) -> dict:
+    """Merge config files like ``snakemake --configfile`` (later files win, dicts merged)."""
+    from snakemake.utils import update_config
+
+    paths = list(paths)
+    cfg = load_yaml(paths[0]) or {}
+    for extra in paths[1:]:
+        update_config(cfg, load_yaml(extra) or {})
+    return cfg
+
+
+def plan(config) -> Plan:
+    """Validate (filling defaults, in place) and resolve a config dict or config file path(s)."""
+    if isinstance(config, (str, Path)):
+        config = load_config([config])
+    elif isinstance(config, (list, tuple)):
+        config = load_config(config)
+    return Plan(validate_config(config))

@@ -1,0 +1,178 @@
+"""The registry of experiment kinds: one declarative entry per kind of computation.
+
+A *kind* (a :class:`Kind` subclass registered with :func:`register`) says everything the
+pipeline needs about one kind of experiment:
+
+* ``schema``   the JSON schema of its config block (defaults live there, nowhere else);
+* ``check``    the checks JSON Schema cannot express (each failure names the config key);
+* ``resolve``  config block -> resolved parameters (``results/params/<experiment>.yaml``);
+* ``products`` the datasets it makes: path, stage, inputs and the library call that builds it;
+* ``tasks`` / ``chart_ics``  its escape-chart tile jobs, if any (rule ``chart_tile``);
+* ``cost``     upper-bound trajectory-steps (cost estimate, cluster resources);
+* ``builder`` / ``figure_inputs``  its figure (papermill notebook, report entry).
+
+An *experiment* is one instance of a kind: the paper's figures and the beyond-the-paper
+products are declared in :mod:`safebasins.pipeline.catalog`; further experiments can be
+declared in the config under ``experiments:`` with their ``kind``.  The Snakefile, the rule
+scripts, the notebook generator, the cost estimate and the report all read :func:`plan`.
+Adding a kind = one entry (docs/adding-an-experiment.md) + its library call + its plotting
+function.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable, ClassVar, Mapping
+
+__all__ = ["Kind", "Product", "FigureSpec", "Experiment", "KINDS", "register", "STAGES"]
+
+#: dataset stages and their directories under results/data
+STAGES = {"analytic": "results/data/analytic", "numeric": "results/data/numeric", "extras": "results/data/extras"}
+PARAMS_DIR = "results/params"
+PARTS_DIR = "results/data/numeric/parts"
+FIGURE_DIR = "results/figures"
+
+
+def params_path(experiment: str) -> str:
+    return f"{PARAMS_DIR}/{experiment}.yaml"
+
+
+def dataset_path(stage: str, name: str) -> str:
+    return f"{STAGES[stage]}/{name}.nc"
+
+
+@dataclass(frozen=True)
+class Product:
+    """One dataset of an experiment.
+
+    ``build(params, inputs, threads)`` returns the Dataset (the runtime adds CF/provenance
+    attributes with ``title`` and ``history`` and writes it atomically); ``inputs`` maps names
+    to the files it reads besides the experiment's parameter file (tiles, other datasets);
+    ``heavy`` products run with ``numerics.threads`` numba threads; ``tiles`` products read
+    the chart tiles of their experiment (``inputs["tiles"]``, tasks x tiles, task-major).
+    ``contract`` names the variables readers rely on and their dims (docs/contracts.md; the
+    tests check it on every dataset of the quick run).
+    """
+
+    path: str
+    stage: str
+    build: Callable
+    title: str
+    history: str
+    inputs: Mapping[str, object] = field(default_factory=dict)
+    heavy: bool = False
+    tiles: bool = False
+    contract: Mapping[str, tuple] = field(default_factory=dict)
+
+    @property
+    def name(self) -> str:
+        return self.path.rsplit("/", 1)[1].removesuffix(".nc")
+
+
+@dataclass(frozen=True)
+class FigureSpec:
+    """One figure: a papermill notebook calling ``builder`` on ``inputs`` (dataset paths)."""
+
+    name: str            # results/figures/<name>.png|pdf
+    stem: str            # notebook file stem
+    builder: str         # "safebasins.plotting.<module>:<function>"
+    inputs: Mapping[str, object]
+    options: Mapping[str, object]
+    caption: str         # the paper's caption (or what the figure shows)
+    look: str            # what to look for
+    label: str           # report label ("Fig. 13", a title)
+    category: str        # report category
+    packaged: bool       # notebook committed under notebooks/ (else generated under results/)
+
+    @property
+    def png(self) -> str:
+        return f"{FIGURE_DIR}/{self.name}.png"
+
+    @property
+    def pdf(self) -> str:
+        return f"{FIGURE_DIR}/{self.name}.pdf"
+
+    @property
+    def notebook(self) -> str:
+        """The papermill template notebook."""
+        return f"notebooks/{self.stem}.ipynb" if self.packaged else f"results/notebooks/templates/{self.stem}.ipynb"
+
+    @property
+    def executed_notebook(self) -> str:
+        return f"results/notebooks/{self.stem}.ipynb"
+
+    def dataset_files(self) -> list[str]:
+        return [x for v in self.inputs.values() for x in (v if isinstance(v, (list, tuple)) else [v])]
+
+
+class Kind:
+    """Base of every experiment kind (see the module docstring); subclasses set the class
+    attributes and override what they make."""
+
+    name: ClassVar[str]
+    description: ClassVar[str]
+    schema: ClassVar[dict]
+    #: plotting function of its figure, "safebasins.plotting.<module>:<function>" (None: no figure)
+    builder: ClassVar[str | None] = None
+
+    def check(self, block: dict, key: str, ctx) -> None:
+        """Checks beyond the schema; raise ``ctx.fail(key + ".field", message)``."""
+
+    def resolve(self, block: dict, ctx) -> dict:
+        raise NotImplementedError
+
+    def products(self, experiment: str, params: dict) -> list[Product]:
+        return []
+
+    def tasks(self, params: dict) -> list[dict]:
+        """Escape-chart tasks (one chart each), split into tile jobs by ``numerics.tiles``: kinds
+        that integrate charts resolve them into ``params["tasks"]`` (each with ``F``,
+        ``xi_max``, ``q_max`` lists and optionally ``Psi``)."""
+        return list(params.get("tasks", ()))
+
+    def chart_ics(self, params: dict):
+        """``(q0, p0, grid)`` of the chart tasks: grid axes (grid=True) or paired samples."""
+        raise NotImplementedError(f"kind {self.name!r} has no escape-chart tasks")
+
+    def cost(self, params: dict) -> int:
+        """Upper bound of the trajectory-steps its numerics integrate (no early escape)."""
+        return 0
+
+    def figure_inputs(self, experiment: str, params: dict) -> dict:
+        """Notebook parameter name -> dataset path(s) of its figure."""
+        return {}
+
+    def default_figure_text(self, experiment: str, params: dict) -> tuple[str, str]:
+        """(caption, what to look for) of a figure not described in the catalog."""
+        return self.description, self.description
+
+
+KINDS: dict[str, Kind] = {}
+
+
+def register(cls):
+    """Class decorator: add a kind to the registry (its ``name`` must be new)."""
+    name = cls.name
+    if name in KINDS and type(KINDS[name]) is not cls:
+        raise ValueError(f"experiment kind {name!r} is registered twice ({type(KINDS[name]).__name__}, {cls.__name__})")
+    KINDS[name] = cls()
+    return cls
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """One experiment of a run: its name, kind, config location and resolved parameters."""
+
+    name: str
+    kind: Kind
+    key: str                 # dotted config key of its block, for messages
+    params: dict
+    figure: FigureSpec | None
+    products: tuple[Product, ...]
+    tasks: tuple[dict, ...]
+
+    @property
+    def params_file(self) -> str:
+        return params_path(self.name)
+
+    def dataset_files(self) -> list[str]:
+        return [p.path for p in self.products]

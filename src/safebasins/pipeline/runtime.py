@@ -1,0 +1,124 @@
+"""What the rule scripts call: one function per generic rule (``scripts/*.py`` stay thin).
+
+* :func:`write_params` -- rule ``parameters``: ``results/params/<experiment>.yaml``;
+* :func:`make_dataset` -- rules ``analytic``, ``numeric``, ``extras``: the product of the
+  registry that the output path names is built from its inputs, given CF/provenance
+  attributes and written atomically;
+* :func:`make_tile` -- rule ``chart_tile``: one tile (a contiguous block of q0 rows or of
+  samples) of one escape-chart task.
+
+Each receives the ``snakemake`` object of its script.  The product to build is looked up in
+the registry by the kind named in the experiment's parameter file, so a rule never needs to
+know the kinds.
+"""
+from __future__ import annotations
+
+import json
+import os
+import sys
+from pathlib import Path
+
+import yaml
+
+from safebasins.pipeline.config import load_kinds
+from safebasins.pipeline.registry import KINDS
+
+
+def redirect_output(log_path):
+    """Send stdout and stderr of a rule script to its log file (line buffered)."""
+    os.makedirs(os.path.dirname(os.fspath(log_path)) or ".", exist_ok=True)
+    fh = open(log_path, "w", buffering=1)
+    sys.stdout = fh
+    sys.stderr = fh
+    return fh
+
+
+def set_threads(n):
+    """Limit numba's thread pool to the rule's ``threads:`` (no oversubscription under -j2)."""
+    n = max(1, int(n))
+    os.environ.setdefault("NUMBA_NUM_THREADS", str(n))
+    import numba
+
+    numba.set_num_threads(min(n, numba.config.NUMBA_NUM_THREADS))
+
+
+def load_params(path) -> dict:
+    with open(path) as fh:
+        return yaml.safe_load(fh)
+
+
+def dump_params(params: dict) -> str:
+    return yaml.safe_dump(params, sort_keys=False, default_flow_style=None, width=100)
+
+
+def write_params(smk):
+    """Rule ``parameters``: write one experiment's resolved parameters atomically."""
+    from safebasins.io.datasets import params_hash
+    from safebasins.io.files import atomic_path
+
+    params = json.loads(smk.params.spec)
+    path = Path(smk.output[0])
+    text = (f"# Resolved parameters of {params['experiment']} ({params['kind']}), generated from the\n"
+            "# configuration by the `parameters` rule; edit config/config.yaml, not this file.\n"
+            + dump_params(params))
+    with atomic_path(path) as tmp:
+        tmp.write_text(text)
+    Path(smk.log[0]).parent.mkdir(parents=True, exist_ok=True)
+    Path(smk.log[0]).write_text(f"wrote {path} (params sha256 {params_hash(params)})\n")
+
+
+def _job(smk):
+    redirect_output(smk.log[0])
+    set_threads(smk.threads)
+    load_kinds(smk.params.extensions)
+    params = load_params(smk.input.params)
+    return params, KINDS[params["kind"]]
+
+
+def make_dataset(smk):
+    """Rules ``analytic`` / ``numeric`` / ``extras``: build, finalize and write one product."""
+    from safebasins.io.datasets import finalize, params_hash, write_netcdf
+
+    params, kind = _job(smk)
+    out = str(smk.output[0])
+    product = next(p for p in kind.products(params["experiment"], params) if p.path == out)
+    inputs = {k: (list(v) if k == "tiles" else v) for k, v in smk.input.items()}
+    ds = product.build(params, inputs, smk.threads)
+    finalize(ds, title=product.title, params=params, config_hash=params_hash(params),
+             history=f"{product.history} (rule {smk.rule})")
+    write_netcdf(ds, out)
+    print(ds)
+
+
+def make_tile(smk):
+    """Rule ``chart_tile``: integrate one tile of one escape-chart task.
+
+    Grid tasks: a contiguous block of q0 rows x all p0 (dims q0, p0).  Paired ICs: a contiguous
+    block of the samples (dim ``sample``, global index).  A task may carry its own forcing phase
+    ``Psi``.  Each trajectory is independent: the gathered chart is the same for any tile count.
+    """
+    import numpy as np
+
+    from safebasins.io.datasets import write_netcdf
+    from safebasins.numerics import escape_chart
+    from safebasins.pipeline.values import tile_slice
+
+    params, kind = _job(smk)
+    k, tile, tiles = int(smk.wildcards.task), int(smk.wildcards.tile), int(smk.wildcards.tiles)
+    task = kind.tasks(params)[k]
+    Psi = task.get("Psi", params.get("Psi"))
+    q0, p0, grid = kind.chart_ics(params)
+    sl = tile_slice(q0.size, tiles, tile)
+    q0 = q0[sl]
+    p0 = p0 if grid else p0[sl]
+    print(f"{params['experiment']} task {k} tile {tile}/{tiles}: F={task['F']} Omega={params['Omega']} Psi={Psi} "
+          f"xi_max={task['xi_max']} q_max={task['q_max']} cycles={params['cycles']} "
+          f"ICs={q0.size}x{p0.size if grid else 1}", flush=True)
+    ds = escape_chart(q0, p0, task["F"], params["Omega"], Psi, xi_max=tuple(task["xi_max"]),
+                      q_max=tuple(task["q_max"]), cycles=params["cycles"], steps_per_cycle=params["steps_per_cycle"],
+                      threads=smk.threads, grid=grid)
+    if not grid:
+        ds = ds.assign_coords(sample=np.arange(sl.start, sl.stop))
+    ds.attrs.update(task=k, tile=tile, tiles=tiles)
+    write_netcdf(ds, smk.output[0])
+    print(ds)

@@ -1,0 +1,86 @@
+"""Config errors and the checks JSON Schema cannot express; every message names the key.
+
+Messages read ``config key figures.fig13.xi_max[2]: <what is wrong and what to do>``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+class ConfigError(ValueError):
+    """A configuration error; the message starts with the offending key."""
+
+
+def key_path(path) -> str:
+    """Dotted key of a JSON path: ``("figures", "fig13", "xi_max", 2)`` -> ``figures.fig13.xi_max[2]``."""
+    out = ""
+    for part in path:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += ("." if out else "") + str(part)
+    return out or "<config>"
+
+
+def fail(key: str, msg: str):
+    raise ConfigError(f"config key {key}: {msg}")
+
+
+def indexed(key: str, values, i: int) -> str:
+    """``key[i]`` when the config value is a list, else ``key``."""
+    return f"{key}[{i}]" if isinstance(values, (list, tuple)) else key
+
+
+@dataclass
+class CheckContext:
+    """What a kind's ``check`` may consult: the whole config, and the kind and config block of
+    every experiment by name (for cross-references between experiments)."""
+
+    config: dict
+    kinds: dict          # experiment name -> kind name
+    blocks: dict         # experiment name -> its (default-filled) config block
+
+    def block(self, experiment: str) -> dict:
+        return self.blocks[experiment]
+
+    @property
+    def tiles(self) -> int:
+        return int(self.config["numerics"]["tiles"])
+
+    fail = staticmethod(fail)
+
+    def check_range(self, key, r, *, positive=False):
+        start, stop = float(r["start"]), float(r["stop"])
+        if not (math.isfinite(start) and math.isfinite(stop)):
+            fail(key, "start and stop must be finite")
+        if stop < start or (stop == start and r.get("num", 1) != 1):
+            fail(key, f"empty range: stop ({stop}) must be greater than start ({start})")
+        if "step" in r and r["step"] > stop - start and stop > start:
+            fail(f"{key}.step", f"step {r['step']} is larger than the range [{start}, {stop}]")
+        if positive and start <= 0:
+            fail(f"{key}.start", f"must be > 0, got {start}")
+
+    def check_interval(self, key, iv):
+        lo, hi = iv
+        if not hi > lo:
+            fail(key, f"empty interval [{lo}, {hi}]: the second value must be greater than the first")
+
+    def check_grid(self, key, g):
+        self.check_interval(f"{key}.q0", g["q0"])
+        self.check_interval(f"{key}.p0", g["p0"])
+        n = g["n"]
+        nq = n if isinstance(n, int) else n[0]
+        if self.tiles > nq:
+            fail("numerics.tiles", f"{self.tiles} tiles but {key} has only {nq} q0 rows")
+
+    def check_thresholds_below_separatrix(self, key, values, what):
+        for i, x in enumerate(values if isinstance(values, (list, tuple)) else [values]):
+            if x >= 0.25:
+                fail(indexed(key, values, i),
+                     f"{what} needs xi_max < 0.25 (the action-angle map is singular on the separatrix), got {x}")
+
+    def check_t_eval_within(self, key, t_eval, cycles):
+        t = t_eval if isinstance(t_eval, (list, tuple)) else [t_eval]
+        if max(t) > cycles:
+            fail(key, f"evaluation time {max(t)} beyond the horizon cycles = {cycles}")

@@ -1,0 +1,90 @@
+"""Turning config values into resolved parameters: ranges, grids, angles, curve lists.
+
+Resolved parameters are plain Python (lists, floats, ints, str) so that they dump to YAML and
+hash stably (``results/params/<experiment>.yaml``).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def as_list(v):
+    return list(v) if isinstance(v, (list, tuple)) else [v]
+
+
+def angle(v) -> float:
+    """A config angle: a number (radians) or the string "pi" / "-pi"."""
+    if isinstance(v, str):
+        return -math.pi if v.strip().startswith("-") else math.pi
+    return float(v)
+
+
+def fmt(v) -> str:
+    if isinstance(v, str):
+        return v
+    return f"{float(v):g}"
+
+
+def range_values(r) -> list[float]:
+    """Values of a {start, stop, num} or {start, stop, step} range (endpoints included)."""
+    start, stop = float(r["start"]), float(r["stop"])
+    if "num" in r:
+        vals = np.linspace(start, stop, int(r["num"]))
+    else:
+        step = float(r["step"])
+        n = int(math.floor((stop - start) / step + 1e-9)) + 1
+        vals = start + step * np.arange(n)
+    # round away float noise (0.30000000000000004) so YAML files read well and stay stable
+    return [float(np.round(v, 12)) for v in vals]
+
+
+def values(v) -> list[float]:
+    """A scalar, a list or a range, as a list of floats."""
+    if isinstance(v, dict):
+        return range_values(v)
+    return [float(x) for x in as_list(v)]
+
+
+def grid(g) -> dict:
+    """Resolved IC grid ``{q0: [lo, hi], p0: [lo, hi], n: [nq, np]}``."""
+    n = g["n"]
+    nq, np_ = (n, n) if isinstance(n, int) else (int(n[0]), int(n[1]))
+    return {"q0": [float(g["q0"][0]), float(g["q0"][1])], "p0": [float(g["p0"][0]), float(g["p0"][1])],
+            "n": [nq, np_]}
+
+
+def grid_axes(g: dict):
+    """1-D q0 and p0 axes of a resolved grid (endpoints included)."""
+    nq, np_ = g["n"]
+    return (np.linspace(g["q0"][0], g["q0"][1], nq), np.linspace(g["p0"][0], g["p0"][1], np_))
+
+
+def box(b) -> list[list[float]]:
+    return [[float(lo), float(hi)] for lo, hi in b]
+
+
+def curves(blk, with_psi) -> list[dict]:
+    """F_cr curves from list-valued xi_max / xi_ini / gamma_ini (equal lengths or length 1)."""
+    lists = {k: as_list(blk[k]) for k in ("xi_max", "xi_ini", "gamma_ini")}
+    n = max(len(v) for v in lists.values())
+    varying = [k for k, v in lists.items() if len(v) > 1]
+    out = []
+    for i in range(n):
+        c = {k: (v[i] if len(v) > 1 else v[0]) for k, v in lists.items()}
+        xi_max, xi0, gamma0 = float(c["xi_max"]), float(c["xi_ini"]), angle(c["gamma_ini"])
+        label = ", ".join(f"{k} = {fmt(c[k])}" for k in varying) if varying else f"xi_max = {fmt(xi_max)}"
+        cur = {"label": label, "xi_max": xi_max, "xi0": xi0, "gamma0": gamma0}
+        if with_psi:
+            cur["Psi"] = angle(blk["Psi"])
+        out.append(cur)
+    return out
+
+
+def tile_slice(n: int, tiles: int, tile: int) -> slice:
+    """Contiguous block ``tile`` (0-based) of ``tiles`` nearly equal blocks of range(n)."""
+    if not 0 <= tile < tiles:
+        raise ValueError(f"tile must lie in [0, {tiles}), got {tile}")
+    edges = np.linspace(0, n, tiles + 1).round().astype(int)
+    return slice(int(edges[tile]), int(edges[tile + 1]))

@@ -1,0 +1,92 @@
+"""Reading datasets for figures: exact names only (docs/contracts.md).
+
+A figure reads what the pipeline wrote and never recomputes physics.  Every read names the
+variable or parameter exactly; a missing one is a ``KeyError`` naming the dataset (its file)
+and the name, never a silent fallback to another spelling.
+"""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import xarray as xr
+import yaml
+
+
+def open_dataset(src):
+    """Path -> fully loaded Dataset (file closed again; its path kept in ``encoding["source"]``);
+    a Dataset passes through; None stays None."""
+    if src is None or isinstance(src, (xr.Dataset, xr.DataArray)):
+        return src
+    with xr.open_dataset(src) as ds:
+        out = ds.load()
+    out.encoding["source"] = os.fspath(src)
+    return out
+
+
+def source(ds) -> str:
+    return ds.encoding.get("source", "<dataset>")
+
+
+def var(ds, name):
+    """Data variable or coordinate ``name``; KeyError naming the dataset if absent."""
+    if name not in ds.variables:
+        raise KeyError(f"{source(ds)}: no variable {name!r} (it has {sorted(map(str, ds.variables))})")
+    return ds[name]
+
+
+def param(ds, name):
+    """A parameter of a dataset: its global attribute, or its coordinate when the dataset is
+    stacked over it with a single value (docs/contracts.md).  KeyError naming both if absent."""
+    if name in ds.attrs:
+        v = ds.attrs[name]
+        return v.item() if isinstance(v, np.ndarray) and v.size == 1 else v
+    if name in ds.coords and ds[name].size == 1:
+        return ds[name].item()
+    raise KeyError(f"{source(ds)}: no attribute or single-valued coordinate {name!r}")
+
+
+def load_params(src):
+    """Resolved parameter file (results/params/<experiment>.yaml) -> dict."""
+    with open(src) as fh:
+        return yaml.safe_load(fh)
+
+
+#: attributes and headline variables printed by :func:`describe` when a dataset has them
+SUMMARY_ATTRS = ("title", "F", "Omega", "Psi", "xi_max", "q_max", "xi0", "gamma0", "cycles",
+                 "steps_per_cycle", "integrator", "tol", "criterion", "fourier", "seed", "level",
+                 "saddle_gamma", "saddle_xi", "source_experiment", "git_commit", "config_hash",
+                 "safebasins_version")
+HEADLINE = ("iou", "pixel_agreement", "F_GIM", "F_LIM", "F_IF", "xi_true", "GIM_true", "LIM_true", "IF_true",
+            "GIM_continuous", "GIM_closed", "LIM_closed", "rms_rel_error", "mean_abs_rel_error", "mean_iou")
+
+
+def describe(**datasets):
+    """Text summary of the datasets a figure reads (paths, lists of paths, Datasets or parameter
+    files): dims, variables, parameters, provenance and headline numbers."""
+    lines = []
+    for name, src in datasets.items():
+        for s in (src if isinstance(src, (list, tuple)) else [src]):
+            if s is None:
+                continue
+            if str(s).endswith((".yaml", ".yml")):
+                lines.append(f"[{name}] {s}")
+                for k, v in load_params(s).items():
+                    if k != "tasks":
+                        txt = repr(v)
+                        lines.append(f"  {k}: {txt if len(txt) < 120 else txt[:117] + '...'}")
+                continue
+            ds = open_dataset(s)
+            lines.append(f"[{name}] {source(ds)}")
+            lines.append("  dims: " + ", ".join(f"{k}={v}" for k, v in ds.sizes.items()))
+            lines.append(f"  variables: {', '.join(map(str, ds.data_vars))}")
+            lines += [f"  {k}: {ds.attrs[k]}" for k in SUMMARY_ATTRS if k in ds.attrs]
+            for v in HEADLINE:
+                if v in ds:
+                    da = ds[v]
+                    dims = ", ".join(f"{d}={np.array2string(np.asarray(da[d].values), precision=4)}" for d in da.dims)
+                    vals = np.array2string(np.asarray(da.values), precision=4, suppress_small=True)
+                    lines.append(f"  {v}" + (f" over ({dims})" if dims else "") + ":\n    " + vals.replace("\n", "\n    "))
+    text = "\n".join(lines)
+    print(text)
+    return text

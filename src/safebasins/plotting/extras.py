@@ -1,0 +1,364 @@
+"""Figures for the beyond-the-paper products (they only read datasets, never recompute).
+
+* :func:`figure_erosion`    -> ``extra_erosion.png``: GIM / LIM / IF versus F, analytic
+  lines (paper solid, exact dashed) vs numeric markers shaded by t_eval (light = early).
+* :func:`figure_true_basin` -> ``extra_true_basin.png``: per-phase basins (faint) and the
+  phase-invariant basin, analytic vs numeric, with the LIM/IF disks and integrity numbers.
+* :func:`figure_fourier`    -> ``extra_fourier.png``: relative F_cr error versus Omega and
+  the IoU per chart, paper vs exact first harmonic.
+
+Inputs are the Datasets of :mod:`safebasins.analysis.erosion`,
+:mod:`safebasins.analysis.phase_invariant` and :mod:`safebasins.analysis.fourier_compare` (or
+paths to netCDF files holding them).  Like every figure builder they return the Figure; the
+notebook applies the style and saves it.
+"""
+from __future__ import annotations
+
+import re
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.colors import to_rgb
+from matplotlib.lines import Line2D
+from matplotlib.patches import Circle, Patch
+
+from safebasins.plotting.basins import draw_well
+from safebasins.plotting.data import open_dataset, param, var
+from safebasins.plotting.fcr import curve_labels, ic_text
+from safebasins.plotting.style import LABELS, param_text
+
+__all__ = ["figure_erosion", "figure_true_basin", "figure_fourier", "shade"]
+
+MEASURE_LABELS = {"GIM": "GIM (safe area)", "LIM": "LIM (disk at the well bottom)", "IF": "IF (largest disk)"}
+FOURIER_STYLE = {"paper": dict(ls="-", marker="o", label="paper G (eq 20)"),
+                 "exact": dict(ls="--", marker="s", label="exact first harmonic")}
+FOURIER_COLOR = {"paper": "tab:blue", "exact": "tab:orange"}
+LIM_COLOR, IF_COLOR, XI_TRUE_COLOR = "crimson", "#7b3fa0", "black"
+
+
+def shade(color, frac):
+    """Mix ``color`` with white: frac = 1 -> the colour, frac = 0 -> white."""
+    c = np.asarray(to_rgb(color))
+    return tuple(1 - frac * (1 - c))
+
+
+def _values(ds, dim):
+    return list(ds[dim].values) if dim in ds.dims else [None]
+
+
+def _sel(da, **kw):
+    kw = {k: v for k, v in kw.items() if v is not None and k in da.dims}
+    return da.sel(**kw) if kw else da
+
+
+def figure_erosion(analytic=None, numeric=None, *, measures=("GIM", "LIM", "IF"), xi_max=None,
+                   t_eval=None, title=None):
+    """GIM / LIM / IF versus F: analytic lines vs numeric markers, several t_eval shades.
+
+    analytic : Dataset over ([fourier,] F, xi_max) (``erosion_profile_analytic``) or None.
+    numeric  : Dataset over (F, xi_max, t_eval) (``erosion_profile_numeric`` /
+               ``profile_from_charts``) or None.
+    xi_max, t_eval : subsets to draw (default: all).
+    """
+    analytic, numeric = open_dataset(analytic), open_dataset(numeric)
+    if analytic is None and numeric is None:
+        raise ValueError("give at least one of analytic, numeric")
+    ref = analytic if analytic is not None else numeric
+    xis = list(np.atleast_1d(xi_max)) if xi_max is not None else _values(ref, "xi_max")
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    fig, axes = plt.subplots(1, len(measures), figsize=(4.0 * len(measures), 3.9), sharey=True,
+                             squeeze=False)
+    handles = []
+    for a, m in enumerate(measures):
+        ax = axes[0, a]
+        for i, x in enumerate(xis):
+            col = colors[i % len(colors)]
+            if analytic is not None:
+                for f in _values(analytic, "fourier"):
+                    y = _sel(analytic[m], xi_max=x, fourier=f)
+                    st = FOURIER_STYLE[f or param(analytic, "fourier")]
+                    ax.plot(y["F"], y.values, color=col, ls=st["ls"], lw=1.5, zorder=3)
+            if numeric is not None:
+                ts = list(np.atleast_1d(t_eval)) if t_eval is not None else _values(numeric, "t_eval")
+                for k, t in enumerate(ts):
+                    frac = 0.35 + 0.65 * (k + 1) / len(ts)
+                    y = _sel(numeric[m], xi_max=x, t_eval=t)
+                    ms = 6.5 - 3.0 * k / max(len(ts) - 1, 1)  # early t_eval: big and light, late: small and dark
+                    ax.plot(y["F"], y.values, ls="none", marker="o", ms=ms, mfc=shade(col, frac),
+                            mec=shade(col, min(1.0, frac + 0.2)), mew=0.6, zorder=4)
+        ax.set_xlabel(LABELS["F"])
+        ax.set_title(MEASURE_LABELS.get(m, m))
+        ax.set_ylim(-0.03, 1.05)
+        ax.axhline(0.5, color="0.7", lw=0.6, ls=":", zorder=1)
+    axes[0, 0].set_ylabel("normalised integrity")
+    for i, x in enumerate(xis):
+        if x is not None:
+            handles.append(Patch(color=colors[i % len(colors)], label=rf"$\xi_{{max}}$ = {float(x):g}"))
+    if analytic is not None:
+        for f in _values(analytic, "fourier"):
+            key = f or param(analytic, "fourier")
+            handles.append(Line2D([], [], color="0.2", ls=FOURIER_STYLE[key]["ls"],
+                                  label=f"analytic, {FOURIER_STYLE[key]['label']}"))
+    if numeric is not None:
+        ts = list(np.atleast_1d(t_eval)) if t_eval is not None else _values(numeric, "t_eval")
+        for k, t in enumerate(ts):
+            frac = 0.35 + 0.65 * (k + 1) / len(ts)
+            lab = "numeric" + (f", $t_{{eval}}$ = {float(t):g} EC" if t is not None else "")
+            handles.append(Line2D([], [], ls="none", marker="o", mfc=shade("0.2", frac), mec="0.2", mew=0.6,
+                                  label=lab))
+    ncol = len(handles) if len(handles) <= 4 else (len(handles) + 1) // 2
+    fig.legend(handles=handles, loc="lower center", ncol=ncol, fontsize=7.5, frameon=False,
+               bbox_to_anchor=(0.5, 0.0), columnspacing=1.5)
+    par = {k: param(ref, k) for k in ("Omega", "Psi")}
+    fig.suptitle(title or "Erosion profiles: " + param_text(par), fontsize=10)
+    fig.tight_layout(rect=(0, 0.04 + 0.045 * -(-len(handles) // ncol), 1, 1))
+    return fig
+
+
+def _draw_basin_panel(ax, ds, sel, label):
+    safe = _sel(ds["safe"], **sel)
+    true = _sel(ds["true_safe"], **sel)
+    q, p = ds["q0"].values, ds["p0"].values
+    ext = [q[0], q[-1], p[0], p[-1]]
+    n = safe.sizes["Psi"]
+    sv = safe.transpose("Psi", "q0", "p0").values
+    union = sv.any(axis=0)
+    ax.contourf(q, p, union.T.astype(float), levels=[0.5, 1.5], colors=["0.9"], zorder=0)
+    cmap = plt.get_cmap("twilight")
+    psis = np.asarray(safe["Psi"].values, float)
+    for k in range(n):  # each per-phase basin: a faint outline coloured by its phase
+        if sv[k].any() and not sv[k].all():
+            ax.contour(q, p, sv[k].T.astype(float), levels=[0.5], linewidths=0.5, alpha=0.5,
+                       colors=[cmap((psis[k] % (2 * np.pi)) / (2 * np.pi))], zorder=2)
+    tv = true.transpose("q0", "p0").values
+    ax.contourf(q, p, tv.T.astype(float), levels=[0.5, 1.5], colors=["tab:green"], alpha=0.55)
+    draw_well(ax, float(sel["xi_max"]))
+    g = {k: float(_sel(ds[f"{k}_true"], **sel)) for k in ("GIM", "LIM", "IF")}
+    rl = float(_sel(ds["r_local_true"], **sel))
+    rg = float(_sel(ds["r_global_true"], **sel))
+    # IF below (wide, solid), LIM on top (thin, dashed): both stay visible when they coincide
+    if rg > 0:
+        c = (float(_sel(ds["if_q0_true"], **sel)), float(_sel(ds["if_p0_true"], **sel)))
+        ax.add_patch(Circle(c, rg, fill=False, ec=IF_COLOR, lw=2.2, zorder=6))
+        ax.plot(*c, marker="+", color=IF_COLOR, ms=6, mew=1.2, zorder=7)
+    if rl > 0:
+        ax.add_patch(Circle((0, 0), rl, fill=False, ec=LIM_COLOR, lw=1.1, ls=(0, (3, 2)), zorder=7))
+    ax.set_title(f"{label}, {n} phases\ntrue basin: GIM = {g['GIM']:.3f}, LIM = {g['LIM']:.3f}, "
+                 f"IF = {g['IF']:.3f}", fontsize=8.5)
+    ax.set_xlabel(LABELS["q0"])
+    ax.set_aspect("equal", adjustable="box")
+
+
+def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, fourier="paper", title=None,
+                      ):
+    """Per-phase safe basins (faint outlines coloured by Psi, light grey union) and the
+    phase-invariant basin (green) with its LIM (red dashed) and IF (purple) disks; analytic
+    and/or numeric panels."""
+    analytic, numeric = open_dataset(analytic), open_dataset(numeric)
+    panels = [(d, lab) for d, lab in ((analytic, "analytic"), (numeric, "numeric")) if d is not None]
+    if not panels:
+        raise ValueError("give at least one of analytic, numeric")
+    fig, axes = plt.subplots(1, len(panels), figsize=(4.3 * len(panels), 4.5), squeeze=False)
+    for ax, (ds, lab) in zip(axes[0], panels):
+        x = xi_max if xi_max is not None else (float(ds["xi_max"][0]) if "xi_max" in ds.dims else None)
+        sel = {"xi_max": x, "fourier": fourier}
+        if "t_eval" in ds.dims:
+            sel["t_eval"] = t_eval if t_eval is not None else float(ds["t_eval"][-1])
+            lab = f"{lab}, $t_{{eval}}$ = {sel['t_eval']:g} EC"
+        elif "fourier" in ds.dims or "fourier" in ds.attrs:
+            lab = f"{lab} ({fourier} G)"
+        _draw_basin_panel(ax, ds, sel, lab)
+        if "xi_true" in ds:
+            xt = float(_sel(ds["xi_true"], **sel))
+            if xt > 0:
+                draw_well(ax, xt, color=XI_TRUE_COLOR, ls=":", lw=1.0, zorder=8)
+    axes[0, 0].set_ylabel(LABELS["p0"])
+    ref = panels[0][0]
+    handles = [Patch(color="0.9", label="safe for some phase"),
+               Line2D([], [], color=plt.get_cmap("twilight")(0.3), lw=0.8,
+                      label=r"per-phase basins (colour: $\Psi$)"),
+               Patch(color="tab:green", alpha=0.55, label="safe for all sampled phases"),
+               Line2D([], [], color=IF_COLOR, lw=2.2, marker="+", ms=6, label="IF disk (+ centre)"),
+               Line2D([], [], color=LIM_COLOR, lw=1.1, ls=(0, (3, 2)), label="LIM disk")]
+    if "xi_true" in ref:
+        handles.append(Line2D([], [], color=XI_TRUE_COLOR, ls=":", lw=1.0,
+                              label=r"$H_0 = \xi_{true}$ (all $\Psi$)"))
+    fig.legend(handles=handles, loc="lower center", ncol=3, fontsize=7.5, frameon=False,
+               bbox_to_anchor=(0.5, 0.0), columnspacing=1.5)
+    par = {"F": param(ref, "F"), "Omega": param(ref, "Omega")}
+    if xi_max is not None or "xi_max" in ref.dims:
+        par["xi_max"] = float(xi_max if xi_max is not None else ref["xi_max"][0])
+    head = "Phase-invariant safe basin" + (": " + param_text(par) if any(v is not None for v in par.values()) else "")
+    fig.suptitle(title or head, fontsize=10)
+    fig.subplots_adjust(left=0.08, right=0.98, top=0.84, bottom=0.2, wspace=0.22)
+    return fig
+
+
+def _source_name(ds, k):
+    """"Fig 10" from the dataset's ``source_experiment`` attribute (else "set k+1")."""
+    src = str(param(ds, "source_experiment"))
+    m = re.fullmatch(r"fig(\d+)", src)
+    return f"Fig {int(m.group(1))}" if m else (src or f"set {k + 1}")
+
+
+def _compact(txt):
+    return txt.replace(" = ", "=")
+
+
+def _curve_labels(ds):
+    """Short label per curve of an F_cr comparison (the parameters that vary between its curves,
+    e.g. "ξini=0.05") and the title text of the constant ones."""
+    if "curve" in ds.dims:
+        labels, const = curve_labels(ds)
+    else:
+        labels, const = [], {k: ds[k].values if k in ds.coords else ds.attrs[k]
+                             for k in ("xi_max", "xi0", "gamma0", "Psi") if k in ds.coords or k in ds.attrs}
+        labels = [param_text({"xi_max": const.pop("xi_max")})] if "xi_max" in const else ["theory"]
+    return [_compact(t) for t in labels], _compact(ic_text(const))
+
+
+def _curves(ds):
+    return [ds.isel(curve=c) for c in range(ds.sizes["curve"])] if "curve" in ds.dims else [ds]
+
+
+def _rms(x):
+    x = np.ravel(np.asarray(x, float))
+    x = x[np.isfinite(x)]
+    return float(np.sqrt(np.mean(x ** 2))) if x.size else np.nan
+
+
+def _grouped_bars(ax, groups, ylabel, *, ymax, fmt="{:.2f}"):
+    """Paired bars (paper, exact) grouped by source figure: ``groups`` = [(title, [(tick, paper,
+    exact), ...]), ...]. Group titles sit inside the axes above ``ymax``, dotted separators
+    between groups. Returns the (paper, exact) values."""
+    w, x0, ticks, labels = 0.4, 0, [], []
+    allv = {"paper": [], "exact": []}
+    for g, (head, bars) in enumerate(groups):
+        x = x0 + np.arange(len(bars))
+        for s, f, i in ((-1, "paper", 1), (1, "exact", 2)):
+            v = [b[i] for b in bars]
+            allv[f] += v
+            ax.bar(x + s * w / 2, v, width=w, color=FOURIER_COLOR[f], label=FOURIER_STYLE[f]["label"] if g == 0 else None)
+        ticks += list(x)
+        labels += [b[0] for b in bars]
+        ax.text(x.mean(), 0.985, head, transform=ax.get_xaxis_transform(), ha="center", va="top", fontsize=7.5)
+        if g:
+            ax.axvline(x0 - 0.75, color="0.6", lw=0.7, ls=":")
+        x0 += len(bars) + 0.5
+    ax.set_xlim(-0.6, x0 - 0.9)
+    ax.set_ylim(0, ymax)
+    ax.set_xticks(ticks)
+    ax.set_xticklabels(labels, rotation=60, ha="right", rotation_mode="anchor", fontsize=7)
+    ax.tick_params(axis="x", which="both", top=False, length=2)
+    ax.set_ylabel(ylabel)
+    return allv
+
+
+def figure_fourier(fcr=None, iou=None, *, title=None):
+    """Paper vs exact first harmonic against the numerics.
+
+    Top row: relative F_cr error versus Omega, one panel per F_cr dataset (source figure), paper G
+    solid, exact dashed, one colour per curve. Bottom row: RMS relative F_cr error per curve and
+    IoU of the analytic and numeric safe basins per chart, paired bars grouped by source figure.
+    The overall RMS error and mean IoU are in the title.
+
+    fcr : Dataset(s) of ``fcr_fourier_comparison`` (optionally with a ``curve`` dim), or a list.
+    iou : Dataset(s) of ``iou_fourier_comparison``, or a list (one per chart file); each
+          combination of its non-singleton dims becomes one pair of bars.
+    """
+    fcrs = [open_dataset(d) for d in (fcr if isinstance(fcr, (list, tuple)) else [fcr]) if d is not None]
+    ious = [open_dataset(d) for d in (iou if isinstance(iou, (list, tuple)) else [iou]) if d is not None]
+    if not fcrs and not ious:
+        raise ValueError("give at least one of fcr, iou")
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    summary = []
+    nf = len(fcrs)
+    fig = plt.figure(figsize=(max(11.0, 3.7 * nf), 3.3 * (bool(fcrs) + bool(ious or fcrs)) + 0.9))
+    rows = int(bool(fcrs)) + 1
+    gs = fig.add_gridspec(rows, 1, height_ratios=[1.0] * rows, hspace=0.45)
+    if fcrs:
+        top = gs[0].subgridspec(1, nf, wspace=0.08)
+        ax0 = None
+        for k, ds in enumerate(fcrs):
+            ax = fig.add_subplot(top[0, k], sharey=ax0)
+            ax0 = ax0 or ax
+            labs, const = _curve_labels(ds)
+            for c, (d, lab) in enumerate(zip(_curves(ds), labs)):
+                col = colors[c % len(colors)]
+                for f in ("paper", "exact"):
+                    if f in d["fourier"].values:
+                        ax.plot(d["Omega"], 100 * d["rel_error"].sel(fourier=f).values, color=col,
+                                ls=FOURIER_STYLE[f]["ls"], lw=1.1, marker="o", ms=2.2,
+                                label=lab if f == "paper" else None)
+            ax.axhline(0, color="0.5", lw=0.6, zorder=0)
+            ax.set_xlabel(LABELS["Omega"])
+            ax.set_title(_source_name(ds, k) + (f": {const}" if const else ""), fontsize=8.5)
+            if k == 0:
+                ax.set_ylabel(r"rel. $F_{cr}$ error vs numeric (%)")
+            else:
+                ax.tick_params(labelleft=False)
+            ax.legend(loc="upper center", bbox_to_anchor=(0.56, 1.0), fontsize=6.5, ncol=2 if len(labs) > 3 else 1, handlelength=1.4,
+                      columnspacing=0.8, labelspacing=0.25, framealpha=0.9)
+        style_h = [Line2D([], [], color="0.25", ls=FOURIER_STYLE[f]["ls"], label=FOURIER_STYLE[f]["label"])
+                   for f in ("paper", "exact")]
+        fig.legend(handles=style_h, loc="center", bbox_to_anchor=(0.5, 0.925), ncol=2, fontsize=8,
+                   frameon=False, handlelength=2.5)
+        rms = {f: _rms(np.concatenate([np.ravel(ds["rel_error"].sel(fourier=f).values) for ds in fcrs]))
+               for f in ("paper", "exact")}
+        summary.append(rf"RMS rel. $F_{{cr}}$ error: paper {100 * rms['paper']:.1f}%, "
+                       rf"exact {100 * rms['exact']:.1f}%")
+    bottom = gs[rows - 1].subgridspec(1, 2, width_ratios=[max(sum(len(_curves(d)) for d in fcrs), 1) + 2,
+                                                          max(sum(_n_iou(d) for d in ious), 1) + 2] if fcrs and ious
+                                      else [1, 0.0001], wspace=0.12)
+    bi = 0
+    if fcrs:
+        ax = fig.add_subplot(bottom[0, bi])
+        bi += 1
+        groups = []
+        for k, ds in enumerate(fcrs):
+            bars = []
+            for d, lab in zip(_curves(ds), _curve_labels(ds)[0]):
+                r = {f: _rms(d["rel_error"].sel(fourier=f).values) if f in d["fourier"].values else np.nan
+                     for f in ("paper", "exact")}
+                bars.append((lab, 100 * r["paper"], 100 * r["exact"]))
+            groups.append((_source_name(ds, k), bars))
+        allv = [v for g in groups for b in g[1] for v in b[1:] if np.isfinite(v)]
+        _grouped_bars(ax, groups, r"RMS rel. $F_{cr}$ error (%)", ymax=1.18 * max(allv or [1.0]))
+        ax.legend(loc="upper left", bbox_to_anchor=(0.0, 0.9), fontsize=7, framealpha=0.9)
+        ax.set_title(r"critical forcing: RMS error per curve over $\Omega$", fontsize=9)
+    if ious:
+        ax = fig.add_subplot(bottom[0, bi])
+        groups = []
+        for k, ds in enumerate(ious):
+            it = ds["iou"]
+            others = [dd for dd in it.dims if dd != "fourier"]
+            shown = [dd for dd in others if it.sizes[dd] > 1]
+            st = it.stack(_pos=others) if others else it.expand_dims(_pos=[0])
+            fixed = {kk: ds.attrs[kk] for kk in ("Omega", "Psi", "F") if kk in ds.attrs and kk not in shown}
+            fixed.update({dd: float(it[dd][0]) for dd in others if dd not in shown and dd in ("xi_max", "F")})
+            bars = []
+            for i in range(st.sizes["_pos"]):
+                cell = st.isel(_pos=i)
+                lab = _compact(param_text({dd: float(cell[dd]) for dd in shown}))
+                v = {f: float(cell.sel(fourier=f)) if f in cell["fourier"].values else np.nan
+                     for f in ("paper", "exact")}
+                bars.append((lab or _source_name(ds, k), v["paper"], v["exact"]))
+            head = _source_name(ds, k) + "\n" + _compact(param_text(fixed, sep="\n"))
+            groups.append((head, bars))
+        allv = _grouped_bars(ax, groups, "IoU, analytic vs numeric", ymax=1.45)
+        ax.set_yticks(np.arange(0, 1.01, 0.2))
+        ax.axhline(1.0, color="0.6", lw=0.6, ls="-", zorder=0)
+        ax.set_title("safe basins: IoU per chart", fontsize=9)
+        if not fcrs:
+            ax.legend(loc="lower left", fontsize=7, framealpha=0.9)
+        summary.append("mean IoU: paper {:.3f}, exact {:.3f}".format(np.nanmean(allv["paper"]),
+                                                                    np.nanmean(allv["exact"])))
+    head = title or "First harmonic: paper's truncated G (eq 20) vs exact, against the numerics"
+    fig.suptitle(head + ("\n" + "; ".join(summary) if summary and not title else ""), fontsize=10, y=0.995)
+    fig.subplots_adjust(left=0.06, right=0.99, top=0.87 if fcrs else 0.8, bottom=0.12 if fcrs else 0.3)
+    return fig
+
+
+def _n_iou(ds):
+    it = ds["iou"]
+    return int(np.prod([it.sizes[d] for d in it.dims if d != "fourier"]))

@@ -1,0 +1,65 @@
+"""The papermill notebook of a figure, built from its :class:`~safebasins.pipeline.registry.FigureSpec`.
+
+Every notebook is: a title cell, a ``parameters`` cell (dataset paths relative to the
+repository root, output paths, style options; Snakemake overrides the paths with papermill), a
+summary cell (:func:`safebasins.plotting.data.describe`) and one call of the figure's builder.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import nbformat
+from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
+
+KERNELSPEC = {"name": "python3", "display_name": "Python 3 (ipykernel)", "language": "python"}
+
+
+def _literal(v):
+    """Python literal for a notebook parameter."""
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_literal(x) for x in v) + "]"
+    return repr(v)
+
+
+def build_notebook(fig) -> nbformat.NotebookNode:
+    module, function = fig.builder.split(":")
+    heading = (f"# {fig.label} (`{fig.stem}`)\n\n"
+               f"**Caption.** {fig.caption}\n\n"
+               f"**What to look for.** {fig.look}\n\n"
+               "Generated from the registry (`safebasins.pipeline`) by `scripts/make_notebooks.py`; edit the "
+               f"catalog or the plotting code, not this file. Run through Snakemake: `snakemake {fig.png}`.")
+    lines = ["# Parameters (papermill overrides these; paths are relative to the repository root)"]
+    lines += [f"{name} = {_literal(path)}" for name, path in fig.inputs.items()]
+    lines += [f"png = {_literal(fig.png)}", f"pdf = {_literal(fig.pdf)}", "dpi = 180",
+              "title = None  # None: built from the datasets' parameters"]
+    lines += [f"{k} = {_literal(v)}" for k, v in fig.options.items()]
+    params = new_code_cell("\n".join(lines))
+    params.metadata["tags"] = ["parameters"]
+    inputs = ", ".join(f"{k}={k}" for k in fig.inputs)
+    opts = "".join(f", {k}={k}" for k in fig.options)
+    setup = new_code_cell("from safebasins.plotting.data import describe\n"
+                          "from safebasins.plotting.style import apply_style, save_figure\n"
+                          f"from {module} import {function}\n\n"
+                          f"apply_style()\ndescribe({inputs});")
+    draw = new_code_cell(f"fig = {function}({inputs}{opts}, title=title)\nsave_figure(fig, png, pdf, dpi=dpi)")
+    nb = new_notebook(cells=[new_markdown_cell(heading), params, setup, draw])
+    nb.metadata["kernelspec"] = dict(KERNELSPEC)
+    nb.metadata["language_info"] = {"name": "python"}
+    for i, c in enumerate(nb.cells):  # deterministic cell ids (no churn when regenerating)
+        c["id"] = f"{fig.stem.replace('_', '-')}-cell{i}"
+    return nb
+
+
+def notebook_text(fig) -> str:
+    return nbformat.writes(build_notebook(fig)) + "\n"
+
+
+def write_notebook(fig, path):
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    Path(path).write_text(notebook_text(fig))
+
+
+def report_caption(fig) -> str:
+    """The report caption (reStructuredText) of a figure."""
+    files = ", ".join(f"``{p}``" for p in fig.dataset_files())
+    return f"{fig.label}: {fig.caption}\n\n{fig.look}\n\nNotebook ``{fig.notebook}``; datasets {files}.\n"

@@ -1,0 +1,131 @@
+"""Shared plotting style: rcParams, labels and symbols, number formatting, saving figures."""
+from __future__ import annotations
+
+import os
+from contextlib import contextmanager
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+DEFAULT_DPI = 180
+
+LABELS = {
+    "gamma": r"slow phase $\gamma$",
+    "xi": r"averaged energy $\xi$",
+    "q0": r"initial displacement $q_0$",
+    "p0": r"initial momentum $p_0$",
+    "q": r"displacement $q$",
+    "p": r"momentum $p$",
+    "Omega": r"forcing frequency $\Omega$",
+    "F": r"forcing amplitude $F$",
+    "F_cr": r"critical forcing $F_{cr}$",
+    "t_eval": r"evaluation time $t_{eval}$ (EC)",
+}
+
+# symbols used in titles / legends for parameters
+SYMBOLS = {
+    "F": r"$F$",
+    "Omega": r"$\Omega$",
+    "Psi": r"$\Psi$",
+    "xi_max": r"$\xi_{max}$",
+    "q_max": r"$q_{max}$",
+    "xi0": r"$\xi_{ini}$",
+    "xi_ini": r"$\xi_{ini}$",
+    "gamma0": r"$\gamma_{ini}$",
+    "gamma_ini": r"$\gamma_{ini}$",
+    "t_eval": r"$t_{eval}$",
+}
+
+
+SB_FACE = "0.72"        # safe basin grey (RM portraits, Figs 5-9)
+SB_EDGE = "tab:red"     # safe basin boundary (Figs 5-9)
+TRUNC_COLOR = "tab:blue"  # truncation level xi = xi_max (Figs 5-9, "blue dashed")
+
+RC = {
+    "figure.dpi": 100,
+    "savefig.dpi": DEFAULT_DPI,
+    "savefig.bbox": "tight",
+    "font.size": 10,
+    "axes.titlesize": 10,
+    "axes.labelsize": 10,
+    "legend.fontsize": 8,
+    "legend.framealpha": 0.9,
+    "xtick.direction": "in",
+    "ytick.direction": "in",
+    "xtick.top": True,
+    "ytick.right": True,
+    "axes.grid": False,
+    "lines.linewidth": 1.6,
+    "pdf.fonttype": 42,
+}
+
+
+def apply_style(**overrides):
+    """Set the shared rcParams (call once at the top of a notebook)."""
+    plt.rcParams.update({**RC, **overrides})
+
+
+@contextmanager
+def style(**overrides):
+    with plt.rc_context({**RC, **overrides}):
+        yield
+
+
+def save_figure(fig, png=None, pdf=None, *, dpi=DEFAULT_DPI):
+    """Write ``fig`` to PNG (``dpi``) and/or PDF, creating parent folders."""
+    for path, kw in ((png, dict(dpi=dpi)), (pdf, {})):
+        if path:
+            d = os.path.dirname(os.fspath(path))
+            if d:
+                os.makedirs(d, exist_ok=True)
+            fig.savefig(path, bbox_inches="tight", **kw)
+    return fig
+
+
+
+def fmt_value(v, name=None):
+    """Compact number for titles; multiples of pi are written with pi."""
+    try:
+        v = float(v)
+    except (TypeError, ValueError):
+        return str(v)
+    if not np.isfinite(v):
+        return str(v)
+    if name in ("Psi", "gamma0", "gamma_ini") and v != 0:
+        r = v / np.pi
+        for num, txt in ((1, r"\pi"), (0.5, r"\pi/2"), (-1, r"-\pi"), (-0.5, r"-\pi/2"), (2, r"2\pi")):
+            if abs(r - num) < 1e-9:
+                return f"${txt}$"
+    if v != 0 and (abs(v) < 1e-3 or abs(v) >= 1e5):
+        return f"{v:.3g}"
+    return f"{v:.6g}" if abs(v) >= 1 else f"{round(v, 6):g}"
+
+
+def param_text(params, *, sep=", "):
+    """``{"F": 0.0876, "Omega": 0.92}`` -> ``$F$ = 0.0876, $\\Omega$ = 0.92``."""
+    parts = []
+    for k, v in params.items():
+        if v is None:
+            continue
+        parts.append(f"{SYMBOLS.get(k, k)} = {fmt_value(v, k)}")
+    return sep.join(parts)
+
+
+def pi_ticks(ax, lo, hi, axis="x"):
+    """Ticks at multiples of pi/2 between lo and hi."""
+    k = np.arange(np.ceil(lo / (np.pi / 2) - 1e-9), np.floor(hi / (np.pi / 2) + 1e-9) + 1)
+    names = {0: "0", 1: r"$\pi/2$", -1: r"$-\pi/2$", 2: r"$\pi$", -2: r"$-\pi$", 3: r"$3\pi/2$",
+             -3: r"$-3\pi/2$", 4: r"$2\pi$", -4: r"$-2\pi$"}
+    ticks = k * np.pi / 2
+    labels = [names.get(int(i), f"{int(i)}" + r"$\pi/2$") for i in k]
+    if axis == "x":
+        ax.set_xticks(ticks, labels)
+    else:
+        ax.set_yticks(ticks, labels)
+
+
+def grey_levels(n, light=0.86, dark=0.32):
+    """n grey shades, lightest first."""
+    if n <= 1:
+        return [str(round((light + dark) / 2, 3))]
+    return [str(round(v, 3)) for v in np.linspace(light, dark, n)]
