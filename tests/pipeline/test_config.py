@@ -1,22 +1,28 @@
-"""Configuration: schema + semantic validation (bad configs stop with a message naming the key),
-resolution into per-experiment parameters, quick-config merge."""
+"""Configuration: schema + kind checks (bad configs stop with a message naming the key),
+resolution into per-experiment parameters through the registry, quick-config merge."""
 from __future__ import annotations
 
 import copy
-import math
 
 import pytest
 import yaml
+from jsonschema import Draft202012Validator
 from snakemake.utils import update_config
 
-from safebasins import config as sbc
+from safebasins.pipeline import catalog
+from safebasins.pipeline.config import REPO_ROOT, ConfigError, build_schema, load_yaml, validate_config
+from safebasins.pipeline.plan import plan
+from safebasins.pipeline.registry import KINDS
+from safebasins.pipeline.runtime import dump_params
+from safebasins.pipeline.values import range_values, tile_slice
+from safebasins.io.datasets import params_hash
 
-ROOT = sbc.REPO_ROOT
+ROOT = REPO_ROOT
 
 
 @pytest.fixture(scope="module")
 def base():
-    return sbc.load_yaml(ROOT / "config" / "config.yaml")
+    return load_yaml(ROOT / "config" / "config.yaml")
 
 
 def merged(base, override):
@@ -25,74 +31,74 @@ def merged(base, override):
     return cfg
 
 
-def test_paper_config_valid_and_resolves(base):
-    cfg = sbc.validate_config(copy.deepcopy(base))
-    res = sbc.resolve(cfg)
-    assert list(res) == list(sbc.EXPERIMENTS) + list(sbc.EXTRAS)
-    ero, tb, fo = res["extra_erosion"], res["extra_true_basin"], res["extra_fourier"]
-    assert ero["F"][0] == 0.0 and ero["xi_max"] == [0.18, 0.22] and ero["Psi"] == pytest.approx(math.pi)
-    assert len(ero["tasks"]) == len(ero["F"]) and max(ero["t_eval"]) <= ero["cycles"]
-    assert len(tb["tasks"]) == len(tb["Psi"]) == 16 and tb["tasks"][3]["Psi"] == tb["Psi"][3]
-    assert fo["fcr"] == ["fig10", "fig11", "fig12"] and len(fo["iou"]) == 5
-    assert sbc.dataset_files("extra_fourier", params=fo)[0] == "results/data/extras/fourier_fcr_fig10.nc"
-    # paper values survive resolution
-    assert res["fig05"]["F"] == 0.0876 and res["fig05"]["Omega"] == 0.92 and res["fig05"]["xi_max"] == 0.24
-    assert res["fig13"]["scan"] == "xi_max" and res["fig13"]["Psi"] == pytest.approx(math.pi)
-    assert res["fig16"]["scan"] == "F" and len(res["fig16"]["tasks"]) == len(res["fig16"]["F"])
-    assert res["fig13"]["grid"]["n"] == [200, 200] and res["fig13"]["cycles"] == 3000
-    f19 = res["fig19"]
-    assert f19["F"][0] == 0.001 and f19["F"][-1] == 0.071 and len(f19["F"]) == 15
-    assert f19["q_max"] == 1.0 and f19["n_ic"] == 10000 and f19["repeats"] == 5 and len(set(f19["seeds"])) == 5
-    assert f19["Omega"] == 0.9 and f19["Psi"] == 0.0 and f19["xi_max"] == 0.25
-    assert res["fig18"]["n_trajectories"] == 100 and res["fig18"]["n_iter"] == 3000
-    for e in ("fig20", "fig21"):
-        assert res[e]["grid"]["n"] == [300, 300] and res[e]["cycles"] == 11000 and res[e]["t_eval"] == [500, 11000]
-    assert res["fig10"]["numeric"]["tol"] == 5e-5 and res["fig10"]["numeric"]["cycles"] == 3000
-    assert 20 <= len(res["fig10"]["numeric"]["Omega"]) <= 30
-    assert res["fig11"]["curves"][0]["gamma0"] == 0.25 and res["fig12"]["curves"][0]["xi0"] == 0.15
+def test_paper_config_plans_every_declared_experiment(base):
+    run = plan(copy.deepcopy(base))
+    assert list(run.experiments) == [d.name for d in catalog.DECLARATIONS]
+    for name, exp in run.experiments.items():
+        assert exp.params["experiment"] == name and exp.params["kind"] == exp.kind.name
+        assert yaml.safe_load(dump_params(exp.params)) == exp.params, name     # the YAML file round-trips
+        assert exp.figure is not None and exp.figure.packaged
+        for f in exp.figure.dataset_files():  # a figure reads only datasets and parameter files of the run
+            assert f in run.datasets() or f in run.param_files(), (name, f)
+        assert len(exp.tasks) == len(exp.params.get("tasks", ())), name
+    # random experiments never share a stream
+    seeds = [s for e in run.experiments.values() for s in ([e.params["seed"]] if "seed" in e.params else [])
+             + e.params.get("seeds", [])]
+    assert len(seeds) == len(set(seeds)) > 5
 
 
 def test_quick_config_merges_and_is_small(base):
-    cfg = sbc.validate_config(merged(base, sbc.load_yaml(ROOT / "config" / "quick.yaml")))
-    res = sbc.resolve(cfg)
-    assert res["fig05"]["F"] == 0.0876  # paper values inherited from config.yaml
-    assert res["fig13"]["grid"]["n"] == [24, 24] and res["fig13"]["grid"]["q0"] == [-0.95, 0.95]
+    run = plan(merged(base, load_yaml(ROOT / "config" / "quick.yaml")))
+    res = run.params()
+    assert res["fig05"]["F"] == base["figures"]["fig05"]["F"]  # paper values inherited from config.yaml
+    assert res["fig13"]["grid"]["n"] == [24, 24] and res["fig13"]["grid"]["q0"] == base["figures"]["fig13"]["grid"]["q0"]
     assert res["fig21"]["cycles"] <= 300
 
 
-def test_defaults_filled(base):
+def test_defaults_filled_from_the_schema(base):
     cfg = copy.deepcopy(base)
     del cfg["numerics"], cfg["fourier"]
     del cfg["figures"]["fig13"]["cycles"]
-    sbc.validate_config(cfg)
-    assert cfg["fourier"] == "paper" and cfg["numerics"] == {"steps_per_cycle": 64, "threads": 1, "tiles": 1}
+    validate_config(cfg)
+    assert cfg["fourier"] == "paper" and cfg["numerics"] == {"steps_per_cycle": 32, "threads": 1, "tiles": 1}
     assert cfg["figures"]["fig13"]["cycles"] == 3000
+    assert cfg["experiments"] == {} and cfg["extensions"] == []
+
+
+def test_schema_is_valid_and_library_default_agrees():
+    """One schema assembled from the registry; its steps_per_cycle default is the engine's."""
+    from safebasins.numerics import DEFAULT_STEPS_PER_CYCLE
+
+    schema = build_schema()
+    Draft202012Validator.check_schema(schema)
+    assert set(KINDS) <= set(schema["$defs"])
+    assert schema["properties"]["numerics"]["properties"]["steps_per_cycle"]["default"] == DEFAULT_STEPS_PER_CYCLE
 
 
 def test_extras_defaults_match_config(base):
     """Without an `extras:` block the schema defaults give the same parameters as config.yaml."""
     cfg = copy.deepcopy(base)
     del cfg["extras"]
-    a = sbc.resolve_extras(sbc.validate_config(cfg))
-    b = sbc.resolve_extras(sbc.validate_config(copy.deepcopy(base)))
-    assert a == b and set(a) == set(sbc.EXTRAS)
+    a = plan(cfg).params()
+    b = plan(copy.deepcopy(base)).params()
+    extras = [d.name for d in catalog.DECLARATIONS if d.key[0] == "extras"]
+    assert [a[e] for e in extras] == [b[e] for e in extras]
 
 
 def test_resolution_is_per_experiment(base):
     """Changing Fig 16's F list changes only fig16's resolved parameters (and hash)."""
-    a = sbc.resolve(sbc.validate_config(copy.deepcopy(base)))
-    b = sbc.resolve(sbc.validate_config(merged(base, {"figures": {"fig16": {"F": [0.001, 0.002]}}})))
-    changed = [e for e in a if sbc.params_hash(a[e]) != sbc.params_hash(b[e])]
+    a = plan(copy.deepcopy(base)).params()
+    b = plan(merged(base, {"figures": {"fig16": {"F": [0.001, 0.002]}}})).params()
+    changed = [e for e in a if params_hash(a[e]) != params_hash(b[e])]
     assert changed == ["fig16"]
     # tiles / threads do not change any result, so they are not part of any parameter file
-    c = sbc.resolve(sbc.validate_config(merged(base, {"numerics": {"tiles": 4, "threads": 2}})))
-    assert all(sbc.params_hash(a[e]) == sbc.params_hash(c[e]) for e in a)
+    c = plan(merged(base, {"numerics": {"tiles": 4, "threads": 2}})).params()
+    assert all(params_hash(a[e]) == params_hash(c[e]) for e in a)
 
 
 def test_range_values():
-    assert sbc.range_values({"start": 0.001, "stop": 0.071, "step": 0.005})[-1] == 0.071
-    assert sbc.range_values({"start": 0.5, "stop": 1.0, "num": 3}) == [0.5, 0.75, 1.0]
-    assert sbc.q_max_from_xi(0.25) == 1.0
+    assert range_values({"start": 0.001, "stop": 0.071, "step": 0.005})[-1] == 0.071
+    assert range_values({"start": 0.5, "stop": 1.0, "num": 3}) == [0.5, 0.75, 1.0]
 
 
 def test_tile_slices_cover_exactly():
@@ -100,8 +106,8 @@ def test_tile_slices_cover_exactly():
         for tiles in range(1, min(n, 9) + 1):
             idx = []
             for t in range(tiles):
-                s = sbc.tile_slice(n, tiles, t)
-                idx.extend(range(s.start, s.stop))
+                sl = tile_slice(n, tiles, t)
+                idx.extend(range(sl.start, sl.stop))
             assert idx == list(range(n))
 
 
@@ -139,7 +145,7 @@ BAD = [
     ({"extras": {"erosion": {"fourier": ["paper", "truncated"]}}}, "extras.erosion.fourier", ""),
     ({"extras": {"true_basin": {"n_psi": 0}}}, "extras.true_basin.n_psi", "minimum"),
     ({"extras": {"true_basin": {"grid": {"p0": [0.5, -0.5]}}}}, "extras.true_basin.grid.p0", "empty interval"),
-    ({"extras": {"fourier_compare": {"iou": ["fig13", "fig20"]}}}, "extras.fourier_compare.iou[1]", "fig20"),
+    ({"extras": {"fourier_compare": {"iou": ["fig13", "fig20"]}}}, "extras.fourier_compare.iou[1]", "'fig20' has no escape chart"),
     ({"extras": {"fourier_compare": {"fcr": ["fig10", "fig10"]}}}, "extras.fourier_compare.fcr[1]", "twice"),
     ({"extras": {"fourier_compare": {"t_eval": 5000}}}, "extras.fourier_compare.t_eval", "horizon"),
     ({"extras": {"phase_map": {}}}, "extras.phase_map", "unknown key"),
@@ -154,7 +160,12 @@ BAD = [
     ({"figures": {"fig19": {"q_max": 1.5}}}, "figures.fig19.q_max", "maximum"),
     ({"figures": {"fig19": {"repeats": 0}}}, "figures.fig19.repeats", "minimum"),
     ({"figures": {"fig21": {"t_eval": [500, 20000]}}}, "figures.fig21.t_eval", "horizon"),
-    ({"figures": {"fig22": {"source": "fig13"}}}, "figures.fig22.source", ""),
+    ({"figures": {"fig22": {"source": "fig13"}}}, "figures.fig22.source", "not an escape-chart experiment"),
+    ({"experiments": {"toy": {"kind": "no_such_kind"}}}, "experiments.toy.kind", ""),
+    ({"experiments": {"fig13": {"kind": "chart"}}}, "experiments.fig13", "already an experiment"),
+    ({"experiments": {"zoom": {"kind": "chart", "F": 0.01, "Omega": 0.9, "Psi": 0, "xi_max": 0.3,
+                               "grid": {"q0": [-1, 1], "p0": [-1, 1], "n": 10}}}}, "experiments.zoom.xi_max", "maximum"),
+    ({"extensions": ["no.such.module"]}, "extensions[0]", "cannot import"),
     ({"figures": {"fig10": {"numeric": {"F_bracket": [0.3, 0.1]}}}}, "figures.fig10.numeric.F_bracket", "empty bracket"),
     ({"figures": {"fig10": {"numeric": {"tol": 0}}}}, "figures.fig10.numeric.tol", ""),
     ({"seed": -3}, "seed", "minimum"),
@@ -164,8 +175,8 @@ BAD = [
 @pytest.mark.parametrize("override,key,words", BAD, ids=[b[1] + ":" + (b[2] or "x") for b in BAD])
 def test_bad_config_names_key(base, override, key, words):
     cfg = merged(base, override)
-    with pytest.raises(sbc.ConfigError) as exc:
-        sbc.validate_config(cfg)
+    with pytest.raises(ConfigError) as exc:
+        validate_config(cfg)
     msg = str(exc.value)
     assert msg.startswith(f"config key {key}:") or msg.startswith(f"config key {key}"), msg
     assert words in msg, msg
@@ -180,28 +191,11 @@ def test_missing_key_named(base, missing):
     for k in missing[:-1]:
         d = d[k]
     del d[missing[-1]]
-    with pytest.raises(sbc.ConfigError) as exc:
-        sbc.validate_config(cfg)
+    with pytest.raises(ConfigError) as exc:
+        validate_config(cfg)
     assert f"config key {'.'.join(missing)}: missing required key" in str(exc.value)
 
 
 def test_not_a_mapping():
-    with pytest.raises(sbc.ConfigError, match="mapping"):
-        sbc.validate_config([1, 2, 3])
-
-
-def test_snakemake_validate_agrees(base):
-    """The schema is also valid for snakemake.utils.validate (used by the workflow)."""
-    from snakemake.utils import validate
-
-    cfg = copy.deepcopy(base)
-    validate(cfg, str(sbc.SCHEMA_PATH))
-    bad = merged(base, {"figures": {"fig05": {"xi_max": 0.3}}})
-    with pytest.raises(Exception, match="xi_max"):
-        validate(bad, str(sbc.SCHEMA_PATH))
-
-
-def test_params_yaml_roundtrip(base):
-    res = sbc.resolve(sbc.validate_config(copy.deepcopy(base)))
-    for e, p in res.items():
-        assert yaml.safe_load(sbc.dump_params(p)) == p, e
+    with pytest.raises(ConfigError, match="mapping"):
+        validate_config([1, 2, 3])

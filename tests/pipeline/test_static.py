@@ -1,7 +1,7 @@
 """Fast workflow checks (no job runs): dry run, bad config stops before any job, lint."""
 import re
 
-from conftest import make_sandbox, run_snakemake
+from tests.pipeline.sandbox import run_snakemake
 
 
 def test_dry_run_quick_and_full(sandbox):
@@ -9,8 +9,8 @@ def test_dry_run_quick_and_full(sandbox):
         r = run_snakemake(sandbox, "-n", "all", "archive", configfiles=cfg)
         assert r.returncode == 0, r.stderr[-3000:]
         out = r.stdout + r.stderr
-        for rule in ("parameters", "analytic_fcr", "analytic_basin", "numeric_fcr", "chart_tile", "chart_gather",
-                     "chart_final", "criteria", "strobe", "agreement", "archive"):
+        for rule in ("parameters", "analytic_dataset", "numeric_dataset", "extras_dataset", "chart_tile",
+                     "fig01", "extra_fourier", "archive"):
             assert re.search(rf"^{rule}\s+\d+", out, re.M), rule
     assert not (sandbox / "results").exists()
 
@@ -29,7 +29,7 @@ def test_bad_config_stops_before_any_job(sandbox):
 
 def test_lint(sandbox):
     """`snakemake --lint`: no findings except the conda/container one (the environment is the
-    hashed environment.lock venv, not conda). Figure/extra rule files are reported, not failed."""
+    hashed environment.lock venv, not conda)."""
     r = run_snakemake(sandbox, "--lint", configfiles=())
     text = r.stdout + r.stderr
     findings = []
@@ -43,7 +43,4 @@ def test_lint(sandbox):
         if m and where:
             findings.append((where, m.group(1)))
     other = [(w, f) for w, f in findings if not f.startswith("Specify a conda environment or container")]
-    mine = [(w, f) for w, f in other if "figures.smk" not in w and "extras.smk" not in w]
-    if other != mine:
-        print("lint findings in figure/extra rule files:", [x for x in other if x not in mine])
-    assert not mine, mine
+    assert not other, other

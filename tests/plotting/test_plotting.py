@@ -13,8 +13,8 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 import xarray as xr  # noqa: E402
 
-import safebasins.plotting as sbp  # noqa: E402
-from safebasins.plotting import core  # noqa: E402
+from safebasins.plotting import basins, charts, fcr, maps  # noqa: E402
+from safebasins.plotting.style import SB_EDGE, fmt_value, save_figure  # noqa: E402
 
 RNG = np.random.default_rng(0)
 
@@ -76,11 +76,11 @@ def nested(param="xi_max", n=40):
     if param == "xi_max":
         chart = xr.Dataset(dict(escape_cycle_energy=(("xi_max", "q0", "p0"), ec)),
                            coords=dict(xi_max=vals, q0=q0, p0=p0),
-                           attrs=dict(F=0.015, Omega=1.04, Psi=np.pi, cycles=100))
+                           attrs=dict(F=0.015, Omega=1.04, Psi=np.pi, cycles=100, scan="xi_max", agreement_t_eval=100))
     else:
         chart = xr.Dataset(dict(escape_cycle_energy=(("F", "xi_max", "q0", "p0"), ec[:, None])),
                            coords=dict(F=vals, xi_max=[0.18], q0=q0, p0=p0),
-                           attrs=dict(Omega=0.9, Psi=np.pi, cycles=100))
+                           attrs=dict(Omega=0.9, Psi=np.pi, cycles=100, scan="F", agreement_t_eval=100))
     chart["iou"] = ((param,), [0.9, 0.95, 0.97])
     chart["pixel_agreement"] = ((param,), [0.99, 0.98, 0.97])
     t = np.linspace(0, 2 * np.pi, 60)
@@ -89,6 +89,7 @@ def nested(param="xi_max", n=40):
     basins = xr.Dataset(
         dict(q0_vertex=((param, "vertex"), qv), p0_vertex=((param, "vertex"), pv),
              curve_index=((param, "vertex"), np.zeros(qv.shape, int)),
+             kind=((param, "curve"), [["island"]] * 3),
              escapes=((param, "q0", "p0"), ~np.isinf(ec))),
         coords={param: vals, "q0": q0, "p0": p0})
     return basins, chart
@@ -107,7 +108,7 @@ def criteria():
     F = np.arange(0.001, 0.072, 0.01)
     rd = F[:, None] * (1 + 0.3 * RNG.standard_normal((F.size, 5)))
     return xr.Dataset(dict(rel_diff=(("F", "repeat"), rd)), coords=dict(F=F, repeat=np.arange(5)),
-                      attrs=dict(Omega=0.9, Psi=0.0, xi_max=0.25))
+                      attrs=dict(Omega=0.9, Psi=0.0, xi_max=0.25, q_max=1.0, n_ic=10000, cycles=3000))
 
 
 def dsb_esb(n=40, cycles=1000):
@@ -133,7 +134,7 @@ def assert_nontrivial_png(path, min_bytes=15_000):
 
 def render(fig, tmp_path, name="fig"):
     png, pdf = tmp_path / f"{name}.png", tmp_path / f"{name}.pdf"
-    sbp.save_figure(fig, png, pdf, dpi=120)
+    save_figure(fig, png, pdf, dpi=120)
     plt.close(fig)
     assert pdf.exists() and pdf.stat().st_size > 2000
     assert_nontrivial_png(png)
@@ -144,7 +145,7 @@ def render(fig, tmp_path, name="fig"):
 @pytest.mark.parametrize("color_by", ["curve", "mechanism"])
 def test_figure_fcr(tmp_path, color_by):
     ds = fcr_stack(n_curve=3 if color_by == "curve" else 1)
-    fig = sbp.figure_fcr(ds, color_by=color_by, show_branches=(color_by == "mechanism"))
+    fig = fcr.figure_fcr(ds, color_by=color_by, show_branches=(color_by == "mechanism"))
     ax = fig.axes[0]
     labels = [t.get_text() for t in ax.get_legend().get_texts()]
     assert "SM" in labels and "SMM" in labels and any("MM" in t and "pi" in t for t in labels)
@@ -156,7 +157,7 @@ def test_fcr_segments_follow_mechanism():
     fig, ax = plt.subplots()
     Om = np.linspace(0, 1, 10)
     mech = np.array([4, 4, 4, 3, 3, 3, 0, 2, 2, 2])
-    drawn = sbp.draw_fcr_curve(ax, Om, Om + 1, mech, color="k")
+    drawn = fcr.draw_fcr_curve(ax, Om, Om + 1, mech, color="k")
     assert drawn == {2, 3, 4}
     styles = [ln.get_linestyle() for ln in ax.lines]
     assert styles == [":", "-", "--"]
@@ -167,7 +168,7 @@ def test_fcr_segments_follow_mechanism():
 
 def test_figure_fcr_comparison(tmp_path):
     for layout in ("panels", "overlay"):
-        fig = sbp.figure_fcr_comparison(fcr_stack(), fcr_stack(numeric=True), layout=layout)
+        fig = fcr.figure_fcr_comparison(fcr_stack(), fcr_stack(numeric=True), layout=layout)
         assert len(fig.axes) == (3 if layout == "panels" else 1)
         texts = [t.get_text() for ax in fig.axes if ax.get_legend() for t in ax.get_legend().get_texts()]
         assert any("non-monotone" in t for t in texts)
@@ -175,22 +176,22 @@ def test_figure_fcr_comparison(tmp_path):
 
 
 def test_figure_rm_basin(tmp_path):
-    fig = sbp.figure_rm_basin(rm_basin())
+    fig = basins.figure_rm_basin(rm_basin())
     left, right = fig.axes[:2]
     assert left.get_xlabel().endswith(r"$\gamma$") and left.get_ylabel().endswith(r"$\xi$")
     assert "q_0" in right.get_xlabel() and "p_0" in right.get_ylabel()
     # truncation level dashed at xi_max, red boundary present on both panels
     assert any(ln.get_linestyle() == "--" and np.allclose(ln.get_ydata(), 0.24) for ln in left.lines)
     for ax in (left, right):
-        assert any(ln.get_color() == core.SB_EDGE for ln in ax.lines)
+        assert any(ln.get_color() == SB_EDGE for ln in ax.lines)
     assert "0.0876" in fig._suptitle.get_text()
     render(fig, tmp_path)
 
 
 @pytest.mark.parametrize("param", ["xi_max", "F"])
 def test_figure_nested_basins(tmp_path, param):
-    basins, chart = nested(param)
-    fig = sbp.figure_nested_basins(basins, chart, param=param)
+    basins_ds, chart = nested(param)
+    fig = charts.figure_nested_basins(basins_ds, chart)
     texts = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
     assert sum("IoU" in t for t in texts) == 3
     assert any("escape for all" in t for t in texts)
@@ -198,10 +199,10 @@ def test_figure_nested_basins(tmp_path, param):
 
 
 def test_nested_shading_lighter_contains_darker():
-    basins, chart = nested("xi_max")
-    vals, masks, _ = core._stack_param(chart, "xi_max")
+    _, chart = nested("xi_max")
+    vals, masks = charts.scan_masks(chart, "xi_max", 100)
     fig, ax = plt.subplots()
-    shade = sbp.draw_nested_safe(ax, masks)
+    shade = charts.draw_nested_safe(ax, masks)
     plt.close(fig)
     order = sorted(shade, key=lambda i: float(shade[i]))  # darkest (smallest grey value) first
     for darker, lighter in zip(order, order[1:]):
@@ -210,41 +211,42 @@ def test_nested_shading_lighter_contains_darker():
 
 
 def test_period_map_criteria_dsb_area(tmp_path):
-    render(sbp.figure_period_map(rm_basin(), strobe()), tmp_path, "strobe")
-    fig = sbp.figure_criteria(criteria())
+    render(maps.figure_period_map(rm_basin(), strobe()), tmp_path, "strobe")
+    fig = charts.figure_criteria(criteria())
     colors = [ln.get_color() for ln in fig.axes[0].lines if ln.get_marker() == "o"]
     assert colors == ["tab:blue", "tab:orange", "tab:green"]
     render(fig, tmp_path, "criteria")
-    fig = sbp.figure_dsb_esb(dsb_esb(), {"t_eval": [100, 1000]})
+    fig = charts.figure_dsb_esb(dsb_esb(), None, t_evals=[100, 1000])
     assert [ax.get_title() for ax in fig.axes[:2]] == [r"$t_{eval}$ = 100 EC", r"$t_{eval}$ = 1,000 EC"]
     render(fig, tmp_path, "dsb")
-    fig = sbp.figure_area_vs_time(dsb_esb(), {"t_eval": list(range(50, 1001, 50))})
+    fig = charts.figure_area_vs_time(dsb_esb(), None, t_evals=list(range(50, 1001, 50)))
     ls = sorted(ln.get_linestyle() for ln in fig.axes[0].lines)
     assert ls == ["-", "--"]
     render(fig, tmp_path, "area")
 
 
 # ------------------------------------------------------------------ small helpers
-def test_safe_area_curve_matches_direct_count():
-    ec = np.array([0, 5, 10, np.inf, 20, np.inf])
-    t = np.array([0, 4, 5, 19, 100])
-    assert sbp.safe_area_curve(ec, t).tolist() == [int((ec > x).sum()) for x in t]
-    assert sbp.safe_from_cycles(ec, 10).tolist() == [False, False, False, True, True, True]
+def test_exact_names_fail_loudly():
+    """A missing variable or parameter is a KeyError naming the dataset and the name."""
+    ds = rm_basin().drop_vars("q0_vertex")
+    ds.encoding["source"] = "results/data/analytic/basin_figXX.nc"
+    with pytest.raises(KeyError, match="basin_figXX.nc.*'q0_vertex'"):
+        basins.boundary_polylines(ds, "q0_vertex", "p0_vertex")
+    with pytest.raises(KeyError, match="'saddle_gamma'"):
+        basins.figure_rm_basin(rm_basin().drop_attrs(deep=False).assign_attrs(F=0.1, Omega=0.9, Psi=0.0, xi_max=0.2))
+    plt.close("all")
 
 
-def test_fmt_and_vertex_names():
-    assert sbp.fmt_value(np.pi, "Psi") == r"$\pi$"
-    assert sbp.fmt_value(1.0, "Psi") == "1"
-    assert sbp.fmt_value(5e-5) == "5e-05"
-    ds = rm_basin()
-    assert core.vertex_var(ds, "q0").name == "q0_vertex"
-    assert core.vertex_var(ds, "gamma").name == "gamma"
-    polys = core._boundary_polylines(ds, "q0", "p0")
+def test_fmt_and_boundary_polylines():
+    assert fmt_value(np.pi, "Psi") == r"$\pi$"
+    assert fmt_value(1.0, "Psi") == "1"
+    assert fmt_value(5e-5) == "5e-05"
+    polys = basins.boundary_polylines(rm_basin(), "q0_vertex", "p0_vertex")
     assert len(polys) == 2 and polys[1][2] == "saddle"
 
 
 def test_break_wraps():
-    x, y = core._break_wraps([3.0, 3.1, -3.1, -3.0], [0, 1, 2, 3])
+    x, y = basins.break_wraps([3.0, 3.1, -3.1, -3.0], [0, 1, 2, 3])
     assert np.isnan(x[2]) and x.size == 5
 
 
@@ -254,6 +256,6 @@ def test_interior_curves_are_not_drawn_as_boundaries():
     Q, P = np.meshgrid(q0, p0, indexing="ij")
     safe = xr.DataArray(np.hypot(Q, P) < 0.6, dims=("q0", "p0"), coords=dict(q0=q0, p0=p0))
     t = np.linspace(0, 2 * np.pi, 80)
-    assert core.separates_mask(0.6 * np.cos(t), 0.6 * np.sin(t), safe)       # the edge
-    assert not core.separates_mask(0.3 * np.cos(t), 0.3 * np.sin(t), safe)   # inside the basin
-    assert not core.separates_mask(0.9 * np.cos(t), 0.9 * np.sin(t), safe)   # in the escape region
+    assert basins.separates_mask(0.6 * np.cos(t), 0.6 * np.sin(t), safe)       # the edge
+    assert not basins.separates_mask(0.3 * np.cos(t), 0.3 * np.sin(t), safe)   # inside the basin
+    assert not basins.separates_mask(0.9 * np.cos(t), 0.9 * np.sin(t), safe)   # in the escape region

@@ -19,6 +19,8 @@ PROVENANCE_ATTRS = ("date_created", "git_commit", "safebasins_version", "config_
 
 
 def _same_array(a: np.ndarray, b: np.ndarray) -> bool:
+    if a.dtype.kind in "OUS" and b.dtype.kind in "OUS":  # text: object vs fixed-width is storage only
+        return a.shape == b.shape and bool(np.array_equal(a.astype(str), b.astype(str)))
     if a.shape != b.shape or a.dtype != b.dtype:
         return False
     if a.dtype.kind in "fc":
@@ -27,12 +29,17 @@ def _same_array(a: np.ndarray, b: np.ndarray) -> bool:
 
 
 def _same_attr(a, b) -> bool:
-    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
-        a, b = np.asarray(a), np.asarray(b)
-        return a.shape == b.shape and (np.array_equal(a, b, equal_nan=a.dtype.kind in "fc"
-                                                      and b.dtype.kind in "fc"))
-    if isinstance(a, float) and isinstance(b, float) and np.isnan(a) and np.isnan(b):
-        return True
+    """Equal attribute values: numbers and arrays by value (NaN == NaN; a netCDF round trip turns
+    Python scalars into numpy ones), everything else by equality."""
+    numeric = (int, float, np.number, np.ndarray, list, tuple)
+    if isinstance(a, numeric) and isinstance(b, numeric) and not isinstance(a, bool) and not isinstance(b, bool):
+        try:
+            x, y = np.asarray(a), np.asarray(b)
+        except (TypeError, ValueError):
+            return a == b
+        if x.dtype.kind in "fciub" and y.dtype.kind in "fciub":
+            return x.shape == y.shape and bool(np.array_equal(x, y, equal_nan=x.dtype.kind in "fc" and y.dtype.kind in "fc"))
+        return x.shape == y.shape and bool(np.array_equal(x, y))
     return type(a) is type(b) and a == b
 
 
@@ -67,7 +74,7 @@ def dataset_differences(old: xr.Dataset, new: xr.Dataset, *, ignore_attrs=PROVEN
             continue
         va, vb = np.asarray(a.values), np.asarray(b.values)
         if not _same_array(va, vb):
-            if va.shape != vb.shape or va.dtype != vb.dtype:
+            if va.shape != vb.shape or (va.dtype != vb.dtype and not (va.dtype.kind in "OUS" and vb.dtype.kind in "OUS")):
                 out.append(f"{n}: shape/dtype {va.shape} {va.dtype} vs {vb.shape} {vb.dtype}")
             else:
                 neq = ~((va == vb) | ((va != va) & (vb != vb))) if va.dtype.kind in "fc" else (va != vb)
