@@ -36,9 +36,9 @@ def _slow_flow_escapes(q0, p0, F, Omega, Psi, xi_max, fourier="paper"):
     return out | _escapes_on_manifold(th - Psi, xi, F, Omega, xi_max, fourier)
 
 
-def _critical_forcing(Omega, xi_max, xi0=0.0, gamma0=0.0, fourier="paper"):
+def _critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier="paper"):
     Om = np.atleast_1d(np.asarray(Omega, float))
-    F = (xi_max - xi0) / (K[fourier] * (1 + np.cos(gamma0))) * (1 + (Om - 0.9) ** 2)
+    F = (xi_max - xi_ini) / (K[fourier] * (1 + np.cos(gamma_ini))) * (1 + (Om - 0.9) ** 2)
     return xr.Dataset({"F_cr": ("Omega", F)}, coords={"Omega": Om})
 
 
@@ -183,8 +183,8 @@ def test_fourier_comparisons_toy(toy):
     # toy numerics uses k = 1.05: paper (k=1) and exact (k=1.1) equally far, relative +-
     assert float(ds["rel_error"].sel(fourier="paper")[0]) > 0 > float(ds["rel_error"].sel(fourier="exact")[0])
     stacked = xr.concat([_critical_forcing_numeric([0.8, 0.9], x) for x in (0.15, 0.2)], dim="curve")
-    stacked = stacked.assign_coords(xi_max=("curve", [0.15, 0.2]), xi0=("curve", [0.0, 0.0]),
-                                    gamma0=("curve", [0.0, 0.0]), Psi=("curve", [0.0, 0.0]))
+    stacked = stacked.assign_coords(xi_max=("curve", [0.15, 0.2]), xi_ini=("curve", [0.0, 0.0]),
+                                    gamma_ini=("curve", [0.0, 0.0]), Psi=("curve", [0.0, 0.0]))
     ds2 = fourier_compare.fcr_fourier_comparison_from_numeric(stacked)
     assert ds2["error"].dims == ("curve", "fourier", "Omega")
 

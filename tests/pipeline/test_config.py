@@ -7,7 +7,7 @@ import copy
 import pytest
 import yaml
 from jsonschema import Draft202012Validator
-from snakemake.utils import update_config
+from safebasins.pipeline.config import merge_config as update_config
 
 from safebasins.pipeline import catalog
 from safebasins.pipeline.config import REPO_ROOT, ConfigError, build_schema, load_yaml, validate_config

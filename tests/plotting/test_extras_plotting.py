@@ -49,8 +49,8 @@ def test_extra_figure_labels(toy):  # noqa: F811
     assert r"\pi" in fig._suptitle.get_text() and "3.14" not in fig._suptitle.get_text()
 
     import xarray as xr
-    ds = xr.Dataset(coords={"xi_max": ("curve", [0.242, 0.242]), "xi0": ("curve", [0.0, 0.05]),
-                            "gamma0": ("curve", [0.25, 0.25]), "Psi": ("curve", [np.pi, np.pi])})
+    ds = xr.Dataset(coords={"xi_max": ("curve", [0.242, 0.242]), "xi_ini": ("curve", [0.0, 0.05]),
+                            "gamma_ini": ("curve", [0.25, 0.25]), "Psi": ("curve", [np.pi, np.pi])})
     labels, const = plotting_extras._curve_labels(ds)
     assert labels == [r"$\xi_{ini}$=0", r"$\xi_{ini}$=0.05"]
     assert r"\pi" in const and "0.242" in const

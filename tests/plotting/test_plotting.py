@@ -28,8 +28,8 @@ def fcr_stack(n_curve=3, n_omega=40, numeric=False):
         dict(F_cr=(("curve", "Omega"), F), mechanism=(("curve", "Omega"), np.tile(mech, (n_curve, 1))),
              F_MM_0=(("curve", "Omega"), F * 1.1), F_MM_pi=(("curve", "Omega"), F * 1.2),
              F_SM=(("curve", "Omega"), F * 1.05), F_SMM=(("curve", "Omega"), np.where(Om < 0.7, F, np.nan))),
-        coords=dict(Omega=Om, xi_max=("curve", [0.242] * n_curve), xi0=("curve", 0.05 * np.arange(n_curve)),
-                    gamma0=("curve", [0.25] * n_curve), Psi=("curve", [np.pi] * n_curve),
+        coords=dict(Omega=Om, xi_max=("curve", [0.242] * n_curve), xi_ini=("curve", 0.05 * np.arange(n_curve)),
+                    gamma_ini=("curve", [0.25] * n_curve), Psi=("curve", [np.pi] * n_curve),
                     label=("curve", [f"c{i}" for i in range(n_curve)])),
         attrs=dict(fourier="paper"))
     if not numeric:

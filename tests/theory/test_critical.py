@@ -7,29 +7,29 @@ from safebasins.theory import G, J, critical_forcing, escapes_on_manifold, first
 MM_0, MM_PI, SM, SMM = 1, 2, 3, 4
 
 
-def _bisect_F(gamma0, xi0, Om, xi_max, hi):
-    assert escapes_on_manifold(gamma0, xi0, hi, Om, xi_max)
+def _bisect_F(gamma_ini, xi_ini, Om, xi_max, hi):
+    assert escapes_on_manifold(gamma_ini, xi_ini, hi, Om, xi_max)
     lo = 0.0
-    assert not escapes_on_manifold(gamma0, xi0, lo, Om, xi_max)
+    assert not escapes_on_manifold(gamma_ini, xi_ini, lo, Om, xi_max)
     for _ in range(45):
         mid = 0.5 * (lo + hi)
-        if escapes_on_manifold(gamma0, xi0, mid, Om, xi_max):
+        if escapes_on_manifold(gamma_ini, xi_ini, mid, Om, xi_max):
             hi = mid
         else:
             lo = mid
     return 0.5 * (lo + hi)
 
 
-@pytest.mark.parametrize("xi_max, xi0, gamma0", [(0.15, 0.0, 0.0), (0.242, 0.15, 0.25),
+@pytest.mark.parametrize("xi_max, xi_ini, gamma_ini", [(0.15, 0.0, 0.0), (0.242, 0.15, 0.25),
                                                  (0.242, 0.1, 2.0), (0.2499, 0.0, 0.0)])
-def test_critical_forcing_against_bisection(xi_max, xi0, gamma0):
+def test_critical_forcing_against_bisection(xi_max, xi_ini, gamma_ini):
     Om = np.array([0.55, 0.7, 0.8, 0.9, 1.0, 1.15])
-    ds = critical_forcing(Om, xi_max, xi0, gamma0)
+    ds = critical_forcing(Om, xi_max, xi_ini, gamma_ini)
     for k, om in enumerate(Om):
         F = float(ds.F_cr[k])
         if np.isnan(F):
             continue
-        ref = _bisect_F(gamma0, xi0, om, xi_max, 1.5 * F + 1e-6)
+        ref = _bisect_F(gamma_ini, xi_ini, om, xi_max, 1.5 * F + 1e-6)
         assert F == pytest.approx(ref, rel=1e-6, abs=1e-10), (om, int(ds.mechanism[k]))
 
 
@@ -55,13 +55,13 @@ def test_mm_closed_form_is_a_tangency():
 
 
 def test_sm_branch_passes_through_a_saddle():
-    for xi0, g0, Om in [(0.0, 0.0, np.array([0.75, 0.85, 0.9])),
+    for xi_ini, g0, Om in [(0.0, 0.0, np.array([0.75, 0.85, 0.9])),
                         (0.15, 0.25, np.array([0.7, 0.75, 0.8]))]:
-        ds = critical_forcing(Om, 0.242, xi0, g0)
+        ds = critical_forcing(Om, 0.242, xi_ini, g0)
         for k, om in enumerate(Om):
             F, xs, gs = float(ds.F_SM[k]), float(ds.xi_saddle[k]), float(ds.gamma_saddle[k])
             assert np.isfinite(F)
-            C0 = first_integral(g0, xi0, F, om)
+            C0 = first_integral(g0, xi_ini, F, om)
             assert first_integral(gs, xs, F, om) == pytest.approx(C0, abs=1e-12)      # eq (26)
             h = 1e-6
             dCdx = (first_integral(gs, xs + h, F, om) - first_integral(gs, xs - h, F, om)) / (2 * h)
@@ -120,7 +120,7 @@ def test_dataset_layout():
     assert list(ds.mechanism.attrs["flag_values"]) == [0, 1, 2, 3, 4]
     assert ds.mechanism.attrs["flag_meanings"] == "none MM_0 MM_pi SM SMM"
     assert ds.attrs["fourier"] == "exact" and ds.attrs["xi_max"] == 0.2
-    assert ds.attrs["xi0"] == 0.0 and ds.attrs["gamma0"] == 0.0
+    assert ds.attrs["xi_ini"] == 0.0 and ds.attrs["gamma_ini"] == 0.0
     assert ds.F_cr.attrs["units"] == "1"
     # exact G is larger -> smaller forcing needed
     assert float(ds.F_cr[0]) < float(critical_forcing(0.9, 0.2).F_cr[0])
@@ -141,9 +141,9 @@ def test_separatrix_threshold_has_no_mm_branch():
     (dict(Omega=[0.9, -1.0], xi_max=0.2), "Omega"),
     (dict(Omega=0.9, xi_max=0.0), "xi_max"),
     (dict(Omega=0.9, xi_max=0.3), "xi_max"),
-    (dict(Omega=0.9, xi_max=0.2, xi0=-0.1), "xi0"),
-    (dict(Omega=0.9, xi_max=0.2, xi0=0.2), "xi0"),
-    (dict(Omega=0.9, xi_max=0.2, gamma0=np.inf), "gamma0"),
+    (dict(Omega=0.9, xi_max=0.2, xi_ini=-0.1), "xi_ini"),
+    (dict(Omega=0.9, xi_max=0.2, xi_ini=0.2), "xi_ini"),
+    (dict(Omega=0.9, xi_max=0.2, gamma_ini=np.inf), "gamma_ini"),
     (dict(Omega=0.9, xi_max=0.2, fourier="bad"), "fourier"),
 ])
 def test_out_of_domain_raises(kw, name):

@@ -158,7 +158,7 @@ def test_against_real_dynamics_eq1():
     """Eq (1), q'' + q - q^3 = F sin(Omega tau + Psi), integrated directly for a few ICs well away
     from the predicted boundary (F = 0.015, Omega = 1.04, Psi = pi, xi_max = 0.2; Fig 13).
 
-    At xi0 = 0.185 the prediction depends on the phase: gamma0 = 0 escapes, gamma0 = pi is safe.
+    At xi_ini = 0.185 the prediction depends on the phase: gamma_ini = 0 escapes, gamma_ini = pi is safe.
     A wrong sign/phase convention swaps them."""
     F, Om, Psi, xm = 0.015, 1.04, np.pi, 0.2
 
@@ -173,8 +173,8 @@ def test_against_real_dynamics_eq1():
              (0.15, 1.0), (0.1, 0.4)]
     ring = 0.02 * np.exp(1j * np.linspace(0, 2 * np.pi, 12, endpoint=False))
     results = []
-    for xi0, g0 in cases:
-        q0, p0 = initial_condition(xi0, g0, Psi)
+    for xi_ini, g0 in cases:
+        q0, p0 = initial_condition(xi_ini, g0, Psi)
         pred = bool(slow_flow_escapes(q0, p0, F, Om, Psi, xm))
         # "well away from the boundary": every IC within 0.02 has the same prediction
         assert (slow_flow_escapes(q0 + ring.real, p0 + ring.imag, F, Om, Psi, xm) == pred).all()

@@ -25,6 +25,7 @@ import numpy as np
 import xarray as xr
 
 from safebasins import checks
+from safebasins.io import cf
 from safebasins.analysis.common import as_1d, fourier_list, mesh, stack_charts
 from safebasins.analysis.integrity import integrity_measures, unforced_safe_mask
 from safebasins.analysis.safe import safe_stack
@@ -124,7 +125,7 @@ def profile_from_charts(charts, t_eval=None, *, criterion="energy", stack_dim="F
     thr = "xi_max" if criterion == "energy" else "q_max"
     lead = [d for d in (stack_dim, thr) if d in ds.dims]
     ds = ds.transpose(*lead, "t_eval", ...)
-    ds["t_eval"].attrs.update(units="forcing cycles", long_name="evaluation time")
+    ds["t_eval"].attrs.update(cf.attrs("t_eval"))
     ds.attrs.update({k: v for k, v in chart.attrs.items() if k in ("Omega", "Psi", "F", "cycles",
                                                                        "steps_per_cycle", "integrator")})
     ds.attrs.update({"kind": "numeric", "criterion": criterion,

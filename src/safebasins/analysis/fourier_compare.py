@@ -5,7 +5,7 @@ function; the exact first harmonic is G / (1 - nome) (``theory.G(..., fourier=
 "exact")``).  Both variants are compared with the same numerics:
 
 * :func:`fcr_fourier_comparison` -- critical forcing ``F_cr(Omega)`` for an IC
-  ``(xi0, gamma0)`` and phase Psi: ``theory.critical_forcing`` with both variants vs
+  ``(xi_ini, gamma_ini)`` and phase Psi: ``theory.critical_forcing`` with both variants vs
   ``numerics.critical_forcing_numeric`` (computed here or passed in, e.g. the
   pipeline's ``results/data/numeric/fcr_fig10.nc``).
 * :func:`iou_fourier_comparison` -- safe basins: analytic masks with both variants vs
@@ -34,10 +34,10 @@ __all__ = ["fcr_fourier_comparison", "fcr_fourier_comparison_from_numeric", "iou
 _FOURIER = list(FOURIER_VARIANTS)
 
 
-def _analytic_fcr(Omega, xi_max, xi0, gamma0):
+def _analytic_fcr(Omega, xi_max, xi_ini, gamma_ini):
     out = []
     for f in _FOURIER:
-        ds = critical_forcing(Omega, xi_max, xi0=xi0, gamma0=gamma0, fourier=f)
+        ds = critical_forcing(Omega, xi_max, xi_ini=xi_ini, gamma_ini=gamma_ini, fourier=f)
         out.append(np.asarray(ds["F_cr"].values, float))
     return np.stack(out)
 
@@ -77,12 +77,12 @@ def _fcr_dataset(Omega, F_num, F_an, extra=None, attrs=None):
     return ds
 
 
-def fcr_fourier_comparison(Omega, xi_max, *, xi0=0.0, gamma0=0.0, Psi=0.0, cycles=3000, tol=5e-5,
+def fcr_fourier_comparison(Omega, xi_max, *, xi_ini=0.0, gamma_ini=0.0, Psi=0.0, cycles=3000, tol=5e-5,
                            **numeric_kwargs):
     """F_cr(Omega): paper vs exact first harmonic against the numeric bisection.
 
-    The numeric IC is ``(q0, p0) = theory.initial_condition(xi0, gamma0, Psi)`` so that
-    both sides describe the same trajectory (gamma0 = theta0 - Psi).
+    The numeric IC is ``(q0, p0) = theory.initial_condition(xi_ini, gamma_ini, Psi)`` so that
+    both sides describe the same trajectory (gamma_ini = theta0 - Psi).
 
     Returns
     -------
@@ -94,17 +94,17 @@ def fcr_fourier_comparison(Omega, xi_max, *, xi0=0.0, gamma0=0.0, Psi=0.0, cycle
     """
     Om = as_1d("Omega", Omega, checks.check_positive)
     xi_max = float(QUARTIC.check_threshold("xi_max", xi_max))
-    xi0 = float(QUARTIC.check_energy("xi0", xi0))
-    gamma0 = float(checks.check_finite("gamma0", gamma0))
+    xi_ini = float(QUARTIC.check_energy("xi_ini", xi_ini))
+    gamma_ini = float(checks.check_finite("gamma_ini", gamma_ini))
     Psi = float(checks.check_finite("Psi", Psi))
-    if xi0 > 0:
-        q0, p0 = initial_condition(xi0, gamma0, Psi)
+    if xi_ini > 0:
+        q0, p0 = initial_condition(xi_ini, gamma_ini, Psi)
         q0, p0 = float(q0), float(p0)
     else:
         q0, p0 = 0.0, 0.0
     num = critical_forcing_numeric(Om, xi_max, q0=q0, p0=p0, Psi=Psi, cycles=cycles, tol=tol,
                                                    **numeric_kwargs)
-    return fcr_fourier_comparison_from_numeric(num, xi0=xi0, gamma0=gamma0)
+    return fcr_fourier_comparison_from_numeric(num, xi_ini=xi_ini, gamma_ini=gamma_ini)
 
 
 def _curve_param(ds, name, default=None):
@@ -117,40 +117,40 @@ def _curve_param(ds, name, default=None):
     raise ValueError(f"numeric F_cr dataset has no {name!r} (coordinate, variable or attribute)")
 
 
-def fcr_fourier_comparison_from_numeric(numeric, *, xi0=None, gamma0=None):
+def fcr_fourier_comparison_from_numeric(numeric, *, xi_ini=None, gamma_ini=None):
     """Paper vs exact F_cr against an existing ``critical_forcing_numeric`` Dataset.
 
     ``numeric`` may be stacked over ``curve`` (pipeline files ``fcr_fig10-12.nc``, with
-    per-curve coordinates ``xi_max``, ``xi0``, ``gamma0``, ``Psi``); the result then has a
-    ``curve`` dimension.  Without ``xi0``/``gamma0`` (coordinates or arguments) the IC
+    per-curve coordinates ``xi_max``, ``xi_ini``, ``gamma_ini``, ``Psi``); the result then has a
+    ``curve`` dimension.  Without ``xi_ini``/``gamma_ini`` (coordinates or arguments) the IC
     ``(q0, p0)`` of the numeric run is converted with ``theory.angle_energy``
-    (gamma0 = theta0 - Psi).
+    (gamma_ini = theta0 - Psi).
     """
     if "curve" in numeric.dims:
-        parts = [fcr_fourier_comparison_from_numeric(numeric.isel(curve=k), xi0=xi0, gamma0=gamma0)
+        parts = [fcr_fourier_comparison_from_numeric(numeric.isel(curve=k), xi_ini=xi_ini, gamma_ini=gamma_ini)
                  for k in range(numeric.sizes["curve"])]
         out = xr.concat(parts, dim="curve", coords="different", compat="equals", combine_attrs="drop_conflicts")
         return out
     xi_max = _curve_param(numeric, "xi_max")
     Psi = _curve_param(numeric, "Psi", 0.0)
-    if xi0 is None:
-        xi0 = _curve_param(numeric, "xi0", np.nan)
-    if gamma0 is None:
-        gamma0 = _curve_param(numeric, "gamma0", np.nan)
-    if not (np.isfinite(xi0) and np.isfinite(gamma0)):
+    if xi_ini is None:
+        xi_ini = _curve_param(numeric, "xi_ini", np.nan)
+    if gamma_ini is None:
+        gamma_ini = _curve_param(numeric, "gamma_ini", np.nan)
+    if not (np.isfinite(xi_ini) and np.isfinite(gamma_ini)):
         q0 = _curve_param(numeric, "q0", 0.0)
         p0 = _curve_param(numeric, "p0", 0.0)
         if q0 == 0.0 and p0 == 0.0:
-            xi0, gamma0 = 0.0, 0.0
+            xi_ini, gamma_ini = 0.0, 0.0
         else:
             th, x = angle_energy(np.array([q0]), np.array([p0]))
-            xi0, gamma0 = float(x[0]), float(np.mod(th[0] - Psi, 2 * np.pi))
+            xi_ini, gamma_ini = float(x[0]), float(np.mod(th[0] - Psi, 2 * np.pi))
     Om = np.asarray(numeric["Omega"].values, float)
     F_num = np.asarray(numeric["F_cr"].values, float)
-    F_an = _analytic_fcr(Om, xi_max, xi0, gamma0)
+    F_an = _analytic_fcr(Om, xi_max, xi_ini, gamma_ini)
     extra = {k: ("Omega", np.asarray(numeric[k].values), dict(numeric[k].attrs))
              for k in ("non_monotone", "F_escape_low", "F_escape_all") if k in numeric}
-    attrs = {"xi_max": xi_max, "xi0": float(xi0), "gamma0": float(gamma0), "Psi": Psi,
+    attrs = {"xi_max": xi_max, "xi_ini": float(xi_ini), "gamma_ini": float(gamma_ini), "Psi": Psi,
              "cycles": numeric.attrs.get("cycles", np.nan)}
     return _fcr_dataset(Om, F_num, F_an, extra, attrs)
 

@@ -7,13 +7,13 @@ the safe basins over Psi.
 Analytic (isolated 1:1 resonance)
 ---------------------------------
 The slow phase is ``gamma = theta - Psi - Omega tau``, so the basin for phase Psi is
-the Psi = 0 basin rotated in the slow angle: an IC ``(theta0, xi0)`` is safe for Psi
-iff ``(gamma0, xi0) = (theta0 - Psi, xi0)`` is safe on the resonance manifold.  One
+the Psi = 0 basin rotated in the slow angle: an IC ``(theta0, xi_ini)`` is safe for Psi
+iff ``(gamma_ini, xi_ini) = (theta0 - Psi, xi_ini)`` is safe on the resonance manifold.  One
 ``angle_energy`` evaluation of the grid therefore serves every phase
-(``escapes_on_manifold(theta0 - Psi, xi0, ...)``).
+(``escapes_on_manifold(theta0 - Psi, xi_ini, ...)``).
 
 Over a *continuum* of phases the intersection is a sub-level set of the energy:
-an IC is safe for every Psi iff the whole circle ``xi = xi0`` of the manifold is safe.
+an IC is safe for every Psi iff the whole circle ``xi = xi_ini`` of the manifold is safe.
 If a point of the circle ``xi1`` lies on a level curve of C that reaches xi_max,
 that curve crosses every circle ``xi1 < xi < xi_max`` on its way, so the set of
 all-safe circles is an interval ``[0, xi_true)``.  Hence
@@ -106,15 +106,15 @@ def _one_analytic(F, Omega, xi_max, q, p, Psi, fourier, n_gamma):
     Q, P = np.meshgrid(q, p, indexing="ij")
     S0 = unforced_safe_mask(q, p, xi_max)
     theta = np.zeros(Q.shape)
-    xi0 = np.zeros(Q.shape)
+    xi_ini = np.zeros(Q.shape)
     th, x = angle_energy(Q[S0], P[S0])
-    theta[S0], xi0[S0] = th, x
+    theta[S0], xi_ini[S0] = th, x
     safe = np.zeros((Psi.size,) + Q.shape, dtype=bool)
     for k, ps in enumerate(Psi):
         gamma = np.mod(theta[S0] - ps, 2 * np.pi)
-        safe[k][S0] = ~np.asarray(escapes_on_manifold(gamma, xi0[S0], F, Omega, xi_max, fourier=fourier), dtype=bool)
+        safe[k][S0] = ~np.asarray(escapes_on_manifold(gamma, xi_ini[S0], F, Omega, xi_max, fourier=fourier), dtype=bool)
     xt = xi_true_analytic(F, Omega, xi_max, fourier, n_gamma=n_gamma)
-    cont = S0 & (xi0 < xt)
+    cont = S0 & (xi_ini < xt)
     closed_gim = float(J(xt) / J(xi_max)) if xt > 0 else 0.0
     return safe, cont, xt, closed_gim, float(np.sqrt(xt / xi_max))
 
@@ -211,7 +211,7 @@ def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fouri
     if scalar:
         ds = ds.isel(fourier=0)
     ds.attrs.update({"kind": "analytic", "F": F, "Omega": Omega, "n_gamma": int(n_gamma),
-                     "method": "rotation of the Psi = 0 manifold classification: gamma0 = theta0 - Psi"})
+                     "method": "rotation of the Psi = 0 manifold classification: gamma_ini = theta0 - Psi"})
     return annotate(ds)
 
 

@@ -12,6 +12,7 @@ import numpy as np
 import xarray as xr
 
 from safebasins import checks
+from safebasins.io import cf
 
 __all__ = ["is_safe", "check_t_eval", "safe_mask", "safe_area", "safe_stack", "escape_variable"]
 
@@ -45,8 +46,7 @@ def check_t_eval(t_eval, cycles):
 
 
 def _t_eval_array(t, name="t_eval"):
-    return xr.DataArray(t, dims=(name,) if t.ndim else (), name=name,
-                        attrs={"units": "1", "long_name": "evaluation time (forcing cycles)"})
+    return xr.DataArray(t, dims=(name,) if t.ndim else (), name=name, attrs=cf.attrs("t_eval"))
 
 
 def safe_mask(chart, t_eval):
@@ -123,7 +123,7 @@ def safe_stack(chart, t_eval=None, criterion="energy"):
     cycles = chart.attrs.get("cycles")
     t = np.atleast_1d(check_t_eval(float(cycles) if t_eval is None else t_eval, cycles)).astype(float)
     tda = xr.DataArray(t, dims="t_eval", coords={"t_eval": t},
-                       attrs={"units": "forcing cycles", "long_name": "evaluation time"})
+                       attrs=cf.attrs("t_eval"))
     safe = is_safe(esc, tda).transpose("t_eval", ..., "q0", "p0")
     if thr == "xi_max":
         xi_norm = safe["xi_max"]

@@ -12,10 +12,11 @@ REFERENCE = ("G. Karmi, P. Kravetc, O. Gendelman, Analytic exploration of safe b
              "benchmark problem of forced escape")
 INSTITUTION = "safebasins reproduction"
 
-# name -> (units, long_name). Dimensionless units are "1"; time in forcing cycles.
+# name -> (units, long_name). Dimensionless units are "1" (CF); times are counted in forcing cycles
+# (dimensionless, named so in the long_name).
 VARIABLES = {
     "q0": ("1", "initial displacement q(0)"),
-    "p0": ("1", "initial momentum p(0)"),
+    "p0": ("1", "initial momentum p(0) = dq/dt(0)"),
     "q": ("1", "displacement at the stroboscopic instants"),
     "p": ("1", "momentum at the stroboscopic instants"),
     "sample": ("1", "initial-condition index"),
@@ -25,7 +26,7 @@ VARIABLES = {
     "Psi": ("rad", "forcing phase Psi"),
     "xi_max": ("1", "energy truncation level xi_max (escape threshold on H0)"),
     "q_max": ("1", "displacement escape threshold q_max"),
-    "t_eval": ("forcing cycles", "evaluation time"),
+    "t_eval": ("1", "evaluation time (forcing cycles)"),
     "gamma": ("rad", "slow phase gamma = theta - Psi - Omega tau"),
     "xi": ("1", "averaged energy xi"),
     "gamma_rm": ("rad", "slow phase gamma on the resonance-manifold grid"),
@@ -34,8 +35,6 @@ VARIABLES = {
     "seed": ("1", "random seed of the repetition"),
     "xi_ini": ("1", "initial averaged energy xi_ini"),
     "gamma_ini": ("rad", "initial slow phase gamma_ini"),
-    "xi0": ("1", "initial averaged energy xi_ini"),
-    "gamma0": ("rad", "initial slow phase gamma_ini"),
     "curve": ("1", "curve index"),
     "label": ("", "curve label"),
     "vertex": ("1", "boundary vertex index"),
@@ -45,9 +44,9 @@ VARIABLES = {
     "C": ("1", "first integral C(gamma, xi) of the slow flow, eq (18)"),
     "escapes": ("1", "analytic (slow-flow) escape: True = the IC escapes"),
     "escapes_rm": ("1", "analytic escape of the resonance-manifold point: True = escapes"),
-    "escape_cycle_energy": ("forcing cycles", "first cycle with H0 > xi_max (+inf = none within the horizon)"),
-    "escape_cycle_displacement": ("forcing cycles", "first cycle with |q| > q_max (+inf = none within the horizon)"),
-    "escape_cycle": ("forcing cycles", "escape time (+inf = none within the horizon)"),
+    "escape_cycle_energy": ("1", "escape time in forcing cycles, energy criterion H0 > xi_max (inf: no escape)"),
+    "escape_cycle_displacement": ("1", "escape time in forcing cycles, displacement criterion |q| > q_max (inf: no escape)"),
+    "escape_cycle": ("1", "escape time in forcing cycles (inf: no escape)"),
     "escaped": ("1", "trajectory escaped within the horizon"),
     "F_cr": ("1", "critical forcing amplitude"),
     "F_MM_0": ("1", "critical forcing, maximum mechanism through gamma* = 0"),
@@ -84,3 +83,9 @@ def annotate(ds: xr.Dataset) -> xr.Dataset:
             attrs["units"] = units
         attrs.setdefault("long_name", long_name)
     return ds
+
+
+def attrs(name: str) -> dict:
+    """``{"units": ..., "long_name": ...}`` of a shared variable name (KeyError if not in the table)."""
+    units, long_name = VARIABLES[name]
+    return {"units": units, "long_name": long_name} if units else {"long_name": long_name}

@@ -5,12 +5,10 @@ import numpy as np
 import xarray as xr
 
 from safebasins import checks
+from safebasins.io import cf
 from safebasins.wells.quartic import QUARTIC
 from safebasins.numerics import engine
 from safebasins.numerics import kernels
-
-_CYC = "1"  # time in forcing cycles (dimensionless)
-
 
 def _monotone(a):
     d = np.diff(a)
@@ -86,23 +84,19 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000
     tQ = engine.steps_to_cycles(sQ, spc).T
     if is_grid:
         shape, dims = (qa.size, pa.size), ("q0", "p0")
-        coords = {"q0": ("q0", qa, {"units": "1", "long_name": "initial displacement q(0)"}),
-                  "p0": ("p0", pa, {"units": "1", "long_name": "initial momentum p(0) = dq/dt(0)"})}
+        coords = {"q0": ("q0", qa, cf.attrs("q0")), "p0": ("p0", pa, cf.attrs("p0"))}
     else:
         shape, dims = (Q.size,), ("sample",)
-        coords = {"sample": ("sample", np.arange(Q.size), {"long_name": "initial-condition index"}),
-                  "q0": ("sample", Q, {"units": "1", "long_name": "initial displacement q(0)"}),
-                  "p0": ("sample", P, {"units": "1", "long_name": "initial momentum p(0) = dq/dt(0)"})}
-    coords["xi_max"] = ("xi_max", xi, {"units": "1", "long_name": "energy threshold: escape when H0 > xi_max"})
-    coords["q_max"] = ("q_max", qm, {"units": "1", "long_name": "displacement threshold: escape when |q| > q_max"})
+        coords = {"sample": ("sample", np.arange(Q.size), cf.attrs("sample")), "q0": ("sample", Q, cf.attrs("q0")),
+                  "p0": ("sample", P, cf.attrs("p0"))}
+    coords["xi_max"] = ("xi_max", xi, cf.attrs("xi_max"))
+    coords["q_max"] = ("q_max", qm, cf.attrs("q_max"))
     ds = xr.Dataset(
         {
-            "escape_cycle_energy": (("xi_max",) + dims, tE.reshape((xi.size,) + shape), {
-                "units": _CYC,
-                "long_name": "escape time in forcing cycles, energy criterion H0 > xi_max (inf: no escape)"}),
-            "escape_cycle_displacement": (("q_max",) + dims, tQ.reshape((qm.size,) + shape), {
-                "units": _CYC,
-                "long_name": "escape time in forcing cycles, displacement criterion |q| > q_max (inf: no escape)"}),
+            "escape_cycle_energy": (("xi_max",) + dims, tE.reshape((xi.size,) + shape),
+                                    cf.attrs("escape_cycle_energy")),
+            "escape_cycle_displacement": (("q_max",) + dims, tQ.reshape((qm.size,) + shape),
+                                          cf.attrs("escape_cycle_displacement")),
         },
         coords=coords,
     )

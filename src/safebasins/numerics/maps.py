@@ -5,6 +5,7 @@ import numpy as np
 import xarray as xr
 
 from safebasins import checks
+from safebasins.io import cf
 from safebasins.wells.quartic import QUARTIC
 from safebasins.numerics import engine
 from safebasins.numerics import kernels
@@ -52,16 +53,16 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
     n = Q.size
     ds = xr.Dataset(
         {
-            "q": (("sample", "iteration"), st[:, :, 0], {"units": "1", "long_name": "displacement at the stroboscopic instants"}),
-            "p": (("sample", "iteration"), st[:, :, 1], {"units": "1", "long_name": "momentum at the stroboscopic instants"}),
+            "q": (("sample", "iteration"), st[:, :, 0], cf.attrs("q")),
+            "p": (("sample", "iteration"), st[:, :, 1], cf.attrs("p")),
             "escaped": ("sample", np.isfinite(esc_cycle), {"long_name": "escaped within n_iter cycles"}),
-            "escape_cycle": ("sample", esc_cycle, {"units": "1", "long_name": "escape time in forcing cycles (inf: no escape)"}),
+            "escape_cycle": ("sample", esc_cycle, cf.attrs("escape_cycle")),
         },
         coords={
-            "sample": ("sample", np.arange(n), {"long_name": "initial-condition index"}),
-            "iteration": ("iteration", np.arange(n_iter + 1), {"units": "1", "long_name": "stroboscopic-map iteration (forcing cycles)"}),
-            "q0": ("sample", Q, {"units": "1", "long_name": "initial displacement q(0)"}),
-            "p0": ("sample", P, {"units": "1", "long_name": "initial momentum p(0)"}),
+            "sample": ("sample", np.arange(n), cf.attrs("sample")),
+            "iteration": ("iteration", np.arange(n_iter + 1), cf.attrs("iteration")),
+            "q0": ("sample", Q, cf.attrs("q0")),
+            "p0": ("sample", P, cf.attrs("p0")),
         },
     )
     ds.attrs.update(F=F, Omega=Omega, Psi=Psi, xi_max=xi[0] if xi else np.nan, q_max=qm[0] if qm else np.nan,

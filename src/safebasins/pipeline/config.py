@@ -29,12 +29,23 @@ SCHEMA_PATH = REPO_ROOT / "workflow" / "schemas" / "config.schema.yaml"
 KIND_MODULES = ("safebasins.pipeline.kinds.fcr", "safebasins.pipeline.kinds.basins",
                 "safebasins.pipeline.kinds.charts", "safebasins.pipeline.kinds.extras")
 
-__all__ = ["ConfigError", "load_yaml", "build_schema", "validate_config", "experiment_blocks", "SCHEMA_PATH"]
+__all__ = ["ConfigError", "load_yaml", "merge_config", "build_schema", "validate_config", "experiment_blocks", "SCHEMA_PATH"]
 
 
 def load_yaml(path):
     with open(path) as fh:
         return yaml.safe_load(fh)
+
+
+def merge_config(base: dict, override: dict) -> dict:
+    """Merge ``override`` into ``base`` in place like ``snakemake --configfile``: mappings are
+    merged key by key, everything else (lists included) is replaced."""
+    for k, v in (override or {}).items():
+        if isinstance(v, dict) and isinstance(base.get(k), dict):
+            merge_config(base[k], v)
+        else:
+            base[k] = copy.deepcopy(v)
+    return base
 
 
 def load_kinds(extensions=()):

@@ -13,7 +13,7 @@ import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
-from safebasins.pipeline.config import experiment_blocks, load_yaml, validate_config
+from safebasins.pipeline.config import experiment_blocks, load_yaml, merge_config, validate_config
 from safebasins.pipeline.registry import (KINDS, PARTS_DIR, Experiment, FigureSpec, Product, params_path)
 
 __all__ = ["Plan", "ResolveContext", "plan", "tile_path", "load_config"]
@@ -116,12 +116,10 @@ class Plan:
 
 def load_config(paths) -> dict:
     """Merge config files like ``snakemake --configfile`` (later files win, dicts merged)."""
-    from snakemake.utils import update_config
-
     paths = list(paths)
     cfg = load_yaml(paths[0]) or {}
     for extra in paths[1:]:
-        update_config(cfg, load_yaml(extra) or {})
+        merge_config(cfg, load_yaml(extra) or {})
     return cfg
 
 

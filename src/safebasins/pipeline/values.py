@@ -73,9 +73,9 @@ def curves(blk, with_psi) -> list[dict]:
     out = []
     for i in range(n):
         c = {k: (v[i] if len(v) > 1 else v[0]) for k, v in lists.items()}
-        xi_max, xi0, gamma0 = float(c["xi_max"]), float(c["xi_ini"]), angle(c["gamma_ini"])
+        xi_max, xi_ini, gamma_ini = float(c["xi_max"]), float(c["xi_ini"]), angle(c["gamma_ini"])
         label = ", ".join(f"{k} = {fmt(c[k])}" for k in varying) if varying else f"xi_max = {fmt(xi_max)}"
-        cur = {"label": label, "xi_max": xi_max, "xi0": xi0, "gamma0": gamma0}
+        cur = {"label": label, "xi_max": xi_max, "xi_ini": xi_ini, "gamma_ini": gamma_ini}
         if with_psi:
             cur["Psi"] = angle(blk["Psi"])
         out.append(cur)

@@ -53,7 +53,7 @@ def load_params(src):
 
 
 #: attributes and headline variables printed by :func:`describe` when a dataset has them
-SUMMARY_ATTRS = ("title", "F", "Omega", "Psi", "xi_max", "q_max", "xi0", "gamma0", "cycles",
+SUMMARY_ATTRS = ("title", "F", "Omega", "Psi", "xi_max", "q_max", "xi_ini", "gamma_ini", "cycles",
                  "steps_per_cycle", "integrator", "tol", "criterion", "fourier", "seed", "level",
                  "saddle_gamma", "saddle_xi", "source_experiment", "git_commit", "config_hash",
                  "safebasins_version")

@@ -212,7 +212,7 @@ def _curve_labels(ds):
         labels, const = curve_labels(ds)
     else:
         labels, const = [], {k: ds[k].values if k in ds.coords else ds.attrs[k]
-                             for k in ("xi_max", "xi0", "gamma0", "Psi") if k in ds.coords or k in ds.attrs}
+                             for k in ("xi_max", "xi_ini", "gamma_ini", "Psi") if k in ds.coords or k in ds.attrs}
         labels = [param_text({"xi_max": const.pop("xi_max")})] if "xi_max" in const else ["theory"]
     return [_compact(t) for t in labels], _compact(ic_text(const))
 

@@ -1,8 +1,8 @@
 """Figures of the critical forcing F_cr(Omega): theory curves by mechanism (Figs 1-4) and
 theory versus numerics (Figs 10-12).
 
-Reads ``critical_forcing`` datasets stacked over ``curve`` (coordinates ``xi_max``, ``xi0``,
-``gamma0``, ``Psi``, ``label``) and ``critical_forcing_numeric`` ones (docs/contracts.md).
+Reads ``critical_forcing`` datasets stacked over ``curve`` (coordinates ``xi_max``, ``xi_ini``,
+``gamma_ini``, ``Psi``, ``label``) and ``critical_forcing_numeric`` ones (docs/contracts.md).
 """
 from __future__ import annotations
 
@@ -22,7 +22,7 @@ MECHANISMS = {
 }
 # branch variables of the critical_forcing dataset, in the mechanism order above
 BRANCHES = {1: "F_MM_0", 2: "F_MM_pi", 3: "F_SM", 4: "F_SMM"}
-CURVE_COORDS = ("xi_max", "xi0", "gamma0", "Psi")
+CURVE_COORDS = ("xi_max", "xi_ini", "gamma_ini", "Psi")
 
 
 def curve_labels(ds, dim="curve"):
@@ -50,9 +50,9 @@ def curve_labels(ds, dim="curve"):
 def ic_text(const):
     """Title text for the constant curve parameters; the zero IC is named as such."""
     const = dict(const)
-    if "xi0" in const and float(const["xi0"]) == 0.0:
-        const.pop("xi0")
-        const.pop("gamma0", None)
+    if "xi_ini" in const and float(const["xi_ini"]) == 0.0:
+        const.pop("xi_ini")
+        const.pop("gamma_ini", None)
         txt = param_text(const)
         return (txt + ", zero IC") if txt else "zero IC"
     return param_text(const)

@@ -29,9 +29,7 @@ SYMBOLS = {
     "Psi": r"$\Psi$",
     "xi_max": r"$\xi_{max}$",
     "q_max": r"$q_{max}$",
-    "xi0": r"$\xi_{ini}$",
     "xi_ini": r"$\xi_{ini}$",
-    "gamma0": r"$\gamma_{ini}$",
     "gamma_ini": r"$\gamma_{ini}$",
     "t_eval": r"$t_{eval}$",
 }
@@ -91,7 +89,7 @@ def fmt_value(v, name=None):
         return str(v)
     if not np.isfinite(v):
         return str(v)
-    if name in ("Psi", "gamma0", "gamma_ini") and v != 0:
+    if name in ("Psi", "gamma_ini") and v != 0:
         r = v / np.pi
         for num, txt in ((1, r"\pi"), (0.5, r"\pi/2"), (-1, r"-\pi"), (-0.5, r"-\pi/2"), (2, r"2\pi")):
             if abs(r - num) < 1e-9:

@@ -1,7 +1,7 @@
 """Critical forcing F_cr(Omega) for escape from one initial point on the RM (paper eqs 22-26).
 
-With ``h(xi) = xi - Omega J(xi)``, ``h0 = h(xi0)``, ``G0 = G(xi0)``, ``c = cos(gamma0)`` the IC
-escapes iff (see :mod:`safebasins.theory.slow_flow`) for every ``xi`` in ``(xi0, xi_max]``
+With ``h(xi) = xi - Omega J(xi)``, ``h0 = h(xi_ini)``, ``G0 = G(xi_ini)``, ``c = cos(gamma_ini)`` the IC
+escapes iff (see :mod:`safebasins.theory.slow_flow`) for every ``xi`` in ``(xi_ini, xi_max]``
 
     (A)  F (G(xi) - G0 c) >= h(xi) - h0      (level curve stays above the ray gamma = 0)
     (B)  F (G(xi) + G0 c) >= h0 - h(xi)      (level curve stays below the ray gamma = pi)
@@ -31,7 +31,7 @@ For the zero IC this reduces to ``F_cr = max_{0 < xi <= xi_max} |xi - Omega J(xi
 Notes on the paper
 ------------------
 * Eq (24) is written with ``C0`` as if it were independent of F; for a nonzero IC
-  ``C0 = h0 - F G0 cos(gamma0)`` depends on F and the explicit solution is the one above.  The
+  ``C0 = h0 - F G0 cos(gamma_ini)`` depends on F and the explicit solution is the one above.  The
   "+" sign of eq (24) is the tangency at gamma* = pi, the "-" sign the one at gamma* = 0.
 * At ``xi_max = 1/4`` exactly, ``G(1/4) = 0`` and the tangency point is undefined (as the paper
   remarks); in the slow flow no level curve except ``C = h(1/4)`` reaches the separatrix, so
@@ -98,7 +98,7 @@ def _interior_max(L, valid, xi, refine_fun, n_iter=60):
     return x_out, v_out, exists
 
 
-def critical_forcing(Omega, xi_max, xi0=0.0, gamma0=0.0, fourier="paper", n_grid=2001):
+def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier="paper", n_grid=2001):
     """Critical forcing amplitude F_cr(Omega) of the slow flow (eqs 22-26).
 
     Parameters
@@ -107,8 +107,8 @@ def critical_forcing(Omega, xi_max, xi0=0.0, gamma0=0.0, fourier="paper", n_grid
         Forcing frequencies (becomes the coordinate ``Omega``).
     xi_max : float in (0, 1/4]
         Energy truncation level.
-    xi0, gamma0 : float
-        Initial point on the RM (``0 <= xi0 < xi_max``; gamma0 = theta0 - Psi).  Zero IC by default.
+    xi_ini, gamma_ini : float
+        Initial point on the RM (``0 <= xi_ini < xi_max``; gamma_ini = theta0 - Psi).  Zero IC by default.
     fourier : "paper" | "exact"
         Which G (eq 20) to use.
     n_grid : int
@@ -117,7 +117,7 @@ def critical_forcing(Omega, xi_max, xi0=0.0, gamma0=0.0, fourier="paper", n_grid
     Returns
     -------
     xarray.Dataset over ``Omega`` with
-      ``F_cr``   smallest F at which the level curve through (gamma0, xi0) reaches xi_max
+      ``F_cr``   smallest F at which the level curve through (gamma_ini, xi_ini) reaches xi_max
                  (NaN if it never does),
       ``mechanism`` int8, flag_values [0..4], flag_meanings "none MM_0 MM_pi SM SMM",
       ``F_MM_0`` eq (24) through gamma* = 0 where no gamma = 0 saddle lies above xi_max
@@ -125,21 +125,21 @@ def critical_forcing(Omega, xi_max, xi0=0.0, gamma0=0.0, fourier="paper", n_grid
       ``F_SMM``  the same eq (24) value where such a saddle exists above xi_max (the branches
                  F_MM_0 and F_SMM are disjoint; their union is eq (24) with gamma* = 0),
       ``F_MM_pi`` eq (24) through gamma* = pi,
-      ``F_SM``   largest F of eqs (25)-(26) with the saddle in (xi0, xi_max) (NaN if none),
+      ``F_SM``   largest F of eqs (25)-(26) with the saddle in (xi_ini, xi_max) (NaN if none),
       ``xi_saddle``, ``gamma_saddle`` the saddle of the F_SM branch (gamma 0 or pi),
       ``xi_saddle_smm`` the saddle above xi_max on the F_SMM branch.
     F_cr equals the largest existing branch, provided no upper-bound constraint excludes it.
-    Attributes: xi_max, xi0, gamma0, fourier.
+    Attributes: xi_max, xi_ini, gamma_ini, fourier.
     """
     check_fourier(fourier)
     Om = np.atleast_1d(check_positive("Omega", Omega)).astype(float)
     if Om.ndim != 1:
         raise ValueError("Omega must be a scalar or 1-D array")
     xm = _scalar("xi_max", xi_max, QUARTIC.check_threshold)
-    x0 = _scalar("xi0", xi0, QUARTIC.check_energy)
+    x0 = _scalar("xi_ini", xi_ini, QUARTIC.check_energy)
     if x0 >= xm:
-        raise ValueError(f"xi0 must be < xi_max ({xm}), got {x0}")
-    g0 = _scalar("gamma0", gamma0, check_finite)
+        raise ValueError(f"xi_ini must be < xi_max ({xm}), got {x0}")
+    g0 = _scalar("gamma_ini", gamma_ini, check_finite)
     if not isinstance(n_grid, (int, np.integer)) or n_grid < 16:
         raise ValueError("n_grid must be an integer >= 16")
 
@@ -159,7 +159,7 @@ def critical_forcing(Omega, xi_max, xi0=0.0, gamma0=0.0, fourier="paper", n_grid
         LA = numA / dA[None, :]
         LB = numB / dB[None, :]
     posA, posB = dA > tiny, dB > tiny
-    posA[0] = posB[0] = False                 # xi0 itself: trivially satisfied
+    posA[0] = posB[0] = False                 # xi_ini itself: trivially satisfied
     # upper bounds and infeasible zero-denominator constraints
     negA, negB = dA < -tiny, dB < -tiny
     negA[0] = negB[0] = False
@@ -273,7 +273,7 @@ def critical_forcing(Omega, xi_max, xi0=0.0, gamma0=0.0, fourier="paper", n_grid
             "xi_saddle_smm": var(xi_smm, "averaged energy of the saddle above xi_max on the F_SMM branch"),
         },
         coords={"Omega": ("Omega", Om, {"units": "1", "long_name": "forcing frequency"})},
-        attrs={"xi_max": xm, "xi0": x0, "gamma0": g0, "fourier": fourier,
+        attrs={"xi_max": xm, "xi_ini": x0, "gamma_ini": g0, "fourier": fourier,
                "description": "slow-flow (isolated 1:1 resonance) escape threshold, Karmi et al. eqs 18-26"},
     )
     return ds

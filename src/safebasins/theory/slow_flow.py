@@ -17,12 +17,12 @@ Write ``h(xi) = xi - Omega J(xi)``, ``a(xi) = h - F G`` (C on the ray gamma = 0)
 ``b(xi) = h + F G`` (C on gamma = pi).  For F > 0, C is strictly increasing in gamma on
 (0, pi) and even in gamma, so on each circle xi = const the level ``c`` is attained (in the
 upper half) at exactly one gamma iff ``a(xi) <= c <= b(xi)``.  The component of the level set
-``C = c0`` through ``(gamma0, xi0)`` is therefore, in the upper half, a graph ``gamma(xi)``
-over the maximal xi-interval around xi0 on which ``a < c0 < b``; its ends lie on the rays
+``C = c0`` through ``(gamma_ini, xi_ini)`` is therefore, in the upper half, a graph ``gamma(xi)``
+over the maximal xi-interval around xi_ini on which ``a < c0 < b``; its ends lie on the rays
 gamma = 0 or pi, where it joins its mirror image, unless the interval reaches xi_max.
 Hence the IC escapes (the level curve (21) reaches the circle xi = xi_max) iff
 
-    max_{xi in [xi0, xi_max]} a(xi)  <=  c0  <=  min_{xi in [xi0, xi_max]} b(xi).
+    max_{xi in [xi_ini, xi_max]} a(xi)  <=  c0  <=  min_{xi in [xi_ini, xi_max]} b(xi).
 
 Interior maxima of ``a`` are the saddles on gamma = 0 (``a'(xi) = 0``, i.e.
 ``1 - Omega/omega - F G' = 0``, eq 25); interior minima of ``b`` are saddles on gamma = pi;
@@ -132,9 +132,9 @@ class SlowFlowProfile:
         self.A = np.maximum.accumulate(self.a[::-1])[::-1]
         self.B = np.minimum.accumulate(self.b[::-1])[::-1]
 
-    def suffix(self, xi0):
-        """(max a, min b) over [xi0, xi_max] for xi0 < xi_max, excluding a(xi0), b(xi0)."""
-        j = np.searchsorted(self.xi, xi0, side="right")
+    def suffix(self, xi_ini):
+        """(max a, min b) over [xi_ini, xi_max] for xi_ini < xi_max, excluding a(xi_ini), b(xi_ini)."""
+        j = np.searchsorted(self.xi, xi_ini, side="right")
         j = np.minimum(j, self.xi.size - 1)
         return self.A[j], self.B[j]
 
@@ -195,8 +195,8 @@ def escapes_on_manifold(gamma, xi, F, Omega, xi_max, fourier="paper"):
 def slow_flow_escapes(q0, p0, F, Omega, Psi, xi_max, fourier="paper"):
     """Analytic escape prediction for initial conditions ``(q0, p0)`` at tau = 0.
 
-    Each IC is mapped to ``(theta0, xi0)`` (eqs 7, 14), ``gamma0 = theta0 - Psi``, and
-    classified by whether the level curve of C (eq 18) through ``(gamma0, xi0)`` reaches
+    Each IC is mapped to ``(theta0, xi_ini)`` (eqs 7, 14), ``gamma_ini = theta0 - Psi``, and
+    classified by whether the level curve of C (eq 18) through ``(gamma_ini, xi_ini)`` reaches
     ``xi_max`` (eq 21).  ICs with ``H0 >= xi_max`` or ``|q0| >= 1`` escape.  Broadcasts q0 and
     p0; F, Omega, Psi, xi_max are scalars.  Returns a bool array (True = escapes).
     """

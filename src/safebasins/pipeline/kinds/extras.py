@@ -89,7 +89,7 @@ def build_fourier(params, inputs, threads, *, what, source):
     if what == "fcr":
         ds = fc.fcr_fourier_comparison_from_numeric(src)
         if "curve" in ds.dims:  # per-curve parameters of the source (attributes would conflict across curves)
-            ds = ds.assign_coords({c: ("curve", src[c].values) for c in ("label", "xi_max", "xi0", "gamma0", "Psi")
+            ds = ds.assign_coords({c: ("curve", src[c].values) for c in ("label", "xi_max", "xi_ini", "gamma_ini", "Psi")
                                    if c in src.coords and src[c].dims == ("curve",)})
     else:
         ds = fc.iou_fourier_comparison(src, params["t_eval"])

@@ -16,10 +16,10 @@ from safebasins.pipeline.registry import Kind, Product, dataset_path, register
 
 _CO = ("curve", "Omega")
 ANALYTIC_CONTRACT = {**{v: _CO for v in ("F_cr", "mechanism", "F_MM_0", "F_MM_pi", "F_SM", "F_SMM")},
-                     **{c: ("curve",) for c in ("xi_max", "xi0", "gamma0", "label")}}
+                     **{c: ("curve",) for c in ("xi_max", "xi_ini", "gamma_ini", "label")}}
 NUMERIC_CONTRACT = {**{v: _CO for v in ("F_cr", "F_cr_low", "F_cr_high", "F_escape_low", "F_escape_all",
                                          "non_monotone")},
-                    **{c: ("curve",) for c in ("xi_max", "xi0", "gamma0", "Psi", "label", "q0", "p0")}}
+                    **{c: ("curve",) for c in ("xi_max", "xi_ini", "gamma_ini", "Psi", "label", "q0", "p0")}}
 
 CURVES_SCHEMA = {
     "Omega": {"$ref": "#/$defs/omega_range"},
@@ -55,9 +55,9 @@ def build_fcr_analytic(params, inputs, threads):
     parts = []
     for c in curves:
         print(f"{params['experiment']}: critical_forcing for {c['label']}")
-        parts.append(critical_forcing(Omega, c["xi_max"], xi0=c["xi0"], gamma0=c["gamma0"],
+        parts.append(critical_forcing(Omega, c["xi_max"], xi_ini=c["xi_ini"], gamma_ini=c["gamma_ini"],
                                       fourier=params["fourier"]))
-    coords = {k: [c[k] for c in curves] for k in ("xi_max", "xi0", "gamma0", "label")}
+    coords = {k: [c[k] for c in curves] for k in ("xi_max", "xi_ini", "gamma_ini", "label")}
     if all("Psi" in c for c in curves):
         coords["Psi"] = [c["Psi"] for c in curves]
     out = stack(parts, "curve", coords=coords)
@@ -75,7 +75,7 @@ def build_fcr_numeric(params, inputs, threads):
     Omega = np.asarray(num["Omega"], dtype=float)
     parts, q0s, p0s = [], [], []
     for c in params["curves"]:
-        q0, p0 = (float(v) for v in initial_condition(c["xi0"], c["gamma0"], c["Psi"]))
+        q0, p0 = (float(v) for v in initial_condition(c["xi_ini"], c["gamma_ini"], c["Psi"]))
         q0s.append(q0)
         p0s.append(p0)
         print(f"{params['experiment']}: {c['label']}: IC (q0, p0) = ({q0:.6f}, {p0:.6f})", flush=True)
@@ -83,7 +83,7 @@ def build_fcr_numeric(params, inputs, threads):
             Omega, c["xi_max"], q0=q0, p0=p0, Psi=c["Psi"], cycles=num["cycles"], tol=num["tol"],
             F_bracket=tuple(num["F_bracket"]), criterion=num["criterion"], n_scan=num["n_scan"],
             steps_per_cycle=num["steps_per_cycle"], threads=threads))
-    coords = {k: [c[k] for c in params["curves"]] for k in ("xi_max", "xi0", "gamma0", "Psi", "label")}
+    coords = {k: [c[k] for c in params["curves"]] for k in ("xi_max", "xi_ini", "gamma_ini", "Psi", "label")}
     coords.update(q0=q0s, p0=p0s)
     return stack(parts, "curve", coords=coords)
 
