@@ -28,7 +28,7 @@ def main():
          lambda: slow_flow_escapes(Q, P, 0.0876, 0.57, 0.0, 0.2499, fourier="exact"), 1.0),
         ("critical_forcing 400 Omega (zero IC, xi_max=0.15)",
          lambda: critical_forcing(Om, 0.15), 2.0),
-        ("critical_forcing 400 Omega (xi0=0.15, gamma0=0.25, xi_max=0.242)",
+        ("critical_forcing 400 Omega (xi_ini=0.15, gamma_ini=0.25, xi_max=0.242)",
          lambda: critical_forcing(Om, 0.242, 0.15, 0.25), 2.0),
         ("safe_basin_boundaries Fig 9 (n_points=400)",
          lambda: safe_basin_boundaries(0.0478, 0.76, 0.0, 0.235), None),
