@@ -6,12 +6,15 @@
 #   snakemake -j2 --configfile config/quick.yaml         # the same DAG at coarse resolution
 #   snakemake -j2 archive                                # results/archive/*.tar.gz
 #   snakemake --report results/report.html               # HTML report
+import os
+
 from snakemake.utils import min_version
 
 min_version("9.0")
 
 
-configfile: "config/config.yaml"
+# found beside this Snakefile, whatever the working directory (`-s path/Snakefile`)
+configfile: os.path.join(workflow.basedir, "config", "config.yaml")
 
 
 report: "workflow/report/workflow.rst"

@@ -12,5 +12,5 @@ from safebasins.pipeline.cost import report
 from safebasins.pipeline.plan import plan
 
 if __name__ == "__main__":
-    for line in report(plan(sys.argv[1:] or [str(REPO_ROOT / "config" / "config.yaml")])):
+    for line in report(plan(sys.argv[1:] or [str(REPO_ROOT / "config" / "config.yaml")]), cores=2):
         print(line)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 
+import numpy as np
 import pytest
 import yaml
 from jsonschema import Draft202012Validator
@@ -60,7 +61,8 @@ def test_defaults_filled_from_the_schema(base):
     del cfg["numerics"], cfg["fourier"]
     del cfg["figures"]["fig13"]["cycles"]
     validate_config(cfg)
-    assert cfg["fourier"] == "paper" and cfg["numerics"] == {"steps_per_cycle": 32, "threads": 1, "tiles": 1}
+    assert cfg["fourier"] == "paper" and cfg["numerics"] == {"steps_per_cycle": 32, "threads": 1, "tiles": 1,
+                                                            "budget_core_hours": 1.0, "allow_expensive": False}
     assert cfg["figures"]["fig13"]["cycles"] == 3000
     assert cfg["experiments"] == {} and cfg["extensions"] == []
 
@@ -169,6 +171,22 @@ BAD = [
     ({"figures": {"fig10": {"numeric": {"F_bracket": [0.3, 0.1]}}}}, "figures.fig10.numeric.F_bracket", "empty bracket"),
     ({"figures": {"fig10": {"numeric": {"tol": 0}}}}, "figures.fig10.numeric.tol", ""),
     ({"seed": -3}, "seed", "minimum"),
+    # issue 11: non-finite numbers, degenerate grids, duplicates, ranges that stop short, num + step
+    ({"figures": {"fig05": {"F": float("nan")}}}, "figures.fig05.F", "finite"),
+    ({"figures": {"fig05": {"Omega": float("inf")}}}, "figures.fig05.Omega", "finite"),
+    ({"figures": {"fig13": {"xi_max": [0.12, float("nan")]}}}, "figures.fig13.xi_max[1]", "finite"),
+    ({"figures": {"fig13": {"grid": {"q0": [float("-inf"), 0.9]}}}}, "figures.fig13.grid.q0[0]", "finite"),
+    ({"figures": {"fig10": {"numeric": {"tol": float("nan")}}}}, "figures.fig10.numeric.tol", "finite"),
+    ({"figures": {"fig13": {"grid": {"n": 1}}}}, "figures.fig13.grid.n", "minimum of 3"),
+    ({"figures": {"fig13": {"grid": {"n": [2, 200]}}}}, "figures.fig13.grid.n[0]", "minimum of 3"),
+    ({"figures": {"fig16": {"F": [0.01, 0.01]}}}, "figures.fig16.F[1]", "listed twice"),
+    ({"figures": {"fig14": {"xi_max": [0.16, 0.16]}}}, "figures.fig14.xi_max[1]", "listed twice"),
+    ({"figures": {"fig21": {"t_eval": [500, 500]}}}, "figures.fig21.t_eval[1]", "listed twice"),
+    ({"extras": {"erosion": {"t_eval": [10, 10]}}}, "extras.erosion.t_eval[1]", "listed twice"),
+    ({"figures": {"fig01": {"xi_ini": [0.1, 0.1]}}}, "figures.fig01", "repeats an earlier curve"),
+    ({"figures": {"fig19": {"F": {"start": 0.001, "stop": 0.07, "step": 0.005}}}}, "figures.fig19.F",
+     "not reached by whole steps"),
+    ({"figures": {"fig01": {"Omega": {"step": 0.01}}}}, "figures.fig01.Omega", "set the other one to null"),
 ]
 
 
@@ -199,3 +217,21 @@ def test_missing_key_named(base, missing):
 def test_not_a_mapping():
     with pytest.raises(ConfigError, match="mapping"):
         validate_config([1, 2, 3])
+
+
+def test_override_can_switch_a_range_from_num_to_step(base):
+    cfg = merged(base, {"figures": {"fig01": {"Omega": {"num": None, "step": 0.01}}}})
+    assert plan(cfg).params()["fig01"]["Omega"] == pytest.approx(list(np.arange(0.5, 1.2 + 1e-9, 0.01)))
+
+
+def test_cost_guard_refuses_above_budget_unless_allowed(base):
+    from safebasins.pipeline.cost import guard
+
+    huge = {"figures": {"fig13": {"grid": {"n": 100000}, "cycles": 10000000}}}
+    with pytest.raises(ConfigError) as exc:
+        guard(plan(merged(base, huge)), cores=2)
+    msg = str(exc.value)
+    assert msg.startswith("config key numerics.budget_core_hours:") and "fig13" in msg and "allow_expensive" in msg
+    line = guard(plan(merged(base, {**huge, "numerics": {"allow_expensive": True}})), cores=2)
+    assert "core-hours" in line and "h on 2 core(s)" in line
+    assert "core-hours" in guard(plan(copy.deepcopy(base)), cores=2)  # the paper run is within budget

@@ -1,7 +1,9 @@
 """Fast workflow checks (no job runs): dry run, bad config stops before any job, lint."""
 import re
 
-from tests.pipeline.sandbox import run_snakemake
+import subprocess
+
+from tests.pipeline.sandbox import BIN, run_snakemake, snakemake_env
 
 
 def test_dry_run_quick_and_full(sandbox):
@@ -44,3 +46,21 @@ def test_lint(sandbox):
             findings.append((where, m.group(1)))
     other = [(w, f) for w, f in findings if not f.startswith("Specify a conda environment or container")]
     assert not other, other
+
+
+def test_config_found_beside_the_snakefile_from_another_directory(sandbox, tmp_path):
+    """`snakemake -s path/Snakefile` from elsewhere still loads config/config.yaml (the paper run)."""
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    r = subprocess.run([str(BIN / "snakemake"), "-n", "-s", str(sandbox / "Snakefile"), "-d", str(sandbox), "datasets"],
+                       capture_output=True, text=True, cwd=elsewhere, env=snakemake_env(), timeout=600)
+    assert r.returncode == 0, r.stderr[-3000:]
+    assert "cost estimate" in r.stderr and "chart_tile" in r.stdout + r.stderr
+
+
+def test_cost_guard_stops_before_any_job(sandbox):
+    big = sandbox / "big.yaml"
+    big.write_text("figures:\n  fig13:\n    grid: {n: 100000}\n    cycles: 10000000\n")
+    r = run_snakemake(sandbox, "-n", configfiles=("config/quick.yaml", big))
+    assert r.returncode != 0 and "config key numerics.budget_core_hours" in r.stderr + r.stdout
+    assert not (sandbox / "results").exists()

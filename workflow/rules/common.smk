@@ -2,12 +2,15 @@
 # naming the offending key; every experiment resolved through the registry of kinds) and the
 # target lists and input functions every other rule file uses.
 import json
+import sys
 from pathlib import Path
 
+from safebasins.pipeline.cost import guard as _cost_guard
 from safebasins.pipeline.plan import plan as _plan
 from safebasins.pipeline.registry import STAGES
 
 RUN = _plan(config)
+print(_cost_guard(RUN, workflow.cores), file=sys.stderr)
 PARAMS_JSON = {e: json.dumps(p, sort_keys=True) for e, p in RUN.params().items()}
 NUM_THREADS = RUN.threads
 EXTENSIONS = config["extensions"]

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import copy
 import importlib
+import math
 from pathlib import Path
 
 import yaml
@@ -160,10 +161,23 @@ def experiment_blocks(config: dict):
     return out
 
 
+def _check_finite(value, path=()):
+    """Every number in the config is finite (YAML's .nan / .inf pass JSON Schema's type checks)."""
+    if isinstance(value, dict):
+        for k, v in value.items():
+            _check_finite(v, (*path, k))
+    elif isinstance(value, list):
+        for i, v in enumerate(value):
+            _check_finite(v, (*path, i))
+    elif isinstance(value, float) and not math.isfinite(value):
+        fail(key_path(path), f"must be a finite number, got {value}")
+
+
 def validate_config(config: dict) -> dict:
     """Validate ``config`` in place (filling schema defaults); raise ConfigError naming the key."""
     if not isinstance(config, dict):
         raise ConfigError(f"config key <config>: the configuration must be a mapping, got {type(config).__name__}")
+    _check_finite(config)
     ext = config.get("extensions", [])
     if not isinstance(ext, list) or not all(isinstance(m, str) for m in ext):
         fail("extensions", "must be a list of importable module names that register experiment kinds")

@@ -52,14 +52,34 @@ class CheckContext:
 
     def check_range(self, key, r, *, positive=False):
         start, stop = float(r["start"]), float(r["stop"])
-        if not (math.isfinite(start) and math.isfinite(stop)):
-            fail(key, "start and stop must be finite")
-        if stop < start or (stop == start and r.get("num", 1) != 1):
+        num, step = r.get("num"), r.get("step")
+        if num is not None and step is not None:
+            fail(key, f"give either num ({num}) or step ({step}), not both; an override file merged into "
+                      "config.yaml keeps the key it does not mention: set the other one to null there "
+                      "(e.g. `num: null`)")
+        if num is None and step is None:
+            fail(key, "give num (number of points, endpoints included) or step (spacing from start to stop)")
+        if not stop > start:
             fail(key, f"empty range: stop ({stop}) must be greater than start ({start})")
-        if "step" in r and r["step"] > stop - start and stop > start:
-            fail(f"{key}.step", f"step {r['step']} is larger than the range [{start}, {stop}]")
+        if step is not None:
+            k = (stop - start) / step
+            if step > stop - start:
+                fail(f"{key}.step", f"step {step} is larger than the range [{start}, {stop}]")
+            if abs(k - round(k)) > 1e-9 * max(1.0, k):
+                last = start + math.floor(k + 1e-9) * step
+                fail(key, f"stop {stop} is not reached by whole steps of {step} from {start} (the last value "
+                          f"would be {last:.12g}): make stop = start + k * step or give num instead")
         if positive and start <= 0:
             fail(f"{key}.start", f"must be > 0, got {start}")
+
+    def check_unique(self, key, values):
+        """A list that becomes a coordinate must not repeat a value."""
+        if isinstance(values, (list, tuple)):
+            seen = set()
+            for i, v in enumerate(values):
+                if v in seen:
+                    fail(f"{key}[{i}]", f"{v!r} is listed twice: each value is one point of a coordinate")
+                seen.add(v)
 
     def check_interval(self, key, iv):
         lo, hi = iv

@@ -28,9 +28,10 @@ def fmt(v) -> str:
 
 
 def range_values(r) -> list[float]:
-    """Values of a {start, stop, num} or {start, stop, step} range (endpoints included)."""
+    """Values of a {start, stop, num} or {start, stop, step} range (endpoints included; a key
+    set to null counts as absent)."""
     start, stop = float(r["start"]), float(r["stop"])
-    if "num" in r:
+    if r.get("num") is not None:
         vals = np.linspace(start, stop, int(r["num"]))
     else:
         step = float(r["step"])

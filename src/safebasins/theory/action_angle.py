@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from safebasins.checks import as_array
+from safebasins.checks import check_finite
 from safebasins.wells.quartic import (QUARTIC, _G, _J, _angle_energy, _dG_dxi, _nome, _omega,
                                       _phase_point, check_fourier)
 
@@ -19,7 +19,7 @@ __all__ = ["H0", "q_max_from_xi", "J", "omega", "G", "dJ_dxi", "dG_dxi", "nome",
 
 def H0(q, p):
     """Basic Hamiltonian, eq (7) untruncated: ``p^2/2 + q^2/2 - q^4/4``."""
-    return QUARTIC.H0(as_array("q", q), as_array("p", p))
+    return QUARTIC.H0(check_finite("q", q), check_finite("p", p))
 
 
 def q_max_from_xi(xi_max):
@@ -98,7 +98,7 @@ def phase_point(theta, xi):
     ``q = sqrt(1 - mu) sn(2 K theta / pi | m)``,
     ``p = sqrt((1 - mu^2)/2) cn(.) dn(.)``.  Inverse of :func:`angle_energy`.
     """
-    theta = as_array("theta", theta)
+    theta = check_finite("theta", theta)
     xi = QUARTIC.check_energy("xi", xi)
     theta, xi = np.broadcast_arrays(theta, xi)
     return _phase_point(theta, xi)
@@ -111,6 +111,6 @@ def initial_condition(xi_ini, gamma_ini, Psi):
     returns ``phase_point(gamma_ini + Psi, xi_ini)``.
     """
     xi = QUARTIC.check_energy("xi_ini", xi_ini)
-    g = as_array("gamma_ini", gamma_ini)
-    ps = as_array("Psi", Psi)
+    g = check_finite("gamma_ini", gamma_ini)
+    ps = check_finite("Psi", Psi)
     return phase_point(g + ps, xi)

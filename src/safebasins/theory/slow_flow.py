@@ -146,6 +146,8 @@ def slow_flow_profile(F, Omega, xi_max, fourier="paper", n=1500):
     F = _scalar("F", F, check_nonnegative)
     Omega = _scalar("Omega", Omega, check_positive)
     xi_max = _scalar("xi_max", xi_max, QUARTIC.check_threshold)
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 16:
+        raise ValueError(f"n must be an integer >= 16 (nodes of the xi grid of the profile), got {n!r}")
     return SlowFlowProfile(F, Omega, xi_max, fourier, n)
 
 

@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import special
 
-from safebasins.checks import as_array, value_repr
+from safebasins.checks import as_array, check_finite, value_repr
 from safebasins.wells.base import Well
 
 __all__ = ["QuarticWell", "QUARTIC", "XI_SEPARATRIX", "FOURIER_VARIANTS", "check_fourier"]
@@ -267,7 +267,7 @@ class QuarticWell(Well):
         return _omega(self.check_energy("E", E, allow_separatrix=True))
 
     def angle_energy(self, q, p):
-        q, p = np.broadcast_arrays(as_array("q", q), as_array("p", p))
+        q, p = np.broadcast_arrays(check_finite("q", q), check_finite("p", p))
         if (np.abs(q) >= 1.0).any():
             raise ValueError("q must satisfy |q| < 1 (inside the potential well)")
         if (_H0(q, p) >= XI_SEPARATRIX).any():
@@ -275,7 +275,7 @@ class QuarticWell(Well):
         return _angle_energy(q, p)
 
     def phase_point(self, theta, E):
-        theta = as_array("theta", theta)
+        theta = check_finite("theta", theta)
         xi = self.check_energy("E", E)
         theta, xi = np.broadcast_arrays(theta, xi)
         return _phase_point(theta, xi)

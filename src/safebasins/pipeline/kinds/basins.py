@@ -258,6 +258,8 @@ class BasinChart(Kind):
         ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin")
         if isinstance(block["F"], list) and isinstance(block["xi_max"], list):
             ctx.fail(f"{key}.F", "only one of F and xi_max may be a list (the scanned parameter)")
+        ctx.check_unique(f"{key}.F", block["F"])
+        ctx.check_unique(f"{key}.xi_max", block["xi_max"])
 
     def resolve(self, block, ctx):
         scan = "F" if isinstance(block["F"], list) else "xi_max"

@@ -84,6 +84,7 @@ class Criteria(Kind):
             ctx.check_range(f"{key}.F", block["F"])
             if block["F"]["start"] < 0:
                 ctx.fail(f"{key}.F.start", f"must be >= 0 (a forcing amplitude), got {block['F']['start']}")
+        ctx.check_unique(f"{key}.F", block["F"])
 
     def resolve(self, block, ctx):
         from safebasins.wells.quartic import QUARTIC
@@ -146,6 +147,8 @@ class Chart(Kind):
             ctx.check_t_eval_within(f"{key}.t_eval", block["t_eval"], block["cycles"])
         if not values.as_list(block["xi_max"]) and not values.as_list(block["q_max"]):
             ctx.fail(f"{key}.xi_max", "at least one threshold needed")
+        for k in ("xi_max", "q_max", "t_eval"):
+            ctx.check_unique(f"{key}.{k}", block.get(k))
 
     def resolve(self, block, ctx):
         xis = [float(x) for x in values.as_list(block["xi_max"])]

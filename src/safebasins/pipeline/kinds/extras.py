@@ -102,6 +102,8 @@ def _check_grid_block(block, key, ctx):
     ctx.check_grid(f"{key}.grid", block["grid"])
     ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "the analytic criterion")
     ctx.check_t_eval_within(f"{key}.t_eval", block["t_eval"], block["cycles"])
+    for k in ("xi_max", "t_eval"):
+        ctx.check_unique(f"{key}.{k}", block[k])
 
 
 def _chart_cost(params):
@@ -144,6 +146,7 @@ class Erosion(Kind):
             ctx.check_range(f"{key}.F", block["F"])
             if block["F"]["start"] < 0:
                 ctx.fail(f"{key}.F.start", f"must be >= 0 (a forcing amplitude), got {block['F']['start']}")
+        ctx.check_unique(f"{key}.F", block["F"])
 
     def resolve(self, block, ctx):
         Fs = values.values(block["F"])

@@ -39,6 +39,12 @@ def _check_curves(block, key, ctx):
     ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "analytic F_cr")
     xm = values.as_list(block["xi_max"]) * (n // lens["xi_max"])
     xi = values.as_list(block["xi_ini"]) * (n // lens["xi_ini"])
+    ga = values.as_list(block["gamma_ini"]) * (n // lens["gamma_ini"])
+    seen = set()
+    for i, curve in enumerate(zip(xm, xi, ga)):
+        if curve in seen:
+            ctx.fail(key, f"curve {i} (xi_max, xi_ini, gamma_ini) = {curve} repeats an earlier curve")
+        seen.add(curve)
     for i, (a, b) in enumerate(zip(xm, xi)):
         if b >= a:
             ctx.fail(f"{key}.xi_ini" + (f"[{i}]" if lens["xi_ini"] > 1 else ""),

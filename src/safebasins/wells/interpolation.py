@@ -1,0 +1,176 @@
+"""Piecewise Chebyshev interpolation of orbit data in the energy ``E`` on ``[0, E_b)``.
+
+Action-angle data of a well are analytic in ``x = sqrt(E)`` at the well bottom (the orbit's
+amplitude is ~ ``x``; ``J`` and ``omega`` are even in it) and behave like
+``a + b log(E_b - E) + O((E_b - E) log)`` at the separatrix (eq 16: ``omega -> 0``
+logarithmically).  The energy range is therefore split at ``E_split`` into
+
+* *bottom panels* in ``x = sqrt(E)`` on ``[0, sqrt(E_split)]``, and
+* *separatrix panels* in ``u = log(E_b - E)`` on ``[log(s_min), log(E_b - E_split)]``, a
+  geometric partition of ``E_b - E`` down to below the float spacing of ``E_b`` (every float
+  ``E < E_b`` is covered); in ``u`` the logarithmic terms are polynomial and ``s log s`` is
+  entire, so few nodes per panel suffice.
+
+Each panel holds ``n`` Chebyshev coefficients (first-kind nodes: neither ``E = 0`` nor
+``E = E_b`` is ever sampled).  Panels are split until the trailing coefficients of every
+quantity are below ``tol`` relative to the panel's values (plus a noise floor supplied by the
+caller, e.g. the conditioning near the separatrix).  Evaluation is vectorised Clenshaw with
+per-point coefficient gathers; derivatives with respect to ``E`` use the differentiated series.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numpy.polynomial import chebyshev as _cheb
+
+__all__ = ["EnergyInterpolant"]
+
+BOTTOM, SEPARATRIX = 0, 1
+
+
+class EnergyInterpolant:
+    """Adaptive piecewise Chebyshev interpolant of ``Q`` functions of ``E`` on ``[0, E_b)``.
+
+    ``func(E)`` (1-D array, ``0 < E < E_b``) returns an array ``(Q, len(E))``.
+    ``noise(kind, a, b)`` returns the relative accuracy to which ``func`` is known on a panel
+    (``kind`` BOTTOM/SEPARATRIX, ``[a, b]`` in that panel's variable).
+    """
+
+    def __init__(self, func, E_b, *, E_split=None, n=20, tol=1e-13, noise=None,
+                 bottom_panels=2, separatrix_step=2.5, max_rounds=12):
+        self.E_b = float(E_b)
+        self.E_split = 0.5 * self.E_b if E_split is None else float(E_split)
+        self.n = int(n)
+        self.tol = float(tol)
+        s_top = self.E_b - self.E_split
+        s_min = 0.25 * np.spacing(self.E_b)
+        self.u_min = float(np.log(s_min))
+        xs = np.sqrt(self.E_split)
+        bottom = [(BOTTOM, a, b) for a, b in zip(np.linspace(0.0, xs, bottom_panels + 1)[:-1],
+                                                 np.linspace(0.0, xs, bottom_panels + 1)[1:])]
+        u_top = float(np.log(s_top))
+        k = max(int(np.ceil((u_top - self.u_min) / separatrix_step)), 1)
+        ub = np.linspace(self.u_min, u_top, k + 1)
+        sep = [(SEPARATRIX, a, b) for a, b in zip(ub[:-1], ub[1:])]
+        j = np.arange(self.n)
+        self._t = np.cos(np.pi * (j + 0.5) / self.n)          # first-kind nodes, descending
+        # coefficient transform c = M f (DCT-II)
+        self._M = (2.0 / self.n) * np.cos(np.pi * np.outer(j, j + 0.5) / self.n)
+        self._M[0] *= 0.5
+        todo = bottom + sep
+        done = []
+        self.n_evaluations = 0
+        for _ in range(max_rounds):
+            if not todo:
+                break
+            E_nodes = np.concatenate([self._energies(p) for p in todo])
+            vals = np.asarray(func(E_nodes), dtype=float)
+            self.n_evaluations += E_nodes.size
+            vals = vals.reshape(vals.shape[0], len(todo), self.n)
+            coefs = np.einsum("kj,qpj->qpk", self._M, vals)
+            nxt = []
+            for i, p in enumerate(todo):
+                scale = np.max(np.abs(vals[:, i, :]), axis=1)
+                tail = np.max(np.abs(coefs[:, i, -3:]), axis=1)
+                floor = self.tol + (noise(*p) if noise is not None else 0.0)
+                err = np.max(tail / np.where(scale > 0, scale, 1.0))
+                if err <= floor:
+                    done.append((p, coefs[:, i, :], err))
+                else:
+                    kind, a, b = p
+                    c = 0.5 * (a + b)
+                    nxt += [(kind, a, c), (kind, c, b)]
+            todo = nxt
+        if todo:
+            raise RuntimeError(f"energy interpolation did not converge: {len(todo)} panels still above "
+                               f"tolerance after {max_rounds} rounds (kinds/bounds {todo[:3]}...)")
+        self.n_quantities = done[0][1].shape[0]
+        self.error_estimate = max(e for _, _, e in done)
+        self._build(done)
+
+    # ------------------------------------------------------------------ construction
+    def _energies(self, panel):
+        kind, a, b = panel
+        var = 0.5 * (a + b) + 0.5 * (b - a) * self._t
+        return var * var if kind == BOTTOM else self.E_b - np.exp(var)
+
+    def _build(self, done):
+        self.breaks, self.coef, self.dcoef = {}, {}, {}
+        for kind in (BOTTOM, SEPARATRIX):
+            items = sorted([(p[1], p[2], c) for p, c, _ in done if p[0] == kind])
+            a = np.array([it[0] for it in items])
+            b = np.array([it[1] for it in items])
+            if not np.allclose(a[1:], b[:-1], rtol=0, atol=1e-14 * max(1.0, np.abs(b).max())):
+                raise RuntimeError("energy interpolation panels do not tile the range")
+            C = np.stack([it[2] for it in items], axis=-1)          # (Q, n, P)
+            D = np.zeros_like(C)
+            D[:, :-1, :] = _cheb.chebder(C, axis=1)
+            self.breaks[kind] = np.append(a, b[-1])
+            self.coef[kind] = np.ascontiguousarray(C)
+            self.dcoef[kind] = np.ascontiguousarray(D)
+
+    @property
+    def n_panels(self):
+        return sum(len(b) - 1 for b in self.breaks.values())
+
+    # ------------------------------------------------------------------ evaluation
+    def _locate(self, E):
+        """Split energies into the two kinds: index arrays, variable, panel index, local t."""
+        out = []
+        low = E <= self.E_split
+        for kind, mask in ((BOTTOM, low), (SEPARATRIX, ~low)):
+            idx = np.nonzero(mask)[0]
+            if kind == BOTTOM:
+                var = np.sqrt(E[idx])
+            else:
+                var = np.log(self.E_b - E[idx])
+            br = self.breaks[kind]
+            p = np.clip(np.searchsorted(br, var, side="right") - 1, 0, len(br) - 2)
+            a, b = br[p], br[p + 1]
+            t = (2.0 * var - (a + b)) / (b - a)
+            out.append((kind, idx, var, p, t, 2.0 / (b - a)))
+        return out
+
+    @staticmethod
+    def _clenshaw(C, p, t):
+        n = C.shape[0]
+        b1 = np.zeros_like(t)
+        b2 = np.zeros_like(t)
+        t2 = 2.0 * t
+        for k in range(n - 1, 0, -1):
+            b1, b2 = C[k, p] + t2 * b1 - b2, b1
+        return C[0, p] + t * b1 - b2
+
+    def evaluate(self, E, quantity, derivative=False):
+        """Values (and, with ``derivative``, ``d/dvar`` plus the variable) of one quantity.
+
+        Returns ``(value, dvalue_dE)`` where ``dvalue_dE`` is None unless requested.
+        ``E`` is a validated 1-D array in ``[0, E_b)``.
+        """
+        val = np.empty(E.shape)
+        der = np.empty(E.shape) if derivative else None
+        for kind, idx, var, p, t, scale in self._locate(E):
+            if idx.size == 0:
+                continue
+            val[idx] = self._clenshaw(self.coef[kind][quantity], p, t)
+            if derivative:
+                dv = self._clenshaw(self.dcoef[kind][quantity], p, t) * scale
+                if kind == BOTTOM:
+                    with np.errstate(divide="ignore", invalid="ignore"):
+                        der[idx] = dv / (2.0 * var)          # dx/dE = 1/(2x)
+                else:
+                    der[idx] = -dv / (self.E_b - E[idx])    # du/dE = -1/(E_b - E)
+        return val, der
+
+    def evaluate_var(self, E, quantity):
+        """Values and derivatives with respect to the panel variable (x or u) and the kind
+        mask (True on bottom panels), for callers that combine factors analytically."""
+        val = np.empty(E.shape)
+        dvar = np.empty(E.shape)
+        bottom = np.zeros(E.shape, dtype=bool)
+        for kind, idx, var, p, t, scale in self._locate(E):
+            if idx.size == 0:
+                continue
+            val[idx] = self._clenshaw(self.coef[kind][quantity], p, t)
+            dvar[idx] = self._clenshaw(self.dcoef[kind][quantity], p, t) * scale
+            bottom[idx] = kind == BOTTOM
+        return val, dvar, bottom

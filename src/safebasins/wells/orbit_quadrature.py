@@ -1,0 +1,291 @@
+"""Quadrature over one free orbit of a general well (paper Sec. 2.1, eqs 8, 12-17 generalised).
+
+The orbit of energy ``E`` runs between its turning points ``q_minus < 0 < q_plus``
+(``V(q_pm) = E``).  With ``m = (q_plus + q_minus)/2``, ``d = (q_plus - q_minus)/2`` and
+``q = m + d sin(phi)`` the upper branch (``p > 0``) is ``phi`` in ``[-pi/2, pi/2]`` and
+
+    ``p = R(phi) cos(phi)``,   ``dt/dphi = d / R(phi)``,   ``R = sqrt(2 (E - V(q))) / |cos phi|``,
+
+where ``R > 0`` is smooth: the square-root end singularities of ``dt = dq / p`` are removed.
+Each half ``phi <= 0`` / ``phi >= 0`` is measured from its own end, ``psi = pi/2 -+ phi`` in
+``[0, pi/2]`` (``psi = 0`` at the turning point), so that
+
+    ``q = q_end - sigma 2 d sin^2(psi/2)``   (``sigma = -1`` left end, ``+1`` right end),
+
+and near the end ``E - V(q) = (q_end - q) <V'>`` with ``<V'>`` the mean of ``V'`` over
+``[q, q_end]`` (Gauss-Legendre), which gives ``R = sqrt(sigma d <V'>) / cos(psi/2)`` without
+cancellation.  Close to the separatrix the orbit lingers near a barrier and ``dt/dpsi`` has a
+peak of width ``alpha ~ (E_b - E)^(1/4)`` at ``psi = 0`` (complex zeros of ``<V'>`` at
+``psi = +-i alpha``); the map ``psi = alpha sinh(v)`` turns it into an integrand of unit width
+in ``v``, integrated by composite Clenshaw-Curtis panels of length <= ``panel_length``
+(spectral convergence, work ~ ``log(1/alpha)``).
+
+Quantities of one orbit (``tau_side(psi)`` = time from the side's turning point):
+
+* period ``T = 2 (tau_left(pi/2) + tau_right(pi/2))``, ``omega = 2 pi / T`` (eq 16);
+* action ``J = (1/pi) int p dq = (d/pi) int R cos^2(phi) dphi`` (eqs 8, 13);
+* angle ``theta = omega t``, ``theta = 0`` at ``q = 0, p > 0`` (eq 14): the left turning point
+  has ``theta_minus = -omega tau_minus(0) in (-pi, 0)``, the right one ``theta_plus =
+  theta_minus + pi``;
+* first harmonic (eq 12): ``q(theta)`` is even about ``theta_plus`` (time reversal), so
+  ``q_1 = exp(-i theta_plus) |q_1|`` with, after an integration by parts,
+  ``|q_1| = (1/pi) int_{q_minus}^{q_plus} sin(omega tau_plus(q)) dq``.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numpy.polynomial import chebyshev as _cheb
+from numpy.polynomial import legendre as _leg
+
+__all__ = ["clenshaw_curtis", "solve_increasing", "OrbitQuadrature"]
+
+EPS = np.finfo(float).eps
+
+
+def clenshaw_curtis(n):
+    """Clenshaw-Curtis rule on [-1, 1]: ascending nodes ``x``, weights ``w`` and the matrix
+    ``S`` of the indefinite integral, ``int_{-1}^{x_i} f ~ sum_j S[i, j] f(x_j)``."""
+    x = -np.cos(np.pi * np.arange(n) / (n - 1))
+    x[(n - 1) // 2] = 0.0 if n % 2 else x[(n - 1) // 2]
+    vinv = np.linalg.inv(_cheb.chebvander(x, n - 1))
+    anti = np.empty((n, n))
+    for k in range(n):
+        c = np.zeros(n)
+        c[k] = 1.0
+        anti[:, k] = _cheb.chebval(x, _cheb.chebint(c, lbnd=-1.0))
+    S = anti @ vinv
+    return x, S[-1].copy(), S
+
+
+def solve_increasing(fdf, lo, hi, x0, *, xtol=4 * EPS, maxiter=200):
+    """Vectorised safeguarded Newton (rtsafe) for increasing ``F`` with ``F(lo) <= 0 <= F(hi)``.
+
+    ``fdf(x, idx)`` returns ``F(x), F'(x)`` for the items ``idx``.  Newton steps that leave the
+    bracket, or that do not halve the step before last, are replaced by bisection, so the
+    iteration always converges (to the bracketed root, or to the noise band of ``F``).
+    Converged when a step is below ``xtol (|x| + tiny)`` or ``F == 0``.
+    """
+    lo = np.array(lo, dtype=float, copy=True)
+    hi = np.array(hi, dtype=float, copy=True)
+    x = np.clip(np.array(x0, dtype=float, copy=True), lo, hi)
+    n = x.size
+    dx_old = hi - lo
+    dx = dx_old.copy()
+    active = np.arange(n)
+    tiny = 1e-300
+    for _ in range(maxiter):
+        if active.size == 0:
+            return x
+        xa = x[active]
+        F, dF = fdf(xa, active)
+        F = np.asarray(F, dtype=float)
+        dF = np.asarray(dF, dtype=float)
+        done = F == 0.0
+        neg = F < 0.0
+        lo[active] = np.where(neg, xa, lo[active])
+        hi[active] = np.where(F > 0.0, xa, hi[active])
+        la, ha = lo[active], hi[active]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            step = F / dF
+            xn = xa - step
+        bad = (~np.isfinite(xn)) | (xn <= la) | (xn >= ha) | (dF <= 0.0) | \
+              (np.abs(2.0 * step) > np.abs(dx_old[active]))
+        xb = 0.5 * (la + ha)
+        xn = np.where(bad, xb, xn)
+        dx_old[active] = dx[active]
+        dx[active] = xn - xa
+        x[active] = np.where(done, xa, xn)
+        conv = done | (np.abs(xn - xa) <= xtol * (np.abs(xn) + tiny)) | (ha - la <= xtol * (np.abs(xn) + tiny))
+        active = active[~conv]
+    raise RuntimeError(f"turning-point / angle solver did not converge for {active.size} items")
+
+
+class OrbitQuadrature:
+    """Orbit integrals of ``q'' = -V'(q)`` in the coordinates of the module docstring.
+
+    ``V``, ``dV`` are the (vectorised) potential and its derivative; ``limits`` the brackets
+    ``(q_lo, q_hi)`` of the turning points (barriers or points where ``V`` exceeds the escape
+    energy); ``barriers`` the barrier positions (``+-inf`` where none); ``kappa = (-V''(q_left), -V''(q_right))`` the barrier curvatures (``nan`` where a
+    side has no barrier) which set the width ``alpha`` of the near-separatrix peak.
+    """
+
+    def __init__(self, V, dV, limits, barriers, kappa, *, n_nodes=20, panel_length=1.5,
+                 alpha_max=3.0, gap_switch=0.02, n_mean=6, barrier_zone=0.1):
+        self.V, self.dV = V, dV
+        self.limits = (float(limits[0]), float(limits[1]))
+        self.barriers = tuple(float(b) for b in barriers)
+        self.barrier_V = tuple(float(V(np.array([b]))[0]) if np.isfinite(b) else np.inf
+                               for b in self.barriers)
+        self.kappa = tuple(float(k) for k in kappa)
+        self.barrier_zone = float(barrier_zone)
+        self.panel_length = float(panel_length)
+        self.alpha_max = float(alpha_max)
+        self.gap_switch = float(gap_switch)
+        self.x, self.w, self.S = clenshaw_curtis(n_nodes)
+        gx, gw = _leg.leggauss(n_mean)
+        self.mean_t = 0.5 * (gx + 1.0)
+        self.mean_w = 0.5 * gw
+
+    # ------------------------------------------------------------------ turning points
+    def turning_points(self, E, guess=None):
+        """``(q_minus, q_plus)`` with ``V = E`` for ``0 <= E <= E_b`` (validated, 1-D)."""
+        E = np.asarray(E, dtype=float)
+        out = []
+        for k, side in enumerate((-1.0, 1.0)):
+            lim, qb, Vb = self.limits[k], self.barriers[k], self.barrier_V[k]
+            x0 = np.full(E.shape, 0.5 * lim) if guess is None else guess[k]
+
+            # F(s) = V(side s) - E is increasing in s = side q on [0, |lim|]; near a barrier
+            # V(q) - E = (V_b - E) - (q_b - q) <V'>_[q, q_b]: only V' and the exact difference
+            # V_b - E enter, so q is found to ~eps (the energy to ~eps sqrt(V_b - E)).
+            def fdf(s, idx, side=side, qb=qb, Vb=Vb):
+                q = side * s
+                F = self.V(q) - E[idx]
+                if np.isfinite(qb):
+                    zone = np.abs(qb - q) <= self.barrier_zone * abs(qb)
+                    if zone.any():
+                        qz = q[zone]
+                        mean = np.zeros_like(qz)
+                        for t, wt in zip(self.mean_t, self.mean_w):
+                            mean += wt * self.dV(qz + (qb - qz) * t)
+                        F[zone] = (Vb - E[idx][zone]) - (qb - qz) * mean
+                return F, side * self.dV(q)
+            s = solve_increasing(fdf, np.zeros(E.shape), np.full(E.shape, abs(lim)), side * x0)
+            out.append(side * s)
+        return out[0], out[1]
+
+    def geometry(self, E, q_minus, q_plus):
+        """Centre ``m``, half-width ``d`` and peak widths ``alpha`` of each side."""
+        m = 0.5 * (q_plus + q_minus)
+        d = 0.5 * (q_plus - q_minus)
+        alphas = []
+        for sigma, q_end, kappa in ((-1.0, q_minus, self.kappa[0]), (1.0, q_plus, self.kappa[1])):
+            if np.isfinite(kappa) and kappa > 0:
+                slope = np.maximum(sigma * self.dV(q_end), 0.0)
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    a = 2.0 * np.sqrt(slope / (kappa * d))
+                a = np.where(np.isfinite(a), a, self.alpha_max)
+                a = np.clip(a, 1e-12, self.alpha_max)
+            else:
+                a = np.full(np.shape(E), self.alpha_max)
+            alphas.append(a)
+        return m, d, alphas[0], alphas[1]
+
+    # ------------------------------------------------------------------ integrand
+    def integrand(self, E, q_end, d, alpha, sigma, v):
+        """At nodes ``v`` (items along axis 0, per-item arrays of shape (N, 1)): ``psi``, ``q``,
+        ``R`` and ``dpsi/dv``."""
+        psi = alpha * np.sinh(v)
+        dpsi = alpha * np.cosh(v)
+        half = 0.5 * psi
+        s2 = np.sin(half) ** 2
+        q = q_end - sigma * (2.0 * d) * s2
+        shape = np.broadcast_shapes(psi.shape, np.shape(E), np.shape(d))
+        q = np.broadcast_to(q, shape)
+        psi_b = np.broadcast_to(psi, shape)
+        near = np.broadcast_to(2.0 * s2 <= self.gap_switch, shape)
+        R = np.empty(shape)
+        Eb = np.broadcast_to(E, shape)
+        # away from the end: E - V(q) directly (no cancellation there)
+        far = ~near
+        if far.any():
+            gap = Eb[far] - self.V(q[far])
+            R[far] = np.sqrt(2.0 * gap) / np.sin(psi_b[far])
+        if near.any():
+            qn = q[near]
+            qe = np.broadcast_to(q_end, shape)[near]
+            dn = np.broadcast_to(d, shape)[near]
+            sg = np.broadcast_to(sigma, shape)[near]
+            mean = np.zeros_like(qn)
+            for t, wt in zip(self.mean_t, self.mean_w):
+                mean += wt * self.dV(qn + (qe - qn) * t)
+            R[near] = np.sqrt(np.maximum(sg * dn * mean, 0.0)) / np.cos(0.5 * psi_b[near])
+        return psi, q, R, dpsi
+
+    # ------------------------------------------------------------------ composite rules
+    def _nodes(self, v_end, m):
+        """Composite CC nodes on ``[0, v_end]`` (per item) with ``m`` equal panels:
+        shape (N, m, n) and the panel half-lengths (N, 1, 1)."""
+        h = (v_end / m)[:, None, None]
+        a = h * np.arange(m)[None, :, None]
+        v = a + h * 0.5 * (self.x[None, None, :] + 1.0)
+        return v, 0.5 * h
+
+    def side_profile(self, E, q_end, d, alpha, sigma, m=None):
+        """Half orbit from one turning point to ``q = m`` (``psi`` in [0, pi/2]), all nodes.
+
+        Returns dict with per-node ``psi``, ``q``, ``R``, ``dpsi`` (N, K), the cumulative time
+        ``tau`` from the turning point (N, K) and the CC weights in v (N, K).
+        """
+        v_end = np.arcsinh(0.5 * np.pi / alpha)
+        if m is None:
+            m = max(int(np.ceil(np.max(v_end) / self.panel_length)), 1)
+        v, half = self._nodes(v_end, m)
+        N = v.shape[0]
+        col = lambda a: np.asarray(a, dtype=float).reshape(N, 1, 1)
+        psi, q, R, dpsi = self.integrand(col(E), col(q_end), col(d), col(alpha), sigma, v)
+        f = col(d) / R * dpsi
+        cum = half * (f @ self.S.T)
+        tot = cum[..., -1]
+        off = np.concatenate([np.zeros((N, 1)), np.cumsum(tot, axis=1)[:, :-1]], axis=1)
+        tau = cum + off[..., None]
+        wts = np.broadcast_to(half * self.w, v.shape)
+        flat = lambda a: np.broadcast_to(a, v.shape).reshape(N, -1)
+        return {"psi": flat(psi), "q": flat(q), "R": flat(R), "dpsi": flat(dpsi),
+                "tau": flat(tau), "w": flat(wts), "total": tau[:, -1, -1]}
+
+    def side_time(self, E, q_end, d, alpha, sigma, psi):
+        """Time from the turning point ``q_end`` to the point at ``psi`` (1-D arrays), by
+        composite CC in ``v = asinh(psi/alpha)``, items grouped by their number of panels."""
+        E, q_end, d, alpha, psi = (np.asarray(a, dtype=float) for a in (E, q_end, d, alpha, psi))
+        sigma = np.broadcast_to(np.asarray(sigma, dtype=float), E.shape)
+        v_end = np.arcsinh(psi / alpha)
+        m = np.maximum(np.ceil(v_end / self.panel_length), 1).astype(int)
+        out = np.zeros(E.shape)
+        for mm in np.unique(m):
+            idx = np.nonzero(m == mm)[0]
+            v, half = self._nodes(v_end[idx], int(mm))
+            col = lambda a: a[idx].reshape(-1, 1, 1)
+            _, _, R, dpsi = self.integrand(col(E), col(q_end), col(d), col(alpha), col(sigma), v)
+            f = col(d) / R * dpsi
+            out[idx] = np.sum(half[:, :, 0] * (f @ self.w), axis=1)
+        return out
+
+    def rate(self, E, q_end, d, alpha, sigma, v):
+        """``dtau/dv`` and ``(psi, q, R)`` at single nodes ``v`` (1-D arrays)."""
+        psi, q, R, dpsi = self.integrand(E, q_end, d, alpha, sigma, v)
+        return d / R * dpsi, psi, q, R
+
+    # ------------------------------------------------------------------ one orbit
+    def orbit_data(self, E, guess=None):
+        """Period, action, first harmonic and angle data of the orbits of energies ``E``
+        (1-D, ``0 < E < E_b``): dict of 1-D arrays ``q_minus, q_plus, T, J, q1_abs,
+        theta_minus, t_left`` (``t_left``: time from ``q_minus`` to ``m``)."""
+        E = np.asarray(E, dtype=float)
+        qm, qp = self.turning_points(E, guess)
+        m, d, aL, aR = self.geometry(E, qm, qp)
+        left = self.side_profile(E, qm, d, aL, -1.0)
+        right = self.side_profile(E, qp, d, aR, 1.0)
+        T = 2.0 * (left["total"] + right["total"])
+        omega = 2.0 * np.pi / T
+        J = 0.0
+        q1 = 0.0
+        for side in (left, right):
+            s = np.sin(side["psi"])
+            J = J + np.sum(side["w"] * side["R"] * s * s * side["dpsi"], axis=1)
+            q1 = q1 + np.sum(side["w"] * np.sin(omega[:, None] * side["tau"]) * s * side["dpsi"], axis=1)
+        J = d / np.pi * J
+        q1 = d / np.pi * q1
+        # time from q_minus to q = 0 (upper branch)
+        on_left = m >= 0.0
+        ratio = np.where(on_left, -qm, qp) / (2.0 * d)
+        psi0 = 2.0 * np.arcsin(np.sqrt(np.clip(ratio, 0.0, 1.0)))
+        tl = self.side_time(E, np.where(on_left, qm, qp), d, np.where(on_left, aL, aR),
+                            np.where(on_left, -1.0, 1.0), psi0)
+        t0 = np.where(on_left, tl, 0.5 * T - tl)
+        out = {"q_minus": qm, "q_plus": qp, "T": T, "J": J, "q1_abs": q1,
+               "theta_minus": -omega * t0, "t_left": left["total"]}
+        for k, a in out.items():
+            if not np.isfinite(a).all():
+                raise RuntimeError(f"orbit quadrature produced non-finite {k} (E in [{E.min()}, {E.max()}])")
+        return out
