@@ -26,7 +26,7 @@ def unforced_basin(q0, p0, xi_max):
                       coords={"q0": q0, "p0": p0}, attrs={"xi_max": xi_max})
 
 
-def build(params, inputs, threads):
+def build(params, inputs, job):
     q0, p0 = values.grid_axes(params["grid"])
     return unforced_basin(q0, p0, params["xi_max"])
 

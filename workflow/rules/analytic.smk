@@ -15,6 +15,7 @@ rule analytic_dataset:
         name=alternatives(dataset_names("analytic")),
     params:
         extensions=EXTENSIONS,
+        backend=BACKEND,
     threads: dataset_threads("analytic")
     script:
         "../../scripts/dataset.py"

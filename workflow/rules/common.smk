@@ -13,6 +13,7 @@ RUN = _plan(config)
 print(_cost_guard(RUN, workflow.cores), file=sys.stderr)
 PARAMS_JSON = {e: json.dumps(p, sort_keys=True) for e, p in RUN.params().items()}
 NUM_THREADS = RUN.threads
+BACKEND = config["numerics"]["backend"]
 EXTENSIONS = config["extensions"]
 
 PARAM_FILES = RUN.param_files()

@@ -16,6 +16,7 @@ rule extras_dataset:
         name=alternatives(dataset_names("extras")),
     params:
         extensions=EXTENSIONS,
+        backend=BACKEND,
     threads: dataset_threads("extras")
     script:
         "../../scripts/dataset.py"

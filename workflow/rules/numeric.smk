@@ -19,6 +19,7 @@ rule chart_tile:
         experiment=alternatives(RUN.chart_experiments()),
     params:
         extensions=EXTENSIONS,
+        backend=BACKEND,
     threads: NUM_THREADS
     script:
         "../../scripts/chart_tile.py"
@@ -39,6 +40,7 @@ rule numeric_dataset:
         name=alternatives(dataset_names("numeric")),
     params:
         extensions=EXTENSIONS,
+        backend=BACKEND,
     threads: dataset_threads("numeric")
     script:
         "../../scripts/dataset.py"

@@ -12,19 +12,19 @@ from safebasins.numerics import kernels
 DEFAULT_N_SCAN = 301
 
 
-def _escapes(q0, p0, Omega, F, Psi, thr_kw, cycles, spc, threads, integrator):
+def _escapes(q0, p0, Omega, F, Psi, thr_kw, cycles, spc, threads, integrator, backend):
     """One compiled ensemble: trajectory k with (Omega[k], F[k]); True where it escapes."""
     n = Omega.size
-    sE, sQ, _ = engine.run_ensemble(np.full(n, q0), np.full(n, p0), np.arange(n), Omega, F, Psi, cycles=cycles,
-                               steps_per_cycle=spc, threads=threads, stop_any=True, integrator=integrator,
-                               **thr_kw)
+    sE, sQ = engine.integrate(np.full(n, q0), np.full(n, p0), np.arange(n), Omega, F, Psi, cycles=cycles,
+                              steps_per_cycle=spc, threads=threads, stop_any=True, integrator=integrator,
+                              backend=backend, **thr_kw)
     return ((sE >= 0).any(axis=1)) | ((sQ >= 0).any(axis=1))
 
 
 def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3000, tol=5e-5,
                              F_bracket=(0.0, 0.3), criterion="energy", n_scan=DEFAULT_N_SCAN,
                              steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None,
-                             integrator=engine.DEFAULT_INTEGRATOR):
+                             integrator=engine.DEFAULT_INTEGRATOR, backend="cpu"):
     """Numeric escape threshold F_cr(Omega) for the IC (q0, p0) (Section 3.1, Figs 10-12).
 
     Bisection: all Omega points advance together, one compiled ensemble per bisection level,
@@ -35,7 +35,7 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     equally spaced F in F_bracket (one ensemble, Omega x F) also gives F_escape_low (lowest
     escaping F), F_escape_all (lowest F above which every scanned F escapes) and non_monotone
     (F_escape_all - F_escape_low > tol).  n_scan=0 skips the scan (variables NaN / False).
-    integrator: "srkn6b" (default) or "rk4" (see escape_chart).
+    integrator: "srkn6b" (default) or "rk4"; backend: "cpu", "cuda" or "auto" (see escape_chart).
 
     Returns xr.Dataset over Omega: F_cr, F_cr_low, F_cr_high (final bracket), F_escape_low,
     F_escape_all, non_monotone; attrs xi_max, q0, p0, Psi, cycles, tol, criterion, F_bracket,
@@ -70,7 +70,7 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     nO = Om.size
     # ---- bracket ends (one ensemble)
     ends = _escapes(q0, p0, np.concatenate([Om, Om]), np.concatenate([np.full(nO, br[0]), np.full(nO, br[1])]),
-                    Psi, thr_kw, cycles, spc, threads, integrator)
+                    Psi, thr_kw, cycles, spc, threads, integrator, backend)
     valid = ~ends[:nO] & ends[nO:]
     lo = np.full(nO, br[0])
     hi = np.full(nO, br[1])
@@ -79,7 +79,7 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     while active.any():
         idx = np.flatnonzero(active)
         mid = 0.5 * (lo[idx] + hi[idx])
-        esc = _escapes(q0, p0, Om[idx], mid, Psi, thr_kw, cycles, spc, threads, integrator)
+        esc = _escapes(q0, p0, Om[idx], mid, Psi, thr_kw, cycles, spc, threads, integrator, backend)
         hi[idx[esc]] = mid[esc]
         lo[idx[~esc]] = mid[~esc]
         levels += 1
@@ -95,7 +95,7 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     if n_scan:
         Fs = np.linspace(br[0], br[1], int(n_scan))
         OO, FF = np.meshgrid(Om, Fs, indexing="ij")
-        esc = _escapes(q0, p0, OO.ravel(), FF.ravel(), Psi, thr_kw, cycles, spc, threads, integrator).reshape(nO, Fs.size)
+        esc = _escapes(q0, p0, OO.ravel(), FF.ravel(), Psi, thr_kw, cycles, spc, threads, integrator, backend).reshape(nO, Fs.size)
         for k in range(nO):
             e = esc[k]
             if e.any():

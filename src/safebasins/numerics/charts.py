@@ -35,7 +35,7 @@ def _ic_arrays(q0, p0, grid):
 
 def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000,
                  steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None, grid=None,
-                 integrator=engine.DEFAULT_INTEGRATOR):
+                 integrator=engine.DEFAULT_INTEGRATOR, backend="cpu"):
     """Escape time (forcing cycles) of every initial condition, for every threshold.
 
     Parameters
@@ -56,6 +56,8 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000
         RK4, same engine; not symplectic, it drains energy: needs ~256 steps/cycle for a 1e-5
         relative energy error over 11,000 cycles).  Dataset attr `integrator` names it.
     threads : numba threads (None: current setting); results are bitwise independent of it.
+    backend : "cpu" (default, the reference), "cuda" (numba-cuda kernels, bitwise equal escape
+        steps) or "auto" (the GPU when one is visible).
 
     Returns
     -------
@@ -78,8 +80,9 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000
     threads = engine.check_threads(threads)
     kernels.check_integrator(integrator)
 
-    sE, sQ, _ = engine.run_ensemble(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
-                               cycles=cycles, steps_per_cycle=spc, threads=threads, integrator=integrator)
+    sE, sQ = engine.integrate(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
+                              cycles=cycles, steps_per_cycle=spc, threads=threads, integrator=integrator,
+                              backend=backend)
     tE = engine.steps_to_cycles(sE, spc).T   # (nE, N)
     tQ = engine.steps_to_cycles(sQ, spc).T
     if is_grid:

@@ -12,6 +12,9 @@ from safebasins.numerics import kernels
 
 DEFAULT_STEPS_PER_CYCLE = 32
 DEFAULT_INTEGRATOR = "srkn6b"
+#: where ensembles run: the CPU lanes (the reference), a CUDA GPU (cuda_engine: bitwise equal
+#: escape steps) or "auto" (the GPU when one is visible, else the CPU)
+BACKENDS = ("cpu", "cuda", "auto")
 LANES = 128          # trajectories in flight per task (4 chains x up to 32-lane segments)
 
 
@@ -103,3 +106,25 @@ def steps_to_cycles(steps, steps_per_cycle):
     out = steps.astype(float) / steps_per_cycle
     out[steps < 0] = np.inf
     return out
+
+
+def resolve_backend(backend):
+    """"cpu" or "cuda" for a requested backend ("auto": the GPU when numba-cuda sees one)."""
+    if backend not in BACKENDS:
+        raise ValueError(f"backend must be one of {BACKENDS}, got {backend!r}")
+    if backend == "auto":
+        from safebasins.numerics.cuda_engine import cuda_available
+
+        return "cuda" if cuda_available() else "cpu"
+    return backend
+
+
+def integrate(q0, p0, pidx, Omega, F, Psi, *, backend="cpu", threads=None, **kwargs):
+    """:func:`run_ensemble` on the chosen backend; returns (steps_E, steps_Q), bitwise the same
+    on either (the CUDA kernels repeat the CPU lanes' operations; tests/numerics/test_cuda_simulator.py)."""
+    if resolve_backend(backend) == "cuda":
+        from safebasins.numerics.cuda_engine import run_ensemble_cuda
+
+        return run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, **kwargs)
+    steps_E, steps_Q, _ = run_ensemble(q0, p0, pidx, Omega, F, Psi, threads=threads, **kwargs)
+    return steps_E, steps_Q

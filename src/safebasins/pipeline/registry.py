@@ -23,7 +23,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable, ClassVar, Mapping
 
-__all__ = ["Kind", "Product", "FigureSpec", "Experiment", "KINDS", "register", "STAGES"]
+__all__ = ["Kind", "Job", "Product", "FigureSpec", "Experiment", "KINDS", "register", "STAGES"]
 
 #: dataset stages and their directories under results/data
 STAGES = {"analytic": "results/data/analytic", "numeric": "results/data/numeric", "extras": "results/data/extras"}
@@ -41,11 +41,20 @@ def dataset_path(stage: str, name: str) -> str:
 
 
 @dataclass(frozen=True)
+class Job:
+    """How a job computes (never what): numba threads and the numerics backend."""
+
+    threads: int = 1
+    backend: str = "cpu"
+
+
+@dataclass(frozen=True)
 class Product:
     """One dataset of an experiment.
 
-    ``build(params, inputs, threads)`` returns the Dataset (the runtime adds CF/provenance
-    attributes with ``title`` and ``history`` and writes it atomically); ``inputs`` maps names
+    ``build(params, inputs, job)`` returns the Dataset (the runtime adds CF/provenance
+    attributes with ``title`` and ``history`` and writes it atomically; ``job`` is a :class:`Job`:
+    numba threads and numerics backend, which never change a result); ``inputs`` maps names
     to the files it reads besides the experiment's parameter file (tiles, other datasets);
     ``heavy`` products run with ``numerics.threads`` numba threads; ``tiles`` products read
     the chart tiles of their experiment (``inputs["tiles"]``, tasks x tiles, task-major).

@@ -21,7 +21,7 @@ from pathlib import Path
 import yaml
 
 from safebasins.pipeline.config import load_kinds
-from safebasins.pipeline.registry import KINDS
+from safebasins.pipeline.registry import KINDS, Job
 
 
 def redirect_output(log_path):
@@ -83,7 +83,7 @@ def make_dataset(smk):
     out = str(smk.output[0])
     product = next(p for p in kind.products(params["experiment"], params) if p.path == out)
     inputs = {k: (list(v) if k == "tiles" else v) for k, v in smk.input.items()}
-    ds = product.build(params, inputs, smk.threads)
+    ds = product.build(params, inputs, Job(threads=smk.threads, backend=smk.params.backend))
     finalize(ds, title=product.title, params=params, config_hash=params_hash(params),
              history=f"{product.history} (rule {smk.rule})")
     write_netcdf(ds, out)
@@ -116,7 +116,7 @@ def make_tile(smk):
           f"ICs={q0.size}x{p0.size if grid else 1}", flush=True)
     ds = escape_chart(q0, p0, task["F"], params["Omega"], Psi, xi_max=tuple(task["xi_max"]),
                       q_max=tuple(task["q_max"]), cycles=params["cycles"], steps_per_cycle=params["steps_per_cycle"],
-                      threads=smk.threads, grid=grid)
+                      threads=smk.threads, grid=grid, backend=smk.params.backend)
     if not grid:
         ds = ds.assign_coords(sample=np.arange(sl.start, sl.stop))
     ds.attrs.update(task=k, tile=tile, tiles=tiles)

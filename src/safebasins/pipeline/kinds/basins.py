@@ -59,7 +59,7 @@ def _basin_attrs(out, params):
     return out
 
 
-def build_basin_single(params, inputs, threads):
+def build_basin_single(params, inputs, job):
     """One analytic basin (Fig 18); with a ``manifold`` grid also C and escapes_rm (Figs 5-9)."""
     from safebasins.theory import escapes_on_manifold, first_integral
 
@@ -77,7 +77,7 @@ def build_basin_single(params, inputs, threads):
     return _basin_attrs(out, params)
 
 
-def build_basin_stack(params, inputs, threads):
+def build_basin_stack(params, inputs, job):
     """Analytic basins stacked over the scanned parameter (Figs 13-17)."""
     from safebasins.io.datasets import stack
 
@@ -111,7 +111,7 @@ def gather_chart(params, tiles):
     return out
 
 
-def build_chart_agreement(params, inputs, threads):
+def build_chart_agreement(params, inputs, job):
     """Gathered chart + IoU and pixel agreement with the analytic basin, per scanned value.
 
     numeric safe = escape_cycle_energy > t_eval (= cycles); analytic safe = not escapes.
@@ -157,14 +157,14 @@ def build_chart_agreement(params, inputs, threads):
     return out
 
 
-def build_strobe(params, inputs, threads):
+def build_strobe(params, inputs, job):
     """Stroboscopic map of the first ``n_trajectories`` non-escaping seeded random ICs."""
     from safebasins.numerics import random_initial_conditions, stroboscopic_map
 
     q0, p0 = random_initial_conditions(params["n_candidates"], params["seed"], box=tuple(tuple(b) for b in params["box"]))
     ds = stroboscopic_map(np.asarray(q0, float), np.asarray(p0, float), params["F"], params["Omega"], params["Psi"],
                           n_iter=params["n_iter"], xi_max=params["xi_max"], steps_per_cycle=params["steps_per_cycle"],
-                          threads=threads)
+                          threads=job.threads)
     safe = np.flatnonzero(~np.asarray(ds["escaped"].values, dtype=bool))
     print(f"{safe.size} of {params['n_candidates']} candidates never escape in {params['n_iter']} iterations", flush=True)
     if safe.size < params["n_trajectories"]:

@@ -15,7 +15,7 @@ from safebasins.pipeline.registry import Kind, Product, dataset_path, params_pat
 Q_MAX = {"type": "number", "exclusiveMinimum": 0, "maximum": 1}
 
 
-def build_criteria(params, inputs, threads):
+def build_criteria(params, inputs, job):
     """A_E, A_q (safe counts by the energy and displacement criterion) per (F, repeat)."""
     import xarray as xr
 
@@ -46,7 +46,7 @@ def build_criteria(params, inputs, threads):
     return out
 
 
-def build_chart(params, inputs, threads):
+def build_chart(params, inputs, job):
     """The escape chart gathered from its tiles (attributes ``t_eval``, ``cycles``)."""
     return gather_chart(params, inputs["tiles"])
 

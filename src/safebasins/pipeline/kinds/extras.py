@@ -39,7 +39,7 @@ def _level_crossings(ds, level):
     return ds
 
 
-def build_erosion_analytic(params, inputs, threads):
+def build_erosion_analytic(params, inputs, job):
     """GIM / LIM / IF versus F from the slow flow on the chart grid, per first-harmonic variant."""
     from safebasins.analysis.erosion import erosion_profile_analytic
 
@@ -52,7 +52,7 @@ def build_erosion_analytic(params, inputs, threads):
     return ds
 
 
-def build_erosion_numeric(params, inputs, threads):
+def build_erosion_numeric(params, inputs, job):
     """GIM / LIM / IF versus (F, xi_max, t_eval) from one escape chart per F."""
     from safebasins.analysis.erosion import profile_from_charts
 
@@ -62,7 +62,7 @@ def build_erosion_numeric(params, inputs, threads):
     return ds
 
 
-def build_true_basin_analytic(params, inputs, threads):
+def build_true_basin_analytic(params, inputs, job):
     """Per-phase analytic basins, their intersection and the all-phase basin H0 < xi_true."""
     from safebasins.analysis.phase_invariant import true_safe_basin_analytic
 
@@ -73,14 +73,14 @@ def build_true_basin_analytic(params, inputs, threads):
                                     fourier=params["fourier"], n_gamma=params["n_gamma"])
 
 
-def build_true_basin_numeric(params, inputs, threads):
+def build_true_basin_numeric(params, inputs, job):
     """Intersection over Psi of the numeric safe basins (one escape chart per Psi)."""
     from safebasins.analysis.phase_invariant import true_safe_basin_from_charts
 
     return true_safe_basin_from_charts(_grid_charts(params, inputs["tiles"], "Psi"), params["t_eval"])
 
 
-def build_fourier(params, inputs, threads, *, what, source):
+def build_fourier(params, inputs, job, *, what, source):
     """Paper vs exact first harmonic against the numerics of experiment ``source``."""
     from safebasins.analysis import fourier_compare as fc
     from safebasins.io.datasets import load

@@ -51,7 +51,7 @@ def _check_curves(block, key, ctx):
                      f"initial energy {b} must be below the truncation level xi_max = {a}")
 
 
-def build_fcr_analytic(params, inputs, threads):
+def build_fcr_analytic(params, inputs, job):
     """One theory.critical_forcing per curve, stacked over ``curve``."""
     from safebasins.io.datasets import stack
     from safebasins.theory import critical_forcing
@@ -71,7 +71,7 @@ def build_fcr_analytic(params, inputs, threads):
     return out
 
 
-def build_fcr_numeric(params, inputs, threads):
+def build_fcr_numeric(params, inputs, job):
     """One numerics.critical_forcing_numeric per curve (IC from (xi_ini, gamma_ini, Psi))."""
     from safebasins.io.datasets import stack
     from safebasins.numerics import critical_forcing_numeric
@@ -88,7 +88,7 @@ def build_fcr_numeric(params, inputs, threads):
         parts.append(critical_forcing_numeric(
             Omega, c["xi_max"], q0=q0, p0=p0, Psi=c["Psi"], cycles=num["cycles"], tol=num["tol"],
             F_bracket=tuple(num["F_bracket"]), criterion=num["criterion"], n_scan=num["n_scan"],
-            steps_per_cycle=num["steps_per_cycle"], threads=threads))
+            steps_per_cycle=num["steps_per_cycle"], threads=job.threads, backend=job.backend))
     coords = {k: [c[k] for c in params["curves"]] for k in ("xi_max", "xi_ini", "gamma_ini", "Psi", "label")}
     coords.update(q0=q0s, p0=p0s)
     return stack(parts, "curve", coords=coords)
