@@ -34,11 +34,12 @@ def merged(base, override):
 
 def test_paper_config_plans_every_declared_experiment(base):
     run = plan(copy.deepcopy(base))
-    assert list(run.experiments) == [d.name for d in catalog.DECLARATIONS]
+    declared = [d.name for d in catalog.DECLARATIONS]
+    assert list(run.experiments) == declared + list(base["experiments"])
     for name, exp in run.experiments.items():
         assert exp.params["experiment"] == name and exp.params["kind"] == exp.kind.name
         assert yaml.safe_load(dump_params(exp.params)) == exp.params, name     # the YAML file round-trips
-        assert exp.figure is not None and exp.figure.packaged
+        assert exp.figure is not None and exp.figure.packaged == (name in declared)
         for f in exp.figure.dataset_files():  # a figure reads only datasets and parameter files of the run
             assert f in run.datasets() or f in run.param_files(), (name, f)
         assert len(exp.tasks) == len(exp.params.get("tasks", ())), name
@@ -65,7 +66,7 @@ def test_defaults_filled_from_the_schema(base):
                                                             "budget_core_hours": 1.0, "allow_expensive": False,
                                                             "backend": "cpu"}
     assert cfg["figures"]["fig13"]["cycles"] == 3000
-    assert cfg["experiments"] == {} and cfg["extensions"] == []
+    assert cfg["extensions"] == []
 
 
 def test_schema_is_valid_and_library_default_agrees():

@@ -27,8 +27,15 @@ def gather_tiles(paths) -> xr.Dataset:
     return ds
 
 
+def task_blocks(paths, ntasks: int) -> list[list]:
+    """The flat tile list (tasks x tiles, task-major) split into the tiles of each task."""
+    paths = list(paths)
+    if ntasks < 1 or len(paths) % ntasks:
+        raise ValueError(f"{len(paths)} tile files do not split into {ntasks} tasks")
+    per_task = len(paths) // ntasks
+    return [paths[i * per_task:(i + 1) * per_task] for i in range(ntasks)]
+
+
 def task_charts(paths, ntasks: int) -> list[xr.Dataset]:
     """The gathered chart of every task from the flat tile list (tasks x tiles, task-major)."""
-    paths = list(paths)
-    per_task = len(paths) // ntasks
-    return [gather_tiles(paths[i * per_task:(i + 1) * per_task]) for i in range(ntasks)]
+    return [gather_tiles(block) for block in task_blocks(paths, ntasks)]

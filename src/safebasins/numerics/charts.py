@@ -111,3 +111,48 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000
         safe_basin="escape_cycle > t_eval (t_eval <= cycles)",
     )
     return ds
+
+
+def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000,
+                       steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None,
+                       integrator=engine.DEFAULT_INTEGRATOR, backend="cpu"):
+    """Escape charts of one IC grid for several control points ``(F[k], Omega[k])`` in ONE ensemble.
+
+    Every trajectory carries its control point (the lanes refill across charts, so a control
+    point whose ICs escape early frees its lanes for the others); each chart is bitwise the
+    :func:`escape_chart` of its control point.  ``q0``, ``p0``: 1-D grid axes; ``F``, ``Omega``:
+    1-D of equal length K.  Returns a Dataset with ``escape_cycle_energy (control, xi_max, q0,
+    p0)``, ``escape_cycle_displacement (control, q_max, q0, p0)`` and coordinates ``F(control)``,
+    ``Omega(control)``.
+    """
+    is_grid, qa, pa, Q, P = _ic_arrays(q0, p0, True)
+    F = checks.check_1d("F", F, checks.check_nonnegative)
+    Omega = checks.check_1d("Omega", Omega, checks.check_positive)
+    if F.size != Omega.size or F.size == 0:
+        raise ValueError(f"F and Omega must be 1-D of the same non-zero length, got {F.size} and {Omega.size}")
+    Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
+    xi = engine.thresholds("xi_max", xi_max, QUARTIC.check_threshold)
+    qm = engine.thresholds("q_max", q_max, QUARTIC.check_displacement)
+    if xi.size == 0 and qm.size == 0:
+        raise ValueError("xi_max and q_max: at least one threshold is required")
+    cycles = engine.check_cycles("cycles", cycles)
+    spc = engine.check_steps_per_cycle(steps_per_cycle)
+    threads = engine.check_threads(threads)
+    kernels.check_integrator(integrator)
+    K, n = F.size, Q.size
+    sE, sQ = engine.integrate(np.tile(Q, K), np.tile(P, K), np.repeat(np.arange(K), n), Omega, F, Psi,
+                              xi_max=xi, q_max=qm, cycles=cycles, steps_per_cycle=spc, threads=threads,
+                              integrator=integrator, backend=backend)
+    shape = (K, qa.size, pa.size)
+    tE = np.moveaxis(engine.steps_to_cycles(sE, spc).reshape(shape + (xi.size,)), -1, 1)
+    tQ = np.moveaxis(engine.steps_to_cycles(sQ, spc).reshape(shape + (qm.size,)), -1, 1)
+    ds = xr.Dataset(
+        {"escape_cycle_energy": (("control", "xi_max", "q0", "p0"), tE, cf.attrs("escape_cycle_energy")),
+         "escape_cycle_displacement": (("control", "q_max", "q0", "p0"), tQ, cf.attrs("escape_cycle_displacement"))},
+        coords={"control": ("control", np.arange(K), {"long_name": "control-point index"}),
+                "F": ("control", F, cf.attrs("F")), "Omega": ("control", Omega, cf.attrs("Omega")),
+                "q0": ("q0", qa, cf.attrs("q0")), "p0": ("p0", pa, cf.attrs("p0")),
+                "xi_max": ("xi_max", xi, cf.attrs("xi_max")), "q_max": ("q_max", qm, cf.attrs("q_max"))})
+    ds.attrs.update(Psi=Psi, cycles=cycles, steps_per_cycle=spc, integrator=kernels.INTEGRATORS[integrator],
+                    safe_basin="escape_cycle > t_eval (t_eval <= cycles)")
+    return ds

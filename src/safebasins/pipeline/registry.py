@@ -142,6 +142,13 @@ class Kind:
         """``(q0, p0, grid)`` of the chart tasks: grid axes (grid=True) or paired samples."""
         raise NotImplementedError(f"kind {self.name!r} has no escape-chart tasks")
 
+    def compute_tile(self, params: dict, task: int, tile: int, tiles: int, job):
+        """One job of the ``chart_tile`` rule: by default tile ``tile`` of ``tiles`` (a block of q0
+        rows or samples) of the escape chart of task ``task``."""
+        from safebasins.pipeline.tiles import chart_tile
+
+        return chart_tile(self, params, task, tile, tiles, job)
+
     def cost(self, params: dict) -> int:
         """Upper bound of the trajectory-steps its numerics integrate (no early escape)."""
         return 0

@@ -91,34 +91,13 @@ def make_dataset(smk):
 
 
 def make_tile(smk):
-    """Rule ``chart_tile``: integrate one tile of one escape-chart task.
-
-    Grid tasks: a contiguous block of q0 rows x all p0 (dims q0, p0).  Paired ICs: a contiguous
-    block of the samples (dim ``sample``, global index).  A task may carry its own forcing phase
-    ``Psi``.  Each trajectory is independent: the gathered chart is the same for any tile count.
-    """
-    import numpy as np
-
+    """Rule ``chart_tile``: one tile job of one task of a kind with escape-chart tasks
+    (``Kind.compute_tile``; by default a block of q0 rows or samples of the task's chart)."""
     from safebasins.io.datasets import write_netcdf
-    from safebasins.numerics import escape_chart
-    from safebasins.pipeline.values import tile_slice
 
     params, kind = _job(smk)
     k, tile, tiles = int(smk.wildcards.task), int(smk.wildcards.tile), int(smk.wildcards.tiles)
-    task = kind.tasks(params)[k]
-    Psi = task.get("Psi", params.get("Psi"))
-    q0, p0, grid = kind.chart_ics(params)
-    sl = tile_slice(q0.size, tiles, tile)
-    q0 = q0[sl]
-    p0 = p0 if grid else p0[sl]
-    print(f"{params['experiment']} task {k} tile {tile}/{tiles}: F={task['F']} Omega={params['Omega']} Psi={Psi} "
-          f"xi_max={task['xi_max']} q_max={task['q_max']} cycles={params['cycles']} "
-          f"ICs={q0.size}x{p0.size if grid else 1}", flush=True)
-    ds = escape_chart(q0, p0, task["F"], params["Omega"], Psi, xi_max=tuple(task["xi_max"]),
-                      q_max=tuple(task["q_max"]), cycles=params["cycles"], steps_per_cycle=params["steps_per_cycle"],
-                      threads=smk.threads, grid=grid, backend=smk.params.backend)
-    if not grid:
-        ds = ds.assign_coords(sample=np.arange(sl.start, sl.stop))
+    ds = kind.compute_tile(params, k, tile, tiles, Job(threads=smk.threads, backend=smk.params.backend))
     ds.attrs.update(task=k, tile=tile, tiles=tiles)
     write_netcdf(ds, smk.output[0])
     print(ds)

@@ -1,0 +1,106 @@
+"""Integrity maps: GIM, LIM and IF of the safe basin over the control plane (Omega, F).
+
+For one threshold xi_max and forcing phase Psi, every control point (Omega, F) has a safe basin
+on the same (q0, p0) grid; its integrity measures (:mod:`safebasins.analysis.integrity`,
+normalised by the unforced basin) form a map over (Omega, F).
+
+* analytic: every IC classified by the slow flow (``theory.slow_flow_escapes``) -- seconds;
+  plus the phase-invariant basin of each control point in closed form, ``GIM_true =
+  J(xi_true)/J(xi_max)``, ``LIM_true = IF_true = sqrt(xi_true/xi_max)``
+  (:func:`safebasins.analysis.phase_invariant.xi_true_analytic`);
+* numeric: one escape chart per control point (``numerics.escape_chart_batch``: the control
+  points of a block share one ensemble), safe = ``escape_cycle > t_eval`` for every t_eval;
+* :func:`erosion_front`: the F at which a measure first falls below a level, per Omega (the
+  erosion front), and the numeric - analytic difference map.
+"""
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from safebasins import checks
+from safebasins.analysis.common import as_1d, mesh
+from safebasins.analysis.erosion import level_crossing
+from safebasins.analysis.integrity import integrity_measures, unforced_safe_mask
+from safebasins.analysis.phase_invariant import xi_true_analytic
+from safebasins.analysis.safe import safe_stack
+from safebasins.io.cf import annotate
+from safebasins.numerics import escape_chart_batch
+from safebasins.theory import J, slow_flow_escapes
+from safebasins.wells.quartic import QUARTIC
+
+__all__ = ["integrity_map_analytic", "integrity_map_numeric", "integrity_from_batch", "erosion_front"]
+
+MEASURES = ("GIM", "LIM", "IF")
+
+
+def _control(Omega, F):
+    Om = as_1d("Omega", Omega, checks.check_positive)
+    Fv = as_1d("F", F, checks.check_nonnegative)
+    return Om, Fv
+
+
+def integrity_map_analytic(Omega, F, Psi, xi_max, q0, p0, *, fourier="paper", n_gamma=128, n_xi=64):
+    """Analytic integrity map over (Omega, F): GIM, LIM, IF of the slow-flow basin for phase Psi,
+    and ``xi_true``, ``GIM_true``, ``LIM_true`` of the basin safe for every phase."""
+    Om, Fv = _control(Omega, F)
+    Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
+    xi = checks.check_scalar("xi_max", xi_max, QUARTIC.check_threshold)
+    q, p, Q, P = mesh(q0, p0)
+    S0 = unforced_safe_mask(q, p, xi)
+    safe = np.zeros((Om.size, Fv.size, q.size, p.size), bool)
+    xt = np.zeros((Om.size, Fv.size))
+    for i, om in enumerate(Om):
+        for j, f in enumerate(Fv):
+            safe[i, j] = ~np.asarray(slow_flow_escapes(Q, P, f, om, Psi, xi, fourier=fourier), bool) & S0
+            xt[i, j] = xi_true_analytic(f, om, xi, fourier, n_gamma=n_gamma, n_xi=n_xi)
+    da = xr.DataArray(safe, dims=("Omega", "F", "q0", "p0"), coords={"Omega": Om, "F": Fv, "q0": q, "p0": p})
+    m = integrity_measures(da, xi_max=xi)
+    ds = m[list(MEASURES)].copy()
+    ds["xi_true"] = (("Omega", "F"), xt, {"units": "1", "long_name": "energy radius of the basin safe for every "
+                                                                      "phase (H0 < xi_true)"})
+    ds["GIM_true"] = (("Omega", "F"), np.where(xt > 0, J(xt) / J(xi), 0.0),
+                      {"units": "1", "long_name": "GIM of the all-phase basin, J(xi_true)/J(xi_max)"})
+    ds["LIM_true"] = (("Omega", "F"), np.sqrt(xt / xi),
+                      {"units": "1", "long_name": "LIM = IF of the all-phase basin, sqrt(xi_true/xi_max)"})
+    ds.attrs.update(kind="analytic", Psi=Psi, xi_max=xi, fourier=fourier, n_gamma=int(n_gamma), n_xi=int(n_xi),
+                    method="slow_flow_escapes on the grid per control point; xi_true_analytic for all phases")
+    return annotate(ds)
+
+
+def integrity_from_batch(charts, t_eval=None):
+    """GIM, LIM, IF per control point and t_eval from an ``escape_chart_batch`` Dataset (one
+    energy threshold), over (control, t_eval)."""
+    if charts.sizes["xi_max"] != 1:
+        raise ValueError(f"an integrity map uses one energy threshold, the charts have {charts.sizes['xi_max']}")
+    safe, xi_norm = safe_stack(charts, t_eval, "energy")
+    m = integrity_measures(safe.isel(xi_max=0), xi_max=float(xi_norm.values[0]))
+    return m[list(MEASURES)].transpose("control", "t_eval")
+
+
+def integrity_map_numeric(Omega, F, Psi, xi_max, q0, p0, *, cycles=1000, t_eval=None, **chart_kwargs):
+    """Numeric integrity map over (Omega, F, t_eval): one escape chart per control point (all
+    control points in one ensemble), safe = escape_cycle > t_eval."""
+    Om, Fv = _control(Omega, F)
+    OO, FF = np.meshgrid(Om, Fv, indexing="ij")
+    charts = escape_chart_batch(q0, p0, FF.ravel(), OO.ravel(), Psi, xi_max=(float(xi_max),), cycles=cycles,
+                                **chart_kwargs)
+    m = integrity_from_batch(charts, t_eval)
+    ds = xr.Dataset({k: (("Omega", "F", "t_eval"), m[k].values.reshape(Om.size, Fv.size, -1), m[k].attrs)
+                     for k in MEASURES},
+                    coords={"Omega": Om, "F": Fv, "t_eval": m["t_eval"].values})
+    ds.attrs.update(kind="numeric", Psi=float(Psi), xi_max=float(xi_max), cycles=int(cycles),
+                    steps_per_cycle=charts.attrs["steps_per_cycle"], integrator=charts.attrs["integrator"],
+                    method="escape_chart_batch per block of control points; safe = escape_cycle > t_eval")
+    return annotate(ds)
+
+
+def erosion_front(ds, level=0.5, measures=MEASURES):
+    """The F at which each measure first falls below ``level``, per Omega (and t_eval): variables
+    ``F_<measure>`` (NaN where it never does)."""
+    level = checks.check_scalar("level", level, checks.check_positive)
+    out = xr.Dataset()
+    for k in measures:
+        out[f"F_{k}"] = level_crossing(ds[k], level, dim="F").assign_attrs(
+            units="1", long_name=f"erosion front: first F at which {k} falls below {level:g}")
+    return out

@@ -1,0 +1,33 @@
+"""The default tile job of escape-chart tasks (rule ``chart_tile``, ``Kind.compute_tile``).
+
+Grid tasks: a contiguous block of q0 rows x all p0 (dims q0, p0).  Paired ICs: a contiguous
+block of the samples (dim ``sample``, global index).  A task may carry its own forcing phase
+``Psi`` or frequency ``Omega``.  Each trajectory is independent: the gathered chart is the same
+for any tile count.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from safebasins.pipeline.values import tile_slice
+
+
+def chart_tile(kind, params, k, tile, tiles, job):
+    from safebasins.numerics import escape_chart
+
+    task = kind.tasks(params)[k]
+    Psi = task.get("Psi", params.get("Psi"))
+    Omega = task.get("Omega", params.get("Omega"))
+    q0, p0, grid = kind.chart_ics(params)
+    sl = tile_slice(q0.size, tiles, tile)
+    q0 = q0[sl]
+    p0 = p0 if grid else p0[sl]
+    print(f"{params['experiment']} task {k} tile {tile}/{tiles}: F={task['F']} Omega={Omega} Psi={Psi} "
+          f"xi_max={task['xi_max']} q_max={task['q_max']} cycles={params['cycles']} "
+          f"ICs={q0.size}x{p0.size if grid else 1}", flush=True)
+    ds = escape_chart(q0, p0, task["F"], Omega, Psi, xi_max=tuple(task["xi_max"]), q_max=tuple(task["q_max"]),
+                      cycles=params["cycles"], steps_per_cycle=params["steps_per_cycle"], threads=job.threads,
+                      grid=grid, backend=job.backend)
+    if not grid:
+        ds = ds.assign_coords(sample=np.arange(sl.start, sl.stop))
+    return ds
