@@ -42,7 +42,7 @@ class EnergyInterpolant:
         self.n = int(n)
         self.tol = float(tol)
         s_top = self.E_b - self.E_split
-        s_min = 0.25 * np.spacing(self.E_b)
+        s_min = self.E_b - np.nextafter(self.E_b, 0.0)      # smallest E_b - E of a float E
         self.u_min = float(np.log(s_min))
         xs = np.sqrt(self.E_split)
         bottom = [(BOTTOM, a, b) for a, b in zip(np.linspace(0.0, xs, bottom_panels + 1)[:-1],
@@ -53,9 +53,6 @@ class EnergyInterpolant:
         sep = [(SEPARATRIX, a, b) for a, b in zip(ub[:-1], ub[1:])]
         j = np.arange(self.n)
         self._t = np.cos(np.pi * (j + 0.5) / self.n)          # first-kind nodes, descending
-        # coefficient transform c = M f (DCT-II)
-        self._M = (2.0 / self.n) * np.cos(np.pi * np.outer(j, j + 0.5) / self.n)
-        self._M[0] *= 0.5
         todo = bottom + sep
         done = []
         self.n_evaluations = 0
@@ -66,7 +63,7 @@ class EnergyInterpolant:
             vals = np.asarray(func(E_nodes), dtype=float)
             self.n_evaluations += E_nodes.size
             vals = vals.reshape(vals.shape[0], len(todo), self.n)
-            coefs = np.einsum("kj,qpj->qpk", self._M, vals)
+            coefs = self._coefficients(todo, E_nodes.reshape(len(todo), self.n), vals)
             nxt = []
             for i, p in enumerate(todo):
                 scale = np.max(np.abs(vals[:, i, :]), axis=1)
@@ -92,6 +89,25 @@ class EnergyInterpolant:
         kind, a, b = panel
         var = 0.5 * (a + b) + 0.5 * (b - a) * self._t
         return var * var if kind == BOTTOM else self.E_b - np.exp(var)
+
+    def _coefficients(self, panels, E_nodes, vals):
+        """Chebyshev coefficients (Q, P, n) interpolating the values at the energies actually
+        sampled: a node energy is rounded to a float, which near E_b moves ``u = log(E_b - E)``
+        visibly (only multiples of the float spacing of E_b exist there), so the series is
+        fitted at the true positions (least squares on the distinct ones, lower degree where
+        fewer than n distinct energies exist in the panel)."""
+        Q, P, n = vals.shape
+        coefs = np.zeros((Q, P, n))
+        for i, (kind, a, b) in enumerate(panels):
+            E = E_nodes[i]
+            var = np.sqrt(E) if kind == BOTTOM else np.log(self.E_b - E)
+            t = (2.0 * var - (a + b)) / (b - a)
+            t_u, first = np.unique(t, return_index=True)
+            deg = t_u.size - 1
+            A = _cheb.chebvander(t_u, deg)
+            sol = np.linalg.lstsq(A, vals[:, i, first].T, rcond=None)[0]
+            coefs[:, i, :deg + 1] = sol.T
+        return coefs
 
     def _build(self, done):
         self.breaks, self.coef, self.dcoef = {}, {}, {}

@@ -63,7 +63,8 @@ def solve_increasing(fdf, lo, hi, x0, *, xtol=4 * EPS, maxiter=200):
     ``fdf(x, idx)`` returns ``F(x), F'(x)`` for the items ``idx``.  Newton steps that leave the
     bracket, or that do not halve the step before last, are replaced by bisection, so the
     iteration always converges (to the bracketed root, or to the noise band of ``F``).
-    Converged when a step is below ``xtol (|x| + tiny)`` or ``F == 0``.
+    Converged when a step (or the Newton correction) is below ``xtol (|x| + tiny)`` or
+    ``F == 0``.
     """
     lo = np.array(lo, dtype=float, copy=True)
     hi = np.array(hi, dtype=float, copy=True)
@@ -88,6 +89,9 @@ def solve_increasing(fdf, lo, hi, x0, *, xtol=4 * EPS, maxiter=200):
         with np.errstate(divide="ignore", invalid="ignore"):
             step = F / dF
             xn = xa - step
+        # a finite Newton correction below the tolerance: converged at xa (checked before the
+        # bracket test, as xa - step may round to the bracket end xa itself)
+        done = done | ((dF > 0.0) & (np.abs(step) <= xtol * (np.abs(xa) + tiny)))
         bad = (~np.isfinite(xn)) | (xn <= la) | (xn >= ha) | (dF <= 0.0) | \
               (np.abs(2.0 * step) > np.abs(dx_old[active]))
         xb = 0.5 * (la + ha)
@@ -109,8 +113,8 @@ class OrbitQuadrature:
     side has no barrier) which set the width ``alpha`` of the near-separatrix peak.
     """
 
-    def __init__(self, V, dV, limits, barriers, kappa, *, n_nodes=20, panel_length=1.5,
-                 alpha_max=3.0, gap_switch=0.02, n_mean=6, barrier_zone=0.1):
+    def __init__(self, V, dV, limits, barriers, kappa, *, n_nodes=20, n_point=12, panel_length=1.5,
+                 alpha_max=3.0, gap_switch=0.02, n_mean=4, barrier_zone=0.1):
         self.V, self.dV = V, dV
         self.limits = (float(limits[0]), float(limits[1]))
         self.barriers = tuple(float(b) for b in barriers)
@@ -121,7 +125,8 @@ class OrbitQuadrature:
         self.panel_length = float(panel_length)
         self.alpha_max = float(alpha_max)
         self.gap_switch = float(gap_switch)
-        self.x, self.w, self.S = clenshaw_curtis(n_nodes)
+        self.x, self.w, self.S = clenshaw_curtis(n_nodes)      # profiles (cumulative integrals)
+        self.gx, self.gw = _leg.leggauss(n_point)                # definite integrals to a point
         gx, gw = _leg.leggauss(n_mean)
         self.mean_t = 0.5 * (gx + 1.0)
         self.mean_w = 0.5 * gw
@@ -203,12 +208,13 @@ class OrbitQuadrature:
         return psi, q, R, dpsi
 
     # ------------------------------------------------------------------ composite rules
-    def _nodes(self, v_end, m):
-        """Composite CC nodes on ``[0, v_end]`` (per item) with ``m`` equal panels:
-        shape (N, m, n) and the panel half-lengths (N, 1, 1)."""
+    @staticmethod
+    def _nodes(v_end, m, x):
+        """Composite nodes (reference nodes ``x`` on [-1, 1]) on ``[0, v_end]`` (per item) with
+        ``m`` equal panels: shape (N, m, n) and the panel half-lengths (N, 1, 1)."""
         h = (v_end / m)[:, None, None]
         a = h * np.arange(m)[None, :, None]
-        v = a + h * 0.5 * (self.x[None, None, :] + 1.0)
+        v = a + h * 0.5 * (x[None, None, :] + 1.0)
         return v, 0.5 * h
 
     def side_profile(self, E, q_end, d, alpha, sigma, m=None):
@@ -220,7 +226,7 @@ class OrbitQuadrature:
         v_end = np.arcsinh(0.5 * np.pi / alpha)
         if m is None:
             m = max(int(np.ceil(np.max(v_end) / self.panel_length)), 1)
-        v, half = self._nodes(v_end, m)
+        v, half = self._nodes(v_end, m, self.x)
         N = v.shape[0]
         col = lambda a: np.asarray(a, dtype=float).reshape(N, 1, 1)
         psi, q, R, dpsi = self.integrand(col(E), col(q_end), col(d), col(alpha), sigma, v)
@@ -236,7 +242,8 @@ class OrbitQuadrature:
 
     def side_time(self, E, q_end, d, alpha, sigma, psi):
         """Time from the turning point ``q_end`` to the point at ``psi`` (1-D arrays), by
-        composite CC in ``v = asinh(psi/alpha)``, items grouped by their number of panels."""
+        composite Gauss-Legendre in ``v = asinh(psi/alpha)``, items grouped by their number of
+        panels."""
         E, q_end, d, alpha, psi = (np.asarray(a, dtype=float) for a in (E, q_end, d, alpha, psi))
         sigma = np.broadcast_to(np.asarray(sigma, dtype=float), E.shape)
         v_end = np.arcsinh(psi / alpha)
@@ -244,11 +251,11 @@ class OrbitQuadrature:
         out = np.zeros(E.shape)
         for mm in np.unique(m):
             idx = np.nonzero(m == mm)[0]
-            v, half = self._nodes(v_end[idx], int(mm))
+            v, half = self._nodes(v_end[idx], int(mm), self.gx)
             col = lambda a: a[idx].reshape(-1, 1, 1)
             _, _, R, dpsi = self.integrand(col(E), col(q_end), col(d), col(alpha), col(sigma), v)
             f = col(d) / R * dpsi
-            out[idx] = np.sum(half[:, :, 0] * (f @ self.w), axis=1)
+            out[idx] = np.sum(half[:, :, 0] * (f @ self.gw), axis=1)
         return out
 
     def rate(self, E, q_end, d, alpha, sigma, v):

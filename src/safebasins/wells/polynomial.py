@@ -1,0 +1,144 @@
+"""Polynomial wells ``V(q) = sum_k c_k q^k`` (the paper's eq (2) is ``c = (0, 0, 1/2, 0, -1/4)``).
+
+:class:`PolynomialWell` is a :class:`~safebasins.wells.numeric.NumericWell` whose potential is
+a polynomial: V and V' by Horner's rule, the barriers from the real roots of ``V'``.
+
+Which sides have a barrier.  ``c_0 = c_1 = 0`` and ``c_2 > 0`` make ``q = 0`` a non-degenerate
+minimum, so ``V' > 0`` just right of 0 and ``V' < 0`` just left of it.  On each side the barrier
+is the real root of ``V'`` nearest to 0 at which ``V'`` changes sign (a root of even
+multiplicity is an inflection point of V, not a maximum).  If ``V'`` has no such root on a side
+it keeps its sign there, so ``V`` increases monotonically and, being a non-constant polynomial,
+tends to ``+inf``: no escape that way (barrier ``+-inf``).  A side on which ``V -> -inf``
+without a maximum is therefore impossible: ``V`` would have to turn down, and ``V'`` to change
+sign, somewhere.  The remaining special cases are rejected with ValueError by
+:class:`NumericWell`: no barrier on either side (e.g. an even polynomial with positive leading
+coefficient, or the harmonic well) and a degenerate barrier (a root of ``V'`` of odd
+multiplicity >= 3, ``V''(q_b) = 0``).
+
+``cubic()`` is the Helmholtz-Thompson escape equation ``q'' + q - q^2 = F sin(Omega t + Psi)``:
+``V = q^2/2 - q^3/3``, one barrier at ``q = 1`` with energy 1/6, none on the left.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numpy.polynomial import polynomial as P
+
+from safebasins.checks import as_array
+from safebasins.wells.numeric import NumericWell
+
+__all__ = ["PolynomialWell", "polynomial", "cubic", "quartic"]
+
+
+def _check_coefficients(coefficients):
+    try:
+        c = np.array(coefficients, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"coefficients must be a sequence of numbers c_0..c_n, got {coefficients!r}") from exc
+    if c.ndim != 1 or c.size < 3:
+        raise ValueError(f"coefficients must be a 1-D sequence c_0, c_1, c_2, ... (at least 3), got shape {c.shape}")
+    if not np.isfinite(c).all():
+        raise ValueError("coefficients must be finite (no NaN / inf)")
+    if c[0] != 0.0:
+        raise ValueError(f"coefficients: c_0 = {c[0]!r}, must be 0 (V(0) = 0: energies from the well bottom)")
+    if c[1] != 0.0:
+        raise ValueError(f"coefficients: c_1 = {c[1]!r}, must be 0 (V'(0) = 0: the minimum at q = 0)")
+    if not c[2] > 0.0:
+        raise ValueError(f"coefficients: c_2 = {c[2]!r}, must be > 0 (V''(0) = 2 c_2 > 0: q = 0 a minimum)")
+    return np.trim_zeros(c, "b")
+
+
+class PolynomialWell(NumericWell):
+    """``V(q) = sum_k c_k q^k`` with ``c_0 = c_1 = 0``, ``c_2 > 0``.
+
+    ``coefficients`` (float ndarray, trailing zeros removed) is kept for compiled integrators;
+    ``dV_coefficients`` are those of ``V'``.  Remaining keywords go to :class:`NumericWell`
+    (``tol``); ``search_bound`` defaults to a bound on every real root of ``V'`` and of
+    ``V - E_b`` (Cauchy), so that the no-barrier side closes within it.
+    """
+
+    name = "polynomial"
+
+    def __init__(self, coefficients, *, name=None, **kwargs):
+        c = _check_coefficients(coefficients)
+        self.coefficients = c
+        self.dV_coefficients = P.polyder(c)
+        self._d2 = P.polyder(self.dV_coefficients)
+        if "barriers" in kwargs:
+            raise ValueError("barriers: a PolynomialWell finds its barriers from the roots of V'")
+        kwargs.setdefault("search_bound", self._cauchy_bound())
+        dc = self.dV_coefficients
+        super().__init__(lambda q: P.polyval(q, c), lambda q: P.polyval(q, dc), name=name, **kwargs)
+
+    def _cauchy_bound(self):
+        """Bound on |q| of all roots of V' and of V - E for every 0 <= E <= max_k |c_k|... (x4)."""
+        c = self.coefficients
+        dc = self.dV_coefficients
+        b1 = 1.0 + np.max(np.abs(dc[:-1] / dc[-1])) if dc.size > 1 else 1.0
+        # V - E_b with E_b <= V at the barriers; bound E_b by V on the root bound of V'
+        Eb = np.max(np.abs(P.polyval(np.array([-b1, b1]), c)))
+        cc = c.copy()
+        cc[0] = -Eb
+        b2 = 1.0 + np.max(np.abs(cc[:-1] / cc[-1]))
+        return float(4.0 * max(b1, b2))
+
+    def _locate_barriers(self, B, n):
+        """Nearest sign-changing real roots of V' on each side of 0 (Newton-polished)."""
+        dc = self.dV_coefficients
+        if dc.size <= 2:           # V' = 2 c_2 q: harmonic, no barrier
+            return (-np.inf, np.inf)
+        r = P.polyroots(P.polydiv(dc, [0.0, 1.0])[0])   # V' = q * (2 c_2 + 3 c_3 q + ...)
+        scale = max(1.0, float(np.max(np.abs(r))))
+        real = np.sort(r[np.abs(r.imag) <= 1e-7 * scale].real)
+        real = np.array([self._polish(x) for x in real])
+        out = []
+        for side in (-1.0, 1.0):
+            cand = np.sort(side * real[side * real > 0])        # distances from 0, ascending
+            barrier = side * np.inf
+            for i, s in enumerate(cand):
+                nxt = cand[i + 1] if i + 1 < cand.size else 2.0 * s + 1.0
+                probe = side * 0.5 * (s + nxt)
+                if side * P.polyval(probe, dc) < 0:          # V' changed sign: a maximum
+                    barrier = side * s
+                    break
+            out.append(float(barrier))
+        return tuple(out)
+
+    def _polish(self, x):
+        dc, d2 = self.dV_coefficients, self._d2
+        for _ in range(8):
+            f, g = P.polyval(x, dc), P.polyval(x, d2)
+            if g == 0 or not np.isfinite(f / g):
+                break
+            step = f / g
+            x = x - step
+            if abs(step) <= 4 * np.finfo(float).eps * max(abs(x), 1e-300):
+                break
+        return float(x)
+
+    def _curvature(self, qb):
+        return float(-P.polyval(qb, self._d2))
+
+    def V(self, q):
+        return P.polyval(as_array("q", q), self.coefficients)
+
+    def dV(self, q):
+        return P.polyval(as_array("q", q), self.dV_coefficients)
+
+
+def polynomial(coefficients, **kwargs):
+    """The well ``V = sum_k c_k q^k`` (see :class:`PolynomialWell`)."""
+    return PolynomialWell(coefficients, **kwargs)
+
+
+def cubic(**kwargs):
+    """Helmholtz-Thompson escape well ``V = q^2/2 - q^3/3`` (``q'' + q - q^2 = F sin(...)``):
+    barrier at ``q = 1`` with energy 1/6, none on the left (``V -> inf`` as ``q -> -inf``)."""
+    kwargs.setdefault("name", "cubic")
+    return PolynomialWell([0.0, 0.0, 0.5, -1.0 / 3.0], **kwargs)
+
+
+def quartic(**kwargs):
+    """The paper's well, eq (2), ``V = q^2/2 - q^4/4`` by quadrature (closed form:
+    :mod:`safebasins.wells.quartic`)."""
+    kwargs.setdefault("name", "quartic-numeric")
+    return PolynomialWell([0.0, 0.0, 0.5, 0.0, -0.25], **kwargs)
