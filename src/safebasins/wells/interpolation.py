@@ -14,12 +14,14 @@ logarithmically).  The energy range is therefore split at ``E_split`` into
 Each panel holds ``n`` Chebyshev coefficients (first-kind nodes: neither ``E = 0`` nor
 ``E = E_b`` is ever sampled).  Panels are split until the trailing coefficients of every
 quantity are below ``tol`` relative to the panel's values (plus a noise floor supplied by the
-caller, e.g. the conditioning near the separatrix).  Evaluation is vectorised Clenshaw with
-per-point coefficient gathers; derivatives with respect to ``E`` use the differentiated series.
+caller, e.g. the conditioning near the separatrix).  Evaluation is one compiled (numba) loop:
+binary search of the panel, Clenshaw's recurrence; derivatives with respect to ``E`` use the
+differentiated series and the chain rule of the panel variable.
 """
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 from numpy.polynomial import chebyshev as _cheb
 
 __all__ = ["EnergyInterpolant"]
@@ -129,64 +131,80 @@ class EnergyInterpolant:
         return sum(len(b) - 1 for b in self.breaks.values())
 
     # ------------------------------------------------------------------ evaluation
-    def _locate(self, E):
-        """Split energies into the two kinds: index arrays, variable, panel index, local t."""
-        out = []
-        low = E <= self.E_split
-        for kind, mask in ((BOTTOM, low), (SEPARATRIX, ~low)):
-            idx = np.nonzero(mask)[0]
-            if kind == BOTTOM:
-                var = np.sqrt(E[idx])
-            else:
-                var = np.log(self.E_b - E[idx])
-            br = self.breaks[kind]
-            p = np.clip(np.searchsorted(br, var, side="right") - 1, 0, len(br) - 2)
-            a, b = br[p], br[p + 1]
-            t = (2.0 * var - (a + b)) / (b - a)
-            out.append((kind, idx, var, p, t, 2.0 / (b - a)))
-        return out
+    def _run(self, E, quantities, derivative):
+        E = np.ascontiguousarray(E, dtype=float).ravel()
+        q = np.asarray(quantities, dtype=np.int64)
+        out = np.empty((q.size, E.size))
+        var = np.empty(E.size)
+        scale = np.empty(E.size)
+        bottom = np.empty(E.size, dtype=np.bool_)
+        C = self.dcoef if derivative else self.coef
+        _eval_kernel(E, self.E_split, self.E_b, self.breaks[BOTTOM], C[BOTTOM], self.breaks[SEPARATRIX],
+                     C[SEPARATRIX], q, out, var, scale, bottom)
+        return out, var, scale, bottom
 
-    @staticmethod
-    def _clenshaw(C, p, t):
-        n = C.shape[0]
-        b1 = np.zeros_like(t)
-        b2 = np.zeros_like(t)
-        t2 = 2.0 * t
-        for k in range(n - 1, 0, -1):
-            b1, b2 = C[k, p] + t2 * b1 - b2, b1
-        return C[0, p] + t * b1 - b2
+    def evaluate_many(self, E, quantities):
+        """Values of several quantities (one panel search): array (len(quantities), len(E)).
+        ``E`` is a validated 1-D array in ``[0, E_b)``."""
+        return self._run(E, quantities, False)[0]
 
     def evaluate(self, E, quantity, derivative=False):
-        """Values (and, with ``derivative``, ``d/dvar`` plus the variable) of one quantity.
-
-        Returns ``(value, dvalue_dE)`` where ``dvalue_dE`` is None unless requested.
-        ``E`` is a validated 1-D array in ``[0, E_b)``.
-        """
-        val = np.empty(E.shape)
-        der = np.empty(E.shape) if derivative else None
-        for kind, idx, var, p, t, scale in self._locate(E):
-            if idx.size == 0:
-                continue
-            val[idx] = self._clenshaw(self.coef[kind][quantity], p, t)
-            if derivative:
-                dv = self._clenshaw(self.dcoef[kind][quantity], p, t) * scale
-                if kind == BOTTOM:
-                    with np.errstate(divide="ignore", invalid="ignore"):
-                        der[idx] = dv / (2.0 * var)          # dx/dE = 1/(2x)
-                else:
-                    der[idx] = -dv / (self.E_b - E[idx])    # du/dE = -1/(E_b - E)
+        """``(value, dvalue/dE)`` of one quantity (the derivative None unless requested)."""
+        val = self._run(E, (quantity,), False)[0][0]
+        if not derivative:
+            return val, None
+        dv, var, scale, bottom = self._run(E, (quantity,), True)
+        dv = dv[0] * scale
+        with np.errstate(divide="ignore", invalid="ignore"):
+            # dx/dE = 1/(2x) on bottom panels, du/dE = -1/(E_b - E) on separatrix panels
+            der = np.where(bottom, dv / (2.0 * var), -dv / (self.E_b - E))
         return val, der
 
     def evaluate_var(self, E, quantity):
-        """Values and derivatives with respect to the panel variable (x or u) and the kind
-        mask (True on bottom panels), for callers that combine factors analytically."""
-        val = np.empty(E.shape)
-        dvar = np.empty(E.shape)
-        bottom = np.zeros(E.shape, dtype=bool)
-        for kind, idx, var, p, t, scale in self._locate(E):
-            if idx.size == 0:
-                continue
-            val[idx] = self._clenshaw(self.coef[kind][quantity], p, t)
-            dvar[idx] = self._clenshaw(self.dcoef[kind][quantity], p, t) * scale
-            bottom[idx] = kind == BOTTOM
-        return val, dvar, bottom
+        """Values, derivatives with respect to the panel variable (``x = sqrt(E)`` or
+        ``u = log(E_b - E)``) and the mask of bottom panels, for callers that combine factors
+        analytically."""
+        val = self._run(E, (quantity,), False)[0][0]
+        dv, var, scale, bottom = self._run(E, (quantity,), True)
+        return val, dv[0] * scale, bottom
+
+
+@njit(cache=True)
+def _eval_kernel(E, E_split, E_b, br0, C0, br1, C1, quantities, out, var_out, scale_out, bottom_out):
+    """Piecewise Chebyshev series (Clenshaw) at energies E: for each point the panel variable
+    (``sqrt(E)`` below ``E_split``, ``log(E_b - E)`` above), its panel (binary search in the
+    breaks), the local ``t`` in [-1, 1] and the series ``C[q, :, panel]`` for every q."""
+    n = C0.shape[1]
+    for i in range(E.size):
+        e = E[i]
+        if e <= E_split:
+            v = np.sqrt(e)
+            br = br0
+            C = C0
+            bottom_out[i] = True
+        else:
+            v = np.log(E_b - e)
+            br = br1
+            C = C1
+            bottom_out[i] = False
+        P = br.size - 1
+        p = np.searchsorted(br, v, side="right") - 1
+        if p < 0:
+            p = 0
+        elif p > P - 1:
+            p = P - 1
+        a = br[p]
+        b = br[p + 1]
+        t = (2.0 * v - (a + b)) / (b - a)
+        var_out[i] = v
+        scale_out[i] = 2.0 / (b - a)
+        t2 = 2.0 * t
+        for j in range(quantities.size):
+            qj = quantities[j]
+            b1 = 0.0
+            b2 = 0.0
+            for k in range(n - 1, 0, -1):
+                tmp = C[qj, k, p] + t2 * b1 - b2
+                b2 = b1
+                b1 = tmp
+            out[j, i] = C[qj, 0, p] + t * b1 - b2

@@ -111,6 +111,8 @@ class NumericWell(Well):
                              "on both sides): nothing can escape")
         self._E_b = min(vals)
         self.limits = tuple(self._limit(side, b, B, int(n_scan)) for side, b in zip((-1.0, 1.0), found))
+        for side, lim in zip((-1.0, 1.0), self.limits):
+            self._check_monotone(side, lim)
         self._check_derivative()
         kappa = tuple(self._curvature(b) if np.isfinite(b) else np.nan for b in found)
         for k, b in zip(kappa, found):
@@ -129,10 +131,13 @@ class NumericWell(Well):
             raise ValueError(f"V: V(0) = {v0!r}, must be 0 (energies are measured from the well bottom q = 0)")
         if not (np.isfinite(d0) and abs(d0) <= BOTTOM_ATOL):
             raise ValueError(f"dV: V'(0) = {d0!r}, must be 0 (the minimum of the well must be at q = 0)")
-        h = 1e-6
-        k0 = float((_call(self._dV, np.array([h]))[0] - _call(self._dV, np.array([-h]))[0]) / (2 * h))
-        if not (np.isfinite(k0) and k0 > 0):
-            raise ValueError(f"V: V''(0) = {k0!r} (finite differences of dV), must be > 0: q = 0 must be a "
+        # V''(0) from V'(h)/h on both sides at h = 1e-6 and 1e-7: they must agree (a degenerate
+        # minimum, V'' (0) = 0, has V'(h)/h ~ h^2 and fails the comparison)
+        h = np.array([-1e-6, -1e-7, 1e-7, 1e-6])
+        g = _call(self._dV, h) / h
+        k0 = float(np.mean(g))
+        if not (np.isfinite(g).all() and (g > 0).all() and g.min() > 0.5 * g.max()):
+            raise ValueError(f"V: V''(0) = {float(g.min())!r} (V'(q)/q near 0), must be > 0: q = 0 must be a "
                              "non-degenerate minimum")
         self.omega0 = float(np.sqrt(k0))
 
@@ -146,13 +151,15 @@ class NumericWell(Well):
 
     def _find_barrier(self, side, B, n):
         s, f = self._scan(side, B, n)
-        if not np.isfinite(f).all():
-            raise ValueError(f"dV: not finite on the scan {'left' if side < 0 else 'right'} of 0 up to "
-                             f"search_bound={B}")
-        neg = np.nonzero(f < 0)[0]
-        if neg.size == 0:
+        where = "left" if side < 0 else "right"
+        stop = np.nonzero((f < 0) | ~np.isfinite(f))[0]
+        self._scans = getattr(self, "_scans", {})
+        self._scans[side] = (s, f)
+        if stop.size == 0:
             return side * np.inf
-        i = int(neg[0])
+        i = int(stop[0])
+        if not np.isfinite(f[i]):
+            raise ValueError(f"dV: V'({side * s[i]!r}) is not finite, {where} of 0 before any barrier")
         if i == 0:
             raise ValueError("dV: V' has the wrong sign next to q = 0 (q = 0 is not a minimum)")
         a, b = s[i - 1], s[i]
@@ -161,6 +168,24 @@ class NumericWell(Well):
         g = lambda x: side * float(_call(self._dV, np.array([side * x]))[0])
         r = optimize.brentq(g, a, b, xtol=1e-300, rtol=4 * EPS, maxiter=500)
         return side * r
+
+    def _check_monotone(self, side, lim):
+        """V' must not vanish between 0 and the limit (an interior equilibrium, e.g. an
+        inflection point with V' = 0, carries a non-periodic orbit): interior local minima of
+        ``V'(q)/q`` on the scan are polished and rejected if they reach ~0."""
+        s, f = self._scans[side]
+        keep = s < abs(lim)
+        s, g = s[keep], f[keep] / s[keep]
+        if g.size < 3:
+            return
+        j = np.nonzero((g[1:-1] <= g[:-2]) & (g[1:-1] <= g[2:]) & (g[1:-1] < 1e-3 * g[0]))[0] + 1
+        h = lambda x: side * float(_call(self._dV, np.array([side * x]))[0]) / x
+        for k in j:
+            res = optimize.minimize_scalar(h, bounds=(s[k - 1], s[k + 1]), method="bounded",
+                                           options={"xatol": 1e-12 * s[k]})
+            if res.fun <= 1e-9 * g[0]:
+                raise ValueError(f"V: V' vanishes at q ~ {float(side * res.x)!r} inside the well (an equilibrium that is "
+                                 "not a barrier): the orbit through it is not periodic")
 
     def _check_given_barriers(self, barriers, found):
         try:
@@ -326,17 +351,19 @@ class NumericWell(Well):
 
     def first_harmonic(self, E):
         """Complex ``q_1(E) = |q_1| exp(i arg q_1)`` (eq 12); ``-i G_exact`` for the quartic."""
-        return self.harmonic_amplitude(E) * np.exp(1j * self.harmonic_phase(E))
+        E = self.check_energy("E", E)
+        e = E.ravel()
+        h, thm = self._interp.evaluate_many(e, (_H, _THM))
+        phase = -(thm + np.pi)
+        return ((h * np.sqrt(e)) * (np.cos(phase) + 1j * np.sin(phase))).reshape(E.shape)
 
     # ------------------------------------------------------------------ angles
     def _orbits(self, E):
         """Per-item orbit data for 1-D energies ``0 < E < E_b``: interpolated period, angle of
         q_minus, time to the middle, and Newton-polished turning points with geometry."""
-        it = self._interp
-        T = it.evaluate(E, _T)[0]
-        thm = it.evaluate(E, _THM)[0]
-        tl = it.evaluate(E, _TL)[0] * T
-        guess = (it.evaluate(E, _QM)[0], it.evaluate(E, _QP)[0])
+        T, thm, tl, qm0, qp0 = self._interp.evaluate_many(E, (_T, _THM, _TL, _QM, _QP))
+        tl = tl * T
+        guess = (qm0, qp0)
         qm, qp = self._quad.turning_points(E, guess)
         m, d, aL, aR = self._quad.geometry(E, qm, qp)
         return {"T": T, "omega": 2.0 * np.pi / T, "theta_minus": thm, "t_left": tl,
@@ -356,10 +383,19 @@ class NumericWell(Well):
             o = self._orbits(Ek)
             left = qk <= o["m"]
             q_end = np.where(left, o["q_minus"], o["q_plus"])
-            ratio = np.abs(qk - q_end) / (2.0 * o["d"])
-            psi = 2.0 * np.arcsin(np.sqrt(np.clip(ratio, 0.0, 1.0)))
+            sigma = np.where(left, -1.0, 1.0)
+            # sin(psi/2) from q (h = 2 d sin^2(psi/2)); near the turning point, where that is
+            # ill-conditioned in E (q_end moves with E), from p = 2 sqrt(sigma d <V'>) sin(psi/2)
+            half = np.sqrt(np.clip(np.abs(qk - q_end) / (2.0 * o["d"]), 0.0, 1.0))
+            near = np.nonzero(half < 0.5)[0]
+            if near.size:
+                mean = self._quad.mean_dV(qk[near], q_end[near])
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    hp = np.abs(pk[near]) / (2.0 * np.sqrt(sigma[near] * o["d"][near] * mean))
+                half[near] = np.where(np.isfinite(hp), np.minimum(hp, 1.0), half[near])
+            psi = 2.0 * np.arcsin(half)
             alpha = np.where(left, o["alpha_left"], o["alpha_right"])
-            tau = self._quad.side_time(Ek, q_end, o["d"], alpha, np.where(left, -1.0, 1.0), psi)
+            tau = self._quad.side_time(Ek, q_end, o["d"], alpha, sigma, psi)
             wt = o["omega"] * tau
             upper = pk >= 0
             thm = o["theta_minus"]

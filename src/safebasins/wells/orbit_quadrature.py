@@ -134,11 +134,13 @@ class OrbitQuadrature:
     # ------------------------------------------------------------------ turning points
     def turning_points(self, E, guess=None):
         """``(q_minus, q_plus)`` with ``V = E`` for ``0 <= E <= E_b`` (validated, 1-D)."""
-        E = np.asarray(E, dtype=float)
+        E_all = np.asarray(E, dtype=float)
+        pos = np.nonzero(E_all > 0)[0]              # E = 0: both turning points at the bottom
+        E = E_all[pos]
         out = []
         for k, side in enumerate((-1.0, 1.0)):
             lim, qb, Vb = self.limits[k], self.barriers[k], self.barrier_V[k]
-            x0 = np.full(E.shape, 0.5 * lim) if guess is None else guess[k]
+            x0 = np.full(E.shape, 0.5 * lim) if guess is None else np.asarray(guess[k])[pos]
 
             # F(s) = V(side s) - E is increasing in s = side q on [0, |lim|]; near a barrier
             # V(q) - E = (V_b - E) - (q_b - q) <V'>_[q, q_b]: only V' and the exact difference
@@ -150,14 +152,21 @@ class OrbitQuadrature:
                     zone = np.abs(qb - q) <= self.barrier_zone * abs(qb)
                     if zone.any():
                         qz = q[zone]
-                        mean = np.zeros_like(qz)
-                        for t, wt in zip(self.mean_t, self.mean_w):
-                            mean += wt * self.dV(qz + (qb - qz) * t)
+                        mean = self.mean_dV(qz, qb)
                         F[zone] = (Vb - E[idx][zone]) - (qb - qz) * mean
                 return F, side * self.dV(q)
             s = solve_increasing(fdf, np.zeros(E.shape), np.full(E.shape, abs(lim)), side * x0)
-            out.append(side * s)
+            q = np.zeros(E_all.shape)
+            q[pos] = np.where(E >= Vb, qb, side * s)   # on the separatrix: the barrier itself
+            out.append(q)
         return out[0], out[1]
+
+    def mean_dV(self, q, q_end):
+        """Mean of ``V'`` over the segment ``[q, q_end]`` (Gauss-Legendre, ``n_mean`` nodes)."""
+        mean = np.zeros(np.broadcast_shapes(np.shape(q), np.shape(q_end)))
+        for t, wt in zip(self.mean_t, self.mean_w):
+            mean = mean + wt * self.dV(q + (q_end - q) * t)
+        return mean
 
     def geometry(self, E, q_minus, q_plus):
         """Centre ``m``, half-width ``d`` and peak widths ``alpha`` of each side."""
@@ -201,9 +210,7 @@ class OrbitQuadrature:
             qe = np.broadcast_to(q_end, shape)[near]
             dn = np.broadcast_to(d, shape)[near]
             sg = np.broadcast_to(sigma, shape)[near]
-            mean = np.zeros_like(qn)
-            for t, wt in zip(self.mean_t, self.mean_w):
-                mean += wt * self.dV(qn + (qe - qn) * t)
+            mean = self.mean_dV(qn, qe)
             R[near] = np.sqrt(np.maximum(sg * dn * mean, 0.0)) / np.cos(0.5 * psi_b[near])
         return psi, q, R, dpsi
 

@@ -70,12 +70,13 @@ class PolynomialWell(NumericWell):
         super().__init__(lambda q: P.polyval(q, c), lambda q: P.polyval(q, dc), name=name, **kwargs)
 
     def _cauchy_bound(self):
-        """Bound on |q| of all roots of V' and of V - E for every 0 <= E <= max_k |c_k|... (x4)."""
+        """Search bound (x4 margin) from Cauchy's root bound ``1 + max |a_k / a_n|``: it contains
+        every real root of ``V'`` (the barriers) and of ``V - E`` for every E up to a bound of
+        ``|V|`` on the roots' range, so the no-barrier side rises above the escape energy within it."""
         c = self.coefficients
         dc = self.dV_coefficients
-        b1 = 1.0 + np.max(np.abs(dc[:-1] / dc[-1])) if dc.size > 1 else 1.0
-        # V - E_b with E_b <= V at the barriers; bound E_b by V on the root bound of V'
-        Eb = np.max(np.abs(P.polyval(np.array([-b1, b1]), c)))
+        b1 = 1.0 + np.max(np.abs(dc[:-1] / dc[-1]))
+        Eb = float(np.sum(np.abs(c) * b1 ** np.arange(c.size)))    # >= |V| on |q| <= b1
         cc = c.copy()
         cc[0] = -Eb
         b2 = 1.0 + np.max(np.abs(cc[:-1] / cc[-1]))
@@ -101,7 +102,16 @@ class PolynomialWell(NumericWell):
                     barrier = side * s
                     break
             out.append(float(barrier))
+        self._real_roots = real
         return tuple(out)
+
+    def _check_monotone(self, side, lim):
+        """No root of V' strictly between 0 and the limit (a root of even multiplicity there is
+        an equilibrium with V' = 0 whose orbit is not periodic)."""
+        inner = [r for r in self._real_roots if 0 < side * r < abs(lim) * (1 - 1e-12)]
+        if inner:
+            raise ValueError(f"coefficients: V' vanishes at q = {float(inner[0])!r} inside the well without changing sign "
+                             "(an inflection point with V' = 0): the orbit through it is not periodic")
 
     def _polish(self, x):
         dc, d2 = self.dV_coefficients, self._d2
