@@ -1,0 +1,15 @@
+"""The ``safebasins`` command line: one-off charts, F_cr curves and basins without a pipeline config.
+
+Each command validates its options with the library's own checks (a bad value is named before
+anything is computed), builds its dataset with the build functions of the pipeline's experiment
+kinds (same layout and variables as ``results/data``), adds the CF/provenance attributes with
+:func:`safebasins.io.datasets.finalize`, writes ``PREFIX.nc`` atomically and draws
+``PREFIX.png`` with the pipeline's figure builder.
+
+options   option types and checks (library checks, library/schema defaults)
+output    provenance, progress bars, figures, atomic files, the `info` summary
+commands  the click group ``main`` (console script ``safebasins``) and its commands
+"""
+from safebasins.cli.commands import main
+
+__all__ = ["main"]

@@ -1,0 +1,300 @@
+"""The commands: `chart`, `fcr`, `basin`, `info` (group `main`, the console script)."""
+from __future__ import annotations
+
+import math
+import tempfile
+from pathlib import Path
+
+import click
+
+from safebasins.cli.options import (DISPLACEMENT, ENERGY, FINITE, OPTION_OF, POSITIVE, Deferred, Fields, Number,
+                                    NumberList, analytic_threshold, checked, common_options, forcing_options,
+                                    from_library, from_schema, grid_options, grid_params, joined, lib_check,
+                                    library_errors, numerics_options, out_option)
+from safebasins.cli.output import chatter, describe, draw, finish, fmt, job, progress, write_outputs
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
+@click.version_option(package_name="safebasins")
+def main():
+    """Safe basins of q'' + q - q^3 = F sin(Omega t + Psi): analytic (slow flow) and numeric.
+
+    Each command writes PREFIX.nc (CF + provenance attributes, the pipeline's dataset layout)
+    and PREFIX.png (the pipeline's figure).  Long runs show a progress bar on stderr when it is
+    a terminal.  `safebasins info FILE.nc` tells what a dataset holds and where it came from.
+    """
+
+
+@main.command()
+@forcing_options
+@click.option("--xi-max", "xi_max", type=NumberList("xi_max", analytic_threshold), multiple=True, required=True,
+              callback=joined(unique=True),
+              help="Energy thresholds in (0, 1/4): comma list or repeated (one basin each).")
+@click.option("--q-max", "q_max", type=NumberList("q_max", DISPLACEMENT), multiple=True,
+              callback=joined(unique=True), help="Displacement thresholds |q| > q_max in (0, 1], stored beside the energy ones.")
+@grid_options
+@numerics_options("safebasins.numerics:escape_chart", "integrated; the stored IoU is evaluated at it")
+@click.option("--t-eval", "t_eval", type=Number("t_eval", POSITIVE), default=None,
+              help="Evaluation time (EC, <= --cycles) of the basins drawn in the PNG [default: --cycles].")
+@click.option("--n-points", "n_points", cls=Deferred, type=int, default=from_schema("basin_chart", "n_points"),
+              callback=checked("n_points", lib_check("safebasins.checks:check_positive_int")),
+              help="Vertices per analytic boundary curve.")
+@click.option("--tiles", type=click.IntRange(min=1), default=None,
+              help="Row tiles (blocks of q0) integrated one after another; the progress bar counts them "
+                   "[default: min(NQ, 10)]. The chart does not depend on it.")
+@common_options
+@out_option("chart")
+def chart(F, Omega, Psi, xi_max, q_max, grid, n, cycles, steps_per_cycle, threads, backend, t_eval, n_points, tiles,
+          fourier, no_plot, quiet, verbose, out):
+    """Numeric escape chart on an IC grid with the analytic safe basins and their IoU.
+
+    One integration serves every threshold.  PREFIX.nc is the chart in the layout of the
+    pipeline's Figs 13-15 (`escape_cycle_energy(xi_max, q0, p0)`, `iou(xi_max)`,
+    `pixel_agreement(xi_max)`, numeric safe = escape cycle > cycles); PREFIX.png shows the
+    numeric safe basins (grey, nested) with the slow-flow boundaries (lines).
+
+    Example: safebasins chart --F 0.01 --Omega 0.9 --Psi pi --xi-max 0.14,0.18 --n 100 --cycles 1000
+    """
+    t_eval = float(cycles) if t_eval is None else t_eval
+    if t_eval > cycles:
+        raise click.BadParameter(f"evaluation time {t_eval} beyond the horizon --cycles {cycles}",
+                                 param_hint="'--t-eval'")
+    tiles = min(n[0], 10) if tiles is None else tiles
+    if tiles > n[0]:
+        raise click.BadParameter(f"{tiles} tiles but only {n[0]} q0 rows", param_hint="'--tiles'")
+    name = Path(out).name
+    params = dict(command="chart", kind="basin_chart", experiment=name, fourier=fourier, scan="xi_max", F=F,
+                  xi_max=xi_max, q_max=q_max, Omega=Omega, Psi=Psi, grid=grid_params(grid, n), cycles=cycles,
+                  t_eval=[t_eval], n_points=n_points, steps_per_cycle=steps_per_cycle,
+                  tasks=[{"F": F, "xi_max": xi_max, "q_max": q_max}])
+    params["title"] = (f"Escape chart and slow-flow safe basins, F = {fmt(F)}, Omega = {fmt(Omega)}, "
+                       f"Psi = {fmt(Psi, angle=True)} (safebasins chart {name})")
+    with library_errors(), chatter(verbose):
+        ds, basins = chart_dataset(params, tiles, job(threads, backend), quiet)
+        finish(ds, title=params["title"], params=params)
+        fig = None
+        if not no_plot:
+            from safebasins.plotting.charts import figure_nested_basins
+
+            fig = draw(figure_nested_basins, basins, ds, t_eval=None if t_eval == cycles else t_eval)
+    write_outputs([(f"{out}.nc", ds)], fig, f"{out}.png")
+    for x, a, px in zip(ds["xi_max"].values, ds["iou"].values, ds["pixel_agreement"].values):
+        click.echo(f"xi_max = {fmt(x)}: IoU = {a:.4f}, pixel agreement = {px:.4f} (t_eval = {cycles} EC)")
+
+
+def chart_tiles(params, tiles, job, quiet):
+    """The chart's row tiles (contiguous q0 blocks), each the pipeline's own tile job."""
+    from safebasins.pipeline.registry import KINDS
+
+    kind = KINDS[params["kind"]]
+    parts = []
+    with progress(tiles, "escape chart", "tile", quiet) as bar:
+        for k in range(tiles):
+            parts.append(kind.compute_tile(params, 0, k, tiles, job))
+            bar.update(1)
+    return parts
+
+
+def chart_dataset(params, tiles, job, quiet):
+    """(chart with agreement, analytic basins) through the pipeline's own gather and agreement code:
+    it reads tile and basin files, so they go to a temporary folder as the pipeline rules write them."""
+    from safebasins.io.datasets import finalize, write_netcdf
+    from safebasins.pipeline.kinds.basins import build_basin_stack, build_chart_agreement
+
+    parts = chart_tiles(params, tiles, job, quiet)
+    basins = build_basin_stack(params, {}, job)
+    with tempfile.TemporaryDirectory(prefix="safebasins-chart-") as tmp:
+        paths = [write_netcdf(ds, Path(tmp) / f"tile{k:04d}.nc") for k, ds in enumerate(parts)]
+        basin_path = write_netcdf(finalize(basins.copy(), title="analytic basins", params=params),
+                                  Path(tmp) / "basin.nc")
+        ds = build_chart_agreement(params, {"tiles": paths, "basin": basin_path}, job)
+    return ds, basins
+
+
+def n_scan_check(n):
+    if n < 0 or n == 1:
+        raise ValueError(f"n_scan must be 0 (no scan) or an integer >= 2, got {n}")
+    return n
+
+
+@main.command()
+@click.option("--Omega-range", "Omega_range", type=Fields("range"), default="0.5,1.2,351", show_default=True,
+              help="Analytic Omega values start,stop,num (endpoints included).")
+@click.option("--xi-max", "xi_max", type=NumberList("xi_max", analytic_threshold), multiple=True, required=True,
+              callback=joined(unique=False),
+              help="Truncation levels in (0, 1/4): one curve each (comma list or repeated).")
+@click.option("--xi-ini", "xi_ini", type=NumberList("xi_ini", ENERGY), multiple=True,
+              callback=joined(unique=False), help="Initial energies (< xi_max) [default: 0, the zero IC].")
+@click.option("--gamma-ini", "gamma_ini", type=NumberList("gamma_ini", FINITE, angle=True), multiple=True,
+              callback=joined(unique=False), help="Initial slow phases gamma_ini = theta0 - Psi [default: 0].")
+@click.option("--numeric/--no-numeric", default=False, show_default=True,
+              help="Also the numeric F_cr (bisection + F scan) for the IC (xi_ini, gamma_ini, Psi).")
+@click.option("--numeric-Omega", "numeric_Omega", type=Fields("range"), default=None,
+              help="Numeric Omega values start,stop,num [default: --Omega-range].")
+@click.option("--Psi", "Psi", type=Number("Psi", FINITE, angle=True), default="0", show_default=True,
+              help="Forcing phase of the numeric runs (maps (xi_ini, gamma_ini) to (q0, p0)).")
+@numerics_options("safebasins.numerics:critical_forcing_numeric", "of the numeric escape test")
+@click.option("--tol", type=Number("tol", POSITIVE),
+              cls=Deferred, default=from_library("safebasins.numerics:critical_forcing_numeric", "tol"),
+              help="Bisection tolerance on F.")
+@click.option("--n-scan", "n_scan", type=int, callback=checked(None, n_scan_check),
+              cls=Deferred, default=from_library("safebasins.numerics:critical_forcing_numeric", "n_scan"),
+              help="F values of the non-monotonicity scan (0: none).")
+@click.option("--F-bracket", "F_bracket", type=Fields("bracket"), default="0,0.3", show_default=True,
+              help="Bisection bracket lo,hi of F.")
+@click.option("--criterion", type=click.Choice(["energy", "displacement"]), default="energy", show_default=True,
+              help="Numeric escape: H0 > xi_max, or |q| > q_max(xi_max).")
+@common_options
+@out_option("fcr")
+def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cycles, steps_per_cycle,
+        threads, backend, tol, n_scan, F_bracket, criterion, fourier, no_plot, quiet, verbose, out):
+    """Critical forcing F_cr(Omega): analytic curves, optionally with the numeric bisection.
+
+    Curves come from --xi-max / --xi-ini / --gamma-ini (equal lengths or length 1).  Writes
+    PREFIX.nc (analytic, layout of the pipeline's fcr datasets: `F_cr(curve, Omega)`,
+    `mechanism`, branches) and with --numeric also PREFIX_numeric.nc (`F_cr`, brackets,
+    `non_monotone`); PREFIX.png shows the curves (and the numeric dots).
+
+    Example: safebasins fcr --xi-max 0.15 --numeric --numeric-Omega 0.6,1.1,11 --cycles 1000
+    """
+    from safebasins.pipeline import values
+
+    block = {"xi_max": xi_max, "xi_ini": xi_ini or [0.0], "gamma_ini": gamma_ini or [0.0], "Psi": Psi}
+    lens = {k: len(block[k]) for k in ("xi_max", "xi_ini", "gamma_ini")}
+    ncurve = max(lens.values())
+    for k, m in lens.items():
+        if m not in (1, ncurve):
+            raise click.BadParameter(f"{m} values but another curve list has {ncurve}: give equal lengths or one",
+                                     param_hint=f"'{OPTION_OF[k]}'")
+    curves = values.curves(block, numeric)
+    for c in curves:
+        if not c["xi_ini"] < c["xi_max"]:
+            raise click.BadParameter(f"initial energy {c['xi_ini']} must be below the truncation level xi_max = "
+                                     f"{c['xi_max']}", param_hint="'--xi-ini'")
+    name = Path(out).name
+    params = dict(command="fcr", kind="fcr_compare" if numeric else "fcr_theory", experiment=name, fourier=fourier,
+                  Omega=values.range_values(Omega_range), curves=curves)
+    if numeric:
+        params["numeric"] = {"Omega": values.range_values(numeric_Omega or Omega_range), "cycles": cycles,
+                             "tol": tol, "F_bracket": F_bracket, "n_scan": n_scan, "criterion": criterion,
+                             "steps_per_cycle": steps_per_cycle}
+    params["title"] = f"Critical forcing F_cr(Omega) (safebasins fcr {name})"
+    from safebasins.pipeline.kinds.fcr import build_fcr_analytic
+
+    with library_errors(), chatter(verbose):
+        ana = finish(build_fcr_analytic(params, {}, job(threads, backend)), title=params["title"], params=params)
+        outputs = [(f"{out}.nc", ana)]
+        num = None
+        if numeric:
+            num = finish(fcr_numeric(params, job(threads, backend), quiet), title=params["title"], params=params)
+            outputs.append((f"{out}_numeric.nc", num))
+        fig = None
+        if not no_plot:
+            from safebasins.plotting import fcr as plots
+
+            fig = (draw(plots.figure_fcr_comparison, ana, num) if numeric
+                   else draw(plots.figure_fcr, ana, show_branches=len(curves) == 1))
+    write_outputs(outputs, fig, f"{out}.png")
+    for i, c in enumerate(curves):
+        f = ana["F_cr"].isel(curve=i)
+        line = (f"analytic min F_cr = {fmt(float(f.min()))} at Omega = {fmt(float(f.idxmin('Omega')))}"
+                if bool(f.notnull().any()) else "no analytic F_cr in the Omega range")
+        if num is not None:
+            g = num.isel(curve=i)
+            line += (f"; numeric F_cr at {int(g['F_cr'].notnull().sum())} of {g.sizes['Omega']} Omega, "
+                     f"{int(g['non_monotone'].sum())} non-monotone")
+        click.echo(f"{c['label']}: {line}")
+
+
+def fcr_numeric(params, job, quiet):
+    """Numeric F_cr in chunks of Omega (each point bisects independently, so the result equals one
+    call; the library offers no per-level hook), with a progress bar per chunk."""
+    import numpy as np
+    import xarray as xr
+
+    from safebasins.pipeline.kinds.fcr import build_fcr_numeric
+
+    Om = params["numeric"]["Omega"]
+    size = max(4, math.ceil(len(Om) / 20))
+    parts = []
+    with progress(len(Om), "numeric F_cr", "Omega", quiet) as bar:
+        for i in range(0, len(Om), size):
+            chunk = {**params, "numeric": {**params["numeric"], "Omega": Om[i:i + size]}}
+            parts.append(build_fcr_numeric(chunk, {}, job))
+            bar.update(len(chunk["numeric"]["Omega"]))
+    out = xr.concat(parts, dim="Omega", data_vars="minimal", coords="minimal", compat="override",
+                    combine_attrs="override")
+    # bisection_levels (an attribute, or a coordinate over curve where curves differ) counts the
+    # levels of one call: the chunked run reports the maximum over its chunks, as one call would
+    ncurve = out.sizes["curve"]
+    levels = np.max([p["bisection_levels"].values if "bisection_levels" in p.coords
+                     else np.full(ncurve, p.attrs["bisection_levels"]) for p in parts], axis=0).astype(np.int64)
+    out = out.drop_vars("bisection_levels", errors="ignore")
+    out.attrs.pop("bisection_levels", None)
+    if np.all(levels == levels[0]):
+        out.attrs["bisection_levels"] = int(levels[0])
+    else:
+        out = out.assign_coords(bisection_levels=("curve", levels))
+    return out
+
+
+@main.command()
+@forcing_options
+@click.option("--xi-max", "xi_max", type=Number("xi_max", analytic_threshold), required=True,
+              help="Energy truncation level in (0, 1/4).")
+@grid_options
+@click.option("--n-points", "n_points", cls=Deferred, type=int, default=from_schema("basin_rm", "n_points"),
+              callback=checked("n_points", lib_check("safebasins.checks:check_positive_int")),
+              help="Vertices per boundary curve.")
+@click.option("--n-gamma", "n_gamma", type=click.IntRange(min=2),
+              cls=Deferred, default=from_schema("basin_rm", "manifold", "n_gamma"),
+              help="gamma points of the resonance-manifold panel.")
+@click.option("--n-xi", "n_xi", type=click.IntRange(min=2),
+              cls=Deferred, default=from_schema("basin_rm", "manifold", "n_xi"),
+              help="xi points of the resonance-manifold panel.")
+@click.option("--xi-top", "xi_top", type=Number("xi_top", ENERGY),
+              cls=Deferred, default=from_schema("basin_rm", "manifold", "xi_top"),
+              help="Top of the resonance-manifold panel (< 1/4).")
+@common_options
+@out_option("basin")
+def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, fourier, no_plot, quiet, verbose, out):
+    """Analytic safe basin of the slow flow, on the resonance manifold and on the IC plane.
+
+    PREFIX.nc has the layout of the pipeline's Figs 5-9: boundary curves (`gamma`, `xi`,
+    `q0_vertex`, `p0_vertex`, `kind`), `escapes(q0, p0)`, `C` and `escapes_rm` on
+    (gamma_rm, xi_rm); PREFIX.png is the two-panel figure.
+
+    Example: safebasins basin --F 0.0876 --Omega 0.92 --xi-max 0.24
+    """
+    if not xi_top > 0:
+        raise click.BadParameter(f"must be > 0, got {xi_top}", param_hint="'--xi-top'")
+    name = Path(out).name
+    params = dict(command="basin", kind="basin_rm", experiment=name, fourier=fourier, F=F, Omega=Omega, Psi=Psi,
+                  xi_max=xi_max, grid=grid_params(grid, n), n_points=n_points,
+                  manifold={"n_gamma": n_gamma, "n_xi": n_xi, "xi_top": xi_top})
+    params["title"] = (f"Analytic safe basin, F = {fmt(F)}, Omega = {fmt(Omega)}, Psi = {fmt(Psi, angle=True)}, "
+                       f"xi_max = {fmt(xi_max)} (safebasins basin {name})")
+    from safebasins.pipeline.kinds.basins import build_basin_single
+
+    with library_errors(), chatter(verbose):
+        ds = finish(build_basin_single(params, {}, job(None, "cpu")), title=params["title"], params=params)
+        fig = None
+        if not no_plot:
+            from safebasins.plotting.basins import figure_rm_basin
+
+            fig = draw(figure_rm_basin, ds)
+    write_outputs([(f"{out}.nc", ds)], fig, f"{out}.png")
+    safe = ~ds["escapes"].astype(bool)
+    kinds = sorted({str(k) for k in ds["kind"].values if str(k)})
+    click.echo(f"analytic safe: {int(safe.sum())} of {safe.size} ICs ({float(safe.mean()):.1%}); "
+               f"boundary curves: {', '.join(kinds) or 'none'}")
+
+
+@main.command()
+@click.argument("file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--params/--no-params", "show_params", default=True, show_default=True,
+              help="Print the parameters JSON (briefly).")
+def info(file, show_params):
+    """What a safebasins netCDF dataset holds and where it came from."""
+    for line in describe(file, show_params=show_params):
+        click.echo(line)

@@ -1,0 +1,324 @@
+"""Option values of the command line: parsed here, checked by the library's own checks.
+
+A bad value is rejected while click parses the command line (exit status 2, the option named),
+before anything is computed; the checks are the library's (``safebasins.checks``, the well's
+methods, ``numerics.engine``), imported on use so that ``--help`` stays instant.  Defaults are
+read from the library signatures and the pipeline schema, never restated.
+"""
+from __future__ import annotations
+
+import contextlib
+import inspect
+import math
+import re
+from pathlib import Path
+
+import click
+
+#: numerics backends (safebasins.numerics.engine.BACKENDS: restated so that --help imports no numba;
+#: tests/cli checks that they agree)
+BACKENDS = ("cpu", "cuda", "auto")
+#: first-harmonic variants (safebasins.wells.quartic.FOURIER_VARIANTS; the same)
+FOURIER = ("paper", "exact")
+#: library argument name -> CLI option, to name the option in errors raised by the library
+OPTION_OF = {"F": "--F", "Omega": "--Omega", "Psi": "--Psi", "xi_max": "--xi-max", "q_max": "--q-max",
+             "cycles": "--cycles", "steps_per_cycle": "--steps-per-cycle", "threads": "--threads",
+             "xi_ini": "--xi-ini", "gamma_ini": "--gamma-ini", "tol": "--tol", "n_scan": "--n-scan",
+             "F_bracket": "--F-bracket", "n_points": "--n-points", "q0": "--grid", "p0": "--grid",
+             "xi_top": "--xi-top", "t_eval": "--t-eval", "backend": "--backend"}
+
+_ANGLE = re.compile(r"^([+-]?)(\d+(?:\.\d*)?|\.\d+)?\*?pi(?:/(\d+(?:\.\d*)?))?$", re.IGNORECASE)
+
+
+def parse_number(text, angle=False) -> float:
+    """A float; angles may also be written with pi: ``pi``, ``-pi/2``, ``3pi/4``, ``0.5*pi``."""
+    if isinstance(text, (int, float)):
+        return float(text)
+    s = str(text).strip().replace(" ", "")
+    m = _ANGLE.match(s) if angle else None
+    if m:
+        sign = -1.0 if m.group(1) == "-" else 1.0
+        return sign * float(m.group(2) or 1.0) * math.pi / float(m.group(3) or 1.0)
+    try:
+        return float(s)
+    except ValueError:
+        raise ValueError(f"expected a number{' or a multiple of pi (pi, pi/2, -3pi/4)' if angle else ''}, "
+                         f"got {text!r}") from None
+
+
+def lib_check(path):
+    """A library check named ``module:attribute`` (imported on use: --help stays fast)."""
+    def check(name, value):
+        import importlib
+
+        mod, _, attr = path.partition(":")
+        obj = importlib.import_module(mod)
+        for part in attr.split("."):
+            obj = getattr(obj, part)
+        return obj(name, value)
+    return check
+
+
+NONNEG = lib_check("safebasins.checks:check_nonnegative")
+POSITIVE = lib_check("safebasins.checks:check_positive")
+FINITE = lib_check("safebasins.checks:check_finite")
+ENERGY = lib_check("safebasins.wells.quartic:QUARTIC.check_energy")          # [0, 1/4)
+THRESHOLD = lib_check("safebasins.wells.quartic:QUARTIC.check_threshold")    # (0, 1/4]
+DISPLACEMENT = lib_check("safebasins.wells.quartic:QUARTIC.check_displacement")
+
+
+def analytic_threshold(name, value):
+    """(0, 1/4): the action-angle map of the slow flow is singular on the separatrix."""
+    THRESHOLD(name, value)
+    return ENERGY(name, value)
+
+
+class Number(click.ParamType):
+    """One finite number checked by a library check under the library's argument name."""
+
+    name = "number"
+
+    def __init__(self, arg, check, angle=False):
+        self.arg, self.check, self.angle = arg, check, angle
+
+    def convert(self, value, param, ctx):
+        try:
+            return float(self.check(self.arg, parse_number(value, self.angle)))
+        except ValueError as exc:
+            self.fail(str(exc), param, ctx)
+
+
+class NumberList(Number):
+    """Comma-separated numbers (the option may also be repeated); values must be distinct."""
+
+    name = "list"
+
+    def convert(self, value, param, ctx):
+        if isinstance(value, list):
+            return value
+        try:
+            vals = [parse_number(v, self.angle) for v in str(value).split(",") if v.strip()]
+            if not vals:
+                raise ValueError(f"{self.arg} needs at least one value")
+            return [float(self.check(self.arg, v)) for v in vals]
+        except ValueError as exc:
+            self.fail(str(exc), param, ctx)
+
+
+class Fields(click.ParamType):
+    """Comma-separated fields with a fixed meaning: grid, range, bracket, resolution."""
+
+    def __init__(self, kind):
+        self.kind = kind
+        self.name = {"grid": "q0min,q0max,p0min,p0max", "range": "start,stop,num", "bracket": "lo,hi",
+                     "size": "N|NQxNP"}[kind]
+
+    def convert(self, value, param, ctx):
+        if not isinstance(value, str):
+            return value
+        try:
+            return getattr(self, "_" + self.kind)(value.replace(" ", ""))
+        except ValueError as exc:
+            self.fail(str(exc), param, ctx)
+
+    @staticmethod
+    def _floats(text, n, what):
+        parts = text.split(",")
+        if len(parts) != n:
+            raise ValueError(f"expected {n} comma-separated values ({what}), got {text!r}")
+        return [float(FINITE(what, parse_number(p))) for p in parts]
+
+    def _grid(self, text):
+        q_lo, q_hi, p_lo, p_hi = self._floats(text, 4, "q0min,q0max,p0min,p0max")
+        for ax, lo, hi in (("q0", q_lo, q_hi), ("p0", p_lo, p_hi)):
+            if not hi > lo:
+                raise ValueError(f"empty {ax} interval [{lo}, {hi}]: the max must exceed the min")
+        return {"q0": [q_lo, q_hi], "p0": [p_lo, p_hi]}
+
+    def _range(self, text):
+        parts = text.split(",")
+        if len(parts) != 3:
+            raise ValueError(f"expected start,stop,num (num points, endpoints included), got {text!r}")
+        start, stop = (float(POSITIVE("Omega", parse_number(p))) for p in parts[:2])
+        if not re.fullmatch(r"\d+", parts[2]) or int(parts[2]) < 2:
+            raise ValueError(f"num must be an integer >= 2, got {parts[2]!r}")
+        if not stop > start:
+            raise ValueError(f"empty range: stop ({stop}) must be greater than start ({start})")
+        return {"start": start, "stop": stop, "num": int(parts[2])}
+
+    def _bracket(self, text):
+        lo, hi = (float(NONNEG("F_bracket", v)) for v in self._floats(text, 2, "lo,hi"))
+        if not hi > lo:
+            raise ValueError(f"empty bracket [{lo}, {hi}]")
+        return [lo, hi]
+
+    def _size(self, text):
+        m = re.fullmatch(r"(\d+)(?:x(\d+))?", text.lower())
+        if not m:
+            raise ValueError(f"expected N or NQxNP (points per axis), got {text!r}")
+        n = [int(m.group(1)), int(m.group(2) or m.group(1))]
+        if min(n) < 3:
+            raise ValueError(f"at least 3 points per axis (a basin needs an interior and an edge), got {text!r}")
+        return n
+
+
+def checked(arg, check):
+    """Option callback running a library check that takes (name, value) or (value)."""
+    def callback(ctx, param, value):
+        if value is None:
+            return None
+        try:
+            return check(arg, value) if arg else check(value)
+        except ValueError as exc:
+            raise click.BadParameter(str(exc), ctx, param) from None
+    return callback
+
+
+def joined(unique):
+    """Callback: a repeated list option -> one list; ``unique`` for values that become a coordinate
+    (curve lists of `fcr` pair up element by element and may repeat)."""
+    def callback(ctx, param, value):
+        out = [v for chunk in value for v in chunk]
+        for i, v in enumerate(out):
+            if unique and v in out[:i]:
+                raise click.BadParameter(f"{v!r} is given twice: each value is one point of a coordinate",
+                                         ctx, param)
+        return out
+    return callback
+
+
+def from_library(func, arg):
+    """Default of ``arg`` of a library function (``"module:function"``), looked up on use: the
+    command line never restates a library default."""
+    def default():
+        import importlib
+
+        mod, _, name = func.partition(":")
+        return inspect.signature(getattr(importlib.import_module(mod), name)).parameters[arg].default
+    return default
+
+
+def from_schema(kind, *path):
+    """Default of a config key of a pipeline experiment kind (its schema is their one home)."""
+    def default():
+        from safebasins.pipeline.config import load_kinds
+        from safebasins.pipeline.registry import KINDS
+
+        load_kinds()
+        node = KINDS[kind].schema
+        for p in path:
+            node = node["properties"][p]
+        return node["default"]
+    return default
+
+
+class Deferred(click.Option):
+    """An option whose default is looked up on use (``from_library`` / ``from_schema``) and shown
+    as its value in --help (click shows callables as "(dynamic)")."""
+
+    def __init__(self, *args, **kw):
+        kw.setdefault("show_default", True)
+        super().__init__(*args, **kw)
+
+    def get_default(self, ctx, call=True):
+        return super().get_default(ctx, call=True)
+
+
+@contextlib.contextmanager
+def library_errors():
+    """Library ValueErrors (argument checks name the argument) -> usage errors naming the option."""
+    try:
+        yield
+    except ValueError as exc:
+        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        word = re.match(r"[A-Za-z_]\w*", msg)
+        if word and word.group(0) in OPTION_OF:
+            raise click.BadParameter(msg, param_hint=f"'{OPTION_OF[word.group(0)]}'") from None
+        raise click.UsageError(msg) from None
+
+
+def out_prefix(ctx, param, value):
+    """PREFIX of PREFIX.nc / PREFIX.png: no extension, not a folder."""
+    if value.endswith((".nc", ".png")):
+        raise click.BadParameter(f"give a prefix without extension (PREFIX.nc and PREFIX.png are written), "
+                                 f"got {value!r}", ctx, param)
+    if Path(value).is_dir() or not Path(value).name:
+        raise click.BadParameter(f"{value!r} is a directory: give a file prefix such as {value.rstrip('/')}/run1",
+                                 ctx, param)
+    return value
+
+
+# ----------------------------------------------------------------------------------------------
+# options shared by several commands
+# ----------------------------------------------------------------------------------------------
+def forcing_options(f):
+    f = click.option("--Psi", "Psi", type=Number("Psi", FINITE, angle=True), default="0", show_default=True,
+                     help="Forcing phase (rad): a number, pi, pi/2, -3pi/4, ...")(f)
+    f = click.option("--Omega", "Omega", type=Number("Omega", POSITIVE), required=True,
+                     help="Forcing frequency (> 0).")(f)
+    return click.option("--F", "F", type=Number("F", NONNEG), required=True, help="Forcing amplitude (>= 0).")(f)
+
+
+def grid_options(f):
+    f = click.option("--n", "n", type=Fields("size"), default="200", show_default=True,
+                     help="Points per axis: N, or NQxNP (q0 x p0); at least 3.")(f)
+    return click.option("--grid", "grid", type=Fields("grid"), default="-1,1,-0.75,0.75", show_default=True,
+                        help="IC window q0min,q0max,p0min,p0max (endpoints included; default: the whole well).")(f)
+
+
+def common_options(f):
+    f = click.option("--verbose", "-v", is_flag=True, help="Log lines of the pipeline build functions on stderr.")(f)
+    f = click.option("--quiet", "-q", is_flag=True, help="No progress bar on stderr.")(f)
+    f = click.option("--no-plot", "no_plot", is_flag=True, help="Write only the netCDF file.")(f)
+    f = click.option("--fourier", type=click.Choice(FOURIER), default="paper", show_default=True,
+                     help="First harmonic G(xi): eq (20) as printed, or the exact sn coefficient.")(f)
+    return f
+
+
+def numerics_options(func, what):
+    def deco(f):
+        f = click.option("--backend", type=click.Choice(BACKENDS), default="cpu", show_default=True,
+                         callback=backend_check,
+                         help="Numerics backend: cpu (the reference), cuda (GPU, bitwise equal escapes), auto.")(f)
+        f = click.option("--threads", type=int, default=None, callback=checked(None, engine_check("check_threads")),
+                         help="Numba threads (default: all; results do not depend on it).")(f)
+        f = click.option("--steps-per-cycle", "steps_per_cycle", cls=Deferred, type=int,
+                         default=from_library(func, "steps_per_cycle"),
+                         callback=checked(None, engine_check("check_steps_per_cycle")),
+                         help="Fixed integrator steps per forcing period (>= 4).")(f)
+        return click.option("--cycles", cls=Deferred, type=int, default=from_library(func, "cycles"),
+                            callback=checked("cycles", engine_check("check_cycles")),
+                            help=f"Horizon in forcing cycles (EC) {what}.")(f)
+    return deco
+
+
+def backend_check(ctx, param, value):
+    """--backend cuda without a usable GPU is a usage error found before anything is computed."""
+    if value == "cuda":
+        from safebasins.numerics.cuda_engine import require_cuda
+
+        try:
+            require_cuda()
+        except (RuntimeError, ImportError) as exc:
+            raise click.BadParameter(str(exc), ctx, param) from None
+    return value
+
+
+def engine_check(name):
+    """A check of safebasins.numerics.engine (imports numba: only when the option is used)."""
+    def check(*args):
+        from safebasins.numerics import engine
+
+        return getattr(engine, name)(*args)
+    return check
+
+
+def out_option(default):
+    return click.option("--out", "-o", "out", metavar="PREFIX", default=default, show_default=True,
+                        callback=out_prefix, help="Output prefix: writes PREFIX.nc and PREFIX.png (folders are created).")
+
+
+def grid_params(grid, n):
+    from safebasins.pipeline import values
+
+    return values.grid({**grid, "n": n})
