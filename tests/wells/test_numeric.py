@@ -264,15 +264,18 @@ def test_interior_equilibrium_rejected():
 
 # ----------------------------------------------------------------------------- speed
 def _best(f, n=3):
+    """Best of n CPU times of this process (wall time on a shared machine measures the others)."""
     best = np.inf
     for _ in range(n):
-        t0 = time.perf_counter()
+        t0 = time.process_time()
         f()
-        best = min(best, time.perf_counter() - t0)
+        best = min(best, time.process_time() - t0)
     return best
 
 
 def test_speed(quartic):
+    """Budgets: construction < 2 s, 1e5 energies < 50 ms per quantity, angle_energy on a
+    300 x 300 grid < 0.5 s."""
     assert _best(lambda: NumericWell(quartic_V, quartic_dV), 1) < 2.0
     E = np.random.default_rng(0).uniform(0, 0.2499, 100_000)
     for f in (quartic.J, quartic.omega, quartic.harmonic_amplitude, quartic.harmonic_phase,

@@ -57,13 +57,13 @@ def clenshaw_curtis(n):
     return x, S[-1].copy(), S
 
 
-def solve_increasing(fdf, lo, hi, x0, *, xtol=4 * EPS, maxiter=200):
+def solve_increasing(fdf, lo, hi, x0, *, xtol=4 * EPS, atol=0.0, maxiter=200):
     """Vectorised safeguarded Newton (rtsafe) for increasing ``F`` with ``F(lo) <= 0 <= F(hi)``.
 
     ``fdf(x, idx)`` returns ``F(x), F'(x)`` for the items ``idx``.  Newton steps that leave the
     bracket, or that do not halve the step before last, are replaced by bisection, so the
     iteration always converges (to the bracketed root, or to the noise band of ``F``).
-    Converged when a step (or the Newton correction) is below ``xtol (|x| + tiny)`` or
+    Converged when a step (or the Newton correction) is below ``xtol |x| + atol`` or
     ``F == 0``.
     """
     lo = np.array(lo, dtype=float, copy=True)
@@ -73,7 +73,7 @@ def solve_increasing(fdf, lo, hi, x0, *, xtol=4 * EPS, maxiter=200):
     dx_old = hi - lo
     dx = dx_old.copy()
     active = np.arange(n)
-    tiny = 1e-300
+    tiny = max(float(atol), 1e-300)
     for _ in range(maxiter):
         if active.size == 0:
             return x
@@ -91,7 +91,7 @@ def solve_increasing(fdf, lo, hi, x0, *, xtol=4 * EPS, maxiter=200):
             xn = xa - step
         # a finite Newton correction below the tolerance: converged at xa (checked before the
         # bracket test, as xa - step may round to the bracket end xa itself)
-        done = done | ((dF > 0.0) & (np.abs(step) <= xtol * (np.abs(xa) + tiny)))
+        done = done | ((dF > 0.0) & (np.abs(step) <= (xtol * np.abs(xa) + tiny)))
         bad = (~np.isfinite(xn)) | (xn <= la) | (xn >= ha) | (dF <= 0.0) | \
               (np.abs(2.0 * step) > np.abs(dx_old[active]))
         xb = 0.5 * (la + ha)
@@ -99,7 +99,7 @@ def solve_increasing(fdf, lo, hi, x0, *, xtol=4 * EPS, maxiter=200):
         dx_old[active] = dx[active]
         dx[active] = xn - xa
         x[active] = np.where(done, xa, xn)
-        conv = done | (np.abs(xn - xa) <= xtol * (np.abs(xn) + tiny)) | (ha - la <= xtol * (np.abs(xn) + tiny))
+        conv = done | (np.abs(xn - xa) <= (xtol * np.abs(xn) + tiny)) | (ha - la <= (xtol * np.abs(xn) + tiny))
         active = active[~conv]
     raise RuntimeError(f"turning-point / angle solver did not converge for {active.size} items")
 
