@@ -7,7 +7,7 @@ from numpy.polynomial import polynomial as P
 
 from safebasins.theory import action_angle as aa
 from safebasins.wells.numeric import NumericWell
-from safebasins.wells.polynomial import PolynomialWell, cubic, polynomial, quartic
+from safebasins.wells.polynomial import PolynomialWell, cubic, polynomial, quartic_polynomial
 from tests.wells.reference_orbits import Orbit, action_quad
 
 ASYM = [0.0, 0.0, 0.5, 0.1, -0.25]
@@ -99,7 +99,7 @@ def test_cubic_small_energy_limit(cub):
 
 # ----------------------------------------------------------------------------- quartics
 def test_quartic_polynomial_against_closed_form():
-    w = quartic()
+    w = quartic_polynomial()
     assert w.barriers == (-1.0, 1.0) and w.barrier_energy == 0.25
     E = np.linspace(1e-6, 0.249, 500)
     assert rel(w.J(E), aa.J(E)) <= 1e-12

@@ -48,7 +48,7 @@ from scipy import optimize
 
 from safebasins.checks import as_array, value_repr
 from safebasins.wells.base import Well
-from safebasins.wells.interpolation import BOTTOM, SEPARATRIX, EnergyInterpolant
+from safebasins.wells.interpolation import BOTTOM, EnergyInterpolant
 from safebasins.wells.orbit_quadrature import EPS, OrbitQuadrature, solve_increasing
 
 __all__ = ["NumericWell"]
@@ -151,9 +151,9 @@ class NumericWell(Well):
             raise ValueError(f"V: V(0) = {v0!r}, must be 0 (energies are measured from the well bottom q = 0)")
         if not (np.isfinite(d0) and abs(d0) <= BOTTOM_ATOL):
             raise ValueError(f"dV: V'(0) = {d0!r}, must be 0 (the minimum of the well must be at q = 0)")
-        # V''(0) from V'(h)/h on both sides at h = 1e-6 and 1e-7: they must agree (a degenerate
-        # minimum, V'' (0) = 0, has V'(h)/h ~ h^2 and fails the comparison)
-        h = np.array([-1e-6, -1e-7, 1e-7, 1e-6])
+        # V''(0) from V'(h)/h on both sides at h = 1e-7 and 1e-8 search_bound: they must agree
+        # (a degenerate minimum, V''(0) = 0, has V'(h)/h ~ h^2 and fails the comparison)
+        h = self.search_bound * np.array([-1e-7, -1e-8, 1e-8, 1e-7])
         g = _call(self._dV, h) / h
         k0 = float(np.mean(g))
         if not (np.isfinite(g).all() and (g > 0).all() and g.min() > 0.5 * g.max()):
@@ -179,7 +179,7 @@ class NumericWell(Well):
             return side * np.inf
         i = int(stop[0])
         if not np.isfinite(f[i]):
-            raise ValueError(f"dV: V'({side * s[i]!r}) is not finite, {where} of 0 before any barrier")
+            raise ValueError(f"dV: V'({float(side * s[i])!r}) is not finite, {where} of 0 before any barrier")
         if i == 0:
             raise ValueError("dV: V' has the wrong sign next to q = 0 (q = 0 is not a minimum)")
         a, b = s[i - 1], s[i]

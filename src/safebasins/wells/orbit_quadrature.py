@@ -17,8 +17,9 @@ and near the end ``E - V(q) = (q_end - q) <V'>`` with ``<V'>`` the mean of ``V'`
 cancellation.  Close to the separatrix the orbit lingers near a barrier and ``dt/dpsi`` has a
 peak of width ``alpha ~ (E_b - E)^(1/4)`` at ``psi = 0`` (complex zeros of ``<V'>`` at
 ``psi = +-i alpha``); the map ``psi = alpha sinh(v)`` turns it into an integrand of unit width
-in ``v``, integrated by composite Clenshaw-Curtis panels of length <= ``panel_length``
-(spectral convergence, work ~ ``log(1/alpha)``).
+in ``v``, integrated on panels of length <= ``panel_length`` (Clenshaw-Curtis with its
+integration matrix for cumulative times, Gauss-Legendre for the time to one point): spectral
+convergence, work ~ ``log(1/alpha)``.
 
 Quantities of one orbit (``tau_side(psi)`` = time from the side's turning point):
 
@@ -109,8 +110,17 @@ class OrbitQuadrature:
 
     ``V``, ``dV`` are the (vectorised) potential and its derivative; ``limits`` the brackets
     ``(q_lo, q_hi)`` of the turning points (barriers or points where ``V`` exceeds the escape
-    energy); ``barriers`` the barrier positions (``+-inf`` where none); ``kappa = (-V''(q_left), -V''(q_right))`` the barrier curvatures (``nan`` where a
-    side has no barrier) which set the width ``alpha`` of the near-separatrix peak.
+    energy); ``barriers`` the barrier positions (``+-inf`` where none); ``kappa =
+    (-V''(q_left), -V''(q_right))`` the barrier curvatures (``nan`` where a side has no
+    barrier), which set the width ``alpha`` of the near-separatrix peak.
+
+    Rules: ``n_nodes`` Clenshaw-Curtis nodes per panel for half-orbit profiles (cumulative
+    time), ``n_point`` Gauss-Legendre nodes per panel for the time to one point, panels of
+    length <= ``panel_length`` in ``v``; ``alpha`` is capped at ``alpha_max`` (far from the
+    separatrix the map is nearly linear).  ``E - V(q)`` is evaluated directly where
+    ``(q_end - q)/d > gap_switch``, else as ``(q_end - q) <V'>`` with ``n_mean`` Gauss nodes;
+    turning points within ``barrier_zone |q_b|`` of a barrier use the barrier form.  The
+    defaults give ~1e-15 relative accuracy (tested against closed forms).
     """
 
     def __init__(self, V, dV, limits, barriers, kappa, *, n_nodes=20, n_point=12, panel_length=1.5,

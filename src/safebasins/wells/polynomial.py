@@ -26,7 +26,7 @@ from numpy.polynomial import polynomial as P
 from safebasins.checks import as_array
 from safebasins.wells.numeric import NumericWell
 
-__all__ = ["PolynomialWell", "polynomial", "cubic", "quartic"]
+__all__ = ["PolynomialWell", "polynomial", "cubic", "quartic_polynomial"]
 
 
 def _check_coefficients(coefficients):
@@ -147,7 +147,7 @@ def cubic(**kwargs):
     return PolynomialWell([0.0, 0.0, 0.5, -1.0 / 3.0], **kwargs)
 
 
-def quartic(**kwargs):
+def quartic_polynomial(**kwargs):
     """The paper's well, eq (2), ``V = q^2/2 - q^4/4`` by quadrature (closed form:
     :mod:`safebasins.wells.quartic`)."""
     kwargs.setdefault("name", "quartic-numeric")
