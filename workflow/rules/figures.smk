@@ -4,13 +4,17 @@
 #
 # Inputs  = the figure's datasets + its notebook + the plotting code, so a plot change never
 #           reruns a simulation and the notebooks never recompute physics.
-# Outputs = results/figures/<name>.png (in the report) and .pdf, and the executed notebook
-#           under results/notebooks/.
+# Outputs = results/figures/<name>.png (in the report) and .pdf, the executed notebook under
+#           results/notebooks/, and the report caption results/captions/<name>.rst that the
+#           notebook writes with the numbers read from the datasets (the report shows it).
 # Notebooks of the package's figures are generated into notebooks/ by scripts/make_notebooks.py
 # (committed, checked by the tests); those of config experiments by the rule figure_notebook.
 import glob as _fig_glob
+import os as _fig_os
 import shlex as _fig_shlex
 import sys as _fig_sys
+
+from safebasins.plotting.notebooks import caption_path as _fig_caption_path
 
 _FIG_PLOTTING = sorted(_fig_glob.glob(f"{workflow.basedir}/src/safebasins/plotting/*.py"))
 _FIG_DPI = 180  # PNG resolution (the PDF is vector, rasters inside it embedded at this dpi)
@@ -27,12 +31,14 @@ for _fig in FIGURES:
         output:
             png=report(
                 _fig.png,
-                caption=f"../report/{_fig.name}.rst" if _fig.packaged else "../report/experiment.rst",
+                # absolute: the caption is a result of this rule, read when the report is made
+                caption=_fig_os.path.abspath(_fig_caption_path(_fig)),
                 category=_fig.category,
                 labels={"figure": _fig.label, "slug": _fig.stem},
             ),
             pdf=_fig.pdf,
             notebook=_fig.executed_notebook,
+            caption=_fig_caption_path(_fig),
         log:
             f"results/logs/figures/{_fig.name}.log",
         params:
@@ -44,7 +50,7 @@ for _fig in FIGURES:
         shell:
             "{params.python} -m papermill --no-progress-bar -k python3 "
             "{input.notebook} {output.notebook} -y {params.data} "
-            "-p png {output.png} -p pdf {output.pdf} -p dpi {params.dpi} > {log} 2>&1"
+            "-p png {output.png} -p pdf {output.pdf} -p caption {output.caption} -p dpi {params.dpi} > {log} 2>&1"
 
 
 rule figure_notebook:
