@@ -1,8 +1,9 @@
 #!/usr/bin/env python
-"""Write the notebooks and report captions of the package's figures (the paper's 22 and the
-beyond-the-paper ones) from the registry.
+"""Write the notebooks of the package's figures (the paper's 22 and the beyond-the-paper ones)
+from the registry.  (Their report captions are written by the notebooks themselves at render
+time, with the numbers read from the datasets: results/captions/<name>.rst.)
 
-    .venv/bin/python scripts/make_notebooks.py            # (re)write notebooks/ and workflow/report/
+    .venv/bin/python scripts/make_notebooks.py            # (re)write notebooks/
     .venv/bin/python scripts/make_notebooks.py --check    # exit 1 if any file is out of date
     .venv/bin/python scripts/make_notebooks.py --gallery results/figures
                                    # also write small copies of the built PNGs to docs/figures/
@@ -18,7 +19,7 @@ import sys
 from pathlib import Path
 
 from safebasins.pipeline.plan import plan
-from safebasins.plotting.notebooks import notebook_text, report_caption
+from safebasins.plotting.notebooks import notebook_text
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -30,7 +31,6 @@ def packaged_figures():
 def outputs():
     for fig in packaged_figures():
         yield ROOT / fig.notebook, notebook_text(fig)
-        yield ROOT / "workflow" / "report" / f"{fig.name}.rst", report_caption(fig)
 
 
 def gallery_entries(src: Path):
@@ -55,8 +55,9 @@ def write_gallery(src: Path, width: int = 800):
              "- experiments and their figure texts (datasets, options, paper caption, what to look for): "
              "`src/safebasins/pipeline/catalog.py`, resolved through the registry of kinds "
              "(`src/safebasins/pipeline/kinds/`);",
-             "- `.venv/bin/python scripts/make_notebooks.py` regenerates `notebooks/*.ipynb` and the report "
-             "captions `workflow/report/*.rst` (`--check` verifies they are current);",
+             "- `.venv/bin/python scripts/make_notebooks.py` regenerates `notebooks/*.ipynb` (`--check` verifies "
+             "they are current); each notebook writes its report caption `results/captions/<name>.rst` with the "
+             "numbers read from the datasets;",
              "- `snakemake results/figures/figNN.png` runs one notebook with papermill (`-k python3`) and keeps "
              "the executed copy in `results/notebooks/`; `snakemake figures` builds all 22, `snakemake extras` "
              "the three extra ones;",

@@ -12,15 +12,37 @@ import nbformat
 import pytest
 
 from safebasins.pipeline.plan import plan
+from safebasins.plotting.notebooks import caption_path
 from tests.pipeline.sandbox import ROOT
 
 FIGURES = [f for f in plan(ROOT / "config" / "config.yaml").figures() if f.packaged]
 
 
-def test_every_package_figure_has_notebook_and_caption():
+def test_every_package_figure_has_notebook_writing_its_caption():
     assert len([f for f in FIGURES if f.category == "Figures"]) == 22
     for fig in FIGURES:
-        assert (ROOT / fig.notebook).exists() and (ROOT / "workflow" / "report" / f"{fig.name}.rst").exists()
+        assert (ROOT / fig.notebook).exists()
+        code = "\n".join(c.source for c in nbformat.read(ROOT / fig.notebook, as_version=4).cells
+                         if c.cell_type == "code")
+        assert f"caption = {caption_path(fig)!r}" in code and "write_caption(caption, fig," in code
+
+
+def test_caption_is_rst_inside_a_jinja_raw_block():
+    import docutils.core
+    import jinja2
+    from matplotlib.figure import Figure
+
+    from safebasins.plotting.captions import add_note, caption_rst, notes
+
+    fig = Figure()
+    add_note(fig, "9,250 of 90,000 pixels {{ not a template }} *stay* safe")
+    assert notes(fig) == ["9,250 of 90,000 pixels {{ not a template }} *stay* safe"]
+    text = caption_rst(label="Fig. 1", paper="quoted", look="drawn", data_notes=notes(fig),
+                       notebook="notebooks/x.ipynb", datasets=["results/data/x.nc"])
+    rendered = jinja2.Environment(trim_blocks=True, lstrip_blocks=True).from_string(text).render()
+    assert "{{ not a template }}" in rendered  # Snakemake's Jinja2 pass leaves it alone
+    html = docutils.core.publish_parts(rendered, writer_name="html")["body"]
+    assert "9,250 of 90,000 pixels" in html and "<strong>Paper:</strong>" in html and "*stay*" in html
 
 
 def test_generated_files_are_up_to_date():
@@ -39,7 +61,7 @@ def test_notebook_calls_its_builder(fig):
     params = {}
     exec(code[0].source, {}, params)  # plain literals only
     assert {k: params[k] for k in fig.inputs} == dict(fig.inputs)
-    assert (params["png"], params["pdf"]) == (fig.png, fig.pdf)
+    assert (params["png"], params["pdf"], params["caption"]) == (fig.png, fig.pdf, caption_path(fig))
     text = "\n".join(c.source for c in code)
     assert not re.search(r"['\"]/(work|home|tmp|root)/", text), "hard-coded absolute path"
     assert "def " not in text and all(not c.get("outputs") for c in code)

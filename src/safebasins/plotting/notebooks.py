@@ -2,7 +2,9 @@
 
 Every notebook is: a title cell, a ``parameters`` cell (dataset paths relative to the
 repository root, output paths, style options; Snakemake overrides the paths with papermill), a
-summary cell (:func:`safebasins.plotting.data.describe`) and one call of the figure's builder.
+summary cell (:func:`safebasins.plotting.data.describe`) and one call of the figure's builder,
+which also writes the report caption with the numbers read from the datasets
+(:func:`safebasins.plotting.captions.write_caption`, ``results/captions/<name>.rst``).
 """
 from __future__ import annotations
 
@@ -12,6 +14,12 @@ import nbformat
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
 
 KERNELSPEC = {"name": "python3", "display_name": "Python 3 (ipykernel)", "language": "python"}
+CAPTION_DIR = "results/captions"
+
+
+def caption_path(fig) -> str:
+    """The report caption the figure's notebook writes (the report shows it)."""
+    return f"{CAPTION_DIR}/{fig.name}.rst"
 
 
 def _literal(v):
@@ -30,18 +38,24 @@ def build_notebook(fig) -> nbformat.NotebookNode:
                f"catalog or the plotting code, not this file. Run through Snakemake: `snakemake {fig.png}`.")
     lines = ["# Parameters (papermill overrides these; paths are relative to the repository root)"]
     lines += [f"{name} = {_literal(path)}" for name, path in fig.inputs.items()]
-    lines += [f"png = {_literal(fig.png)}", f"pdf = {_literal(fig.pdf)}", "dpi = 180",
+    lines += [f"png = {_literal(fig.png)}", f"pdf = {_literal(fig.pdf)}", f"caption = {_literal(caption_path(fig))}",
+              "dpi = 180",
               "title = None  # None: built from the datasets' parameters"]
     lines += [f"{k} = {_literal(v)}" for k, v in fig.options.items()]
     params = new_code_cell("\n".join(lines))
     params.metadata["tags"] = ["parameters"]
     inputs = ", ".join(f"{k}={k}" for k in fig.inputs)
     opts = "".join(f", {k}={k}" for k in fig.options)
-    setup = new_code_cell("from safebasins.plotting.data import describe\n"
+    setup = new_code_cell("from safebasins.plotting.captions import notes, write_caption\n"
+                          "from safebasins.plotting.data import describe\n"
                           "from safebasins.plotting.style import apply_style, save_figure\n"
                           f"from {module} import {function}\n\n"
                           f"apply_style()\ndescribe({inputs});")
-    draw = new_code_cell(f"fig = {function}({inputs}{opts}, title=title)\nsave_figure(fig, png, pdf, dpi=dpi)")
+    draw = new_code_cell(f"fig = {function}({inputs}{opts}, title=title)\nsave_figure(fig, png, pdf, dpi=dpi)\n"
+                         f"write_caption(caption, fig, label={fig.label!r}, paper={fig.caption!r},\n"
+                         f"              look={fig.look!r},\n"
+                         f"              notebook={fig.notebook!r}, datasets=[{', '.join(fig.inputs)}])\n"
+                         "print('\\n'.join(notes(fig)))")
     nb = new_notebook(cells=[new_markdown_cell(heading), params, setup, draw])
     nb.metadata["kernelspec"] = dict(KERNELSPEC)
     nb.metadata["language_info"] = {"name": "python"}
@@ -57,9 +71,3 @@ def notebook_text(fig) -> str:
 def write_notebook(fig, path):
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     Path(path).write_text(notebook_text(fig))
-
-
-def report_caption(fig) -> str:
-    """The report caption (reStructuredText) of a figure."""
-    files = ", ".join(f"``{p}``" for p in fig.dataset_files())
-    return f"{fig.label}: {fig.caption}\n\n{fig.look}\n\nNotebook ``{fig.notebook}``; datasets {files}.\n"
