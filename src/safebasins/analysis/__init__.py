@@ -6,4 +6,5 @@ integrity        GIM, LIM, IF of safe masks
 erosion          integrity profiles versus the forcing amplitude
 phase_invariant  the safe basin for every forcing phase
 fourier_compare  the paper's first harmonic (eq 20) versus the exact one
+period_map       rotation numbers, island chains and chaotic orbits of the period map (Fig 18)
 """

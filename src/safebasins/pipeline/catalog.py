@@ -200,10 +200,13 @@ DECLARATIONS = (
                  'following set of parameters: F = 0.0876, Ψ = π, Ω = 0.99, ξ_max = 0.24. Each '
                  'trajectory runs for 3000 iterations. Dashed curve corresponds to the '
                  'theoretically predicted boundary of the SB.'),
-        look=('Stroboscopic points (one colour per trajectory): a large island of invariant tori '
-              'around a fixed point, chains of smaller islands (e.g. a 1:6 chain) and a stochastic '
-              'layer between them. The dashed theoretical boundary is a reasonable first guess of '
-              'the safe region but does not capture the erosion.')),
+        look=('Stroboscopic points of each orbit, coloured by its class (safebasins.analysis.period_map): '
+              'tori of the main island in blue (darker = larger rotation number about the central elliptic '
+              'fixed point, x), each island chain in its own colour with its elliptic periodic orbit (+, '
+              'found by Newton) and the label 1:k of its k-periodic solution (the paper\'s naming), chaotic '
+              'orbits of the stochastic layer in black. Green circles: the line of initial conditions drawn '
+              'first, the rest are seeded random. Dashed: the theoretical SB boundary; dotted: the well edge '
+              'H0 = ξ_max. The escape criterion of the map is in the title.')),
     Declaration(
         name="fig19", kind="criteria", key=("figures", "fig19"), stem="fig19_criteria_rel_diff",
         label="Fig. 19", category="Figures", options={}, seed_offset=19000,

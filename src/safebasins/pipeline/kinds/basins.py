@@ -6,7 +6,8 @@ classification ``escapes(q0, p0)`` of :func:`safebasins.theory.slow_flow_escapes
 experiment's grid; ``basin_rm`` adds the first integral ``C`` and ``escapes_rm`` on the
 resonance-manifold grid ``(gamma_rm, xi_rm)``; ``basin_chart`` stacks the basins over the
 scanned parameter (``xi_max`` or ``F``).  ``basin_chart``'s numeric product is the escape chart
-gathered from its tiles with the analytic/numeric agreement stored in it.
+gathered from its tiles with the analytic/numeric agreement stored in it; ``strobe``'s is the
+classified period map (:func:`safebasins.analysis.period_map.period_map_portrait`).
 """
 from __future__ import annotations
 
@@ -157,26 +158,63 @@ def build_chart_agreement(params, inputs, job):
     return out
 
 
-def build_strobe(params, inputs, job):
-    """Stroboscopic map of the first ``n_trajectories`` non-escaping seeded random ICs."""
-    from safebasins.numerics import random_initial_conditions, stroboscopic_map
+def strobe_candidates(params):
+    """Candidate ICs of the period map in priority order: the ``line`` of ICs (if any), then the
+    seeded random ones in ``box``; and their origin labels."""
+    from safebasins.numerics import random_initial_conditions
 
-    q0, p0 = random_initial_conditions(params["n_candidates"], params["seed"], box=tuple(tuple(b) for b in params["box"]))
-    ds = stroboscopic_map(np.asarray(q0, float), np.asarray(p0, float), params["F"], params["Omega"], params["Psi"],
-                          n_iter=params["n_iter"], xi_max=params["xi_max"], steps_per_cycle=params["steps_per_cycle"],
-                          threads=job.threads)
-    safe = np.flatnonzero(~np.asarray(ds["escaped"].values, dtype=bool))
-    print(f"{safe.size} of {params['n_candidates']} candidates never escape in {params['n_iter']} iterations", flush=True)
-    if safe.size < params["n_trajectories"]:
-        raise RuntimeError(f"only {safe.size} non-escaping candidates, {params['n_trajectories']} requested: "
-                           f"raise n_candidates of experiment {params['experiment']}")
-    keep = safe[: params["n_trajectories"]]
-    out = ds.isel(sample=keep)
-    out = out.assign_coords(candidate=("sample", keep), sample=np.arange(keep.size))
-    out.attrs.update(seed=params["seed"], n_candidates=params["n_candidates"],
+    qr, pr = random_initial_conditions(params["n_candidates"], params["seed"], box=tuple(tuple(b) for b in params["box"]))
+    line = params.get("line")
+    if line:
+        ql = np.linspace(line["q0"][0], line["q0"][1], line["n"])
+        pl = np.linspace(line["p0"][0], line["p0"][1], line["n"])
+    else:
+        ql = pl = np.zeros(0)
+    origin = ["line"] * ql.size + ["random"] * np.asarray(qr).size
+    return np.r_[ql, np.asarray(qr, float)], np.r_[pl, np.asarray(pr, float)], origin
+
+
+def build_strobe(params, inputs, job):
+    """Stroboscopic map of the first ``n_trajectories`` non-escaping candidates (the line of ICs
+    first, then seeded random ones), classified (:func:`safebasins.analysis.period_map.
+    period_map_portrait`: main-island tori, island chains, chaotic orbits); under the
+    displacement criterion each kept orbit also gets its energy-criterion escape cycle."""
+    from safebasins.analysis.period_map import period_map_portrait
+    from safebasins.numerics import escape_chart
+
+    q0, p0, origin = strobe_candidates(params)
+    energy = params["criterion"] == "energy"
+    thresholds = dict(xi_max=params["xi_max"]) if energy else dict(q_max=params["q_max"])
+    c = params["classification"]
+    out = period_map_portrait(q0, p0, params["F"], params["Omega"], params["Psi"], n_keep=params["n_trajectories"],
+                              n_iter=params["n_iter"], steps_per_cycle=params["steps_per_cycle"], threads=job.threads,
+                              min_digits=c["min_digits"], max_period=c["max_period"], **thresholds)
+    cand = np.asarray(out["candidate"].values)
+    out["origin"] = ("sample", np.array([origin[i] for i in cand]), {"long_name": "where the IC comes from (line | random)"})
+    # the other criterion on the same ICs (one escape chart of the kept ICs, paired samples)
+    other = escape_chart(np.asarray(out["q0"].values, float), np.asarray(out["p0"].values, float), params["F"],
+                         params["Omega"], params["Psi"], xi_max=(params["xi_max"],), q_max=(params["q_max"],),
+                         cycles=params["n_iter"], steps_per_cycle=params["steps_per_cycle"], threads=job.threads,
+                         grid=False)
+    out["escape_cycle_energy"] = ("sample", np.asarray(other["escape_cycle_energy"].isel(xi_max=0).values, float),
+                                  {"units": "1", "long_name": "escape time in forcing cycles, energy criterion "
+                                                              "H0 > xi_max (inf: no escape)"})
+    out["escape_cycle_displacement"] = ("sample", np.asarray(other["escape_cycle_displacement"].isel(q_max=0).values, float),
+                                        {"units": "1", "long_name": "escape time in forcing cycles, displacement "
+                                                                    "criterion |q| > q_max (inf: no escape)"})
+    n_line = int(params["line"]["n"]) if params.get("line") else 0
+    print(f"{out.attrs['n_non_escaping']} of {q0.size} candidates never escape in {params['n_iter']} iterations "
+          f"({params['criterion']} criterion); kept {out.sizes['sample']}: {out.attrs['n_main']} main island, "
+          f"{out.attrs['n_chain']} island chains (periods {out['chain_period'].values.tolist()}), "
+          f"{out.attrs['n_chaotic']} chaotic", flush=True)
+    out.attrs.update(seed=params["seed"], n_random=params["n_candidates"], n_line=n_line,
+                     n_line_kept=int(sum(origin[i] == "line" for i in cand)),
                      box=np.asarray(params["box"], float).ravel(), F=params["F"], Omega=params["Omega"],
-                     Psi=params["Psi"], xi_max=params["xi_max"], n_iter=params["n_iter"],
-                     fraction_non_escaping=safe.size / params["n_candidates"])
+                     Psi=params["Psi"], xi_max=params["xi_max"], q_max=params["q_max"], criterion=params["criterion"],
+                     n_iter=params["n_iter"],
+                     fraction_non_escaping=out.attrs["n_non_escaping"] / out.attrs["n_candidates"])
+    if n_line:
+        out.attrs["line"] = np.asarray([*params["line"]["q0"], *params["line"]["p0"]], float)
     return out
 
 
@@ -297,7 +335,8 @@ class BasinChart(Kind):
 @register
 class Strobe(Kind):
     name = "strobe"
-    description = "stroboscopic map of non-escaping trajectories from seeded random ICs, with the analytic basin"
+    description = ("stroboscopic map of non-escaping trajectories (a line of ICs, then seeded random ones), "
+                   "classified into main-island tori, island chains and chaotic orbits, with the analytic basin")
     builder = "safebasins.plotting.maps:figure_period_map"
     schema = {
         "description": description,
@@ -310,8 +349,28 @@ class Strobe(Kind):
             "grid": {"$ref": "#/$defs/grid"},
             "n_trajectories": {"type": "integer", "minimum": 1, "default": 100},
             "n_candidates": {"type": "integer", "minimum": 1, "default": 2000},
-            "n_iter": {"type": "integer", "minimum": 1, "default": 3000},
+            "n_iter": {"type": "integer", "minimum": 5, "default": 3000},
             "box": {"type": "array", "minItems": 2, "maxItems": 2, "items": {"$ref": "#/$defs/interval"}},
+            "criterion": {"description": "escape criterion of the map: energy (H0 > xi_max or |q| > 1) or "
+                                         "displacement (|q| > q_max(xi_max), eq 4)",
+                          "enum": ["energy", "displacement"], "default": "energy"},
+            "line": {"description": "a segment of n ICs from (q0[0], p0[0]) to (q0[1], p0[1]), drawn before the "
+                                    "random ones (null: none)",
+                     "oneOf": [{"type": "null"},
+                               {"type": "object", "additionalProperties": False, "required": ["q0", "p0", "n"],
+                                "properties": {"q0": {"$ref": "#/$defs/interval"}, "p0": {"$ref": "#/$defs/interval"},
+                                               "n": {"type": "integer", "minimum": 1}}}],
+                     "default": None},
+            "classification": {
+                "description": "orbit classification (safebasins.analysis.period_map)",
+                "type": "object", "additionalProperties": False, "default": {},
+                "properties": {
+                    "min_digits": {"description": "chaotic below this many converged digits of the rotation number",
+                                   "type": "number", "exclusiveMinimum": 0, "default": 5.0},
+                    "max_period": {"description": "longest island-chain period looked for",
+                                   "type": "integer", "minimum": 2, "default": 40},
+                },
+            },
             "n_points": N_POINTS,
         },
     }
@@ -322,9 +381,10 @@ class Strobe(Kind):
         if "box" in block:
             ctx.check_interval(f"{key}.box[0]", block["box"][0])
             ctx.check_interval(f"{key}.box[1]", block["box"][1])
-        if block["n_trajectories"] > block["n_candidates"]:
+        n_line = block["line"]["n"] if block.get("line") else 0
+        if block["n_trajectories"] > block["n_candidates"] + n_line:
             ctx.fail(f"{key}.n_trajectories", f"{block['n_trajectories']} trajectories requested but only "
-                                              f"n_candidates = {block['n_candidates']} drawn")
+                                              f"n_candidates + line.n = {block['n_candidates'] + n_line} drawn")
 
     def resolve(self, block, ctx):
         from safebasins.wells.quartic import QUARTIC
@@ -332,21 +392,36 @@ class Strobe(Kind):
         xi = float(block["xi_max"])
         qm = float(QUARTIC.q_max(xi))
         bx = block.get("box") or [[-qm, qm], [-math.sqrt(2 * xi), math.sqrt(2 * xi)]]
+        line = block.get("line")
+        if line:
+            line = {"q0": [float(v) for v in line["q0"]], "p0": [float(v) for v in line["p0"]], "n": int(line["n"])}
+        cl = block["classification"]
         return dict(fourier=ctx.fourier, F=float(block["F"]), Omega=float(block["Omega"]),
-                    Psi=values.angle(block["Psi"]), xi_max=xi, grid=values.grid(block["grid"]),
+                    Psi=values.angle(block["Psi"]), xi_max=xi, q_max=qm, criterion=str(block["criterion"]),
+                    grid=values.grid(block["grid"]),
                     n_points=int(block["n_points"]), n_trajectories=int(block["n_trajectories"]),
                     n_candidates=int(block["n_candidates"]), n_iter=int(block["n_iter"]), box=values.box(bx),
-                    seed=ctx.seed, steps_per_cycle=ctx.steps_per_cycle)
+                    line=line or None, seed=ctx.seed, steps_per_cycle=ctx.steps_per_cycle,
+                    classification={"min_digits": float(cl["min_digits"]), "max_period": int(cl["max_period"])})
 
     def cost(self, params):
-        return params["n_candidates"] * params["n_iter"] * params["steps_per_cycle"]
+        n_line = params["line"]["n"] if params.get("line") else 0
+        return (params["n_candidates"] + n_line) * params["n_iter"] * params["steps_per_cycle"]
 
     def products(self, experiment, params):
         return [_basin_product(experiment, params, build_basin_single, basin_contract()),
                 Product(dataset_path("numeric", f"strobe_{experiment}"), "numeric", build_strobe, heavy=True,
                         title=params["title"],
                         contract={"q": ("sample", "iteration"), "p": ("sample", "iteration"),
-                                  "escaped": ("sample",), "escape_cycle": ("sample",)}, history=f"safebasins.numerics.stroboscopic_map ({experiment})")]
+                                  "escaped": ("sample",), "escape_cycle": ("sample",), "origin": ("sample",),
+                                  "rotation_number": ("sample",), "birkhoff_digits": ("sample",),
+                                  "period": ("sample",), "orbit_class": ("sample",), "chain_index": ("sample",),
+                                  "escape_cycle_energy": ("sample",), "escape_cycle_displacement": ("sample",),
+                                  "chain_period": ("chain",), "chain_winding": ("chain",),
+                                  "chain_n_orbits": ("chain",), "chain_q": ("chain", "island"),
+                                  "chain_p": ("chain", "island")},
+                        history=(f"safebasins.numerics.stroboscopic_map + safebasins.analysis.period_map."
+                                 f"period_map_portrait ({experiment})"))]
 
     def figure_inputs(self, experiment, params):
         return {"analytic": dataset_path("analytic", f"basin_{experiment}"),
