@@ -1,216 +1,84 @@
-"""Compiled ensemble integrator for eq (1): q'' + q - q^3 = F sin(Omega t + Psi).
+"""Compiled ensemble integrator for eq (1) in any supported well: q'' + V'(q) = F sin(Omega t + Psi).
 
-Scheme
-------
-Blanes & Moan (2002) symmetric symplectic Runge-Kutta-Nystrom method SRKN_6^b (order 4,
-7 kicks + 6 drifts per step, kick first):
+The step (schemes, forcing tables, the well's force and energy, the well flags) lives in
+steps.py; this module holds the lane machinery: escape detection, replay, refill, compaction.
 
-    B(b1) A(a1) B(b2) A(a2) B(b3) A(a3) B(b4) A(a3) B(b3) A(a2) B(b2) A(a1) B(b1)
-
-with A = drift q += a h p (time drifts with q: extended phase space) and B = kick
-p += b h (q^3 - q + F sin(Omega t_k + Psi)) at the current sub-time t_k.  Because
-Omega * t_k = 2 pi (s + c_k) / S for sub-step s of a period of S steps, the table
-sin(Omega t_k + Psi) depends only on (S, Psi): one table serves every Omega and F.
-
-Classic RK4 (integrator="rk4") runs in the same engine: 4 force evaluations per step at
-t, t + h/2 (twice) and t + h, table sin(Omega t + Psi) of shape (S, 3).  The scheme of a
-run is the width of its forcing table (7: SRKN6b, 3: RK4); the lane machinery (escape
-detection, replay, refill, compaction) is shared and only the step differs: the period
-loops are inline bodies specialised at compile time on a constant `rk4` flag.
+Schemes and wells are compile-time constants of the inline period bodies: `rk4` (the width of
+the forcing table: 3 RK4, 7 SRKN6b) and `well` (steps.QUARTIC, QUARTIC_SIGNED, POLY4, POLY8).
+Each well flag has its own entry point (_ENSEMBLE) passing the flag down as a global
+constant, which numba types as a literal: every flag value is its own compiled, cached
+kernel, compiled on first use, so the quartic kernel is today's code and a polynomial well
+costs no compile time until one is integrated.
 
 Every lane's arithmetic is written with explicit fused multiply-adds (llvm.fma), no
 fast-math flags: the vector loop and the scalar replay produce bitwise identical numbers
 and a trajectory's result does not depend on which lane, block or thread ran it.
 
+Escape criteria
+---------------
+energy: 2 H0 = p^2 + 2 V(q) > 2 xi_max, or q beyond a barrier (QUARTIC: |q| > 1; the other
+flags: q > q_right or q < q_left, a side without barrier has q_left = -inf / q_right = +inf
+and never escapes that way); displacement: q outside the bound pair (lo, hi), q < lo or
+q > hi (QUARTIC: |q| > q_max, lo = -hi).  The thresholds are sorted: 2 xi_max ascending, the
+bound pairs nested from the inside out (lo non-increasing, hi non-decreasing), so crossing a
+threshold crosses every inner one and each lane only watches its next uncrossed one.
+
 Escape detection
 ----------------
-Per step the kernel tracks, per lane, max 2*H0 and max |q| over the current quarter period
-(vectorised, branch free; the period runs in SEGMENTS = 4 segments with a (q, p) snapshot
-before each).  At the period boundary a lane whose segment maxima crossed its next
-uncrossed threshold replays that segment from its snapshot (scalar, same arithmetic) and
-records the exact step of first crossing of every threshold crossed there.  A period that
-follows a boundary without any crossing runs as one segment (its crossings are replayed over
-the whole period): the snapshots are only paid for while lanes are crossing thresholds.
-A lane whose trajectory is finished (every requested threshold crossed, or the horizon
-reached) takes the next trajectory of its task at the period boundary (lane refill: the
-forcing is periodic, so every lane is always at the same sub-step of the period); when
-the task's queue is empty the active lanes are compacted so the vector loop only runs
-over live trajectories.
+Per step the kernel tracks, per lane, max 2*H0 and max |q| (QUARTIC) or max q and max -q
+(the signed flags) over the current quarter period (vectorised, branch free; the period runs
+in SEGMENTS = 4 segments with a (q, p) snapshot before each).  At the period boundary a lane
+whose segment maxima crossed its next uncrossed threshold replays that segment from its
+snapshot (scalar, same arithmetic) and records the exact step of first crossing of every
+threshold crossed there.  A period that follows a boundary without any crossing runs as one
+segment (its crossings are replayed over the whole period): the snapshots are only paid for
+while lanes are crossing thresholds.  A lane whose trajectory is finished (every requested
+threshold crossed, or the horizon reached) takes the next trajectory of its task at the
+period boundary (lane refill: the forcing is periodic, so every lane is always at the same
+sub-step of the period); when the task's queue is empty the active lanes are compacted so
+the vector loop only runs over live trajectories.
 """
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange, types
-from numba.extending import intrinsic
+from numba import njit, prange
+from numba.extending import overload
 
-# --- Blanes & Moan 2002, SRKN_6^b (Table 3), order 4 -------------------------------------
-_A1 = 0.245298957184271
-_A2 = 0.604872665711080
-_A3 = 0.5 - (_A1 + _A2)
-_B1 = 0.0829844064174052
-_B2 = 0.396309801498368
-_B3 = -0.0390563049223486
-_B4 = 1.0 - 2.0 * (_B1 + _B2 + _B3)
-BM6_DRIFT = np.array([_A1, _A2, _A3, _A3, _A2, _A1])
-BM6_KICK = np.array([_B1, _B2, _B3, _B4, _B3, _B2, _B1])
-# sub-times of the 7 kicks as fractions of a step
-BM6_KICK_TIMES = np.concatenate([[0.0], np.cumsum(BM6_DRIFT)])
-BM6_KICK_TIMES[-1] = 1.0
-DRIFT1, DRIFT2, DRIFT3 = _A1, _A2, _A3
-KICK1, KICK2, KICK3, KICK4 = _B1, _B2, _B3, _B4
-INTEGRATOR = "Blanes-Moan SRKN6b (symplectic RKN, order 4, 6 force evaluations/step)"
-N_KICKS = 7
+from safebasins.numerics.steps import (  # noqa: F401  (re-exported: the step API of the engine)
+    BM6_DRIFT, BM6_KICK, BM6_KICK_TIMES, DRIFT1, DRIFT2, DRIFT3, INTEGRATOR, INTEGRATORS, KICK1, KICK2, KICK3,
+    KICK4, N_KICKS, N_WPAR, POLY4, POLY8, POLY_DEGREES, Q_BARRIER, QUARTIC, QUARTIC_SIGNED, RK4_C1, RK4_C2, RK4_C3,
+    RK4_COEF, RK4_TIMES, WELL_FLAGS, _literal_flag, bm6_step, check_integrator, energy, energy2, fma, force, lane_coefficients,
+    lane_coefs, rk4_step, row, sine_table, step, step_sizes, well_bm6_step, well_energy2, well_force,
+    well_parameters, well_rk4_step, wtuple)
 
-# --- classic RK4 --------------------------------------------------------------------------
-RK4_COEF = np.array([0.5, 1.0, 1.0 / 6.0])       # h/2, h, h/6 (as products h * c)
-RK4_TIMES = np.array([0.0, 0.5, 1.0])            # force sub-times as fractions of a step
-RK4_C1, RK4_C2, RK4_C3 = 0.5, 1.0, 1.0 / 6.0
-INTEGRATORS = {
-    "srkn6b": INTEGRATOR,
-    "rk4": "classic RK4 (order 4, not symplectic, 4 force evaluations/step)",
-}
-
-# q beyond the barrier |q| = 1: out of the well.  Counts as crossing every energy threshold
-# (H0 no longer measures the well energy there; the particle runs away).
-Q_BARRIER = 1.0
 # smallest lane segment of the 4-chain vector loop (lanes run: 4 * segment)
 MIN_SEGMENT = 16
 # segments per period for the crossing replay (a crossing is replayed over S / SEGMENTS steps)
 SEGMENTS = 4
 
 
-@intrinsic
-def fma(typingctx, a, b, c):
-    """Correctly rounded a*b + c (llvm.fma.f64): same bits in vector and scalar code."""
-    sig = types.float64(types.float64, types.float64, types.float64)
-
-    def codegen(context, builder, signature, args):
-        return builder.fma(*args)
-
-    return sig, codegen
-
-
-@njit(cache=True, inline="always")
-def force(q, f):
-    """q^3 - q + f, with f = F sin(Omega t_k + Psi) (a product F * table value)."""
-    return fma(q * q, q, f - q)
-
-
-@njit(cache=True, inline="always")
-def bm6_step(q, p, a1, a2, a3, b1, b2, b3, b4, f1, f2, f3, f4, f5, f6, f7):
-    p = fma(b1, force(q, f1), p)
-    q = fma(a1, p, q)
-    p = fma(b2, force(q, f2), p)
-    q = fma(a2, p, q)
-    p = fma(b3, force(q, f3), p)
-    q = fma(a3, p, q)
-    p = fma(b4, force(q, f4), p)
-    q = fma(a3, p, q)
-    p = fma(b3, force(q, f5), p)
-    q = fma(a2, p, q)
-    p = fma(b2, force(q, f6), p)
-    q = fma(a1, p, q)
-    p = fma(b1, force(q, f7), p)
-    return q, p
-
-
-@njit(cache=True, inline="always")
-def rk4_step(q, p, hh, h, h6, f1, f2, f3):
-    """Classic RK4 for q' = p, p' = q^3 - q + f(t); hh = h/2, h6 = h/6 and f1, f2, f3 the
-    forcing at t, t + h/2, t + h."""
-    k1 = force(q, f1)
-    q2 = fma(hh, p, q)
-    p2 = fma(hh, k1, p)
-    k2 = force(q2, f2)
-    q3 = fma(hh, p2, q)
-    p3 = fma(hh, k2, p)
-    k3 = force(q3, f2)
-    q4 = fma(h, p3, q)
-    p4 = fma(h, k3, p)
-    k4 = force(q4, f3)
-    sq = p2 + p3
-    sp = k2 + k3
-    q = fma(h6, (p + p4) + (sq + sq), q)
-    p = fma(h6, (k1 + k4) + (sp + sp), p)
-    return q, p
-
-
-@njit(cache=True, inline="always")
-def step(rk4, q, p, c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7):
-    """One step of the scheme selected by the (compile-time constant) flag rk4; RK4 uses
-    c1..c3 = h/2, h, h/6 and f1..f3 only."""
-    if rk4:
-        return rk4_step(q, p, c1, c2, c3, f1, f2, f3)
-    return bm6_step(q, p, c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
-
-
-@njit(cache=True, inline="always")
-def _row(tab, s, rk4):
-    """Row s of a forcing table as 7 scalars (RK4: 3 + zeros)."""
-    if rk4:
-        return tab[s, 0], tab[s, 1], tab[s, 2], 0.0, 0.0, 0.0, 0.0
-    return tab[s, 0], tab[s, 1], tab[s, 2], tab[s, 3], tab[s, 4], tab[s, 5], tab[s, 6]
-
-
-@njit(cache=True, inline="always")
-def energy2(q, p):
-    """2 H0 = p^2 + q^2 - q^4/2 (eq 7, untruncated); compared with 2 xi_max (exact doubling)."""
-    q2 = q * q
-    return fma(q2, fma(-0.5, q2, 1.0), p * p)
-
-
 @njit(cache=True)
-def energy(q, p):
-    return 0.5 * energy2(q, p)
-
-
-def check_integrator(integrator):
-    if integrator not in INTEGRATORS:
-        raise ValueError(f"integrator must be one of {sorted(INTEGRATORS)}, got {integrator!r}")
-    return integrator
-
-
-def sine_table(steps_per_cycle, Psi, integrator="srkn6b"):
-    """sin(Omega t + Psi) at the force sub-times of every step of one period: (S, 7) for
-    SRKN6b (7 kicks), (S, 3) for RK4 (t, t + h/2, t + h).  The width selects the scheme."""
-    times = BM6_KICK_TIMES if check_integrator(integrator) == "srkn6b" else RK4_TIMES
-    s = np.arange(steps_per_cycle, dtype=float)[:, None] + times[None, :]
-    return np.ascontiguousarray(np.sin(2.0 * np.pi * s / steps_per_cycle + Psi))
-
-
-def lane_coefficients(Omega, steps_per_cycle, integrator="srkn6b"):
-    """Per-parameter-set step coefficients (n, 7): a1 h, a2 h, a3 h, b1 h, ..., b4 h
-    (SRKN6b) or h/2, h, h/6, 0, 0, 0, 0 (RK4)."""
-    Omega = np.atleast_1d(np.asarray(Omega, dtype=float))
-    h = 2.0 * np.pi / (Omega * steps_per_cycle)
-    out = np.zeros((Omega.size, 7))
-    if check_integrator(integrator) == "srkn6b":
-        out[:, 0:3] = h[:, None] * BM6_DRIFT[None, :3]
-        out[:, 3:7] = h[:, None] * BM6_KICK[None, :4]
-    else:
-        out[:, 0:3] = h[:, None] * RK4_COEF[None, :]
-    return out
-
-
-def step_sizes(Omega, steps_per_cycle):
-    """h = T / S per parameter set (the per-lane path forms h * a_k in the loop)."""
-    Omega = np.atleast_1d(np.asarray(Omega, dtype=float))
-    return 2.0 * np.pi / (Omega * steps_per_cycle)
-
-
-@njit(cache=True)
-def _check_state(i, q, p, step, thrE2, thrQ, iE, iQ, outE, outQ):
+def _check_state(well, wpar, i, q, p, step, thrE2, thrLo, thrHi, iE, iQ, outE, outQ):
     """Record, at `step`, every next-uncrossed threshold the state (q, p) is beyond."""
-    e = energy2(q, p)
-    aq = abs(q)
+    e = well_energy2(well, wtuple(wpar), q, p)
     nE = thrE2.shape[0]
-    nQ = thrQ.shape[0]
-    while iE < nE and (e > thrE2[iE] or aq > Q_BARRIER):
-        outE[i, iE] = step
-        iE += 1
-    while iQ < nQ and aq > thrQ[iQ]:
-        outQ[i, iQ] = step
-        iQ += 1
+    nQ = thrHi.shape[0]
+    if well == QUARTIC:
+        aq = abs(q)
+        while iE < nE and (e > thrE2[iE] or aq > Q_BARRIER):
+            outE[i, iE] = step
+            iE += 1
+        while iQ < nQ and aq > thrHi[iQ]:
+            outQ[i, iQ] = step
+            iQ += 1
+    else:
+        out = q > wpar[1] or q < wpar[0]
+        while iE < nE and (e > thrE2[iE] or out):
+            outE[i, iE] = step
+            iE += 1
+        while iQ < nQ and (q > thrHi[iQ] or q < thrLo[iQ]):
+            outQ[i, iQ] = step
+            iQ += 1
     return iE, iQ
 
 
@@ -219,35 +87,60 @@ def _finished(iE, iQ, nE, nQ, stop_any):
     return (iE == nE and iQ == nQ) or (stop_any and (iE > 0 or iQ > 0))
 
 
+@njit(cache=True, inline="always")
+def _filters(well, wpar, iE, iQ, thrE2, thrLo, thrHi):
+    """(tE, tQ, tN): the lane's next uncrossed 2 xi_max, and the levels its max q (QUARTIC:
+    max |q|) and max -q must exceed to cross its next uncrossed bound or, while an energy
+    threshold is uncrossed, a barrier (inf: none)."""
+    inf = np.inf
+    nE = thrE2.shape[0]
+    nQ = thrHi.shape[0]
+    tE = thrE2[iE] if iE < nE else inf
+    tQ = thrHi[iQ] if iQ < nQ else inf
+    tN = inf
+    if well == QUARTIC:
+        if iE < nE:
+            tQ = min(tQ, Q_BARRIER)
+    else:
+        tN = -thrLo[iQ] if iQ < nQ else inf
+        if iE < nE:
+            tQ = min(tQ, wpar[1])
+            tN = min(tN, -wpar[0])
+    return tE, tQ, tN
+
+
 @njit(cache=True)
-def _replay(i, q, p, period, s0, s1, sintab, c, F, thrE2, thrQ, iE, iQ, outE, outQ, stop_any):
+def _replay(well, wpar, i, q, p, period, s0, s1, sintab, c, F, thrE2, thrLo, thrHi, iE, iQ, outE, outQ,
+            stop_any):
     """Scalar replay of steps [s0, s1) of a period from the state before step s0 (same
     arithmetic as the vector loop); records the step of first crossing of every threshold
     crossed there."""
     S = sintab.shape[0]
     nE = thrE2.shape[0]
-    nQ = thrQ.shape[0]
+    nQ = thrHi.shape[0]
     rk4 = sintab.shape[1] == 3
+    w = wtuple(wpar)
     base = period * S
     for s in range(s0, s1):
         if rk4:
-            q, p = rk4_step(q, p, c[0], c[1], c[2], F * sintab[s, 0], F * sintab[s, 1], F * sintab[s, 2])
+            q, p = well_rk4_step(well, w, q, p, c[0], c[1], c[2], F * sintab[s, 0], F * sintab[s, 1],
+                                 F * sintab[s, 2])
         else:
-            q, p = bm6_step(q, p, c[0], c[1], c[2], c[3], c[4], c[5], c[6],
-                            F * sintab[s, 0], F * sintab[s, 1], F * sintab[s, 2], F * sintab[s, 3],
-                            F * sintab[s, 4], F * sintab[s, 5], F * sintab[s, 6])
-        iE, iQ = _check_state(i, q, p, base + s + 1, thrE2, thrQ, iE, iQ, outE, outQ)
+            q, p = well_bm6_step(well, w, q, p, c[0], c[1], c[2], c[3], c[4], c[5], c[6],
+                                 F * sintab[s, 0], F * sintab[s, 1], F * sintab[s, 2], F * sintab[s, 3],
+                                 F * sintab[s, 4], F * sintab[s, 5], F * sintab[s, 6])
+        iE, iQ = _check_state(well, wpar, i, q, p, base + s + 1, thrE2, thrLo, thrHi, iE, iQ, outE, outQ)
         if _finished(iE, iQ, nE, nQ, stop_any):
             break
     return iE, iQ
 
 
 @njit(cache=True, inline="always")
-def _keep(l, q, p, Q, P, ME, MQ):
+def _keep_abs(well, w, l, q, p, Q, P, ME, MQ, MN):
     """Store lane l's new state and update its maxima of 2*H0 and |q| (branch free)."""
     Q[l] = q
     P[l] = p
-    e = energy2(q, p)
+    e = well_energy2(well, w, q, p)
     x = abs(q)
     m = ME[l]
     ME[l] = e if e > m else m
@@ -256,86 +149,172 @@ def _keep(l, q, p, Q, P, ME, MQ):
 
 
 @njit(cache=True, inline="always")
-def _period_shared_body(rk4, M, Q, P, ME, MQ, c, FS, s0, s1):
-    """Steps [s0, s1) of the forcing period for lanes [0, 4M), all sharing one parameter set;
-    ME, MQ = max 2*H0 and max |q| over these steps.  rk4 is a compile-time constant at
-    every call site (inline body): one specialised loop per scheme.
+def _keep_signed(well, w, l, q, p, Q, P, ME, MQ, MN):
+    """Store lane l's new state and update its maxima of 2*H0, q and -q (branch free)."""
+    Q[l] = q
+    P[l] = p
+    _maxima_signed(well, w, l, q, p, ME, MQ, MN)
+
+
+@njit(cache=True, inline="always")
+def _maxima_signed(well, w, l, q, p, ME, MQ, MN):
+    e = well_energy2(well, w, q, p)
+    m = ME[l]
+    ME[l] = e if e > m else m
+    m = MQ[l]
+    MQ[l] = q if q > m else m
+    y = -q
+    m = MN[l]
+    MN[l] = y if y > m else m
+
+
+@njit(cache=True, inline="always")
+def _reset(well, n, ME, MQ, MN):
+    for l in range(n):
+        ME[l] = -np.inf
+        MQ[l] = -np.inf
+    if well != QUARTIC:
+        for l in range(n):
+            MN[l] = -np.inf
+
+
+def _shared_fused(rk4, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
+    """QUARTIC: steps [s0, s1) of the forcing period for lanes [0, 4M), all sharing one
+    parameter set; ME, MQ = max 2*H0 and max |q| over these steps.
 
     The lane loop (j) vectorises; its body advances 4 independent lanes j, M+j, 2M+j, 3M+j
     so that 4 dependency chains are in flight (the step is latency bound otherwise)."""
     c1 = c[0]; c2 = c[1]; c3 = c[2]; c4 = c[3]; c5 = c[4]; c6 = c[5]; c7 = c[6]
-    for l in range(4 * M):
-        ME[l] = -np.inf
-        MQ[l] = -np.inf
+    w = wtuple(wpar)
+    _reset(well, 4 * M, ME, MQ, MN)
     for s in range(s0, s1):
-        f1, f2, f3, f4, f5, f6, f7 = _row(FS, s, rk4)
+        f1, f2, f3, f4, f5, f6, f7 = row(FS, s, rk4)
         for j in range(M):
             l0 = 0 * M + j
             l1 = 1 * M + j
             l2 = 2 * M + j
             l3 = 3 * M + j
-            q0, p0 = step(rk4, Q[l0], P[l0], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
-            q1, p1 = step(rk4, Q[l1], P[l1], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
-            q2, p2 = step(rk4, Q[l2], P[l2], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
-            q3, p3 = step(rk4, Q[l3], P[l3], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
-            _keep(l0, q0, p0, Q, P, ME, MQ)
-            _keep(l1, q1, p1, Q, P, ME, MQ)
-            _keep(l2, q2, p2, Q, P, ME, MQ)
-            _keep(l3, q3, p3, Q, P, ME, MQ)
+            q0, p0 = step(rk4, well, w, Q[l0], P[l0], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
+            q1, p1 = step(rk4, well, w, Q[l1], P[l1], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
+            q2, p2 = step(rk4, well, w, Q[l2], P[l2], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
+            q3, p3 = step(rk4, well, w, Q[l3], P[l3], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
+            _keep_abs(well, w, l0, q0, p0, Q, P, ME, MQ, MN)
+            _keep_abs(well, w, l1, q1, p1, Q, P, ME, MQ, MN)
+            _keep_abs(well, w, l2, q2, p2, Q, P, ME, MQ, MN)
+            _keep_abs(well, w, l3, q3, p3, Q, P, ME, MQ, MN)
+
+
+def _shared_split(rk4, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
+    """The signed flags: as _shared_fused, with the maxima of 2*H0, q and -q updated in a
+    second lane loop per step.  (Fused, the 4 chains x 5 arrays need 190 runtime alias checks,
+    over LLVM's limit of 128 -vectorize-memory-check-threshold, and the loop stays scalar: 7x
+    slower.  Split, the step loop has 2 arrays x 4 chains and the maxima loop 5 arrays x 1
+    chain; the energy is recomputed from the stored state: the same numbers.)"""
+    c1 = c[0]; c2 = c[1]; c3 = c[2]; c4 = c[3]; c5 = c[4]; c6 = c[5]; c7 = c[6]
+    w = wtuple(wpar)
+    n = 4 * M
+    _reset(well, n, ME, MQ, MN)
+    for s in range(s0, s1):
+        f1, f2, f3, f4, f5, f6, f7 = row(FS, s, rk4)
+        for j in range(M):
+            l0 = 0 * M + j
+            l1 = 1 * M + j
+            l2 = 2 * M + j
+            l3 = 3 * M + j
+            q0, p0 = step(rk4, well, w, Q[l0], P[l0], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
+            q1, p1 = step(rk4, well, w, Q[l1], P[l1], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
+            q2, p2 = step(rk4, well, w, Q[l2], P[l2], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
+            q3, p3 = step(rk4, well, w, Q[l3], P[l3], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
+            Q[l0] = q0
+            P[l0] = p0
+            Q[l1] = q1
+            P[l1] = p1
+            Q[l2] = q2
+            P[l2] = p2
+            Q[l3] = q3
+            P[l3] = p3
+        for l in range(n):
+            _maxima_signed(well, w, l, Q[l], P[l], ME, MQ, MN)
+
+
+def _period_shared_body(rk4, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
+    """Steps [s0, s1) of the forcing period for lanes [0, 4M), all sharing one parameter set;
+    ME, MQ (, MN) = the maxima over these steps (see _keep).  rk4 and well are compile-time
+    constants at every call site (inline body): one specialised loop per scheme and well."""
+    raise NotImplementedError("compiled code (numba)")
+
+
+@overload(_period_shared_body)
+def _ol_period_shared_body(rk4, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
+    return _shared_fused if _literal_flag(well) == QUARTIC else _shared_split
 
 
 @njit(cache=True)
-def _period_shared(M, Q, P, ME, MQ, c, FS, s0, s1):
+def _period_shared(well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
     """_period_shared_body for the scheme of the table FS (width 3: RK4, 7: SRKN6b)."""
     if FS.shape[1] == 3:
-        _period_shared_body(True, M, Q, P, ME, MQ, c, FS, s0, s1)
+        _period_shared_body(True, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1)
     else:
-        _period_shared_body(False, M, Q, P, ME, MQ, c, FS, s0, s1)
+        _period_shared_body(False, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1)
 
 
-@njit(cache=True, inline="always")
-def _lane_coefs(rk4, h):
-    if rk4:
-        return h * RK4_C1, h * RK4_C2, h * RK4_C3, 0.0, 0.0, 0.0, 0.0
-    return h * DRIFT1, h * DRIFT2, h * DRIFT3, h * KICK1, h * KICK2, h * KICK3, h * KICK4
+def _lanes_abs(rk4, well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1):
+    n = 4 * M
+    w = wtuple(wpar)
+    _reset(well, n, ME, MQ, MN)
+    for s in range(s0, s1):
+        t1, t2, t3, t4, t5, t6, t7 = row(sintab, s, rk4)
+        for l in range(n):
+            F = FL[l]
+            c1, c2, c3, c4, c5, c6, c7 = lane_coefs(rk4, HL[l])
+            q, p = step(rk4, well, w, Q[l], P[l], c1, c2, c3, c4, c5, c6, c7,
+                        F * t1, F * t2, F * t3, F * t4, F * t5, F * t6, F * t7)
+            _keep_abs(well, w, l, q, p, Q, P, ME, MQ, MN)
 
 
-@njit(cache=True, inline="always")
-def _period_lanes_body(rk4, M, Q, P, ME, MQ, HL, FL, sintab, s0, s1):
+def _lanes_signed(rk4, well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1):
+    n = 4 * M
+    w = wtuple(wpar)
+    _reset(well, n, ME, MQ, MN)
+    for s in range(s0, s1):
+        t1, t2, t3, t4, t5, t6, t7 = row(sintab, s, rk4)
+        for l in range(n):
+            F = FL[l]
+            c1, c2, c3, c4, c5, c6, c7 = lane_coefs(rk4, HL[l])
+            q, p = step(rk4, well, w, Q[l], P[l], c1, c2, c3, c4, c5, c6, c7,
+                        F * t1, F * t2, F * t3, F * t4, F * t5, F * t6, F * t7)
+            _keep_signed(well, w, l, q, p, Q, P, ME, MQ, MN)
+
+
+def _period_lanes_body(rk4, well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1):
     """As _period_shared for lanes [0, 4M) with per-lane parameters: step h = HL[l] and
     amplitude F = FL[l].  The coefficients h*c_k and forcing values F*sin_k are formed in the
     loop: the same IEEE products as the precomputed ones of the shared path, so both paths
     give bitwise identical trajectories.  (One chain per iteration: with 4 chains and six
     arrays LLVM's runtime alias checks exceed its budget and the loop stays scalar.)"""
-    n = 4 * M
-    for l in range(n):
-        ME[l] = -np.inf
-        MQ[l] = -np.inf
-    for s in range(s0, s1):
-        t1, t2, t3, t4, t5, t6, t7 = _row(sintab, s, rk4)
-        for l in range(n):
-            F = FL[l]
-            c1, c2, c3, c4, c5, c6, c7 = _lane_coefs(rk4, HL[l])
-            q, p = step(rk4, Q[l], P[l], c1, c2, c3, c4, c5, c6, c7,
-                        F * t1, F * t2, F * t3, F * t4, F * t5, F * t6, F * t7)
-            _keep(l, q, p, Q, P, ME, MQ)
+    raise NotImplementedError("compiled code (numba)")
+
+
+@overload(_period_lanes_body)
+def _ol_period_lanes_body(rk4, well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1):
+    return _lanes_abs if _literal_flag(well) == QUARTIC else _lanes_signed
 
 
 @njit(cache=True)
-def _period_lanes(M, Q, P, ME, MQ, HL, FL, sintab, s0, s1):
+def _period_lanes(well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1):
     if sintab.shape[1] == 3:
-        _period_lanes_body(True, M, Q, P, ME, MQ, HL, FL, sintab, s0, s1)
+        _period_lanes_body(True, well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1)
     else:
-        _period_lanes_body(False, M, Q, P, ME, MQ, HL, FL, sintab, s0, s1)
+        _period_lanes_body(False, well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1)
 
 
 @njit(cache=True)
-def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQ, cycles,
-              stop_any, outE, outQ, store, do_store):
+def _run_task(well, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrLo, thrHi,
+              cycles, stop_any, outE, outQ, store, do_store):
     N = q0.shape[0]
     S = sintab.shape[0]
     nE = thrE2.shape[0]
-    nQ = thrQ.shape[0]
+    nQ = thrHi.shape[0]
     shared = coef.shape[0] == 1
     L = np.int64(lanes)
     Lmem = max(L, 4 * MIN_SEGMENT) + 32       # room for the padded segments
@@ -355,6 +334,7 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
     SP = np.zeros((Gmax, Lmem))
     SME = np.empty((Gmax, Lmem))
     SMQ = np.empty((Gmax, Lmem))
+    SMN = np.empty((Gmax, Lmem if well != QUARTIC else 1))    # max -q (signed flags only)
     nhit = np.int64(1)         # crossings at the last period boundary (first period: segmented)
     traj = np.empty(L, np.int64)
     per = np.empty(L, np.int64)
@@ -363,8 +343,8 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
     done = np.zeros(L, np.bool_)
     hit = np.zeros(L, np.bool_)
     tE = np.empty(L)      # next uncrossed 2*xi threshold of the lane (inf: none)
-    tQ = np.empty(L)      # next uncrossed |q| threshold (or the barrier)
-    inf = np.inf
+    tQ = np.empty(L)      # next uncrossed |q| (QUARTIC) or upper bound, or the barrier
+    tN = np.empty(L)      # signed flags: next uncrossed -lower bound, or -q_left
     FS = Fpar[0] * sintab        # (S, 7) or (S, 3), shared path
     HL = np.zeros(Lmem)          # per-lane path
     FL = np.zeros(Lmem)
@@ -385,7 +365,7 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
             while nxt < N:
                 i = nxt
                 nxt += n_tasks
-                iE, iQ = _check_state(i, q0[i], p0[i], 0, thrE2, thrQ, 0, 0, outE, outQ)
+                iE, iQ = _check_state(well, wpar, i, q0[i], p0[i], 0, thrE2, thrLo, thrHi, 0, 0, outE, outQ)
                 if do_store and iE == 0 and iQ == 0:
                     store[i, 0, 0] = q0[i]
                     store[i, 0, 1] = p0[i]
@@ -396,10 +376,7 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
                 HL[l] = hpar[k]
                 FL[l] = Fpar[k]
                 traj[l] = i; per[l] = 0; lE[l] = iE; lQ[l] = iQ
-                tE[l] = thrE2[iE] if iE < nE else inf
-                tQ[l] = thrQ[iQ] if iQ < nQ else inf
-                if iE < nE:
-                    tQ[l] = min(tQ[l], Q_BARRIER)
+                tE[l], tQ[l], tN[l] = _filters(well, wpar, iE, iQ, thrE2, thrLo, thrHi)
                 done[l] = False
                 loaded = True
                 break
@@ -417,7 +394,7 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
                 HL[l] = HL[last]
                 FL[l] = FL[last]
                 traj[l] = traj[last]; per[l] = per[last]; lE[l] = lE[last]; lQ[l] = lQ[last]
-                tE[l] = tE[last]; tQ[l] = tQ[last]; done[l] = done[last]
+                tE[l] = tE[last]; tQ[l] = tQ[last]; tN[l] = tN[last]; done[l] = done[last]
             nact -= 1
         if nact == 0:
             break
@@ -433,19 +410,24 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
             for l in range(nact):
                 SQ[g, l] = Q[l]
                 SP[g, l] = P[l]
-            # segment maxima go straight into the rows SME[g], SMQ[g]
+            # segment maxima go straight into the rows SME[g], SMQ[g] (, SMN[g])
             if shared:
-                _period_shared(M, Q, P, SME[g], SMQ[g], coef[0], FS, seg[g], seg[g + 1])
+                _period_shared(well, wpar, M, Q, P, SME[g], SMQ[g], SMN[g], coef[0], FS, seg[g], seg[g + 1])
             else:
-                _period_lanes(M, Q, P, SME[g], SMQ[g], HL, FL, sintab, seg[g], seg[g + 1])
+                _period_lanes(well, wpar, M, Q, P, SME[g], SMQ[g], SMN[g], HL, FL, sintab, seg[g], seg[g + 1])
         # ---------------------------------------------------- period boundary
         # vectorised test first: only lanes whose maxima crossed a threshold (or, for the
         # map, every lane) need the scalar bookkeeping below
         for l in range(nact):
             hit[l] = False
-        for g in range(G):
-            for l in range(nact):
-                hit[l] = hit[l] | (SME[g, l] > tE[l]) | (SMQ[g, l] > tQ[l])
+        if well == QUARTIC:
+            for g in range(G):
+                for l in range(nact):
+                    hit[l] = hit[l] | (SME[g, l] > tE[l]) | (SMQ[g, l] > tQ[l])
+        else:
+            for g in range(G):
+                for l in range(nact):
+                    hit[l] = hit[l] | (SME[g, l] > tE[l]) | (SMQ[g, l] > tQ[l]) | (SMN[g, l] > tN[l])
         nhit = np.int64(0)
         for l in range(nact):
             nhit += hit[l]
@@ -465,16 +447,13 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
             iQ = lQ[l]
             if hit[l]:
                 for g in range(G):
-                    if SME[g, l] > tE[l] or SMQ[g, l] > tQ[l]:
+                    if SME[g, l] > tE[l] or SMQ[g, l] > tQ[l] or (well != QUARTIC and SMN[g, l] > tN[l]):
                         k = pidx[i]
-                        iE, iQ = _replay(i, SQ[g, l], SP[g, l], per[l] - 1, seg[g], seg[g + 1], sintab,
-                                         coef[k], Fpar[k], thrE2, thrQ, iE, iQ, outE, outQ, stop_any)
+                        iE, iQ = _replay(well, wpar, i, SQ[g, l], SP[g, l], per[l] - 1, seg[g], seg[g + 1], sintab,
+                                         coef[k], Fpar[k], thrE2, thrLo, thrHi, iE, iQ, outE, outQ, stop_any)
                         lE[l] = iE
                         lQ[l] = iQ
-                        tE[l] = thrE2[iE] if iE < nE else inf
-                        tQ[l] = thrQ[iQ] if iQ < nQ else inf
-                        if iE < nE:
-                            tQ[l] = min(tQ[l], Q_BARRIER)
+                        tE[l], tQ[l], tN[l] = _filters(well, wpar, iE, iQ, thrE2, thrLo, thrHi)
                         if _finished(iE, iQ, nE, nQ, stop_any):
                             break
             fin = _finished(iE, iQ, nE, nQ, stop_any)
@@ -486,35 +465,82 @@ def _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE
             done[l] = d
 
 
+# one compiled entry point per well flag: the flag reaches every callee as a numba literal (a
+# global constant), so each flag is its own specialised kernel, compiled (and cached) on first
+# use; `task` is cast to int64 so that _run_task is compiled once (prange indices are uint64
+# inside the parallel region)
 @njit(cache=True, parallel=True)
+def _ensemble_quartic(wpar, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrLo, thrHi, cycles, stop_any, n_tasks,
+                      lanes, outE, outQ, store, do_store):
+    for task in prange(n_tasks):
+        _run_task(QUARTIC, wpar, np.int64(task), n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2,
+                  thrLo, thrHi, cycles, stop_any, outE, outQ, store, do_store)
+
+
+@njit(cache=True, parallel=True)
+def _ensemble_quartic_signed(wpar, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrLo, thrHi, cycles, stop_any,
+                             n_tasks, lanes, outE, outQ, store, do_store):
+    for task in prange(n_tasks):
+        _run_task(QUARTIC_SIGNED, wpar, np.int64(task), n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab,
+                  thrE2, thrLo, thrHi, cycles, stop_any, outE, outQ, store, do_store)
+
+
+@njit(cache=True, parallel=True)
+def _ensemble_poly4(wpar, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrLo, thrHi, cycles, stop_any, n_tasks,
+                    lanes, outE, outQ, store, do_store):
+    for task in prange(n_tasks):
+        _run_task(POLY4, wpar, np.int64(task), n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2,
+                  thrLo, thrHi, cycles, stop_any, outE, outQ, store, do_store)
+
+
+@njit(cache=True, parallel=True)
+def _ensemble_poly8(wpar, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrLo, thrHi, cycles, stop_any, n_tasks,
+                    lanes, outE, outQ, store, do_store):
+    for task in prange(n_tasks):
+        _run_task(POLY8, wpar, np.int64(task), n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2,
+                  thrLo, thrHi, cycles, stop_any, outE, outQ, store, do_store)
+
+
+_ENSEMBLE = {QUARTIC: _ensemble_quartic, QUARTIC_SIGNED: _ensemble_quartic_signed, POLY4: _ensemble_poly4,
+             POLY8: _ensemble_poly8}
+
+
 def ensemble(q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQ, cycles, stop_any, n_tasks, lanes,
-             outE, outQ, store, do_store):
+             outE, outQ, store, do_store, well=QUARTIC, wpar=None, thrQlo=None):
     """Integrate every trajectory i from (q0[i], p0[i]) with parameter set pidx[i]
     (coef[pidx[i]] = step coefficients from lane_coefficients, hpar[pidx[i]] = the step h
     from step_sizes, Fpar[pidx[i]] = F) for at most
     `cycles` forcing periods of S = sintab.shape[0] steps.
 
-    thrE2: sorted ascending 2*xi_max thresholds; thrQ: sorted ascending q_max (either may be
-    empty).  outE (N, nE), outQ (N, nQ): int64 step after which the threshold is first
+    thrE2: sorted ascending 2*xi_max thresholds; thrQ: the upper displacement bounds, sorted
+    ascending (QUARTIC: the q_max of |q| > q_max), thrQlo: the lower bounds (signed flags; None:
+    -thrQ), nested with thrQ (non-increasing); either threshold list may be empty.
+    outE (N, nE), outQ (N, nQ): int64 step after which the threshold is first
     exceeded (0 = the initial condition), pre-filled with -1 (= not within the horizon).
     A trajectory stops when every threshold is crossed (stop_any: when any is crossed).
     store (N, cycles+1, 2): period-map iterates when do_store (pre-filled with NaN).
-    The scheme is the width of sintab (sine_table / lane_coefficients of the same integrator).
+    The scheme is the width of sintab (sine_table / lane_coefficients of the same integrator);
+    the well is the flag `well` (steps.WELL_FLAGS) with its parameters wpar (steps.well_parameters;
+    None: the quartic's barriers).
     Trajectory i is run by task i % n_tasks; the results do not depend on n_tasks, lanes or
     the thread count (each trajectory is the same sequence of IEEE operations).
     """
-    for task in prange(n_tasks):
-        _run_task(task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQ, cycles,
-                  stop_any, outE, outQ, store, do_store)
+    if well not in WELL_FLAGS:
+        raise ValueError(f"well must be one of the kernel flags {WELL_FLAGS}, got {well!r}")
+    if wpar is None:
+        wpar = well_parameters()[1]
+    thrQ = np.ascontiguousarray(thrQ, dtype=float)
+    thrQlo = -thrQ if thrQlo is None else np.ascontiguousarray(thrQlo, dtype=float)
+    _ENSEMBLE[well](np.ascontiguousarray(wpar, dtype=float), q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2,
+              thrQlo, thrQ, cycles, stop_any, n_tasks, lanes, outE, outQ, store, do_store)
 
 
-@njit(cache=True, parallel=True)
-def final_states(q0, p0, pidx, coef, Fpar, sintab, n_periods):
-    """Plain integration (no escape checks) for n_periods periods; returns (q, p).
-    Scalar per trajectory; used by tests (convergence order, energy drift)."""
+@njit(cache=True, inline="always")
+def _final_states_body(well, wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods):
     N = q0.shape[0]
     S = sintab.shape[0]
     rk4 = sintab.shape[1] == 3
+    w = wtuple(wpar)
     qo = np.empty(N)
     po = np.empty(N)
     for i in prange(N):
@@ -526,13 +552,46 @@ def final_states(q0, p0, pidx, coef, Fpar, sintab, n_periods):
         for n in range(n_periods):
             for s in range(S):
                 if rk4:
-                    q, p = rk4_step(q, p, c[0], c[1], c[2], F * sintab[s, 0], F * sintab[s, 1],
-                                    F * sintab[s, 2])
+                    q, p = well_rk4_step(well, w, q, p, c[0], c[1], c[2], F * sintab[s, 0], F * sintab[s, 1],
+                                         F * sintab[s, 2])
                 else:
-                    q, p = bm6_step(q, p, c[0], c[1], c[2], c[3], c[4], c[5], c[6],
-                                    F * sintab[s, 0], F * sintab[s, 1], F * sintab[s, 2],
-                                    F * sintab[s, 3], F * sintab[s, 4], F * sintab[s, 5],
-                                    F * sintab[s, 6])
+                    q, p = well_bm6_step(well, w, q, p, c[0], c[1], c[2], c[3], c[4], c[5], c[6],
+                                         F * sintab[s, 0], F * sintab[s, 1], F * sintab[s, 2],
+                                         F * sintab[s, 3], F * sintab[s, 4], F * sintab[s, 5],
+                                         F * sintab[s, 6])
         qo[i] = q
         po[i] = p
     return qo, po
+
+
+
+
+@njit(cache=True, parallel=True)
+def _final_states_quartic(wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods):
+    return _final_states_body(QUARTIC, wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods)
+
+
+@njit(cache=True, parallel=True)
+def _final_states_poly4(wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods):
+    return _final_states_body(POLY4, wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods)
+
+
+@njit(cache=True, parallel=True)
+def _final_states_poly8(wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods):
+    return _final_states_body(POLY8, wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods)
+
+
+_FINAL_STATES = {QUARTIC: _final_states_quartic, QUARTIC_SIGNED: _final_states_quartic, POLY4: _final_states_poly4,
+                 POLY8: _final_states_poly8}
+
+
+def final_states(q0, p0, pidx, coef, Fpar, sintab, n_periods, well=QUARTIC, wpar=None):
+    """Plain integration (no escape checks) for n_periods periods; returns (q, p).
+    Scalar per trajectory; used by tests (convergence order, energy drift).  well, wpar: as
+    ensemble (the quartic by default)."""
+    if well not in WELL_FLAGS:
+        raise ValueError(f"well must be one of the kernel flags {WELL_FLAGS}, got {well!r}")
+    if wpar is None:
+        wpar = well_parameters()[1]
+    return _FINAL_STATES[well](np.ascontiguousarray(wpar, dtype=float), q0, p0, pidx, coef, Fpar, sintab,
+                         int(n_periods))

@@ -1,0 +1,233 @@
+"""Speed of the compiled engine per well, in ONE process (see docs/numerics.md).
+
+    python benchmarks/bench_wells.py                 # SRKN6b and RK4, 1 thread, best of 7
+    python benchmarks/bench_wells.py --threads 2 --integrators srkn6b
+
+Before / after: the engine's kernels module as it was before the well flag (git revision
+--before, default f85d441, the last commit with the quartic hard-wired) is checked out into a
+temporary directory (`git show REV:src/safebasins/numerics/kernels.py`, self-contained: numpy
+and numba only) and imported beside today's safebasins.numerics.kernels; both run the same
+jobs on the same arrays in this process, interleaved (job A, job B, job A, ... and the best
+time of each), and their escape steps are compared (must be equal: the quartic path is
+bitwise unchanged).
+
+Jobs (kernel only: kernels.ensemble with the arrays engine.run_ensemble would pass):
+  dense  ICs inside the well, F = 0: nothing escapes, every lane steps for --dense-cycles
+         cycles (the per-step rate);
+  chart  the 100x100 chart of bench_escape.py (quartic: F = 0.0876, Omega = 0.95, Psi = pi,
+         xi_max = 0.25, 300 cycles; cubic: F = 0.06, Omega = 0.85, xi_max = 1/6), steps
+         counted to the escape step or the horizon.
+Wells: the quartic's closed-form path (flag QUARTIC: before and after; QUARTIC_SIGNED: the
+same arithmetic with signed maxima, for asymmetric displacement bounds) and the polynomial
+path (POLY4: the cubic V = q^2/2 - q^3/3 and the quartic written as coefficients
+[0, 0, 0.5, 0, -0.25]; POLY8: the cubic run in the degree-8 class, i.e. a degree 5-8 well).
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+QUARTIC_COEFS = [0.0, 0.0, 0.5, 0.0, -0.25]
+CUBIC_COEFS = [0.0, 0.0, 0.5, -1.0 / 3.0]
+CHART_QUARTIC = dict(F=0.0876, Omega=0.95, Psi=np.pi, xi_max=0.25, box=((-1, 1), (-1, 1)))
+CHART_CUBIC = dict(F=0.06, Omega=0.85, Psi=np.pi, xi_max=1.0 / 6.0, box=((-0.8, 1.0), (-0.7, 0.7)))
+
+
+def machine():
+    info = {}
+    try:
+        for line in open("/proc/cpuinfo"):
+            k, _, v = line.partition(":")
+            k = k.strip()
+            if k in ("model name", "flags") and k not in info:
+                info[k] = v.strip()
+    except OSError:   # pragma: no cover
+        pass
+    flags = set(info.get("flags", "").split())
+    simd = ", ".join(f for f in ("avx2", "fma", "avx512f", "avx512dq", "avx512vl") if f in flags) or "?"
+    la = os.getloadavg()
+    return (f"{info.get('model name', '?')}, {os.cpu_count()} CPUs, SIMD: {simd}; "
+            f"load average {la[0]:.2f} {la[1]:.2f} {la[2]:.2f}")
+
+
+def load_before(rev):
+    """The kernels module of git revision `rev`, imported from a temporary directory (its numba
+    cache lives there too, so a second run does not recompile)."""
+    src = subprocess.run(["git", "show", f"{rev}:src/safebasins/numerics/kernels.py"], cwd=ROOT, check=True,
+                         capture_output=True, text=True).stdout
+    if any(line.startswith(("from safebasins", "import safebasins")) for line in src.splitlines()):
+        raise SystemExit(f"kernels.py of {rev} imports safebasins: not the self-contained module this "
+                         "benchmark expects (pick the revision before the well flag)")
+    d = Path(tempfile.gettempdir()) / "safebasins_kernels_before"
+    d.mkdir(exist_ok=True)
+    name = "kernels_" + "".join(ch if ch.isalnum() else "_" for ch in rev)
+    path = d / f"{name}.py"
+    if not path.exists() or path.read_text() != src:
+        path.write_text(src)
+    sys.path.insert(0, str(d))     # an importable module: numba's cache reloads it by name
+    try:
+        return importlib.import_module(name)
+    finally:
+        sys.path.remove(str(d))
+
+
+def disc_ics(n, H0, limit, seed=0):
+    """n ICs with H0 < limit (rejection from the box around the well bottom)."""
+    rng = np.random.default_rng(seed)
+    out = np.empty((0, 2))
+    while out.shape[0] < n:
+        z = rng.uniform(-1, 1, (4 * n, 2))
+        out = np.concatenate([out, z[H0(z[:, 0], z[:, 1]) < limit]])
+    return np.ascontiguousarray(out[:n, 0]), np.ascontiguousarray(out[:n, 1])
+
+
+def grid_ics(box, n=100):
+    q = np.linspace(*box[0], n)
+    p = np.linspace(*box[1], n)
+    Q, P = np.meshgrid(q, p, indexing="ij")
+    return Q.ravel(), P.ravel()
+
+
+def H_quartic(q, p):
+    return 0.5 * p * p + 0.5 * q * q - 0.25 * q ** 4
+
+
+def H_cubic(q, p):
+    return 0.5 * p * p + 0.5 * q * q - q ** 3 / 3.0
+
+
+class Job:
+    """One kernels.ensemble call with fixed arrays; run() returns the escape steps."""
+
+    def __init__(self, name, mod, Q, P, F, Omega, Psi, xi_max, cycles, S, integrator, threads, flag=None,
+                 coefs=None, barriers=(-1.0, 1.0)):
+        from safebasins.numerics import engine, kernels
+        self.name, self.mod, self.flag, self.cycles, self.S = name, mod, flag, cycles, S
+        self.Q, self.P = Q, P
+        N = Q.size
+        self.args = (Q, P, np.zeros(N, np.int64), kernels.lane_coefficients([Omega], S, integrator),
+                     kernels.step_sizes([Omega], S), np.array([F]), kernels.sine_table(S, Psi, integrator),
+                     np.array([2.0 * xi_max]), np.zeros(0), cycles, False,
+                     max(1, min(-(-N // engine.LANES), threads)), engine.LANES)
+        self.kw = {}
+        if flag is not None:
+            cls, wpar = kernels.well_parameters(barriers, coefs)
+            self.kw = dict(well=flag, wpar=wpar, thrQlo=np.zeros(0))
+        self.out = None
+
+    def run(self):
+        N = self.Q.size
+        outE = np.full((N, 1), -1, np.int64)
+        outQ = np.full((N, 0), -1, np.int64)
+        self.mod.ensemble(*self.args, outE, outQ, np.empty((0, 0, 2)), False, **self.kw)
+        self.out = outE
+        return outE
+
+    def steps(self):
+        e = self.out[:, 0]
+        return float(np.where(e < 0, self.cycles * self.S, e).sum())
+
+
+def bench(jobs, repeat):
+    for j in jobs:                      # compile / cache load outside the timings
+        j.run()
+    best = {j.name: np.inf for j in jobs}
+    cpu = {}
+    for _ in range(repeat):
+        for j in jobs:                  # interleaved: load changes hit every job alike
+            t, c = time.perf_counter(), time.process_time()
+            j.run()
+            w = time.perf_counter() - t
+            if w < best[j.name]:
+                best[j.name], cpu[j.name] = w, time.process_time() - c
+    return best, cpu
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--before", default="f85d441", help="git revision of the kernels before the well flag")
+    ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--repeat", type=int, default=7)
+    ap.add_argument("--integrators", nargs="+", default=["srkn6b", "rk4"])
+    ap.add_argument("--dense-n", type=int, default=4096)
+    ap.add_argument("--dense-cycles", type=int, default=600)
+    ap.add_argument("--chart-cycles", type=int, default=300)
+    ap.add_argument("--steps-per-cycle", type=int, default=32)
+    args = ap.parse_args(argv)
+
+    import numba
+    numba.set_num_threads(args.threads)
+    from safebasins.numerics import kernels
+    print("machine:", machine())
+    print(f"numba {numba.__version__}, threads {args.threads}, steps_per_cycle {args.steps_per_cycle}, "
+          f"best of {args.repeat} interleaved runs, kernel only (kernels.ensemble)")
+    t = time.perf_counter()
+    before = load_before(args.before)
+    print(f"before: kernels.py of {args.before} (loaded in {time.perf_counter() - t:.1f} s)")
+    S = args.steps_per_cycle
+    qd, pd = disc_ics(args.dense_n, H_quartic, 0.2)
+    cd_q, cd_p = disc_ics(args.dense_n, H_cubic, 0.14, seed=1)
+    qc, pc = grid_ics(CHART_QUARTIC["box"])
+    cq, cp = grid_ics(CHART_CUBIC["box"])
+    cq_ = {k: CHART_QUARTIC[k] for k in ("F", "Omega", "Psi", "xi_max")}
+    cc_ = {k: CHART_CUBIC[k] for k in ("F", "Omega", "Psi", "xi_max")}
+    cubic_bar = (-np.inf, 1.0)
+    for integ in args.integrators:
+        dense = dict(F=0.0, Omega=1.0, Psi=0.0, xi_max=0.25, cycles=args.dense_cycles, S=S, integrator=integ,
+                     threads=args.threads)
+        dense_c = dict(dense, xi_max=1.0 / 6.0)
+        chart = dict(cycles=args.chart_cycles, S=S, integrator=integ, threads=args.threads)
+        jobs = [
+            Job("quartic dense, before", before, qd, pd, **dense),
+            Job("quartic dense, after (QUARTIC)", kernels, qd, pd, **dense, flag=kernels.QUARTIC),
+            Job("quartic dense, QUARTIC_SIGNED", kernels, qd, pd, **dense, flag=kernels.QUARTIC_SIGNED),
+            Job("quartic dense, POLY4 coefficients", kernels, qd, pd, **dense, flag=kernels.POLY4,
+                coefs=QUARTIC_COEFS),
+            Job("cubic dense, POLY4", kernels, cd_q, cd_p, **dense_c, flag=kernels.POLY4, coefs=CUBIC_COEFS,
+                barriers=cubic_bar),
+            Job("cubic dense, POLY8 class", kernels, cd_q, cd_p, **dense_c, flag=kernels.POLY8, coefs=CUBIC_COEFS,
+                barriers=cubic_bar),
+            Job("quartic chart, before", before, qc, pc, **cq_, **chart),
+            Job("quartic chart, after (QUARTIC)", kernels, qc, pc, **cq_, **chart, flag=kernels.QUARTIC),
+            Job("cubic chart, POLY4", kernels, cq, cp, **cc_, **chart, flag=kernels.POLY4, coefs=CUBIC_COEFS,
+                barriers=cubic_bar),
+        ]
+        t = time.perf_counter()
+        best, cpu = bench(jobs, args.repeat)
+        print(f"\n=== {integ} (compile or cache load + runs: {time.perf_counter() - t:.0f} s) ===")
+        by = {j.name: j for j in jobs}
+        for a, b in (("quartic dense, before", "quartic dense, after (QUARTIC)"),
+                     ("quartic chart, before", "quartic chart, after (QUARTIC)")):
+            same = np.array_equal(by[a].out, by[b].out)
+            print(f"escape steps {a.split(',')[0]}: before == after: {same}")
+            if not same:
+                raise SystemExit("the quartic path changed its results")
+        ref = by["quartic dense, after (QUARTIC)"]
+        ref_rate = ref.steps() / best[ref.name]
+        print(f"{'job':36s} {'traj-steps':>11s} {'wall [s]':>9s} {'steps/s':>10s} {'CPU s':>7s} "
+              f"{'vs QUARTIC dense':>16s}")
+        for j in jobs:
+            n = j.steps()
+            r = n / best[j.name]
+            print(f"{j.name:36s} {n:11.4g} {best[j.name]:9.4f} {r:10.4g} {cpu[j.name]:7.3f} {r / ref_rate:16.3f}")
+        for kind in ("dense", "chart"):
+            b, a = by[f"quartic {kind}, before"], by[f"quartic {kind}, after (QUARTIC)"]
+            print(f"quartic {kind}: after / before = {best[b.name] / best[a.name]:.3f} (steps/s ratio; 1 = same speed)")
+        for name in ("cubic dense, POLY4", "quartic dense, POLY4 coefficients", "cubic dense, POLY8 class",
+                     "quartic dense, QUARTIC_SIGNED"):
+            j = by[name]
+            print(f"{name}: time per step / quartic's = {ref_rate / (j.steps() / best[name]):.3f}")
+    print("\nmachine after:", machine())
+
+
+if __name__ == "__main__":
+    sys.exit(main())

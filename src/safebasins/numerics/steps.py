@@ -1,0 +1,338 @@
+"""The step of the compiled engine: schemes, forcing tables and the well's force and energy.
+
+Equation: q'' + V'(q) = F sin(Omega t + Psi), first order q' = p, p' = -V'(q) + f(t).
+
+Schemes
+-------
+Blanes & Moan (2002) symmetric symplectic Runge-Kutta-Nystrom method SRKN_6^b (order 4,
+7 kicks + 6 drifts per step, kick first):
+
+    B(b1) A(a1) B(b2) A(a2) B(b3) A(a3) B(b4) A(a3) B(b3) A(a2) B(b2) A(a1) B(b1)
+
+with A = drift q += a h p (time drifts with q: extended phase space) and B = kick
+p += b h (-V'(q) + F sin(Omega t_k + Psi)) at the current sub-time t_k.  Because
+Omega * t_k = 2 pi (s + c_k) / S for sub-step s of a period of S steps, the table
+sin(Omega t_k + Psi) depends only on (S, Psi): one table serves every Omega and F.
+
+Classic RK4 (integrator="rk4"): 4 force evaluations per step at t, t + h/2 (twice) and t + h,
+table sin(Omega t + Psi) of shape (S, 3).  The scheme of a run is the width of its forcing
+table (7: SRKN6b, 3: RK4).
+
+Every operation is written with explicit fused multiply-adds (llvm.fma), no fast-math flags:
+vector loop and scalar replay produce bitwise identical numbers.
+
+Wells (the compile-time flag ``well``)
+--------------------------------------
+The well enters the step through the force -V'(q) + f and the escape test through
+2 H0 = p^2 + 2 V(q).  Both are inline functions specialised on a compile-time constant flag,
+like the scheme (kernels.py threads it through as a numba literal: each flag value is its own
+compiled, cached kernel, compiled on first use):
+
+* ``QUARTIC`` (0): the paper's V = q^2/2 - q^4/4 in closed form, force fma(q*q, q, f - q),
+  2 H0 = fma(q2, fma(-0.5, q2, 1.0), p*p) (q2 = q*q); the lanes track max |q| (symmetric
+  displacement thresholds, barrier |q| > 1);
+* ``QUARTIC_SIGNED`` (1): the same arithmetic; the lanes track max q and max -q (asymmetric
+  displacement bounds lo < q < hi);
+* ``POLY4`` (4), ``POLY8`` (8): a polynomial well V = sum_{k=2}^{n} c_k q^k of degree
+  n <= 4 (resp. 8).  The coefficients are run-time numbers (``well_parameters``), so one
+  compiled kernel serves every polynomial well of its degree class; the force
+  -V'(q) + f = f + q (g_1 + q (g_2 + ...)), g_k = -(k+1) c_{k+1}, and
+  2 V(q) + p^2 = q^2 (e_2 + q (e_3 + ...)) + p^2, e_k = 2 c_k, are Horner evaluations with
+  explicit fma over the class's full length (the missing top coefficients are zeros, and a
+  leading zero leaves the Horner value bitwise unchanged: fma(0, q, g) = g for finite q).
+  Signed maxima (max q, max -q) as QUARTIC_SIGNED.
+
+``wpar`` (float64, ``N_WPAR``): [q_left, q_right, g_1 .. g_7, e_2 .. e_8]; the barriers
+(+-inf where there is none) are used by the signed flags, the coefficients by the POLY flags.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, types
+from numba.core import errors
+from numba.extending import intrinsic, overload
+
+# --- Blanes & Moan 2002, SRKN_6^b (Table 3), order 4 -------------------------------------
+_A1 = 0.245298957184271
+_A2 = 0.604872665711080
+_A3 = 0.5 - (_A1 + _A2)
+_B1 = 0.0829844064174052
+_B2 = 0.396309801498368
+_B3 = -0.0390563049223486
+_B4 = 1.0 - 2.0 * (_B1 + _B2 + _B3)
+BM6_DRIFT = np.array([_A1, _A2, _A3, _A3, _A2, _A1])
+BM6_KICK = np.array([_B1, _B2, _B3, _B4, _B3, _B2, _B1])
+# sub-times of the 7 kicks as fractions of a step
+BM6_KICK_TIMES = np.concatenate([[0.0], np.cumsum(BM6_DRIFT)])
+BM6_KICK_TIMES[-1] = 1.0
+DRIFT1, DRIFT2, DRIFT3 = _A1, _A2, _A3
+KICK1, KICK2, KICK3, KICK4 = _B1, _B2, _B3, _B4
+INTEGRATOR = "Blanes-Moan SRKN6b (symplectic RKN, order 4, 6 force evaluations/step)"
+N_KICKS = 7
+
+# --- classic RK4 --------------------------------------------------------------------------
+RK4_COEF = np.array([0.5, 1.0, 1.0 / 6.0])       # h/2, h, h/6 (as products h * c)
+RK4_TIMES = np.array([0.0, 0.5, 1.0])            # force sub-times as fractions of a step
+RK4_C1, RK4_C2, RK4_C3 = 0.5, 1.0, 1.0 / 6.0
+INTEGRATORS = {
+    "srkn6b": INTEGRATOR,
+    "rk4": "classic RK4 (order 4, not symplectic, 4 force evaluations/step)",
+}
+
+# --- wells ----------------------------------------------------------------------------------
+QUARTIC = 0
+QUARTIC_SIGNED = 1
+POLY4 = 4
+POLY8 = 8
+#: degree classes of the polynomial path (a well of degree n runs in the smallest class >= n)
+POLY_DEGREES = (POLY4, POLY8)
+WELL_FLAGS = (QUARTIC, QUARTIC_SIGNED) + POLY_DEGREES
+#: wpar = [q_left, q_right, g_1 .. g_7, e_2 .. e_8]
+N_WPAR = 16
+_G0 = 2      # g_k at wpar[_G0 + k - 1]
+_E0 = 9      # e_k at wpar[_E0 + k - 2]
+# the paper's barrier |q| = 1 (the QUARTIC flag compares |q| with this constant)
+Q_BARRIER = 1.0
+
+
+@intrinsic
+def fma(typingctx, a, b, c):
+    """Correctly rounded a*b + c (llvm.fma.f64): same bits in vector and scalar code."""
+    sig = types.float64(types.float64, types.float64, types.float64)
+
+    def codegen(context, builder, signature, args):
+        return builder.fma(*args)
+
+    return sig, codegen
+
+
+def well_parameters(barriers=(-Q_BARRIER, Q_BARRIER), coefficients=None):
+    """``wpar`` for the kernels: barriers (q_left, q_right) and, for a polynomial well, the
+    Horner coefficients of -V' and 2 V from ``coefficients`` c_0 .. c_n (c_0 = c_1 = 0,
+    n <= max(POLY_DEGREES)).  Returns (flag class or None, wpar): the POLY flag of the
+    coefficients' degree (None without coefficients)."""
+    w = np.zeros(N_WPAR)
+    w[0], w[1] = float(barriers[0]), float(barriers[1])
+    if coefficients is None:
+        return None, w
+    c = np.trim_zeros(np.asarray(coefficients, dtype=float), "b")
+    n = c.size - 1
+    if c.ndim != 1 or n < 2 or c[0] != 0.0 or c[1] != 0.0:
+        raise ValueError(f"coefficients must be c_0 = 0, c_1 = 0, c_2, ... (degree >= 2), got {coefficients!r}")
+    cls = next((d for d in POLY_DEGREES if n <= d), None)
+    if cls is None:
+        raise ValueError(f"coefficients: degree {n} exceeds the largest compiled polynomial class "
+                         f"{max(POLY_DEGREES)}")
+    for k in range(1, n):                   # -V' = sum_k g_k q^k, g_k = -(k+1) c_{k+1}
+        w[_G0 + k - 1] = -(k + 1) * c[k + 1]
+    for k in range(2, n + 1):               # 2 V = sum_k e_k q^k, e_k = 2 c_k
+        w[_E0 + k - 2] = 2.0 * c[k]
+    return cls, w
+
+
+@njit(cache=True, inline="always")
+def wtuple(wpar):
+    """The 14 coefficients of wpar as scalars (loaded once, before the step loops)."""
+    return (wpar[2], wpar[3], wpar[4], wpar[5], wpar[6], wpar[7], wpar[8],
+            wpar[9], wpar[10], wpar[11], wpar[12], wpar[13], wpar[14], wpar[15])
+
+
+_W0 = (0.0,) * 14
+
+
+def _quartic_force(well, w, q, f):
+    return fma(q * q, q, f - q)
+
+
+def _poly4_force(well, w, q, f):
+    return fma(fma(fma(w[2], q, w[1]), q, w[0]), q, f)
+
+
+def _poly8_force(well, w, q, f):
+    a = fma(w[6], q, w[5])
+    a = fma(a, q, w[4])
+    a = fma(a, q, w[3])
+    a = fma(a, q, w[2])
+    a = fma(a, q, w[1])
+    a = fma(a, q, w[0])
+    return fma(a, q, f)
+
+
+def _quartic_energy2(well, w, q, p):
+    q2 = q * q
+    return fma(q2, fma(-0.5, q2, 1.0), p * p)
+
+
+def _poly4_energy2(well, w, q, p):
+    h = fma(fma(w[9], q, w[8]), q, w[7])
+    return fma(h, q * q, p * p)
+
+
+def _poly8_energy2(well, w, q, p):
+    h = fma(w[13], q, w[12])
+    h = fma(h, q, w[11])
+    h = fma(h, q, w[10])
+    h = fma(h, q, w[9])
+    h = fma(h, q, w[8])
+    h = fma(h, q, w[7])
+    return fma(h, q * q, p * p)
+
+
+_FORCES = {QUARTIC: _quartic_force, QUARTIC_SIGNED: _quartic_force, POLY4: _poly4_force, POLY8: _poly8_force}
+_ENERGIES = {QUARTIC: _quartic_energy2, QUARTIC_SIGNED: _quartic_energy2, POLY4: _poly4_energy2,
+             POLY8: _poly8_energy2}
+
+
+def _literal_flag(well):
+    if not isinstance(well, types.IntegerLiteral) or well.literal_value not in WELL_FLAGS:
+        raise errors.TypingError(f"well must be a compile-time constant among {WELL_FLAGS}, got {well}")
+    return well.literal_value
+
+
+def well_force(well, w, q, f):
+    """-V'(q) + f, with f = F sin(Omega t_k + Psi) (a product F * table value), w = wtuple(wpar),
+    for the well flag `well` (a compile-time constant)."""
+    raise NotImplementedError("well_force is compiled code (numba)")
+
+
+def well_energy2(well, w, q, p):
+    """2 H0 = p^2 + 2 V(q) (eq 7, untruncated), compared with 2 xi_max (exact doubling)."""
+    raise NotImplementedError("well_energy2 is compiled code (numba)")
+
+
+# the implementation of the flag is chosen at typing time: a kernel contains only its own
+# well's arithmetic (branches on the flag would compile every well into every kernel)
+@overload(well_force, inline="always")
+def _ol_well_force(well, w, q, f):
+    return _FORCES[_literal_flag(well)]
+
+
+@overload(well_energy2, inline="always")
+def _ol_well_energy2(well, w, q, p):
+    return _ENERGIES[_literal_flag(well)]
+
+
+@njit(cache=True, inline="always")
+def force(q, f):
+    """q^3 - q + f (the quartic), with f = F sin(Omega t_k + Psi)."""
+    return well_force(QUARTIC, _W0, q, f)
+
+
+@njit(cache=True, inline="always")
+def energy2(q, p):
+    """2 H0 = p^2 + q^2 - q^4/2 of the quartic (eq 7, untruncated)."""
+    return well_energy2(QUARTIC, _W0, q, p)
+
+
+@njit(cache=True)
+def energy(q, p):
+    return 0.5 * energy2(q, p)
+
+
+@njit(cache=True, inline="always")
+def well_bm6_step(well, w, q, p, a1, a2, a3, b1, b2, b3, b4, f1, f2, f3, f4, f5, f6, f7):
+    p = fma(b1, well_force(well, w, q, f1), p)
+    q = fma(a1, p, q)
+    p = fma(b2, well_force(well, w, q, f2), p)
+    q = fma(a2, p, q)
+    p = fma(b3, well_force(well, w, q, f3), p)
+    q = fma(a3, p, q)
+    p = fma(b4, well_force(well, w, q, f4), p)
+    q = fma(a3, p, q)
+    p = fma(b3, well_force(well, w, q, f5), p)
+    q = fma(a2, p, q)
+    p = fma(b2, well_force(well, w, q, f6), p)
+    q = fma(a1, p, q)
+    p = fma(b1, well_force(well, w, q, f7), p)
+    return q, p
+
+
+@njit(cache=True, inline="always")
+def well_rk4_step(well, w, q, p, hh, h, h6, f1, f2, f3):
+    """Classic RK4 for q' = p, p' = -V'(q) + f(t); hh = h/2, h6 = h/6 and f1, f2, f3 the
+    forcing at t, t + h/2, t + h."""
+    k1 = well_force(well, w, q, f1)
+    q2 = fma(hh, p, q)
+    p2 = fma(hh, k1, p)
+    k2 = well_force(well, w, q2, f2)
+    q3 = fma(hh, p2, q)
+    p3 = fma(hh, k2, p)
+    k3 = well_force(well, w, q3, f2)
+    q4 = fma(h, p3, q)
+    p4 = fma(h, k3, p)
+    k4 = well_force(well, w, q4, f3)
+    sq = p2 + p3
+    sp = k2 + k3
+    q = fma(h6, (p + p4) + (sq + sq), q)
+    p = fma(h6, (k1 + k4) + (sp + sp), p)
+    return q, p
+
+
+@njit(cache=True, inline="always")
+def bm6_step(q, p, a1, a2, a3, b1, b2, b3, b4, f1, f2, f3, f4, f5, f6, f7):
+    """One SRKN6b step of the quartic."""
+    return well_bm6_step(QUARTIC, _W0, q, p, a1, a2, a3, b1, b2, b3, b4, f1, f2, f3, f4, f5, f6, f7)
+
+
+@njit(cache=True, inline="always")
+def rk4_step(q, p, hh, h, h6, f1, f2, f3):
+    """One RK4 step of the quartic."""
+    return well_rk4_step(QUARTIC, _W0, q, p, hh, h, h6, f1, f2, f3)
+
+
+@njit(cache=True, inline="always")
+def step(rk4, well, w, q, p, c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7):
+    """One step of the scheme selected by the (compile-time constant) flag rk4 for the well
+    flag `well`; RK4 uses c1..c3 = h/2, h, h/6 and f1..f3 only."""
+    if rk4:
+        return well_rk4_step(well, w, q, p, c1, c2, c3, f1, f2, f3)
+    return well_bm6_step(well, w, q, p, c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
+
+
+@njit(cache=True, inline="always")
+def row(tab, s, rk4):
+    """Row s of a forcing table as 7 scalars (RK4: 3 + zeros)."""
+    if rk4:
+        return tab[s, 0], tab[s, 1], tab[s, 2], 0.0, 0.0, 0.0, 0.0
+    return tab[s, 0], tab[s, 1], tab[s, 2], tab[s, 3], tab[s, 4], tab[s, 5], tab[s, 6]
+
+
+@njit(cache=True, inline="always")
+def lane_coefs(rk4, h):
+    if rk4:
+        return h * RK4_C1, h * RK4_C2, h * RK4_C3, 0.0, 0.0, 0.0, 0.0
+    return h * DRIFT1, h * DRIFT2, h * DRIFT3, h * KICK1, h * KICK2, h * KICK3, h * KICK4
+
+
+def check_integrator(integrator):
+    if integrator not in INTEGRATORS:
+        raise ValueError(f"integrator must be one of {sorted(INTEGRATORS)}, got {integrator!r}")
+    return integrator
+
+
+def sine_table(steps_per_cycle, Psi, integrator="srkn6b"):
+    """sin(Omega t + Psi) at the force sub-times of every step of one period: (S, 7) for
+    SRKN6b (7 kicks), (S, 3) for RK4 (t, t + h/2, t + h).  The width selects the scheme."""
+    times = BM6_KICK_TIMES if check_integrator(integrator) == "srkn6b" else RK4_TIMES
+    s = np.arange(steps_per_cycle, dtype=float)[:, None] + times[None, :]
+    return np.ascontiguousarray(np.sin(2.0 * np.pi * s / steps_per_cycle + Psi))
+
+
+def lane_coefficients(Omega, steps_per_cycle, integrator="srkn6b"):
+    """Per-parameter-set step coefficients (n, 7): a1 h, a2 h, a3 h, b1 h, ..., b4 h
+    (SRKN6b) or h/2, h, h/6, 0, 0, 0, 0 (RK4)."""
+    Omega = np.atleast_1d(np.asarray(Omega, dtype=float))
+    h = 2.0 * np.pi / (Omega * steps_per_cycle)
+    out = np.zeros((Omega.size, 7))
+    if check_integrator(integrator) == "srkn6b":
+        out[:, 0:3] = h[:, None] * BM6_DRIFT[None, :3]
+        out[:, 3:7] = h[:, None] * BM6_KICK[None, :4]
+    else:
+        out[:, 0:3] = h[:, None] * RK4_COEF[None, :]
+    return out
+
+
+def step_sizes(Omega, steps_per_cycle):
+    """h = T / S per parameter set (the per-lane path forms h * a_k in the loop)."""
+    Omega = np.atleast_1d(np.asarray(Omega, dtype=float))
+    return 2.0 * np.pi / (Omega * steps_per_cycle)
