@@ -7,4 +7,5 @@ erosion          integrity profiles versus the forcing amplitude
 phase_invariant  the safe basin for every forcing phase
 fourier_compare  the paper's first harmonic (eq 20) versus the exact one
 period_map       rotation numbers, island chains and chaotic orbits of the period map (Fig 18)
+confirm          numeric check of the connected parts of an analytic safe basin (Figs 5-9)
 """

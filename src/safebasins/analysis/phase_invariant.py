@@ -52,6 +52,7 @@ __all__ = [
     "true_safe_basin_analytic",
     "true_safe_basin_numeric",
     "true_safe_basin_from_charts",
+    "phase_boundaries",
 ]
 
 _KEEP = ("GIM", "LIM", "IF", "r_local", "r_global", "area", "if_q0", "if_p0")
@@ -258,3 +259,38 @@ def true_safe_basin_numeric(F, Omega, xi_max, q0, p0, Psi_values=None, t_eval=No
     stacked = stack_charts(charts, "Psi")
     ds = true_safe_basin_from_charts(stacked, t_eval)
     return (ds, stacked) if keep_charts else ds
+
+
+def phase_boundaries(F, Omega, xi_max, Psi_values, *, fourier="paper", n_points=400):
+    """Boundary curves of the analytic per-phase basins on the IC plane, from the slow flow
+    itself (:func:`safebasins.theory.safe_basin_boundaries` for every phase), not from a grid.
+
+    Returns an xr.Dataset over (``Psi``, [``fourier``,] ``xi_max``, ``vertex``) with
+    ``boundary_q0``, ``boundary_p0`` (NaN-padded; NaN rows also split a curve) and
+    ``boundary_curve`` (curve index of the vertex, -1 = padding).
+    """
+    from safebasins.theory import safe_basin_boundaries
+
+    xi = as_1d("xi_max", xi_max, QUARTIC.check_threshold)
+    Psi = as_1d("Psi_values", Psi_values, checks.check_finite)
+    fl, scalar = fourier_list(fourier)
+    parts = {}
+    for k, ps in enumerate(Psi):
+        for a, f in enumerate(fl):
+            for j, x in enumerate(xi):
+                b = safe_basin_boundaries(F, Omega, float(ps), float(x), fourier=f, n_points=n_points)
+                parts[k, a, j] = (np.asarray(b["q0_vertex"], float), np.asarray(b["p0_vertex"], float),
+                                  np.asarray(b["curve_index"], float))
+    nv = max(v[0].size for v in parts.values())
+    shape = (Psi.size, len(fl), xi.size, nv)
+    bq, bp, bc = np.full(shape, np.nan), np.full(shape, np.nan), np.full(shape, -1, np.int64)
+    for (k, a, j), (qv, pv, cv) in parts.items():
+        bq[k, a, j, :qv.size], bp[k, a, j, :pv.size] = qv, pv
+        bc[k, a, j, :cv.size] = np.where(np.isfinite(cv), cv, -1).astype(np.int64)
+    dims = ("Psi", "fourier", "xi_max", "vertex")
+    ds = xr.Dataset({
+        "boundary_q0": (dims, bq, {"units": "1", "long_name": "q0 of the per-phase analytic basin boundary"}),
+        "boundary_p0": (dims, bp, {"units": "1", "long_name": "p0 of the per-phase analytic basin boundary"}),
+        "boundary_curve": (dims, bc, {"units": "1", "long_name": "boundary curve of the vertex (-1: padding)"}),
+    }, coords={"Psi": Psi, "fourier": fl, "xi_max": xi})
+    return ds.isel(fourier=0, drop=True) if scalar else ds

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from functools import partial
 
+import numpy as np
+
 from safebasins.pipeline import values
 from safebasins.pipeline.registry import Kind, Product, dataset_path, register
 
@@ -43,12 +45,14 @@ def build_erosion_analytic(params, inputs, job):
     """GIM / LIM / IF versus F from the slow flow on the chart grid, per first-harmonic variant."""
     from safebasins.analysis.erosion import erosion_profile_analytic
 
-    q0, p0 = values.grid_axes(params["grid"])
-    print(f"{params['experiment']}: {len(params['F'])} F x {len(params['xi_max'])} xi_max x {params['fourier']}")
+    n = params.get("analytic_n")
+    q0, p0 = values.grid_axes(dict(params["grid"], n=[n, n]) if n else params["grid"])
+    print(f"{params['experiment']}: {len(params['F'])} F x {len(params['xi_max'])} xi_max x {params['fourier']} "
+          f"on {q0.size} x {p0.size} ICs")
     ds = erosion_profile_analytic(params["F"], params["Omega"], params["Psi"], params["xi_max"], q0, p0,
                                   fourier=params["fourier"])
     ds = _level_crossings(ds, params["level"])
-    ds.attrs.update(level=params["level"], xi_max=params["xi_max"])
+    ds.attrs.update(level=params["level"], xi_max=params["xi_max"], grid_n=np.array([q0.size, p0.size]))
     return ds
 
 
@@ -66,11 +70,16 @@ def build_true_basin_analytic(params, inputs, job):
     """Per-phase analytic basins, their intersection and the all-phase basin H0 < xi_true."""
     from safebasins.analysis.phase_invariant import true_safe_basin_analytic
 
+    from safebasins.analysis.phase_invariant import phase_boundaries
+
     q0, p0 = values.grid_axes(params["grid"])
     print(f"{params['experiment']}: F={params['F']} Omega={params['Omega']} xi_max={params['xi_max']} "
           f"{len(params['Psi'])} phases {params['fourier']}")
-    return true_safe_basin_analytic(params["F"], params["Omega"], params["xi_max"], q0, p0, params["Psi"],
-                                    fourier=params["fourier"], n_gamma=params["n_gamma"])
+    ds = true_safe_basin_analytic(params["F"], params["Omega"], params["xi_max"], q0, p0, params["Psi"],
+                                  fourier=params["fourier"], n_gamma=params["n_gamma"])
+    b = phase_boundaries(params["F"], params["Omega"], params["xi_max"], params["Psi"], fourier=params["fourier"],
+                         n_points=params["n_points"])
+    return ds.merge(b.assign_coords({c: ds[c] for c in b.coords if c in ds.coords}))
 
 
 def build_true_basin_numeric(params, inputs, job):
@@ -137,6 +146,9 @@ class Erosion(Kind):
             "fourier": {**FOURIER_LIST, "default": ["paper", "exact"]},
             "level": {"description": "integrity level whose first crossing in F is reported (F at GIM = level, ...)",
                       "type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1, "default": 0.5},
+            "analytic_n": {"description": "ICs per axis of the analytic (slow-flow) profile on the grid's window "
+                                          "(null: the chart grid); finer than the chart: smooth analytic curves",
+                           "oneOf": [{"type": "null"}, {"type": "integer", "minimum": 3}], "default": None},
         },
     }
 
@@ -155,6 +167,7 @@ class Erosion(Kind):
                     Psi=values.angle(block["Psi"]), xi_max=xis, grid=values.grid(block["grid"]),
                     cycles=int(block["cycles"]), t_eval=[float(t) for t in values.as_list(block["t_eval"])],
                     level=float(block["level"]), steps_per_cycle=ctx.steps_per_cycle,
+                    analytic_n=None if block["analytic_n"] is None else int(block["analytic_n"]),
                     tasks=[{"F": f, "xi_max": xis, "q_max": []} for f in Fs])
 
     chart_ics = staticmethod(_grid_ics)
@@ -199,6 +212,8 @@ class TrueBasin(Kind):
             "fourier": {**FOURIER_LIST, "default": ["paper", "exact"]},
             "n_gamma": {"description": "gamma resolution of the continuous-phase energy radius xi_true",
                         "type": "integer", "minimum": 8, "default": 512},
+            "n_points": {"description": "samples in xi per branch of each per-phase analytic boundary curve",
+                         "type": "integer", "minimum": 16, "default": 400},
         },
     }
 
@@ -216,7 +231,7 @@ class TrueBasin(Kind):
         return dict(fourier=[str(f) for f in values.as_list(block["fourier"])], F=float(block["F"]),
                     Omega=float(block["Omega"]), xi_max=xis, Psi=psis, grid=values.grid(block["grid"]),
                     cycles=int(block["cycles"]), t_eval=[float(t) for t in values.as_list(block["t_eval"])],
-                    n_gamma=int(block["n_gamma"]), steps_per_cycle=ctx.steps_per_cycle,
+                    n_gamma=int(block["n_gamma"]), n_points=int(block["n_points"]), steps_per_cycle=ctx.steps_per_cycle,
                     tasks=[{"F": float(block["F"]), "Psi": ps, "xi_max": xis, "q_max": []} for ps in psis])
 
     chart_ics = staticmethod(_grid_ics)
@@ -228,7 +243,9 @@ class TrueBasin(Kind):
                     title=params["title"] + " (analytic)",
                     contract={"safe": ("Psi", "fourier", "xi_max", "q0", "p0"),
                               "true_safe": ("fourier", "xi_max", "q0", "p0"), "xi_true": ("fourier", "xi_max"),
-                              "GIM_true": ("fourier", "xi_max"), "contained": ("fourier", "xi_max")},
+                              "GIM_true": ("fourier", "xi_max"), "contained": ("fourier", "xi_max"),
+                              **{v: ("Psi", "fourier", "xi_max", "vertex")
+                                 for v in ("boundary_q0", "boundary_p0", "boundary_curve")}},
                     history=f"safebasins.analysis.phase_invariant.true_safe_basin_analytic ({experiment})"),
             Product(dataset_path("extras", f"{experiment}_numeric"), "extras", build_true_basin_numeric, tiles=True,
                     title=params["title"] + " (numeric)",
