@@ -27,24 +27,6 @@ def test_every_package_figure_has_notebook_writing_its_caption():
         assert f"caption = {caption_path(fig)!r}" in code and "write_caption(caption, fig," in code
 
 
-def test_caption_is_rst_inside_a_jinja_raw_block():
-    import docutils.core
-    import jinja2
-    from matplotlib.figure import Figure
-
-    from safebasins.plotting.captions import add_note, caption_rst, notes
-
-    fig = Figure()
-    add_note(fig, "9,250 of 90,000 pixels {{ not a template }} *stay* safe")
-    assert notes(fig) == ["9,250 of 90,000 pixels {{ not a template }} *stay* safe"]
-    text = caption_rst(label="Fig. 1", paper="quoted", look="drawn", data_notes=notes(fig),
-                       notebook="notebooks/x.ipynb", datasets=["results/data/x.nc"])
-    rendered = jinja2.Environment(trim_blocks=True, lstrip_blocks=True).from_string(text).render()
-    assert "{{ not a template }}" in rendered  # Snakemake's Jinja2 pass leaves it alone
-    html = docutils.core.publish_parts(rendered, writer_name="html")["body"]
-    assert "9,250 of 90,000 pixels" in html and "<strong>Paper:</strong>" in html and "*stay*" in html
-
-
 def test_generated_files_are_up_to_date():
     r = subprocess.run([sys.executable, str(ROOT / "scripts" / "make_notebooks.py"), "--check"],
                        capture_output=True, text=True)

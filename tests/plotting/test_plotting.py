@@ -14,6 +14,7 @@ import pytest  # noqa: E402
 import xarray as xr  # noqa: E402
 
 from safebasins.plotting import basins, charts, fcr, maps  # noqa: E402
+from safebasins.plotting.captions import notes  # noqa: E402
 from safebasins.plotting.style import SB_EDGE, fmt_value, save_figure  # noqa: E402
 
 RNG = np.random.default_rng(0)
@@ -83,6 +84,8 @@ def nested(param="xi_max", n=40):
                            attrs=dict(Omega=0.9, Psi=np.pi, cycles=100, scan="F", agreement_t_eval=100))
     chart["iou"] = ((param,), [0.9, 0.95, 0.97])
     chart["pixel_agreement"] = ((param,), [0.99, 0.98, 0.97])
+    chart["safe_numeric"] = ((param,), np.isinf(ec).sum(axis=(1, 2)))
+    chart["safe_analytic"] = ((param,), np.isinf(ec).sum(axis=(1, 2)) + 3)
     t = np.linspace(0, 2 * np.pi, 60)
     qv = np.stack([0.9 * r * np.cos(t) for r in radii])
     pv = np.stack([0.7 * r * np.sin(t) for r in radii])
@@ -96,12 +99,32 @@ def nested(param="xi_max", n=40):
 
 
 def strobe():
+    """Six orbits in the format of analysis.period_map.period_map_portrait: four tori around the
+    centre, one on a period-3 chain (with its elliptic orbit), one chaotic."""
     n, it = 6, 200
     th = RNG.uniform(0, 6.3, (n, 1)) + np.arange(it) * RNG.uniform(0.1, 0.4, (n, 1))
     r = RNG.uniform(0.1, 0.5, (n, 1))
-    return xr.Dataset(dict(q=(("sample", "iteration"), r * np.cos(th)), p=(("sample", "iteration"), r * np.sin(th)),
-                           escaped=("sample", np.zeros(n, bool))),
-                      attrs=dict(F=0.0876, Omega=0.99, Psi=np.pi, xi_max=0.24, seed=1))
+    q, p = r * np.cos(th), r * np.sin(th)
+    k = np.arange(it) % 3
+    isl = 0.6 * np.exp(2j * np.pi * k / 3) + 0.03 * np.exp(0.7j * np.arange(it))
+    q[4], p[4] = isl.real, isl.imag
+    q[5], p[5] = RNG.uniform(-0.7, 0.7, it), RNG.uniform(-0.7, 0.7, it)
+    chain_pts = 0.6 * np.exp(2j * np.pi * np.arange(3) / 3)
+    return xr.Dataset(
+        dict(q=(("sample", "iteration"), q), p=(("sample", "iteration"), p),
+             escaped=("sample", np.zeros(n, bool)), q0=("sample", q[:, 0]), p0=("sample", p[:, 0]),
+             origin=("sample", ["line"] * 2 + ["random"] * 4),
+             orbit_class=("sample", np.array([1, 1, 1, 1, 2, 3], np.int8)),
+             rotation_number=("sample", [0.05, 0.06, 0.055, 0.058, 1 / 3, 0.2]),
+             birkhoff_digits=("sample", [12.0, 11.0, 13.0, 10.0, 9.0, 2.0]),
+             period=("sample", [0, 0, 0, 0, 3, 0]), chain_index=("sample", [-1, -1, -1, -1, 0, -1]),
+             escape_cycle_energy=("sample", [np.inf] * 4 + [12.0, 3.0]),
+             escape_cycle_displacement=("sample", [np.inf] * 6),
+             chain_period=("chain", [3]), chain_n_orbits=("chain", [1]), chain_trace=("chain", [1.2]),
+             chain_q=(("chain", "island"), chain_pts.real[None]), chain_p=(("chain", "island"), chain_pts.imag[None])),
+        attrs=dict(F=0.0876, Omega=0.99, Psi=np.pi, xi_max=0.24, q_max=0.894, criterion="displacement", seed=1,
+                   center_q=0.0, center_p=0.0, center_rotation=0.06, n_iter=it - 1, min_digits=5.0,
+                   n_candidates=40, n_non_escaping=10, n_line=3))
 
 
 def criteria():
@@ -121,7 +144,7 @@ def dsb_esb(n=40, cycles=1000):
     return xr.Dataset(dict(escape_cycle_energy=(("xi_max", "q0", "p0"), e[None]),
                            escape_cycle_displacement=(("q_max", "q0", "p0"), d[None])),
                       coords=dict(xi_max=[0.25], q_max=[1.0], q0=q0, p0=p0),
-                      attrs=dict(F=0.0876, Omega=0.95, Psi=np.pi, cycles=cycles))
+                      attrs=dict(F=0.0876, Omega=0.95, Psi=np.pi, cycles=cycles, t_eval=[100, cycles]))
 
 
 # ------------------------------------------------------------------ helpers
@@ -211,7 +234,12 @@ def test_nested_shading_lighter_contains_darker():
 
 
 def test_period_map_criteria_dsb_area(tmp_path):
-    render(maps.figure_period_map(rm_basin(), strobe()), tmp_path, "strobe")
+    fig = maps.figure_period_map(rm_basin(), strobe())
+    text = " ".join(notes(fig))
+    assert "1 island chain" in text and "period 3" in text and "Stochastic layer: 1 orbit" in text
+    assert "only 4 of these 6 orbits survive" in text  # energy-criterion escapes read from the data
+    assert any(t.get_text() == "1:3" for t in fig.axes[0].texts)  # the chain is labelled
+    render(fig, tmp_path, "strobe")
     fig = charts.figure_criteria(criteria())
     colors = [ln.get_color() for ln in fig.axes[0].lines if ln.get_marker() == "o"]
     assert colors == ["tab:blue", "tab:orange", "tab:green"]
@@ -219,10 +247,38 @@ def test_period_map_criteria_dsb_area(tmp_path):
     fig = charts.figure_dsb_esb(dsb_esb(), None, t_evals=[100, 1000])
     assert [ax.get_title() for ax in fig.axes[:2]] == [r"$t_{eval}$ = 100 EC", r"$t_{eval}$ = 1,000 EC"]
     render(fig, tmp_path, "dsb")
-    fig = charts.figure_area_vs_time(dsb_esb(), None, t_evals=list(range(50, 1001, 50)))
-    ls = sorted(ln.get_linestyle() for ln in fig.axes[0].lines)
+    chart = dsb_esb()
+    fig = charts.figure_area_vs_time(chart, None, t_evals=list(range(50, 1001, 50)))
+    ls = sorted(ln.get_linestyle() for ln in fig.axes[0].lines if ln.get_linestyle() in ("-", "--"))
     assert ls == ["-", "--"]
+    assert fig.axes[0].get_xscale() == "log" and fig.axes[0].get_xlim()[0] == 1.0  # the early transient shows
+    ec = chart["escape_cycle_energy"].values
+    last = ec[np.isfinite(ec)].max()
+    assert f"loses its last pixel at {fmt_value(last)} EC and keeps {int(np.isinf(ec).sum()):,} pixels" in \
+        " ".join(notes(fig))
     render(fig, tmp_path, "area")
+
+
+def test_settle_time_and_coincident_curves():
+    t = np.array([1, 2, 5, 10, 20, 50, 100.0])
+    n = np.array([500, 300, 120, 104, 101, 100, 100.0])
+    assert charts.settle_time(t, n, 0.01) == 20 and charts.settle_time(t, n, 0.05) == 10
+    s = np.linspace(0, 2 * np.pi, 200)
+    circle = (0, np.cos(s), np.sin(s))
+    same = (1, np.cos(s[::-1]), np.sin(s[::-1]))        # the same curve, other direction and slice
+    other = (2, 1.1 * np.cos(s), 1.1 * np.sin(s))
+    assert charts.coincident_groups([circle, same, other], tol=0.01) == [[0, 1]]
+    assert charts.coincident_groups([circle, other], tol=0.2) == [[0, 1]]
+
+
+def test_nested_basins_draw_shared_boundaries_in_alternating_colours(tmp_path):
+    b, chart = nested("xi_max")
+    b["q0_vertex"][:2] = b["q0_vertex"][0]  # the two smallest basins share their boundary
+    b["p0_vertex"][:2] = b["p0_vertex"][0]
+    fig = charts.figure_nested_basins(b, chart)
+    assert any("shared by 0.1, 0.2" in t.get_text() for t in fig.axes[0].get_legend().get_texts())
+    assert any("coincide along one curve" in n_ for n_ in notes(fig))
+    render(fig, tmp_path, "shared")
 
 
 # ------------------------------------------------------------------ small helpers
@@ -259,3 +315,38 @@ def test_interior_curves_are_not_drawn_as_boundaries():
     assert basins.separates_mask(0.6 * np.cos(t), 0.6 * np.sin(t), safe)       # the edge
     assert not basins.separates_mask(0.3 * np.cos(t), 0.3 * np.sin(t), safe)   # inside the basin
     assert not basins.separates_mask(0.9 * np.cos(t), 0.9 * np.sin(t), safe)   # in the escape region
+
+
+def test_rm_basin_marks_parts_the_numerics_do_not_keep(tmp_path):
+    """A slow-flow island where no IC stays in the stored numeric check is drawn dotted/hatched
+    and left out of the title's (paper's) classification; the caption gives the fractions."""
+    ds = rm_basin()
+    Q, P = np.meshgrid(ds.q0.values, ds.p0.values, indexing="ij")
+    blob = np.hypot(Q - 0.7, P - 0.5) < 0.15
+    ds["escapes"] = (("q0", "p0"), ~((Q**2 + P**2 <= 0.2) | blob))
+    t = np.linspace(0, 2 * np.pi, 50)
+    ds = ds.drop_dims("vertex").assign(
+        q0_vertex=("vertex", np.r_[0.45 * np.cos(t), np.nan, 0.7 + 0.15 * np.cos(t)]),
+        p0_vertex=("vertex", np.r_[0.45 * np.sin(t), np.nan, 0.5 + 0.15 * np.sin(t)]),
+        gamma=("vertex", np.r_[t - np.pi, np.nan, t - np.pi]),
+        xi=("vertex", np.r_[0.1 + 0 * t, np.nan, 0.245 + 0.002 * np.sin(t)]),
+        curve_index=("vertex", np.r_[np.zeros(50, int), -1, np.ones(50, int)]),
+        kind=("curve", ["saddle", "island"]), C_level=("curve", [0.0, 0.1]))
+    region = np.where(Q**2 + P**2 <= 0.2, 1, np.where(blob, 2, 0))
+    ds["region"] = (("q0", "p0"), region)
+    ds["region_size"] = ("region_index", [(region == 1).sum(), (region == 2).sum()])
+    ds["region_numeric_safe"] = ("region_index", [0.9, 0.0])
+    ds.attrs["check_cycles"] = 100
+    assert basins.unconfirmed_parts(ds)[0] == {1}
+    fig = basins.figure_rm_basin(ds)
+    assert fig._suptitle.get_text().endswith("[saddle type (SBST)]")
+    text = " ".join(notes(fig))
+    assert "90.0% stay" in text and "1 further part" in text and "none stays" in text
+    dotted = [a for a in fig.axes[1].lines + fig.axes[1].patches if a.get_linestyle() in (":", "dotted")]
+    assert dotted, "the unconfirmed island is drawn dotted"
+    render(fig, tmp_path, "rm_unconfirmed")
+
+
+def test_join_seams_removes_zero_length_gaps():
+    x, y = basins.join_seams([0.0, 1.0, np.nan, 1.0, 2.0, np.nan, 5.0], [0, 1, np.nan, 1, 0, np.nan, 3])
+    assert np.isnan(x).sum() == 1 and x.size == 6

@@ -27,8 +27,8 @@ class Declaration:
 
 
 _SB_LEFT_RIGHT = ('Left: level curves of the first integral C(γ, ξ) of eq. (18) on the resonance-manifold '
-     'cylinder, the truncation level ξ = ξ_max (thick blue dashed line) and the safe basin (grey '
-     'region with red boundary). Right: the same safe basin mapped to the plane of initial '
+     'cylinder (γ from -π to π in every figure), the truncation level ξ = ξ_max (thick blue dashed line) '
+     'and the safe basin (grey region with red boundary). Right: the same safe basin mapped to the plane of initial '
      'conditions (q0, p0) with eqs. (15), (17); the thin dashed oval is the edge of the unforced '
      'well H0 = ξ_max.')
 
@@ -49,9 +49,8 @@ DECLARATIONS = (
         caption=('Escape threshold versus excitation frequency for various values of ξ_ini and '
                  'γ_ini = 0.25, ξ_max = 0.242.'),
         look=('Theoretical F_cr(Ω) for several initial energies ξ_ini (one colour each); the line '
-              'style gives the mechanism (solid SM, dashed MM through γ* = π, dash-dot MM through '
-              'γ* = 0, dotted SMM). Higher ξ_ini generally lowers F_cr, but the ξ_ini = 0 curve '
-              'lies below some higher-energy curves on its SM part.')),
+              'style gives the mechanism that sets F_cr (legend; the styles that occur are listed '
+              'below). Compare the curves\' minima (below) for the ordering in ξ_ini.')),
     Declaration(
         name="fig02", kind="fcr_theory", key=("figures", "fig02"), stem="fig02_fcr_gamma_ini",
         label="Fig. 2", category="Figures", options={'color_by': 'curve', 'show_branches': False, 'F_max': None},
@@ -59,9 +58,8 @@ DECLARATIONS = (
                'xi_max = 0.242)'),
         caption=('Escape threshold versus excitation frequency for various values of γ_ini and '
                  'ξ_ini = 0.15, ξ_max = 0.242.'),
-        look=('Theoretical F_cr(Ω) for several initial slow phases γ_ini (one colour each), line '
-              'style = mechanism. Increasing γ_ini lowers the SM part of the curve and raises the '
-              'MM part.')),
+        look=('Theoretical F_cr(Ω) for several initial slow phases γ_ini (one colour each); the line '
+              'style gives the mechanism that sets F_cr (legend; the styles that occur are listed below).')),
     Declaration(
         name="fig03", kind="fcr_theory", key=("figures", "fig03"), stem="fig03_fcr_mechanisms",
         label="Fig. 3", category="Figures", options={'color_by': 'mechanism', 'show_branches': True, 'F_max': None},
@@ -71,17 +69,19 @@ DECLARATIONS = (
                  'energy level ξ_max = 0.15. Dotted, solid and dashed lines correspond to SMM, SM '
                  'and MM, respectively.'),
         look=('The overall threshold (thick) is coloured and styled by the mechanism that sets it: '
-              'green dashed MM through the tangent point (γ = π, ξ = 0.15), blue solid SM, red '
-              'dotted SMM (MM through γ = 0 where the saddle energy ξ† exceeds ξ_max). Thin faint '
-              'lines continue each branch where it is not the smallest.')),
+              'MM through the tangent point at γ* = π (green dashed), SM (blue solid), SMM (red dotted); '
+              'thin faint lines in the same colour and style continue each branch where it is not the '
+              'smallest, and a branch that never sets F_cr (MM through γ* = 0, purple dash-dot) appears '
+              'thin only; the legend lists every branch drawn.')),
     Declaration(
         name="fig04", kind="fcr_theory", key=("figures", "fig04"), stem="fig04_fcr_xi_max",
         label="Fig. 4", category="Figures", options={'color_by': 'curve', 'show_branches': False, 'F_max': None},
         title='Critical forcing F_cr(Omega) for the zero IC and several truncation levels xi_max',
         caption=('Escape threshold versus excitation frequency for the zero IC for various values '
                  'of the threshold energy level ξ_max.'),
-        look=('Shallower wells (smaller ξ_max) need less forcing and their resonance minimum moves '
-              'towards Ω = 1 (nearly linear oscillator).')),
+        look=('One colour per truncation level ξ_max, line style = mechanism. Shallower wells (smaller '
+              'ξ_max) need less forcing and their resonance minimum moves towards the linear natural '
+              'frequency (minima below).')),
     Declaration(
         name="fig05", kind="basin_rm", key=("figures", "fig05"), stem="fig05_sbmt_island",
         label="Fig. 5", category="Figures", options={},
@@ -107,7 +107,7 @@ DECLARATIONS = (
                '0.21)'),
         caption=('Peninsula SBMT for the parameters F = 0.0876, Ω = 0.57. Thick dashed line '
                  'corresponds to truncation level ξ_max = 0.21.'),
-        look=_SB_LEFT_RIGHT + " " + 'Peninsula far below resonance (Ω = 0.57).'),
+        look=_SB_LEFT_RIGHT + " " + 'Peninsula far below the resonance.'),
     Declaration(
         name="fig08", kind="basin_rm", key=("figures", "fig08"), stem="fig08_sbst",
         label="Fig. 8", category="Figures", options={},
@@ -115,7 +115,8 @@ DECLARATIONS = (
         caption=('SBST for the parameters F = 0.0876, Ω = 0.57. Thick dashed line corresponds to '
                  'truncation level ξ_max = 0.2499.'),
         look=_SB_LEFT_RIGHT + " " + ('Saddle type: the boundary passes through the saddle (open circle) of C; the safe '
-              'region lies between it and ξ = 0.')),
+              'region lies between it and ξ = 0. Parts of the slow-flow basin where no IC stays in the numeric '
+              'check are dotted / hatched orange and left out of the classification in the title.')),
     Declaration(
         name="fig09", kind="basin_rm", key=("figures", "fig09"), stem="fig09_sb_coexisting",
         label="Fig. 9", category="Figures", options={},
@@ -131,11 +132,10 @@ DECLARATIONS = (
         caption=('Escape threshold versus excitation frequency for different energy truncation '
                  'levels ξ_max and the zero IC. Dots represent values obtained numerically, while '
                  'solid curves correspond to the theoretical prediction.'),
-        look=('One panel per ξ_max. Dots: bisection F_cr (tolerance 5e-5, 3000 EC horizon). Where '
-              'escape is not monotone in F (near the resonance dip), a vertical bar spans the '
-              'lowest escaping F on the scan (F_escape_low) to the F above which every scanned F '
-              'escapes (F_escape_all). Agreement is best near the dip and weaker far from '
-              'resonance, especially on the MM branches.')),
+        look=('One panel per ξ_max. Line: theory; dots: numeric bisection F_cr (tolerance and horizon '
+              'below). Where escape is not monotone in F, a black bar with caps spans the lowest '
+              'escaping F on the scan (F_escape_low) to the F above which every scanned F escapes '
+              '(F_escape_all), and a black ring marks the point (the bar itself is often short).')),
     Declaration(
         name="fig11", kind="fcr_compare", key=("figures", "fig11"), stem="fig11_fcr_numeric_xi_ini",
         label="Fig. 11", category="Figures", options={'layout': 'overlay', 'bracket': True, 'F_max': None},
@@ -143,8 +143,8 @@ DECLARATIONS = (
                'xi_max = 0.242)'),
         caption=('Escape threshold versus excitation frequency for various values of ξ_ini and '
                  'ξ_max = 0.242, γ_ini = 0.25, Ψ = π. The notation is the same as in Figure 10.'),
-        look=('Theory lines and numeric dots share a colour per ξ_ini; bars mark the non-monotone '
-              'escape bracket where it exists.')),
+        look=('Theory lines and numeric markers share a colour (qualitative palette) and each curve has '
+              'its own marker shape; black bars with a ring mark the non-monotone escape brackets.')),
     Declaration(
         name="fig12", kind="fcr_compare", key=("figures", "fig12"), stem="fig12_fcr_numeric_gamma_ini",
         label="Fig. 12", category="Figures", options={'layout': 'overlay', 'bracket': True, 'F_max': None},
@@ -152,8 +152,8 @@ DECLARATIONS = (
                'xi_max = 0.242)'),
         caption=('Escape threshold versus excitation frequency for various values of γ_ini and '
                  'ξ_max = 0.242, ξ_ini = 0.15, Ψ = π. The notation is the same as in Figure 10.'),
-        look=('Theory lines and numeric dots share a colour per γ_ini; bars mark the non-monotone '
-              'escape bracket where it exists.')),
+        look=('Theory lines and numeric markers share a colour (qualitative palette) and each curve has '
+              'its own marker shape; black bars with a ring mark the non-monotone escape brackets.')),
     Declaration(
         name="fig13", kind="basin_chart", key=("figures", "fig13"), stem="fig13_sb_xi_max_a",
         label="Fig. 13", category="Figures", options={},
@@ -176,7 +176,7 @@ DECLARATIONS = (
         label="Fig. 15", category="Figures", options={},
         title='Safe basins versus xi_max, analytic and numeric (F = 0.01, Omega = 0.9, Psi = 1)',
         caption='Same as Figure 14 but for Ψ = 1.',
-        look=_NESTED + " " + 'The forcing phase Ψ = 1 distorts and rotates the basins of Figure 14.'),
+        look=_NESTED + " " + 'The forcing phase of this figure distorts and rotates the basins of Figure 14.'),
     Declaration(
         name="fig16", kind="basin_chart", key=("figures", "fig16"), stem="fig16_sb_forcing_a",
         label="Fig. 16", category="Figures", options={},
@@ -216,8 +216,8 @@ DECLARATIONS = (
                  'maximum of 5 experiments. Other parameters are the following: Ω = 0.9, Ψ = 0, '
                  'ξ_max = 0.25.'),
         look=('Relative difference (A_q − A_E)/A_E between the displacement-criterion (DSB) and '
-              'energy-criterion (ESB) safe counts from 10,000 random ICs in [−1, 1]², F = 0.001 … '
-              '0.071. Near zero for small F, growing with F.')),
+              'energy-criterion (ESB) safe counts of random ICs: minimum, mean and maximum over the '
+              'repetitions per F.')),
     Declaration(
         name="fig20", kind="chart", key=("figures", "fig20"), stem="fig20_dsb_esb_zoom",
         label="Fig. 20", category="Figures", options={'t_evals': None},
@@ -225,9 +225,8 @@ DECLARATIONS = (
         caption=('Zoomed SB Escape Chart simulation for F = 0.0876, Ω = 0.95, Ψ = π, ξ_max = 0.25, '
                  'the resolution is 300×300. Left: t_eval = 500 EC. Right: t_eval = 11,000 EC, DSB '
                  '(grey) and ESB (black).'),
-        look=('DSB (grey) always contains ESB (black). At 500 EC both boundaries are irregular '
-              '(transients); at 11,000 EC they are smoother and the energy criterion gives the '
-              'smoother boundary.')),
+        look=('DSB (grey) under ESB (black); left the first, right the last evaluation time of the '
+              'experiment (panel titles). A pixel is safe when its trajectory has not escaped by t_eval.')),
     Declaration(
         name="fig21", kind="chart", key=("figures", "fig21"), stem="fig21_dsb_esb_full",
         label="Fig. 21", category="Figures", options={'t_evals': None},
@@ -235,15 +234,18 @@ DECLARATIONS = (
         caption=('Entire SB Escape Chart simulation for F = 0.0876, Ω = 0.95, Ψ = π, ξ_max = 0.25, '
                  'the resolution is 300×300. Left: t_eval = 500 EC. Right: t_eval = 11,000 EC, DSB '
                  '(grey) and ESB (black).'),
-        look='Full view of the basins of Figure 20.'),
+        look=('Full view of the basins of Figure 20: DSB (grey) under ESB (black), left the first, right the '
+              'last evaluation time.')),
     Declaration(
         name="fig22", kind="area_time", key=("figures", "fig22"), stem="fig22_sb_area_vs_time",
         label="Fig. 22", category="Figures", options={'t_evals': None},
         title='Safe-basin area versus evaluation time (read from the Fig 21 chart)',
         caption=('Log of SB area in pixels fading with t_eval for DSB (dashed) and ESB (solid), F '
                  '= 0.0876, Ω = 0.95, Ψ = π, ξ_max = 0.25, the resolution is 300×300.'),
-        look=('Natural log of the number of safe pixels of the Figure 21 chart as a function of '
-              'the evaluation time: rapid shrinking for about 2000 EC, then almost constant.')),
+        look=('Natural log of the number of safe pixels of the Figure 21 chart versus the evaluation time on '
+              'a logarithmic axis starting at one cycle (so that the early transient shows), DSB dashed, ESB '
+              'solid; dotted verticals mark the last energy escape and the time from which the DSB area stays '
+              'close to its final value.')),
     Declaration(
         name="extra_erosion", kind="erosion", key=("extras", "erosion"), stem="extra_erosion",
         label='Erosion profiles: integrity measures versus forcing amplitude', category="Beyond the paper", options={'measures': ['GIM', 'LIM', 'IF'], 'xi_max': None, 't_eval': None},
@@ -253,12 +255,11 @@ DECLARATIONS = (
                  'versus the forcing amplitude F, normalised by the unforced well, for the Figs '
                  '16-17 parameters (Ω = 0.9, Ψ = π, ξ_max = 0.18 and 0.22).'),
         look=("Lines: slow-flow (analytic) profiles with the paper's first harmonic (solid) and "
-              'the exact one (dashed). Markers: numeric profiles from one escape chart per F '
-              '(energy criterion), one shade per evaluation time t_eval (light = early); '
-              'coinciding markers mean the profile no longer depends on t_eval. The dotted line is '
-              'the 0.5 level whose first crossing F_GIM, F_LIM, F_IF is stored in both datasets. '
-              'LIM collapses when the well bottom escapes (near the zero-IC F_cr), IF degrades '
-              'gradually.')),
+              'the exact one (dashed), computed on a finer IC grid than the charts. Markers: numeric '
+              'profiles from one escape chart per F (energy criterion), one shade and size per evaluation '
+              'time t_eval (large and light = early), in the colour of their ξ_max (legend alike); '
+              'coinciding markers mean the profile no longer depends on t_eval. The dotted line is the '
+              'level whose first crossing F_GIM, F_LIM, F_IF is stored in both datasets.')),
     Declaration(
         name="extra_true_basin", kind="true_basin", key=("extras", "true_basin"), stem="extra_true_basin",
         label='Phase-invariant (true) safe basin', category="Beyond the paper", options={'xi_max': None, 't_eval': None, 'fourier': 'paper'},
@@ -266,12 +267,12 @@ DECLARATIONS = (
         caption=('Initial conditions that are safe whatever the forcing phase Ψ: intersection of '
                  'the safe basins over equispaced phases, slow flow (left) and numerics (right), F '
                  '= 0.01, Ω = 0.9, ξ_max = 0.18.'),
-        look=('Light grey: safe for at least one phase; thin outlines: the per-phase basins '
-              'coloured by Ψ; green: safe for every sampled phase, with its IF disk (thick purple, '
-              '+ at the centre) and LIM disk (red dashed, drawn on top: where the two coincide the '
-              'outline is purple and red). The dotted black oval is the analytic all-phase basin '
-              'H0 = ξ_true (continuous Ψ). Not knowing the phase leaves a small energy disk around '
-              'the well bottom; the panel titles give its integrity measures.')),
+        look=('Light grey: safe for at least one phase; thin outlines: the per-phase basins coloured by '
+              'Ψ (analytic panel: the slow flow\'s boundary curves; numeric panel: outlines of the chart '
+              'pixels); green: safe for every sampled phase, with its IF disk (thick purple, + at the '
+              'centre) and LIM disk (red dashed, drawn on top: where the two coincide the outline is purple '
+              'and red). The dotted black oval, on both panels, is the analytic all-phase basin H0 = ξ_true '
+              '(continuous Ψ). The panel titles give the integrity measures.')),
     Declaration(
         name="extra_fourier", kind="fourier_compare", key=("extras", "fourier_compare"), stem="extra_fourier",
         label='First harmonic: paper versus exact', category="Beyond the paper", options={},

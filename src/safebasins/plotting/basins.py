@@ -17,6 +17,8 @@ from matplotlib.patches import Patch
 
 from safebasins.plotting.data import open_dataset, param, var
 from safebasins.plotting.style import LABELS, SB_EDGE, SB_FACE, TRUNC_COLOR, fmt_value, param_text, pi_ticks
+
+UNCONFIRMED_COLOR = "tab:orange"  # parts of the analytic basin where no IC stays in the numerics
 from safebasins.wells.quartic import QUARTIC
 
 
@@ -53,6 +55,38 @@ def boundary_polylines(ds, xname, yname):
     return out
 
 
+def join_seams(xs, ys, tol=1e-9):
+    """Drop NaN separators between coincident vertices (a curve split at the gamma = +-pi cut of
+    the cylinder maps to one continuous curve on the IC plane), so that no cap is drawn there."""
+    xs, ys = np.asarray(xs, float), np.asarray(ys, float)
+    gap = np.flatnonzero(~np.isfinite(xs) | ~np.isfinite(ys))
+    drop = [i for i in gap if 0 < i < xs.size - 1 and np.isfinite(xs[i - 1]) and np.isfinite(xs[i + 1])
+            and np.hypot(xs[i + 1] - xs[i - 1], ys[i + 1] - ys[i - 1]) < tol]
+    return np.delete(xs, drop), np.delete(ys, drop)
+
+
+#: boundary lines on the IC plane: round caps and joins, so closed curves have no visible seam
+IC_LINE = dict(solid_capstyle="round", solid_joinstyle="round")
+
+
+def plot_curve(ax, xs, ys, **style):
+    """A boundary polyline on the IC plane: seams at the gamma cut removed (:func:`join_seams`);
+    a curve that closes on itself is drawn as one closed path (no start / end cap)."""
+    from matplotlib.patches import Polygon
+
+    xs, ys = join_seams(xs, ys)
+    ok = np.isfinite(xs) & np.isfinite(ys)
+    if ok.all() and xs.size > 3 and np.hypot(xs[-1] - xs[0], ys[-1] - ys[0]) < 1e-9:
+        kw = {k: v for k, v in style.items() if k not in ("solid_capstyle", "solid_joinstyle", "dash_capstyle")}
+        kw["edgecolor"] = kw.pop("color", SB_EDGE)
+        kw["linewidth"] = kw.pop("lw", 1.8)
+        kw["linestyle"] = kw.pop("ls", "-")
+        patch = Polygon(np.c_[xs[:-1], ys[:-1]], closed=True, fill=False, joinstyle="round", **kw)
+        ax.add_patch(patch)
+        return [patch]
+    return ax.plot(xs, ys, **style)
+
+
 def analytic_safe(ds):
     """Analytic safe mask ``~escapes`` over (q0, p0) of one basin slice."""
     return ~var(ds, "escapes").astype(bool)
@@ -68,10 +102,12 @@ def rm_center(ds):
     return np.pi if safe[..., edge].any() and not safe[..., mid].any() else 0.0
 
 
-def draw_rm_portrait(ax, ds, *, n_levels=24, show_saddle=True, center="auto"):
+def draw_rm_portrait(ax, ds, *, n_levels=24, show_saddle=True, center=0.0, unconfirmed=()):
     """Left panel of Figs 5-9: level curves of C on (gamma, xi), truncation level dashed,
-    safe basin grey with red boundary.  ``center``: gamma at the middle of the window
-    (``"auto"``: see :func:`rm_center`)."""
+    safe basin grey with red boundary.  ``center``: gamma at the middle of the window (0: the
+    window is -pi..pi, as in every figure; ``"auto"``: see :func:`rm_center`).  Boundary curves
+    whose index is in ``unconfirmed`` (parts of the basin the numerics do not keep) are drawn
+    dotted in UNCONFIRMED_COLOR."""
     Z = np.asarray(var(ds, "C").transpose("xi_rm", "gamma_rm"), float)
     g = np.asarray(var(ds, "gamma_rm"), float)
     xi = np.asarray(var(ds, "xi_rm"), float)
@@ -88,10 +124,13 @@ def draw_rm_portrait(ax, ds, *, n_levels=24, show_saddle=True, center="auto"):
         ax.contour(g, xi, Z, levels=levels, colors="k", linewidths=0.5, alpha=0.55, zorder=3,
                    linestyles="solid")
     lo = g.min()
-    for xs, ys, _kind in boundary_polylines(ds, "gamma", "xi"):
+    for k, (xs, ys, _kind) in enumerate(boundary_polylines(ds, "gamma", "xi")):
         xs = (xs - lo) % (2 * np.pi) + lo
         xs, ys = break_wraps(xs, ys)
-        ax.plot(xs, ys, color=SB_EDGE, lw=1.8, zorder=6)
+        if k in unconfirmed:
+            ax.plot(xs, ys, color=UNCONFIRMED_COLOR, lw=1.6, ls=":", zorder=6)
+        else:
+            ax.plot(xs, ys, color=SB_EDGE, lw=1.8, zorder=6)
     ax.axhline(float(xi_max), color=TRUNC_COLOR, ls="--", lw=2.2, zorder=7)
     sg, sx = param(ds, "saddle_gamma"), param(ds, "saddle_xi")
     if show_saddle and np.isfinite(sg) and np.isfinite(sx):
@@ -105,13 +144,22 @@ def draw_rm_portrait(ax, ds, *, n_levels=24, show_saddle=True, center="auto"):
     ax.set_ylabel(LABELS["xi"])
 
 
-def draw_ic_basin(ax, ds, *, well=True):
-    """Right panel of Figs 5-9: analytic safe basin on (q0, p0), boundary red."""
+def draw_ic_basin(ax, ds, *, well=True, unconfirmed=(), unconfirmed_mask=None):
+    """Right panel of Figs 5-9: analytic safe basin on (q0, p0), boundary red; curves in
+    ``unconfirmed`` dotted and the pixels of ``unconfirmed_mask`` hatched (UNCONFIRMED_COLOR)."""
     q, p, Z = xy_grid(var(ds, "escapes"))
     safe_fill(ax, q, p, ~Z.astype(bool))
+    if unconfirmed_mask is not None and unconfirmed_mask.any():
+        _, _, U = xy_grid(unconfirmed_mask)
+        ax.contourf(q, p, U.astype(float), levels=[0.5, 1.5], colors="none", hatches=["xxxx"], zorder=2)
+        safe_fill(ax, q, p, U.astype(bool), color=UNCONFIRMED_COLOR, zorder=1.5, alpha=0.45)
     ax.set_xlim(q.min(), q.max())
     ax.set_ylim(p.min(), p.max())
-    draw_boundaries(ax, ds)
+    for k, (xs, ys, _kind) in enumerate(boundary_polylines(ds, "q0_vertex", "p0_vertex")):
+        if k in unconfirmed:
+            plot_curve(ax, xs, ys, color=UNCONFIRMED_COLOR, lw=1.6, ls=":", zorder=6)
+        else:
+            plot_curve(ax, xs, ys, color=SB_EDGE, lw=1.8, zorder=6, **IC_LINE)
     if well:
         draw_well(ax, float(param(ds, "xi_max")))
     ax.set_aspect("equal")
@@ -143,13 +191,13 @@ def separates_mask(xs, ys, safe, *, halo=2, min_fraction=0.5):
 def draw_boundaries(ax, ds, *, safe=None, **kw):
     """Boundary polylines of a basin dataset on the IC plane.  With ``safe`` (the analytic safe
     mask on (q0, p0)), curves that do not border it are skipped (:func:`separates_mask`)."""
-    style = dict(color=SB_EDGE, lw=1.8, zorder=6)
+    style = dict(color=SB_EDGE, lw=1.8, zorder=6, **IC_LINE)
     style.update(kw)
     lines = []
     for xs, ys, _kind in boundary_polylines(ds, "q0_vertex", "p0_vertex"):
         if safe is not None and not separates_mask(xs, ys, safe):
             continue
-        lines += ax.plot(xs, ys, **style)
+        lines += plot_curve(ax, xs, ys, **style)
     return lines
 
 
@@ -206,29 +254,102 @@ def _basin_legend_handles(xi_max=None, *, saddle=False):
     return h
 
 
-def basin_kinds(ds):
-    return sorted({str(k) for k in np.asarray(ds["kind"]) if str(k)})
+def basin_kinds(ds, skip=()):
+    """Kinds of the boundary curves (those whose index is in ``skip`` left out)."""
+    return sorted({str(k) for i, k in enumerate(np.asarray(ds["kind"])) if str(k) and i not in skip})
+
+
+#: the paper's names of the basin types (Sec. 2.3)
+PAPER_TYPES = {"island": "maximum type (SBMT), island", "peninsula": "maximum type (SBMT), peninsula",
+               "saddle": "saddle type (SBST)"}
+
+
+def unconfirmed_parts(ds):
+    """Parts of the analytic basin that the stored numeric check does not keep at all.
+
+    Returns ``(curve indices, mask over (q0, p0) or None, regions)``: the boundary curves that
+    border such a part, its pixels, and the table [(size, kept fraction), ...] of every part;
+    empty when the dataset has no numeric check (``region``)."""
+    if "region" not in ds.variables:
+        return set(), None, []
+    region = var(ds, "region")
+    size = np.asarray(var(ds, "region_size"), int)
+    frac = np.asarray(var(ds, "region_numeric_safe"), float)
+    dead = [i + 1 for i in range(size.size) if frac[i] == 0.0]
+    mask = region.isin(dead)
+    curves = set()
+    if dead:
+        main = region.isin([i + 1 for i in range(size.size) if frac[i] > 0])
+        for k, (xs, ys, _kind) in enumerate(boundary_polylines(ds, "q0_vertex", "p0_vertex")):
+            if separates_mask(xs, ys, mask) and not separates_mask(xs, ys, main):
+                curves.add(k)
+    return curves, mask, list(zip(size.tolist(), frac.tolist()))
 
 
 def figure_rm_basin(analytic, *, title=None, figsize=(11.5, 4.6)):
-    """Figs 5-9: (left) RM portrait with SB, (right) SB on the IC plane."""
+    """Figs 5-9: (left) RM portrait with SB, (right) SB on the IC plane.  With a numeric check
+    in the dataset, the parts of the basin where no IC stays are hatched / dotted."""
     ds = open_dataset(analytic)
     fig, (a1, a2) = plt.subplots(1, 2, figsize=figsize, layout="constrained",
                                  gridspec_kw=dict(width_ratios=[1.25, 1]))
-    draw_rm_portrait(a1, ds)
-    draw_ic_basin(a2, ds)
+    bad, bad_mask, regions = unconfirmed_parts(ds)
+    draw_rm_portrait(a1, ds, unconfirmed=bad)
+    draw_ic_basin(a2, ds, unconfirmed=bad, unconfirmed_mask=bad_mask)
     has_saddle = bool(np.isfinite(float(param(ds, "saddle_xi"))))
     below = dict(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=8, frameon=False)
-    a1.legend(handles=_basin_legend_handles(param(ds, "xi_max"), saddle=has_saddle),
-              ncol=2, **below)
-    a2.legend(handles=[Patch(facecolor=SB_FACE, edgecolor=SB_EDGE, lw=1.5, label="safe basin (theory)"),
-                       Line2D([], [], color="0.35", ls=(0, (4, 2)), lw=0.9,
-                              label=r"well edge $H_0 = \xi_{max}$")],
-              ncol=2, **below)
+    h1 = _basin_legend_handles(param(ds, "xi_max"), saddle=has_saddle)
+    h2 = [Patch(facecolor=SB_FACE, edgecolor=SB_EDGE, lw=1.5, label="safe basin (theory)"),
+          Line2D([], [], color="0.35", ls=(0, (4, 2)), lw=0.9, label=r"well edge $H_0 = \xi_{max}$")]
+    if bad:
+        cyc = fmt_value(param(ds, "check_cycles"))
+        h1.append(Line2D([], [], color=UNCONFIRMED_COLOR, ls=":", lw=1.6,
+                         label=f"slow-flow islands: no IC stays {cyc} EC (numerics)"))
+        h2.append(Patch(facecolor=UNCONFIRMED_COLOR, alpha=0.45, hatch="xxxx", edgecolor=UNCONFIRMED_COLOR,
+                        label=f"no IC stays {cyc} EC (numerics)"))
+    a1.legend(handles=h1, ncol=2, **below)
+    a2.legend(handles=h2, ncol=2, **below)
     a1.set_title(r"resonance manifold $(\gamma, \xi)$")
     a2.set_title(r"initial conditions $(q_0, p_0)$")
     params = {k: param(ds, k) for k in ("F", "Omega", "Psi", "xi_max")}
-    kinds = basin_kinds(ds)
-    kind_txt = f"  [{' + '.join(kinds)}]" if kinds else ""
+    kinds = basin_kinds(ds, skip=bad)
+    kind_txt = f"  [{' + '.join(PAPER_TYPES.get(k, k) for k in kinds)}]" if kinds else ""
     fig.suptitle(title or (param_text(params) + kind_txt), fontsize=11)
+    _rm_notes(fig, ds, kinds, bad, regions)
     return fig
+
+
+def _rm_notes(fig, ds, kinds, bad, regions):
+    """Caption notes of Figs 5-9, read from the basin dataset."""
+    from safebasins.plotting.captions import add_note, count
+
+    all_kinds = [str(k) for k in np.asarray(ds["kind"])]
+    sg, sx = float(param(ds, "saddle_gamma")), float(param(ds, "saddle_xi"))
+    add_note(fig, "Boundary curves: " + ", ".join(f"{k} (level C = {c:.4g})" for k, c in
+                                                 zip(all_kinds, np.asarray(var(ds, "C_level"), float)))
+             + (f"; saddle of C at (γ, ξ) = ({sg:.3g}, {sx:.4g})." if np.isfinite(sx) else "; no saddle below ξ_max."))
+    add_note(fig, "Paper's classification of what bounds the basin: "
+             + (", ".join(PAPER_TYPES.get(k, k) for k in kinds) if kinds else "none") + ".")
+    if regions:
+        cyc = fmt_value(param(ds, "check_cycles"))
+        live = [(n, f) for n, f in regions if f > 0]
+        dead = [n for n, f in regions if f == 0]
+        txt = "; ".join(f"{'the basin' if len(live) == 1 else f'part {i + 1}'}: {n:,} ICs, {100 * f:.1f}% stay"
+                        for i, (n, f) in enumerate(live))
+        if dead:
+            txt += (("; " if txt else "") + f"{count(len(dead), 'further part')} ({count(sum(dead), 'IC')}): "
+                    "none stays")
+        add_note(fig, f"Numeric check (every analytic-safe IC of the grid integrated {cyc} EC, energy criterion): "
+                      f"{txt}.")
+    g = np.asarray(var(ds, "gamma_rm"), float)
+    safe_rm = ~np.asarray(var(ds, "escapes_rm").transpose("gamma_rm", "xi_rm")).astype(bool)
+    if safe_rm[0].any() and safe_rm[-1].any() and not safe_rm[np.abs(g) < np.pi / 2].any():
+        add_note(fig, "The safe region lies across the cut γ = ±π of the cylinder: it is drawn at both edges of the "
+                      "γ window (the same window, -π..π, in every figure).")
+    if bad:
+        x = [np.asarray(var(ds, "xi"), float)[np.asarray(var(ds, "curve_index"), float) == k] for k in sorted(bad)]
+        lo = min(np.nanmin(v) for v in x)
+        add_note(fig, f"The {count(len(bad), 'thin island')} at ξ ≥ {lo:.4f}, just below ξ_max = "
+                      f"{fmt_value(param(ds, 'xi_max'))}, are closed level curves of C around fixed points of the slow "
+                      "flow (18) that the separatrix singularity creates (G(ξ) → 0 with G'(ξ) → -∞ as ξ → 1/4); no IC "
+                      "in them stays in the numerics, so they are drawn dotted / hatched as an artefact of the "
+                      "ξ → 1/4 singularity and left out of the basin's classification.")

@@ -14,7 +14,9 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from safebasins.analysis.safe import is_safe, safe_area
-from safebasins.plotting.basins import analytic_safe, draw_boundaries, safe_fill, xy_grid
+from safebasins.plotting.basins import (analytic_safe, boundary_polylines, draw_boundaries, plot_curve, safe_fill,
+                                        separates_mask, xy_grid)
+from safebasins.plotting.captions import add_note, count
 from safebasins.plotting.data import load_params, open_dataset, param, var
 from safebasins.plotting.style import LABELS, SYMBOLS, fmt_value, grey_levels, param_text
 
@@ -73,11 +75,49 @@ def theory_slices(basins, scan, vals):
     return out
 
 
+def _resample(xs, ys, n=400):
+    """Points of a polyline (NaN gaps dropped) resampled to about ``n`` points by arc length."""
+    ok = np.isfinite(xs) & np.isfinite(ys)
+    x, y = xs[ok], ys[ok]
+    if x.size < 2:
+        return np.c_[x, y]
+    d = np.r_[0, np.cumsum(np.hypot(np.diff(x), np.diff(y)))]
+    t = np.linspace(0, d[-1], n)
+    return np.c_[np.interp(t, d, x), np.interp(t, d, y)]
+
+
+def coincident_groups(curves, tol):
+    """Groups of polylines (``curves``: [(slice, xs, ys), ...]) of different slices that run
+    along each other (every point of each within ``tol`` of the other): [[i, j, ...], ...]."""
+    from scipy.spatial import cKDTree
+
+    pts = [_resample(np.asarray(x, float), np.asarray(y, float)) for _, x, y in curves]
+    parent = list(range(len(curves)))
+
+    def root(i):
+        while parent[i] != i:
+            i = parent[i]
+        return i
+
+    for i in range(len(curves)):
+        for j in range(i + 1, len(curves)):
+            if curves[i][0] == curves[j][0] or len(pts[i]) < 2 or len(pts[j]) < 2:
+                continue
+            if (cKDTree(pts[j]).query(pts[i])[0].max() < tol and cKDTree(pts[i]).query(pts[j])[0].max() < tol):
+                parent[root(j)] = root(i)
+    groups = {}
+    for i in range(len(curves)):
+        groups.setdefault(root(i), []).append(i)
+    return [g for g in groups.values() if len(g) > 1]
+
+
 def figure_nested_basins(analytic, numeric, *, title=None, t_eval=None, figsize=(9.6, 5.6), boundary_only=True):
     """Figs 13-17: numeric safe basins shaded by the scanned parameter (attribute ``scan``:
     lighter regions include darker ones, white = escape for every value), theory boundaries as
     curves, the stored IoU in the legend.  ``t_eval`` defaults to the agreement's evaluation
-    time; ``boundary_only``: draw only the theory curves that border the analytic safe mask."""
+    time; ``boundary_only``: draw only the theory curves that border the analytic safe mask.
+    Boundaries of several parameter values that coincide (e.g. a saddle-type curve below every
+    threshold) are drawn as one line of alternating colours, each colour still visible."""
     chart = open_dataset(numeric)
     basins = open_dataset(analytic)
     scan = param(chart, "scan")
@@ -87,18 +127,42 @@ def figure_nested_basins(analytic, numeric, *, title=None, t_eval=None, figsize=
     shade = draw_nested_safe(ax, masks)
     theory = theory_slices(basins, scan, vals)
     iou = np.atleast_1d(np.asarray(var(chart, "iou"), float))
+    pix = np.atleast_1d(np.asarray(var(chart, "pixel_agreement"), float))
+    n_num = np.atleast_1d(np.asarray(var(chart, "safe_numeric"), int))
+    n_ana = np.atleast_1d(np.asarray(var(chart, "safe_analytic"), int))
+    q = np.asarray(chart["q0"], float)
+    p = np.asarray(chart["p0"], float)
+    style = {i: (THEORY_COLORS[i % len(THEORY_COLORS)], LINE_STYLES[i % len(LINE_STYLES)]) for i in range(len(vals))}
+    curves = []
+    for i in range(len(vals)):
+        safe = analytic_safe(theory[i]) if boundary_only else None
+        for xs, ys, _kind in boundary_polylines(theory[i], "q0_vertex", "p0_vertex"):
+            if safe is None or separates_mask(xs, ys, safe):
+                curves.append((i, xs, ys))
+    tol = 0.6 * max(q[1] - q[0], p[1] - p[0])  # well below one pixel of the chart
+    groups = coincident_groups(curves, tol)
+    grouped = {k for g in groups for k in g}
+    for k, (i, xs, ys) in enumerate(curves):
+        if k not in grouped:
+            col, ls = style[i]
+            plot_curve(ax, xs, ys, color=col, ls=ls, lw=1.6, zorder=6)
+    shared = []
+    seg = 3.0  # dash length (in line widths): each member draws every n-th segment in its colour
+    for g in groups:
+        members = sorted(g, key=lambda k: vals[curves[k][0]])
+        n = len(members)
+        for r, k in enumerate(members):
+            i, xs, ys = curves[k]
+            plot_curve(ax, xs, ys, color=style[i][0], lw=1.9, ls=(r * seg * 1.9, (seg * 1.9, (n - 1) * seg * 1.9)),
+                       zorder=6, dash_capstyle="butt")
+        shared.append(sorted({float(vals[curves[k][0]]) for k in members}))
     handles = []
     for i in np.argsort(vals):  # legend in parameter order
-        col = THEORY_COLORS[i % len(THEORY_COLORS)]
-        ls = LINE_STYLES[i % len(LINE_STYLES)]
-        draw_boundaries(ax, theory[i], color=col, ls=ls, lw=1.6,
-                        safe=analytic_safe(theory[i]) if boundary_only else None)
+        col, ls = style[i]
         lab = f"{SYMBOLS[scan]} = {fmt_value(vals[i])}"
         if t_eval is None:  # the stored IoU is that of the agreement's t_eval
             lab += f"   IoU = {iou[i]:.3f}"
         handles.append(((Patch(facecolor=shade[i], edgecolor="none"), Line2D([], [], color=col, ls=ls, lw=1.6)), lab))
-    q = np.asarray(chart["q0"], float)
-    p = np.asarray(chart["p0"], float)
     ax.set_xlim(q.min(), q.max())
     ax.set_ylim(p.min(), p.max())
     ax.set_aspect("equal")
@@ -106,6 +170,10 @@ def figure_nested_basins(analytic, numeric, *, title=None, t_eval=None, figsize=
     ax.set_ylabel(LABELS["p0"])
     hs = [h for h, _ in handles] + [Patch(facecolor="white", edgecolor="0.5", lw=0.5)]
     ls_ = [lab for _, lab in handles] + ["escape for all values"]
+    for vs in {tuple(v) for v in shared}:
+        idx = [int(np.flatnonzero(np.isclose(vals, v))[0]) for v in vs]
+        hs.append(tuple(Line2D([], [], color=style[i][0], lw=1.9) for i in idx))
+        ls_.append("alternating colours: one boundary\nshared by " + ", ".join(fmt_value(v) for v in vs))
     ax.legend(hs, ls_, handler_map={tuple: HandlerTuple(ndivide=None, pad=0)}, loc="upper left",
               bbox_to_anchor=(1.02, 1.0), borderaxespad=0,
               title="numeric SB (grey) / theory (lines)", title_fontsize=8)
@@ -113,6 +181,15 @@ def figure_nested_basins(analytic, numeric, *, title=None, t_eval=None, figsize=
     ax.set_title(title or (f"Safe basins vs {SYMBOLS[scan]}: " + param_text(fixed) +
                            f"\n(numeric: {resolution(chart)} ICs, {fmt_value(t_ev)} EC; "
                            "lighter regions contain darker ones)"))
+    name = {"xi_max": "ξ_max", "F": "F"}.get(scan, scan)
+    add_note(fig, f"Numeric basins: {resolution(chart)} ICs, energy criterion, safe = no escape within "
+                  f"{fmt_value(t_ev)} EC (agreement evaluated at {fmt_value(param(chart, 'agreement_t_eval'))} EC).")
+    add_note(fig, "Analytic vs numeric, per " + name + ": " + "; ".join(
+        f"{fmt_value(vals[i])}: IoU {iou[i]:.3f}, pixel agreement {pix[i]:.3f}, safe ICs {n_ana[i]:,} analytic / "
+        f"{n_num[i]:,} numeric" for i in np.argsort(vals)) + ".")
+    for vs in shared:
+        add_note(fig, f"The analytic boundaries of {name} = {', '.join(fmt_value(v) for v in vs)} coincide along "
+                      "one curve (drawn in alternating colours).")
     return fig
 
 
@@ -135,6 +212,14 @@ def figure_criteria(numeric, *, title=None, figsize=(6.4, 4.4)):
     params = {k: param(ds, k) for k in ("Omega", "Psi", "xi_max", "q_max")}
     extra = f"{int(param(ds, 'n_ic'))} random ICs in $[-1,1]^2$, {fmt_value(param(ds, 'cycles'))} EC"
     ax.set_title(title or ("Displacement vs energy criterion: " + param_text(params) + "\n" + extra))
+    mean = np.asarray(rd.mean("repeat"), float)
+    big = mean > 0.01
+    add_note(fig, f"{int(param(ds, 'n_ic')):,} random ICs per repetition, {rd.sizes['repeat']} repetitions, "
+                  f"{fmt_value(param(ds, 'cycles'))} EC, F = {fmt_value(F.min())} ... {fmt_value(F.max())}.")
+    add_note(fig, f"Mean (A_q - A_E)/A_E: {100 * mean[0]:.2f}% at F = {fmt_value(F[0])}, "
+                  f"{100 * mean[-1]:.1f}% at F = {fmt_value(F[-1])}, largest {100 * np.nanmax(mean):.1f}% at "
+                  f"F = {fmt_value(F[np.nanargmax(mean)])}; "
+                  + (f"first above 1% at F = {fmt_value(F[np.argmax(big)])}." if big.any() else "below 1% at every F."))
     return fig
 
 
@@ -168,6 +253,27 @@ def _t_evals(params, t_evals):
     return [float(t) for t in np.atleast_1d(vals)]
 
 
+def _area_curves(chart, t):
+    """Safe pixels of the energy (ESB) and displacement (DSB) criteria at evaluation times t."""
+    area = safe_area(chart, np.asarray(t, float))
+    return (np.asarray(area["pixels_energy"].isel(xi_max=0), float),
+            np.asarray(area["pixels_displacement"].isel(q_max=0), float))
+
+
+def _last_escape(chart, name, dim):
+    """Latest finite escape time of a criterion on the chart (NaN if nothing escapes)."""
+    e = np.asarray(var(chart, name).isel({dim: 0}), float)
+    e = e[np.isfinite(e)]
+    return float(e.max()) if e.size else np.nan
+
+
+def settle_time(t, n, frac=0.01):
+    """First t from which the area n(t) stays within ``frac`` of its final value."""
+    t, n = np.asarray(t, float), np.asarray(n, float)
+    off = np.flatnonzero(np.abs(n - n[-1]) > frac * max(n[-1], 1.0))
+    return float(t[0]) if not off.size else float(t[min(off[-1] + 1, t.size - 1)])
+
+
 def figure_dsb_esb(numeric, params, *, t_evals=None, title=None, figsize=None):
     """Figs 20-21: DSB grey / ESB black at the first (left) and last (right) t_eval."""
     chart = open_dataset(numeric)
@@ -188,32 +294,78 @@ def figure_dsb_esb(numeric, params, *, t_evals=None, title=None, figsize=None):
     shown["xi_max"] = xi
     fig.suptitle(title or ("Safe basins by the displacement (DSB, grey) and energy (ESB, black) "
                            "criterion\n" + param_text(shown) + f", resolution {resolution(chart)}"), fontsize=10.5)
+    # what the data show
+    nE, nD = _area_curves(chart, t_evals)
+    esc = np.asarray(var(chart, "escape_cycle_energy").isel(xi_max=0), float)
+    dsc = np.asarray(var(chart, "escape_cycle_displacement").isel(q_max=0), float)
+    t0, t1 = t_evals[0], t_evals[-1]
+    changed_E = int(((esc > t0) != (esc > t1)).sum())
+    changed_D = int(((dsc > t0) != (dsc > t1)).sum())
+    outside = int(max(((esc > t) & ~(dsc > t)).sum() for t in t_evals))
+    n = esc.size
+    add_note(fig, "Safe pixels of " + f"{n:,}: " + "; ".join(
+        f"t_eval = {fmt_value(t)} EC: ESB {int(e):,}, DSB {int(d):,}" for t, e, d in zip(t_evals, nE, nD)) + ".")
+    add_note(fig, f"Between t_eval = {fmt_value(t0)} and {fmt_value(t1)} EC {count(changed_E, 'ESB pixel')} and "
+                  f"{count(changed_D, 'DSB pixel')} change; the last energy escape in the chart is at "
+                  f"{fmt_value(_last_escape(chart, 'escape_cycle_energy', 'xi_max'))} EC, the last displacement "
+                  f"escape at {fmt_value(_last_escape(chart, 'escape_cycle_displacement', 'q_max'))} EC.")
+    add_note(fig, f"ESB pixels outside the DSB: {outside} (the DSB contains the ESB"
+                  + (")." if outside == 0 else " except for these).")
+                  + (" Paper: both boundaries irregular at the short t_eval, smoother at the long one; ours: the "
+                     "ESB is the same set of pixels at both t_eval." if changed_E == 0 else ""))
     return fig
 
 
-def figure_area_vs_time(numeric, params, *, t_evals=None, title=None, figsize=(6.6, 4.4)):
-    """Fig 22: ln(SB area in pixels) vs t_eval, DSB dashed, ESB solid (one point per t_eval)."""
+def figure_area_vs_time(numeric, params, *, t_evals=None, title=None, figsize=(6.8, 4.6), n_log=300):
+    """Fig 22: ln(SB area in pixels) vs t_eval, DSB dashed, ESB solid, on a logarithmic time axis
+    from one cycle (so that the early transient shows): the experiment's t_eval plus ``n_log``
+    log-spaced times, all read from the same chart."""
     chart = open_dataset(numeric)
-    t_evals = np.asarray(_t_evals(params, t_evals), float)
-    area = safe_area(chart, t_evals)
+    t_cfg = np.asarray(_t_evals(params, t_evals), float)
+    horizon = float(param(chart, "cycles"))
+    t = np.unique(np.r_[np.geomspace(1.0, horizon, n_log), t_cfg])
+    nE, nD = _area_curves(chart, t)
     fig, ax = plt.subplots(figsize=figsize, layout="constrained")
     xi, qm = chart_thresholds(chart)
-    for pix, ls, lab in ((area["pixels_displacement"].isel(q_max=0), "--", f"DSB ($q_{{max}}$ = {fmt_value(qm)})"),
-                         (area["pixels_energy"].isel(xi_max=0), "-", rf"ESB ($\xi_{{max}}$ = {fmt_value(xi)})")):
-        n = np.asarray(pix, float)
-        with np.errstate(divide="ignore"):
-            la = np.where(n > 0, np.log(n), np.nan)
-        ax.plot(t_evals, la, ls=ls, color="k", lw=1.4, marker="o" if t_evals.size <= 40 else None, ms=3, label=lab)
-    ax.set_xlabel(LABELS["t_eval"])
+    with np.errstate(divide="ignore"):
+        lE, lD = (np.where(n > 0, np.log(n), np.nan) for n in (nE, nD))
+    ax.plot(t, lD, ls="--", color="k", lw=1.4, label=f"DSB ($q_{{max}}$ = {fmt_value(qm)})")
+    ax.plot(t, lE, ls="-", color="k", lw=1.4, label=rf"ESB ($\xi_{{max}}$ = {fmt_value(xi)})")
+    tE = _last_escape(chart, "escape_cycle_energy", "xi_max")
+    tD = settle_time(t, nD)
+    for x, txt, yf in ((tE, "last ESB escape", 0.62), (tD, "DSB within 1%\nof its final area", 0.78)):
+        if np.isfinite(x):
+            ax.axvline(x, color="0.55", lw=0.8, ls=":")
+            ax.text(x, yf, f" {txt}:\n {x:,.0f} EC", transform=ax.get_xaxis_transform(), fontsize=7.5,
+                    color="0.3", va="top", ha="left")
+    ax.set_xscale("log")
+    ax.set_xlabel(LABELS["t_eval"] + ", logarithmic")
     ax.set_ylabel(r"$\ln$(SB area / pixels)")
-    ax.set_xlim(0, t_evals.max())
+    ax.set_xlim(1.0, horizon)
     ax.legend(loc="upper right")
     shown = {k: param(chart, k) for k in ("F", "Omega", "Psi")}
     shown["xi_max"] = xi
     ax.set_title(title or ("Safe-basin area vs evaluation time\n" + param_text(shown) +
                            f", resolution {resolution(chart)}"))
+    iD = np.interp(t_cfg, t, nD)
+    t_short = float(np.atleast_1d(param(chart, "t_eval"))[0])
+    ec = "{:,.0f} EC".format
+    add_note(fig, f"Read from the chart of {resolution(chart)} ICs over {fmt_value(horizon)} EC, at the "
+                  f"{t_cfg.size} configured t_eval ({fmt_value(t_cfg.min())} ... {fmt_value(t_cfg.max())} EC) and "
+                  f"{n_log} log-spaced ones from 1 EC.")
+    add_note(fig, f"Paper: the area shrinks rapidly for about 2000 EC and then hardly changes. Ours: the ESB loses "
+                  f"its last pixel at {fmt_value(tE)} EC and keeps {int(nE[-1]):,} pixels from there to "
+                  f"{fmt_value(horizon)} EC (identical at every later t_eval); the DSB falls from "
+                  f"{int(iD[0]):,} pixels at {fmt_value(t_cfg[0])} EC to {int(nD[-1]):,} at {fmt_value(horizon)} EC "
+                  f"and stays within 1% of its final value from {ec(tD)} on "
+                  f"(within 5% from {ec(settle_time(t, nD, 0.05))}, within 0.1% from "
+                  f"{ec(settle_time(t, nD, 0.001))}); the displacement escapes after "
+                  f"{fmt_value(t_cfg[0])} EC are {count(iD[0] - nD[-1], 'pixel')}, "
+                  f"{100 * (iD[0] - np.interp(t_short, t, nD)) / max(iD[0] - nD[-1], 1):.0f}% of them by "
+                  f"{fmt_value(t_short)} EC (the short t_eval of the chart's own figure).")
     return fig
 
 
 __all__ = ["figure_nested_basins", "figure_criteria", "figure_dsb_esb", "figure_area_vs_time",
-           "draw_nested_safe", "draw_dsb_esb", "scan_masks", "theory_slices", "chart_thresholds"]
+           "draw_nested_safe", "draw_dsb_esb", "scan_masks", "theory_slices", "chart_thresholds",
+           "coincident_groups", "settle_time"]

@@ -19,13 +19,15 @@ import re
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import to_rgb
+from matplotlib.legend_handler import HandlerTuple
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Patch
 
-from safebasins.plotting.basins import draw_well
+from safebasins.plotting.basins import draw_well, plot_curve, separates_mask
+from safebasins.plotting.captions import add_note, fmt_range
 from safebasins.plotting.data import open_dataset, param, var
 from safebasins.plotting.fcr import curve_labels, ic_text
-from safebasins.plotting.style import LABELS, param_text
+from safebasins.plotting.style import LABELS, fmt_value, param_text
 
 __all__ = ["figure_erosion", "figure_true_basin", "figure_fourier", "shade"]
 
@@ -99,20 +101,48 @@ def figure_erosion(analytic=None, numeric=None, *, measures=("GIM", "LIM", "IF")
             key = f or param(analytic, "fourier")
             handles.append(Line2D([], [], color="0.2", ls=FOURIER_STYLE[key]["ls"],
                                   label=f"analytic, {FOURIER_STYLE[key]['label']}"))
+    labels = [h.get_label() for h in handles]
     if numeric is not None:
         ts = list(np.atleast_1d(t_eval)) if t_eval is not None else _values(numeric, "t_eval")
         for k, t in enumerate(ts):
             frac = 0.35 + 0.65 * (k + 1) / len(ts)
+            ms = 6.5 - 3.0 * k / max(len(ts) - 1, 1)
             lab = "numeric" + (f", $t_{{eval}}$ = {float(t):g} EC" if t is not None else "")
-            handles.append(Line2D([], [], ls="none", marker="o", mfc=shade("0.2", frac), mec="0.2", mew=0.6,
-                                  label=lab))
+            # the markers as drawn: one per xi_max colour, at this t_eval's shade and size
+            handles.append(tuple(Line2D([], [], ls="none", marker="o", ms=ms, mfc=shade(colors[i % len(colors)], frac),
+                                        mec=shade(colors[i % len(colors)], min(1.0, frac + 0.2)), mew=0.6)
+                                 for i in range(len(xis))))
+            labels.append(lab)
     ncol = len(handles) if len(handles) <= 4 else (len(handles) + 1) // 2
-    fig.legend(handles=handles, loc="lower center", ncol=ncol, fontsize=7.5, frameon=False,
-               bbox_to_anchor=(0.5, 0.0), columnspacing=1.5)
+    fig.legend(handles, labels, handler_map={tuple: HandlerTuple(ndivide=None, pad=0.1)}, loc="lower center",
+               ncol=ncol, fontsize=7.5, frameon=False, bbox_to_anchor=(0.5, 0.0), columnspacing=1.5)
     par = {k: param(ref, k) for k in ("Omega", "Psi")}
     fig.suptitle(title or "Erosion profiles: " + param_text(par), fontsize=10)
     fig.tight_layout(rect=(0, 0.04 + 0.045 * -(-len(handles) // ncol), 1, 1))
+    _erosion_notes(fig, analytic, numeric, measures)
     return fig
+
+
+def _erosion_notes(fig, analytic, numeric, measures):
+    """Caption notes: grids and the first F at which each measure falls to the stored level."""
+    def crossings(ds, **sel):
+        return ", ".join(f"F_{m} = {float(_sel(var(ds, f'F_{m}'), **sel)):.4g}" for m in measures)
+
+    if analytic is not None and "grid_n" in analytic.attrs:  # written by the pipeline's erosion kind
+        n = np.atleast_1d(param(analytic, "grid_n"))
+        add_note(fig, f"Analytic profiles from the slow flow on {' x '.join(str(int(v)) for v in n)} ICs of the "
+                      "window; numeric ones from one escape chart per F.")
+    if analytic is not None and "F_GIM" in analytic.variables:
+        for x in _values(analytic, "xi_max"):
+            for f in _values(analytic, "fourier"):
+                add_note(fig, f"First F at which each measure falls to {fmt_value(param(analytic, 'level'))}, ξ_max = "
+                              f"{fmt_value(x)}, analytic ({f or param(analytic, 'fourier')} G): "
+                              f"{crossings(analytic, xi_max=x, fourier=f)}.")
+    if numeric is not None and "F_GIM" in numeric.variables:
+        for x in _values(numeric, "xi_max"):
+            add_note(fig, f"Numeric, ξ_max = {fmt_value(x)}: " + "; ".join(
+                f"t_eval = {fmt_value(t)} EC: {crossings(numeric, xi_max=x, t_eval=t)}" for t in _values(numeric, "t_eval"))
+                + ".")
 
 
 def _draw_basin_panel(ax, ds, sel, label):
@@ -126,10 +156,22 @@ def _draw_basin_panel(ax, ds, sel, label):
     ax.contourf(q, p, union.T.astype(float), levels=[0.5, 1.5], colors=["0.9"], zorder=0)
     cmap = plt.get_cmap("twilight")
     psis = np.asarray(safe["Psi"].values, float)
+    curves = "boundary_q0" in ds.variables
     for k in range(n):  # each per-phase basin: a faint outline coloured by its phase
-        if sv[k].any() and not sv[k].all():
+        col = cmap((psis[k] % (2 * np.pi)) / (2 * np.pi))
+        if curves:  # analytic: the slow flow's own boundary curves of this phase
+            b = ds.isel(Psi=k)
+            bq = np.asarray(_sel(var(b, "boundary_q0"), **sel), float)
+            bp = np.asarray(_sel(var(b, "boundary_p0"), **sel), float)
+            bc = np.asarray(_sel(var(b, "boundary_curve"), **sel), int)
+            mask = _sel(safe.isel(Psi=k), **sel).transpose("q0", "p0")
+            for c in np.unique(bc[bc >= 0]):
+                xs, ys = bq[bc == c], bp[bc == c]
+                if separates_mask(xs, ys, mask):
+                    plot_curve(ax, xs, ys, color=col, lw=0.7, alpha=0.7, zorder=2)
+        elif sv[k].any() and not sv[k].all():  # numeric: outline of the chart's safe pixels
             ax.contour(q, p, sv[k].T.astype(float), levels=[0.5], linewidths=0.5, alpha=0.5,
-                       colors=[cmap((psis[k] % (2 * np.pi)) / (2 * np.pi))], zorder=2)
+                       colors=[col], zorder=2)
     tv = true.transpose("q0", "p0").values
     ax.contourf(q, p, tv.T.astype(float), levels=[0.5, 1.5], colors=["tab:green"], alpha=0.55)
     draw_well(ax, float(sel["xi_max"]))
@@ -168,10 +210,10 @@ def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, 
         elif "fourier" in ds.dims or "fourier" in ds.attrs:
             lab = f"{lab} ({fourier} G)"
         _draw_basin_panel(ax, ds, sel, lab)
-        if "xi_true" in ds:
-            xt = float(_sel(ds["xi_true"], **sel))
+        if analytic is not None:  # the analytic all-phase basin on every panel (the numeric one is compared to it)
+            xt = float(_sel(var(analytic, "xi_true"), xi_max=x, fourier=fourier))
             if xt > 0:
-                draw_well(ax, xt, color=XI_TRUE_COLOR, ls=":", lw=1.0, zorder=8)
+                draw_well(ax, xt, color=XI_TRUE_COLOR, ls=":", lw=1.4, zorder=9)
     axes[0, 0].set_ylabel(LABELS["p0"])
     ref = panels[0][0]
     handles = [Patch(color="0.9", label="safe for some phase"),
@@ -180,9 +222,9 @@ def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, 
                Patch(color="tab:green", alpha=0.55, label="safe for all sampled phases"),
                Line2D([], [], color=IF_COLOR, lw=2.2, marker="+", ms=6, label="IF disk (+ centre)"),
                Line2D([], [], color=LIM_COLOR, lw=1.1, ls=(0, (3, 2)), label="LIM disk")]
-    if "xi_true" in ref:
-        handles.append(Line2D([], [], color=XI_TRUE_COLOR, ls=":", lw=1.0,
-                              label=r"$H_0 = \xi_{true}$ (all $\Psi$)"))
+    if analytic is not None:
+        handles.append(Line2D([], [], color=XI_TRUE_COLOR, ls=":", lw=1.4,
+                              label=r"analytic $H_0 = \xi_{true}$ (all $\Psi$)"))
     fig.legend(handles=handles, loc="lower center", ncol=3, fontsize=7.5, frameon=False,
                bbox_to_anchor=(0.5, 0.0), columnspacing=1.5)
     par = {"F": param(ref, "F"), "Omega": param(ref, "Omega")}
@@ -191,6 +233,27 @@ def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, 
     head = "Phase-invariant safe basin" + (": " + param_text(par) if any(v is not None for v in par.values()) else "")
     fig.suptitle(title or head, fontsize=10)
     fig.subplots_adjust(left=0.08, right=0.98, top=0.84, bottom=0.2, wspace=0.22)
+    for ds, lab in panels:
+        x = xi_max if xi_max is not None else (float(ds["xi_max"][0]) if "xi_max" in ds.dims else None)
+        sel = {"xi_max": x, "fourier": fourier}
+        if "t_eval" in ds.dims:
+            sel["t_eval"] = t_eval if t_eval is not None else float(ds["t_eval"][-1])
+        m = {k: float(_sel(var(ds, f"{k}_true"), **sel)) for k in ("GIM", "LIM", "IF")}
+        per = np.asarray(_sel(var(ds, "GIM"), **sel), float) if "GIM" in ds.variables else np.array([np.nan])
+        txt = (f"{lab}" + (f" (t_eval = {fmt_value(sel['t_eval'])} EC)" if "t_eval" in sel else f" ({fourier} G)")
+               + f", {ds.sizes['Psi']} phases: true basin GIM = {m['GIM']:.3f}, LIM = {m['LIM']:.3f}, IF = {m['IF']:.3f}"
+               + (f"; single-phase GIM {fmt_range(per, '{:.3f}')}" if np.isfinite(per).any() else "")
+               + (f"; contained in every per-phase basin: {bool(_sel(var(ds, 'contained'), **sel))}"
+                  if "contained" in ds.variables else ""))
+        add_note(fig, txt + ".")
+    if analytic is not None:
+        x = xi_max if xi_max is not None else float(analytic["xi_max"][0])
+        xt = float(_sel(var(analytic, "xi_true"), xi_max=x, fourier=fourier))
+        add_note(fig, f"All phases (continuous Ψ), analytic: the basin is the energy disk H0 < ξ_true = {xt:.4g}, GIM = "
+                      f"{float(_sel(var(analytic, 'GIM_closed'), xi_max=x, fourier=fourier)):.3f}, LIM = IF = "
+                      f"{float(_sel(var(analytic, 'LIM_closed'), xi_max=x, fourier=fourier)):.3f} (closed forms); "
+                      "the analytic per-phase outlines are the slow flow's boundary curves, the numeric ones outline "
+                      "chart pixels.")
     return fig
 
 
@@ -353,6 +416,8 @@ def figure_fourier(fcr=None, iou=None, *, title=None):
             ax.legend(loc="lower left", fontsize=7, framealpha=0.9)
         summary.append("mean IoU: paper {:.3f}, exact {:.3f}".format(np.nanmean(allv["paper"]),
                                                                     np.nanmean(allv["exact"])))
+    for line in summary:
+        add_note(fig, line.replace(r"$F_{cr}$", "F_cr") + " (over the figures' numeric points / charts).")
     head = title or "First harmonic: paper's truncated G (eq 20) vs exact, against the numerics"
     fig.suptitle(head + ("\n" + "; ".join(summary) if summary and not title else ""), fontsize=10, y=0.995)
     fig.subplots_adjust(left=0.06, right=0.99, top=0.87 if fcrs else 0.8, bottom=0.12 if fcrs else 0.3)

@@ -8,10 +8,13 @@ from __future__ import annotations
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.legend_handler import HandlerTuple
 from matplotlib.lines import Line2D
 
+from safebasins.plotting.captions import add_note, count, fmt_range
+
 from safebasins.plotting.data import open_dataset, param, var
-from safebasins.plotting.style import LABELS, fmt_value, param_text
+from safebasins.plotting.style import LABELS, SYMBOLS, fmt_value, param_text
 
 # mechanism flags of theory.critical_forcing: "none MM_0 MM_pi SM SMM"
 MECHANISMS = {
@@ -41,10 +44,17 @@ def curve_labels(ds, dim="curve"):
     if varying:
         labels = [param_text({c: ds[c].values[i] for c in varying}) for i in range(n)]
     elif "label" in ds.coords:
-        labels = [str(v) for v in np.asarray(ds["label"])]
+        labels = [_symbols(str(v)) for v in np.asarray(ds["label"])]
     else:
         labels = [f"curve {i}" for i in range(n)]
     return labels, constant
+
+
+def _symbols(label):
+    """"xi_ini = 0.05" (a stored curve label) -> "$\\xi_{ini}$ = 0.05"."""
+    for name in ("xi_ini", "gamma_ini", "xi_max", "Psi"):
+        label = label.replace(f"{name} =", f"{SYMBOLS[name]} =")
+    return label
 
 
 def ic_text(const):
@@ -138,15 +148,34 @@ def draw_fcr(ax, ds, *, color_by="curve", show_branches=False, colors=None, lw=1
     ax.set_ylabel(LABELS["F_cr"])
     ax.set_xlim(Omega.min(), Omega.max())
     ax.set_ylim(bottom=0)
+    branches = {m for m, v in BRANCHES.items() if np.isfinite(np.asarray(ds[v], float)).any()} if show_branches else set()
     if legend:
-        handles = mechanism_legend_handles(mechs_seen, by_mechanism_color=(color_by == "mechanism"))
+        by_color = color_by == "mechanism"
         if show_branches:
-            handles.append(Line2D([], [], color="0.5", lw=0.9, alpha=0.6,
-                                  label="thin: branch where it is not the minimum"))
-        if color_by == "curve" and n > 1:
-            handles = curve_handles + [Line2D([], [], ls="none", label="")] + handles
-        ax.legend(handles=handles, loc=legend_loc)
-    return mechs_seen
+            # one entry per branch that exists: thick where it sets F_cr, thin (faint) elsewhere
+            handles, labels = [], []
+            for m in sorted(mechs_seen | branches):
+                st = MECHANISMS[m]
+                c = st["color"] if by_color else "k"
+                thin = Line2D([], [], ls=st["ls"], lw=0.9, alpha=0.45 if by_color else 0.6, color=c)
+                thick = Line2D([], [], ls=st["ls"], lw=lw, color=c)
+                if m in mechs_seen:
+                    handles.append((thick, thin) if m in branches else thick)
+                    labels.append(st["label"])
+                else:
+                    handles.append(thin)
+                    labels.append(st["label"] + ": never the minimum")
+            if color_by == "curve" and n > 1:
+                handles = curve_handles + handles
+                labels = [h.get_label() for h in curve_handles] + labels
+            ax.legend(handles, labels, handler_map={tuple: HandlerTuple(ndivide=None, pad=0.3)}, loc=legend_loc,
+                      title="thick: sets $F_{cr}$; thin: branch elsewhere", title_fontsize=8)
+        else:
+            handles = mechanism_legend_handles(mechs_seen, by_mechanism_color=by_color)
+            if color_by == "curve" and n > 1:
+                handles = curve_handles + [Line2D([], [], ls="none", label="")] + handles
+            ax.legend(handles=handles, loc=legend_loc)
+    return mechs_seen, branches
 
 
 def _fcr_ylim(ax, arrays, top=None, pad=1.08):
@@ -166,8 +195,9 @@ def figure_fcr(analytic, *, color_by="curve", show_branches=False, F_max=None, t
     if "curve" not in ds.dims:
         ds = ds.expand_dims("curve")
     fig, ax = plt.subplots(figsize=figsize, layout="constrained")
-    draw_fcr(ax, ds, color_by=color_by, show_branches=show_branches)
+    seen, branches = draw_fcr(ax, ds, color_by=color_by, show_branches=show_branches)
     _fcr_ylim(ax, [ds["F_cr"]], F_max)
+    _fcr_notes(fig, ds, seen, branches, color_by)
     _, const = curve_labels(ds)
     const.pop("Psi", None)  # F_cr on the RM does not depend on the forcing phase
     fourier = param(ds, "fourier")
@@ -178,12 +208,65 @@ def figure_fcr(analytic, *, color_by="curve", show_branches=False, F_max=None, t
     return fig
 
 
-def draw_fcr_numeric(ax, num, *, color="k", label=None, bracket=True, ms=4.5):
-    """Numeric bisection F_cr (dots) and, where escape is non-monotone in F, the bracket
-    F_escape_low .. F_escape_all as a vertical bar."""
+def _mechanism_text(m, color_by):
+    st = MECHANISMS[m]
+    style = {"-": "solid", "--": "dashed", "-.": "dash-dot", ":": "dotted"}[st["ls"]]
+    name = st["label"].replace("$\\gamma^*=0$", "γ* = 0").replace("$\\gamma^*=\\pi$", "γ* = π")
+    return f"{name} {style}" + (f" {st['color'].removeprefix('tab:')}" if color_by == "mechanism" else "")
+
+
+def _fcr_notes(fig, ds, seen, branches, color_by):
+    """Caption notes of Figs 1-4: the line styles drawn and each curve's minimum (read from the data)."""
+    labels, _ = curve_labels(ds)
+    add_note(fig, "Line styles drawn (mechanism setting F_cr): " + ", ".join(_mechanism_text(m, color_by) for m in
+                                                                            sorted(seen)) + ".")
+    never = sorted(branches - seen)
+    if never:
+        add_note(fig, "Drawn thin only (a branch that exists but never sets F_cr): "
+                      + ", ".join(_mechanism_text(m, color_by) + " for Ω = " + _extent(ds, BRANCHES[m]) for m in never)
+                      + ".")
+    Om = np.asarray(ds["Omega"], float)
+    parts = []
+    for i in range(ds.sizes["curve"]):
+        d = ds.isel(curve=i)
+        F = np.asarray(var(d, "F_cr"), float)
+        if not np.isfinite(F).any():
+            parts.append(f"{labels[i]}: no F_cr")
+            continue
+        k = int(np.nanargmin(F))
+        mech = sorted({int(m) for m in _mechanism_array(var(d, "mechanism")) if m})
+        parts.append(f"{_plain(labels[i])}: minimum F_cr = {F[k]:.4g} at Ω = {Om[k]:.3g}, mechanisms "
+                     + "/".join(MECHANISMS[m]["name"] for m in mech))
+    add_note(fig, "; ".join(parts) + ".")
+
+
+def _plain(txt):
+    """Legend label (mathtext) as plain text for captions."""
+    for a, b in (("$\\xi_{max}$", "ξ_max"), ("$\\xi_{ini}$", "ξ_ini"), ("$\\gamma_{ini}$", "γ_ini"),
+                 ("$\\Psi$", "Ψ"), ("$\\pi$", "π"), ("$", "")):
+        txt = txt.replace(a, b)
+    return txt
+
+
+def _extent(ds, name):
+    """Omega range where variable ``name`` is finite (any curve)."""
+    v = np.asarray(ds[name], float).reshape(-1, ds.sizes["Omega"])
+    Om = np.asarray(ds["Omega"], float)[np.isfinite(v).any(axis=0)]
+    return f"{Om.min():.3g}-{Om.max():.3g}" if Om.size else "none"
+
+
+BRACKET_COLOR = "k"
+CURVE_COLORS = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:cyan"]
+CURVE_MARKERS = ["o", "s", "^", "D", "v", "P", "X", "<"]
+
+
+def draw_fcr_numeric(ax, num, *, color="k", marker="o", label=None, bracket=True, ms=5.0):
+    """Numeric bisection F_cr (markers) and, where escape is non-monotone in F, the bracket
+    F_escape_low .. F_escape_all: a black bar with caps and a black ring around the marker (the
+    bracket is often only a few 1e-3 tall)."""
     Om = np.asarray(num["Omega"], float)
     F = np.asarray(num["F_cr"], float)
-    ax.plot(Om, F, "o", ms=ms, mfc=color, mec="k", mew=0.5, color=color, ls="none", zorder=5,
+    ax.plot(Om, F, marker, ms=ms, mfc=color, mec="k", mew=0.5, color=color, ls="none", zorder=5,
             label=label)
     if not bracket:
         return 0
@@ -191,10 +274,17 @@ def draw_fcr_numeric(ax, num, *, color="k", label=None, bracket=True, ms=4.5):
     hi = np.asarray(var(num, "F_escape_all"), float)
     sel = np.asarray(var(num, "non_monotone")).astype(bool) & np.isfinite(lo) & np.isfinite(hi)
     if sel.any():
-        ax.vlines(Om[sel], lo[sel], hi[sel], color=color, lw=1.0, alpha=0.8, zorder=4)
-        ax.plot(Om[sel], lo[sel], "_", color=color, ms=6, zorder=4)
-        ax.plot(Om[sel], hi[sel], "_", color=color, ms=6, zorder=4)
+        ax.vlines(Om[sel], lo[sel], hi[sel], color=BRACKET_COLOR, lw=1.8, zorder=6)
+        ax.plot(Om[sel], lo[sel], "_", color=BRACKET_COLOR, ms=8, mew=1.6, zorder=6)
+        ax.plot(Om[sel], hi[sel], "_", color=BRACKET_COLOR, ms=8, mew=1.6, zorder=6)
+        ax.plot(Om[sel], F[sel], "o", ms=ms + 5, mfc="none", mec=BRACKET_COLOR, mew=1.0, zorder=6)
     return int(sel.sum())
+
+
+def bracket_handle():
+    """Legend entry of the non-monotone bracket, drawn as in the axes."""
+    return (Line2D([], [], color=BRACKET_COLOR, marker="_", ms=8, mew=1.6, lw=1.8),
+            Line2D([], [], ls="none", marker="o", ms=10, mfc="none", mec=BRACKET_COLOR, mew=1.0))
 
 
 def _match_numeric_curve(ana, num, i):
@@ -214,10 +304,11 @@ def _match_numeric_curve(ana, num, i):
 
 def figure_fcr_comparison(analytic, numeric, *, layout="overlay", F_max=None, title=None,
                           bracket=True, figsize=None):
-    """Figs 10-12: theoretical F_cr(Omega) (solid) vs numeric bisection (dots).
+    """Figs 10-12: theoretical F_cr(Omega) (lines) vs numeric bisection (markers).
 
     ``layout="panels"``: one panel per curve (Fig 10: one per truncation level);
-    ``layout="overlay"``: all curves on one axes (Figs 11, 12)."""
+    ``layout="overlay"``: all curves on one axes (Figs 11, 12), one qualitative colour and one
+    marker per curve.  Non-monotone escape brackets are black bars with a ring (legend alike)."""
     ana = open_dataset(analytic)
     num = open_dataset(numeric)
     if "curve" not in ana.dims:
@@ -232,25 +323,30 @@ def figure_fcr_comparison(analytic, numeric, *, layout="overlay", F_max=None, ti
         figsize = figsize or (4.2 * n, 4.0)
         fig, axes = plt.subplots(1, n, figsize=figsize, layout="constrained", squeeze=False)
         axes = list(axes[0])
-        colors = ["tab:blue"] * n
+        colors, markers = ["tab:blue"] * n, ["o"] * n
     else:
-        figsize = figsize or (6.6, 4.8)
+        figsize = figsize or (6.8, 5.0)
         fig, ax = plt.subplots(figsize=figsize, layout="constrained")
         axes = [ax] * n
-        cmap = plt.get_cmap("viridis")
-        colors = ["tab:blue"] if n == 1 else [cmap(v) for v in np.linspace(0.0, 0.88, n)]
+        colors = [CURVE_COLORS[i % len(CURVE_COLORS)] for i in range(n)]
+        markers = [CURVE_MARKERS[i % len(CURVE_MARKERS)] for i in range(n)]
     n_bracket = 0
+    ax_brackets = {}
+    pairs = []
     for i in range(n):
         ax = axes[i]
         a = ana.isel(curve=i)
-        col = colors[i]
+        col, mk = colors[i], markers[i]
         Om = np.asarray(a["Omega"], float)
         ax.plot(Om, np.asarray(a["F_cr"], float), "-", color=col, lw=1.8, zorder=3,
-                label=(f"theory, {labels[i]}" if layout == "overlay" else "theory"))
+                label=(None if layout == "overlay" else "theory"))
         b = _match_numeric_curve(ana, num, i)
         if b is not None:
-            n_bracket += draw_fcr_numeric(ax, b, color=col, bracket=bracket,
-                                          label=("numeric" if layout == "panels" or i == n - 1 else None))
+            nb = draw_fcr_numeric(ax, b, color=col, marker=mk, bracket=bracket,
+                                  label=("numeric" if layout == "panels" else None))
+            n_bracket += nb
+            ax_brackets[id(ax)] = ax_brackets.get(id(ax), 0) + nb
+        pairs.append((labels[i], a, b))
         arrays = [a["F_cr"]] + ([b["F_cr"]] if b is not None else [])
         if layout == "panels" or i == n - 1:
             ax.set_xlabel(LABELS["Omega"])
@@ -261,26 +357,69 @@ def figure_fcr_comparison(analytic, numeric, *, layout="overlay", F_max=None, ti
             ax.set_title(labels[i])
     if layout == "overlay":
         _fcr_ylim(axes[0], [ana["F_cr"], num["F_cr"]], F_max)
-    extra = []
-    if n_bracket and bracket:
-        extra.append(Line2D([], [], color="0.3", marker="_", ms=6, lw=1.0,
-                            label=r"non-monotone: $F_{escape,low}$ .. $F_{escape,all}$"))
+    bracket_label = r"non-monotone in $F$: $F_{escape,low}$ .. $F_{escape,all}$"
     for ax in dict.fromkeys(axes):
-        h, l_ = ax.get_legend_handles_labels()
-        h = [x for x, lab in zip(h, l_) if lab]
         if layout == "overlay":
-            # dots legend entry in neutral colour
-            h = [x for x in h if x.get_label() != "numeric"] + [
-                Line2D([], [], marker="o", ls="none", mfc="0.6", mec="k", mew=0.5,
-                       label=f"numeric (bisection, {fmt_value(cycles)} EC)" if cycles else "numeric")]
-        ax.legend(handles=h + extra, loc="best")
+            hs = [(Line2D([], [], color=colors[i], lw=1.8),
+                   Line2D([], [], ls="none", marker=markers[i], ms=5, mfc=colors[i], mec="k", mew=0.5))
+                  for i in range(n)]
+            ls_ = list(labels)
+            ls_.append(f"line: theory; marker: numeric bisection ({fmt_value(cycles)} EC)" if cycles
+                       else "line: theory; marker: numeric")
+            hs.append(Line2D([], [], ls="none"))
+        else:
+            h, l_ = ax.get_legend_handles_labels()
+            hs, ls_ = [x for x, lab in zip(h, l_) if lab], [lab for lab in l_ if lab]
+        if ax_brackets.get(id(ax)) and bracket:
+            hs.append(bracket_handle())
+            ls_.append(bracket_label)
+        ax.legend(hs, ls_, handler_map={tuple: HandlerTuple(ndivide=None, pad=0.2)}, loc="best")
     head = ic_text(const)
     sub = []
     if cycles:
         sub.append(f"{fmt_value(cycles)} EC")
     if tol:
         sub.append(f"tol {fmt_value(tol)}")
-    fig.suptitle(title or (f"Escape threshold: theory (lines) vs numerics (dots)" +
+    fig.suptitle(title or (f"Escape threshold: theory (lines) vs numerics (markers)" +
                            (f", {head}" if head else "") + (f"  [{', '.join(sub)}]" if sub else "")),
                  fontsize=10)
+    _comparison_notes(fig, pairs, cycles, tol)
     return fig
+
+
+def _comparison_notes(fig, pairs, cycles, tol):
+    """Caption notes of Figs 10-12: settings, per-curve relative error, brackets, isolated dips."""
+    add_note(fig, f"Numeric F_cr: bisection to {fmt_value(tol)} in F, a trajectory is safe if it does not escape "
+                  f"within {fmt_value(cycles)} EC; a scan of the whole F bracket flags non-monotone escape.")
+    errs, dips, brackets = [], [], []
+    for lab, a, b in pairs:
+        if b is None:
+            continue
+        lab = _plain(lab)
+        Om = np.asarray(b["Omega"], float)
+        Fn = np.asarray(b["F_cr"], float)
+        Ft = np.interp(Om, np.asarray(a["Omega"], float), np.asarray(a["F_cr"], float), left=np.nan, right=np.nan)
+        rel = np.abs(Ft - Fn) / Fn
+        if np.isfinite(rel).any():
+            errs.append(f"{lab}: {100 * np.nanmedian(rel):.1f}% (max {100 * np.nanmax(rel):.0f}% at Ω = "
+                        f"{Om[np.nanargmax(rel)]:.3g})")
+        nm = np.asarray(var(b, "non_monotone")).astype(bool)
+        if nm.any():
+            lo, hi = np.asarray(var(b, "F_escape_low"), float), np.asarray(var(b, "F_escape_all"), float)
+            brackets.append(f"{lab}: {count(nm.sum(), 'point')} (Ω = "
+                            + ", ".join(f"{o:.3g}" for o in Om[nm]) + f"; widths {fmt_range((hi - lo)[nm], '{:.2g}')})")
+        # isolated dips: a point below both neighbours, away from the curve's minimum
+        k0 = int(np.nanargmin(Fn)) if np.isfinite(Fn).any() else -1
+        for k in range(1, Fn.size - 1):
+            if abs(k - k0) > 1 and Fn[k] < Fn[k - 1] and Fn[k] < Fn[k + 1]:
+                lo_k = float(np.asarray(var(b, "F_escape_low"), float)[k])
+                dips.append(f"{lab} at Ω = {Om[k]:.3g}: F_cr = {Fn[k]:.4g} between {Fn[k - 1]:.4g} and "
+                            f"{Fn[k + 1]:.4g}" + (", escape monotone in F there and the F scan agrees (lowest "
+                                                  f"escaping F {lo_k:.4g})" if not nm[k] else ", non-monotone there"))
+    if errs:
+        add_note(fig, "Median relative error |theory - numeric| / numeric per curve: " + "; ".join(errs) + ".")
+    add_note(fig, ("Non-monotone escape in F (brackets): " + "; ".join(brackets) + ".") if brackets
+             else "Escape is monotone in F at every numeric Ω (no brackets).")
+    if dips:
+        add_note(fig, "Isolated dips of the numeric F_cr (one Ω point below both neighbours): " + "; ".join(dips)
+                      + ". They are real minima of the numerics on this Ω grid, not bisection failures.")

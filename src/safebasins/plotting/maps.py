@@ -111,8 +111,10 @@ def figure_period_map(analytic, numeric, *, title=None, figsize=(8.2, 7.4), s=0.
     handles += [Line2D([], [], color="k", ls="--", lw=1.6, label="theory: SB boundary"),
                 Line2D([], [], color="0.5", ls=":", lw=0.8, label=r"well edge $H_0 = \xi_{max}$")]
     # frame the portrait and the predicted boundary (not the whole, mostly empty, well)
-    xs = [q[np.isfinite(q)]] + [np.asarray(b.get_xdata(), float) for b in blines]
-    ys = [p[np.isfinite(p)]] + [np.asarray(b.get_ydata(), float) for b in blines]
+    bxy = [np.asarray(b.get_xy() if hasattr(b, "get_xy") else np.c_[b.get_xdata(), b.get_ydata()], float)
+           for b in blines]
+    xs = [q[np.isfinite(q)]] + [b[:, 0] for b in bxy]
+    ys = [p[np.isfinite(p)]] + [b[:, 1] for b in bxy]
     xs, ys = np.concatenate(xs), np.concatenate(ys)
     xs, ys = xs[np.isfinite(xs)], ys[np.isfinite(ys)]
     if xs.size and ys.size:
