@@ -9,20 +9,32 @@ of initial conditions with 2 energy and 1 displacement thresholds (given unsorte
 stop_any, the forcing table in global memory and more trajectories than threads (persistent
 threads take several each; compaction runs); and knife-edge thresholds set to an energy the CPU
 trajectory reaches exactly, where a one-ulp difference in the state would move the recorded
-step (this is what catches a multiply-add rounded twice).  Subprocess: ~5-10 s.
+step (this is what catches a multiply-add rounded twice).  Other wells: the cubic (kernel flag
+POLY4, Horner from run-time coefficients, one barrier) with asymmetric displacement bounds, and
+the quartic with asymmetric bounds (QUARTIC_SIGNED), several parameter sets.  Subprocess: ~10-15 s.
 """
 from __future__ import annotations
 
 import json
+import math
 import os
 import subprocess
 import sys
 import time
 from pathlib import Path
 
+from types import SimpleNamespace
+
 import numpy as np
 
 SRC = Path(__file__).resolve().parents[2] / "src"
+# the cubic V = q^2/2 - q^3/3 as a duck-typed polynomial well (criteria.resolve_well)
+CUBIC = dict(name="cubic", coefficients=[0.0, 0.0, 0.5, -1.0 / 3.0], barriers=[-math.inf, 1.0],
+             barrier_energy=1.0 / 6.0)
+
+
+def _well(spec):
+    return None if spec is None else SimpleNamespace(**spec)
 
 
 def _grid_ics():
@@ -85,6 +97,16 @@ def _cases():
             args=[[a for a, _ in ics], [b for _, b in ics], [0] * len(ics), [0.95], [0.0876], np.pi],
             kw=dict(xi_max=[float(x) for x in xi], cycles=8, steps_per_cycle=16, integrator=integrator),
             expect=expected)
+        Qc, Pc = 0.55 * Q + 0.1, 0.7 * P
+        yield f"{integrator}/cubic", dict(
+            args=[Qc.tolist(), Pc.tolist(), (np.arange(Q.size) % 2).tolist(), [0.85, 0.9], [0.02, 0.03], 0.3],
+            kw=dict(xi_max=[0.12, 1.0 / 6.0], q_bounds=[[-0.43, 0.65], [-math.inf, 0.9]], cycles=20,
+                    steps_per_cycle=16, integrator=integrator),
+            well=CUBIC)
+    yield "srkn6b/quartic_signed", dict(
+        args=[Q.tolist(), P.tolist(), zero, [0.95], [0.0876], np.pi],
+        kw=dict(xi_max=[0.2], q_max=[0.7], q_bounds=[[-0.75, 0.8]], cycles=15, steps_per_cycle=8, stop_any=False),
+        cuda=dict(block=8, grid=2))
 
 
 API_CHART = dict(q0=np.linspace(-0.8, 0.8, 5).tolist(), p0=np.linspace(-0.4, 0.6, 4).tolist(), F=0.0876,
@@ -103,7 +125,7 @@ def child():
     for name, c in json.load(sys.stdin).items():
         cuda_kernels.SHARED_TABLE_BYTES = 0 if c.get("global_table") else 16 * 1024
         t = time.perf_counter()
-        E, Q = cuda_engine.run_ensemble_cuda(*c["args"], **c["kw"], **c.get("cuda", {}))
+        E, Q = cuda_engine.run_ensemble_cuda(*c["args"], **c["kw"], **c.get("cuda", {}), well=_well(c.get("well")))
         out[name] = dict(E=E.tolist(), Q=Q.tolist(), dtype=[str(E.dtype), str(Q.dtype)],
                          seconds=round(time.perf_counter() - t, 2))
     print(json.dumps(out))
@@ -129,14 +151,14 @@ def test_cuda_simulator_matches_cpu_engine_bitwise():
     assert np.array_equal(np.array(api["Q"]), ch["escape_cycle_displacement"].values)
     assert sorted(gpu) == sorted(cases)
     for name, c in cases.items():
-        cpu_E, cpu_Q, _ = engine.run_ensemble(*c["args"], threads=1, **c["kw"])
+        cpu_E, cpu_Q, _ = engine.run_ensemble(*c["args"], threads=1, **c["kw"], well=_well(c.get("well")))
         for j, (ic, step) in enumerate(c.get("expect", ())):   # the knife edges really are ones
             assert cpu_E[ic, 2 * j + 1] == step and cpu_E[ic, 2 * j] != step, (name, cpu_E, c["expect"])
         g = gpu[name]
         assert g["dtype"] == ["int64", "int64"]
         assert np.array_equal(np.array(g["E"], np.int64).reshape(cpu_E.shape), cpu_E), (name, cpu_E, g["E"])
         assert np.array_equal(np.array(g["Q"], np.int64).reshape(cpu_Q.shape), cpu_Q), (name, cpu_Q, g["Q"])
-        if name.endswith("/grid"):   # every outcome: escape at the IC, escape later, no escape
+        if name.endswith(("/grid", "/cubic")):   # every outcome: escape at the IC, escape later, no escape
             both = np.concatenate([cpu_E, cpu_Q], axis=1)
             assert (both == 0).any() and (both > 0).any() and (both < 0).any(), both
     print(f"simulator subprocess: {wall:.1f} s")

@@ -26,6 +26,9 @@ VARIABLES = {
     "Psi": ("rad", "forcing phase Psi"),
     "xi_max": ("1", "energy truncation level xi_max (escape threshold on H0)"),
     "q_max": ("1", "displacement escape threshold q_max"),
+    "q_bounds": ("1", "displacement bound pair index (escape: q < q_lower or q > q_upper)"),
+    "q_lower": ("1", "lower displacement bound: escape when q < q_lower"),
+    "q_upper": ("1", "upper displacement bound: escape when q > q_upper"),
     "t_eval": ("1", "evaluation time (forcing cycles)"),
     "gamma": ("rad", "slow phase gamma = theta - Psi - Omega tau"),
     "xi": ("1", "averaged energy xi"),
@@ -46,6 +49,8 @@ VARIABLES = {
     "escapes_rm": ("1", "analytic escape of the resonance-manifold point: True = escapes"),
     "escape_cycle_energy": ("1", "escape time in forcing cycles, energy criterion H0 > xi_max (inf: no escape)"),
     "escape_cycle_displacement": ("1", "escape time in forcing cycles, displacement criterion |q| > q_max (inf: no escape)"),
+    "escape_cycle_bounds": ("1", "escape time in forcing cycles, displacement criterion q < q_lower or q > q_upper "
+                                 "(inf: no escape)"),
     "escape_cycle": ("1", "escape time in forcing cycles (inf: no escape)"),
     "escaped": ("1", "trajectory escaped within the horizon"),
     "F_cr": ("1", "critical forcing amplitude"),

@@ -1,17 +1,20 @@
-"""Compiled ensembles of eq (1): q'' + q - q^3 = F sin(Omega t + Psi).
+"""Compiled ensembles of q'' + V'(q) = F sin(Omega t + Psi) (eq (1) for the paper's quartic well).
 
 Public API (docs/contracts.md):
 escape_chart, escape_chart_batch charts.py  (safe masks and areas from a chart: safebasins.analysis.safe)
 critical_forcing_numeric         bisection.py
 stroboscopic_map                 maps.py
 random_initial_conditions        initial_conditions.py
+displacement_bounds              criteria.py  (asymmetric displacement bounds from energy levels)
+Every function takes ``well=`` (None: the quartic; a polynomial well: criteria.resolve_well).
 """
 from safebasins.numerics.bisection import critical_forcing_numeric
 from safebasins.numerics.charts import escape_chart, escape_chart_batch
+from safebasins.numerics.criteria import displacement_bounds
 from safebasins.numerics.engine import DEFAULT_STEPS_PER_CYCLE
 from safebasins.numerics.initial_conditions import random_initial_conditions
 from safebasins.numerics.kernels import INTEGRATOR
 from safebasins.numerics.maps import stroboscopic_map
 
 __all__ = ["escape_chart", "escape_chart_batch", "critical_forcing_numeric", "stroboscopic_map", "random_initial_conditions",
-           "DEFAULT_STEPS_PER_CYCLE", "INTEGRATOR"]
+           "displacement_bounds", "DEFAULT_STEPS_PER_CYCLE", "INTEGRATOR"]

@@ -5,33 +5,36 @@ import numpy as np
 import xarray as xr
 
 from safebasins import checks
-from safebasins.wells.quartic import QUARTIC
+from safebasins.numerics import criteria
 from safebasins.numerics import engine
 from safebasins.numerics import kernels
 
 DEFAULT_N_SCAN = 301
 
 
-def _escapes(q0, p0, Omega, F, Psi, thr_kw, cycles, spc, threads, integrator, backend):
+def _escapes(q0, p0, Omega, F, Psi, thr_kw, cycles, spc, threads, integrator, backend, well):
     """One compiled ensemble: trajectory k with (Omega[k], F[k]); True where it escapes."""
     n = Omega.size
     sE, sQ = engine.integrate(np.full(n, q0), np.full(n, p0), np.arange(n), Omega, F, Psi, cycles=cycles,
                               steps_per_cycle=spc, threads=threads, stop_any=True, integrator=integrator,
-                              backend=backend, **thr_kw)
+                              backend=backend, well=well, **thr_kw)
     return ((sE >= 0).any(axis=1)) | ((sQ >= 0).any(axis=1))
 
 
 def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3000, tol=5e-5,
                              F_bracket=(0.0, 0.3), criterion="energy", n_scan=DEFAULT_N_SCAN,
                              steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None,
-                             integrator=engine.DEFAULT_INTEGRATOR, backend="cpu"):
+                             integrator=engine.DEFAULT_INTEGRATOR, backend="cpu", well=None):
     """Numeric escape threshold F_cr(Omega) for the IC (q0, p0) (Section 3.1, Figs 10-12).
 
     Bisection: all Omega points advance together, one compiled ensemble per bisection level,
     until the bracket [F_lo (no escape within `cycles`), F_hi (escape)] is narrower than tol;
     F_cr = (F_lo + F_hi) / 2 (NaN where F_bracket[1] does not escape or F_bracket[0] does).
-    criterion "energy": escape when H0 > xi_max (or |q| > 1); "displacement": |q| > q_max(xi_max)
-    (eq 4).  Escape is not monotone in F near the resonance minimum, so a scan on n_scan
+    criterion "energy": escape when H0 > xi_max (or q beyond a barrier: |q| > 1 for the quartic);
+    "displacement": q outside the turning points of the energy level xi_max, |q| > q_max(xi_max)
+    (eq 4) for the quartic, q < q_minus(xi_max) or q > q_plus(xi_max) (well.turning_points) for
+    any other well.  well: None (the quartic) or a polynomial well (see escape_chart); xi_max in
+    (0, its barrier energy].  Escape is not monotone in F near the resonance minimum, so a scan on n_scan
     equally spaced F in F_bracket (one ensemble, Omega x F) also gives F_escape_low (lowest
     escaping F), F_escape_all (lowest F above which every scanned F escapes) and non_monotone
     (F_escape_all - F_escape_low > tol).  n_scan=0 skips the scan (variables NaN / False).
@@ -39,14 +42,16 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
 
     Returns xr.Dataset over Omega: F_cr, F_cr_low, F_cr_high (final bracket), F_escape_low,
     F_escape_all, non_monotone; attrs xi_max, q0, p0, Psi, cycles, tol, criterion, F_bracket,
-    n_scan, steps_per_cycle, integrator, bisection_levels.
+    n_scan, steps_per_cycle, integrator, bisection_levels, well (name), well_potential,
+    well_barriers, escape_criteria, and for the displacement criterion q_lower, q_upper.
     """
     Om = np.atleast_1d(checks.check_positive("Omega", Omega)).astype(float)
     if Om.ndim != 1:
         raise ValueError(f"Omega must be a scalar or 1-D, got shape {Om.shape}")
     if not np.isfinite(Om).all():
         raise ValueError("Omega must be finite")
-    xi = checks.check_scalar("xi_max", xi_max, QUARTIC.check_threshold)
+    ew = criteria.resolve_well(well)
+    xi = checks.check_scalar("xi_max", xi_max, ew.check_xi_max)
     q0 = checks.check_scalar("q0", q0, checks.check_finite)
     p0 = checks.check_scalar("p0", p0, checks.check_finite)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
@@ -62,15 +67,22 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     spc = engine.check_steps_per_cycle(steps_per_cycle)
     threads = engine.check_threads(threads)
     kernels.check_integrator(integrator)
+    bounds = {}
     if criterion == "energy":
         thr_kw = {"xi_max": (xi,), "q_max": ()}
+    elif ew.closed_form:
+        qm = float(np.sqrt(1.0 - np.sqrt(1.0 - 4.0 * xi)))
+        thr_kw = {"xi_max": (), "q_max": (qm,)}
+        bounds = {"q_lower": -qm, "q_upper": qm}
     else:
-        thr_kw = {"xi_max": (), "q_max": (float(np.sqrt(1.0 - np.sqrt(1.0 - 4.0 * xi))),)}
+        qlo, qhi = criteria.displacement_bounds(xi, well)[0]
+        thr_kw = {"xi_max": (), "q_bounds": ((qlo, qhi),)}
+        bounds = {"q_lower": float(qlo), "q_upper": float(qhi)}
 
     nO = Om.size
     # ---- bracket ends (one ensemble)
     ends = _escapes(q0, p0, np.concatenate([Om, Om]), np.concatenate([np.full(nO, br[0]), np.full(nO, br[1])]),
-                    Psi, thr_kw, cycles, spc, threads, integrator, backend)
+                    Psi, thr_kw, cycles, spc, threads, integrator, backend, well)
     valid = ~ends[:nO] & ends[nO:]
     lo = np.full(nO, br[0])
     hi = np.full(nO, br[1])
@@ -79,7 +91,7 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     while active.any():
         idx = np.flatnonzero(active)
         mid = 0.5 * (lo[idx] + hi[idx])
-        esc = _escapes(q0, p0, Om[idx], mid, Psi, thr_kw, cycles, spc, threads, integrator, backend)
+        esc = _escapes(q0, p0, Om[idx], mid, Psi, thr_kw, cycles, spc, threads, integrator, backend, well)
         hi[idx[esc]] = mid[esc]
         lo[idx[~esc]] = mid[~esc]
         levels += 1
@@ -95,7 +107,8 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     if n_scan:
         Fs = np.linspace(br[0], br[1], int(n_scan))
         OO, FF = np.meshgrid(Om, Fs, indexing="ij")
-        esc = _escapes(q0, p0, OO.ravel(), FF.ravel(), Psi, thr_kw, cycles, spc, threads, integrator, backend).reshape(nO, Fs.size)
+        esc = _escapes(q0, p0, OO.ravel(), FF.ravel(), Psi, thr_kw, cycles, spc, threads, integrator, backend,
+                       well).reshape(nO, Fs.size)
         for k in range(nO):
             e = esc[k]
             if e.any():
@@ -120,5 +133,8 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     ds.attrs.update(xi_max=xi, q0=q0, p0=p0, Psi=Psi, cycles=cycles, tol=tol, criterion=criterion,
                     F_bracket=br, n_scan=int(n_scan), steps_per_cycle=spc, integrator=kernels.INTEGRATORS[integrator],
                     bisection_levels=levels,
-                    F_scan_step=float((br[1] - br[0]) / (n_scan - 1)) if n_scan else np.nan)
+                    F_scan_step=float((br[1] - br[0]) / (n_scan - 1)) if n_scan else np.nan,
+                    escape_criteria=(f"energy ({ew.energy_criterion()})" if criterion == "energy" else
+                                     "displacement: q < q_lower or q > q_upper, the turning points of xi_max"),
+                    **bounds, **ew.attrs())
     return ds

@@ -6,7 +6,7 @@ import xarray as xr
 
 from safebasins import checks
 from safebasins.io import cf
-from safebasins.wells.quartic import QUARTIC
+from safebasins.numerics import criteria
 from safebasins.numerics import engine
 from safebasins.numerics import kernels
 
@@ -33,7 +33,23 @@ def _ic_arrays(q0, p0, grid):
     return False, qa, pa, qa.ravel(), pa.ravel()
 
 
-def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000,
+def _thresholds(ew, xi_max, q_max, q_bounds):
+    """Checked thresholds of a chart: (xi, q_max, q_bounds (n, 2))."""
+    xi = engine.thresholds("xi_max", xi_max, ew.check_xi_max)
+    qm = engine.thresholds("q_max", q_max, ew.check_q_max)
+    qb = ew.check_q_bounds("q_bounds", q_bounds)
+    if xi.size == 0 and qm.size == 0 and qb.shape[0] == 0:
+        raise ValueError("xi_max, q_max and q_bounds: at least one threshold is required")
+    engine.displacement_pairs(qm, qb)          # nested (ValueError naming q_max / q_bounds)
+    return xi, qm, qb
+
+
+def _criteria_text(ew):
+    return (f"energy ({ew.energy_criterion()}); displacement: |q| > q_max, or q < q_lower or q > q_upper "
+            "(q_bounds); checked after every step; escape_cycle = step / steps_per_cycle")
+
+
+def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=(), well=None, cycles=3000,
                  steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None, grid=None,
                  integrator=engine.DEFAULT_INTEGRATOR, backend="cpu"):
     """Escape time (forcing cycles) of every initial condition, for every threshold.
@@ -46,10 +62,21 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000
         strictly monotonic arrays are axes (a grid), anything else is paired.  Random ICs are
         therefore paired automatically; pass grid=False for paired ICs that happen to be sorted
         (e.g. points on a line) and grid=True/False explicitly in library code.
-    F, Omega, Psi : forcing amplitude (>= 0), frequency (> 0), phase of eq (1).
-    xi_max : energy thresholds, H0 = p^2/2 + q^2/2 - q^4/4 > xi_max means escape (eq 7).
-        |q| > 1 (beyond the barrier, out of the well) also counts as energy escape.
-    q_max : displacement thresholds, |q| > q_max means escape (q_max(xi_max): eq 4).
+    F, Omega, Psi : forcing amplitude (>= 0), frequency (> 0), phase of q'' + V'(q) = F sin(Omega t + Psi).
+    well : the potential (None: the paper's quartic V = q^2/2 - q^4/4, eq 1); a polynomial well
+        (an object with `coefficients`, e.g. safebasins.wells.polynomial.cubic()) runs in the
+        same compiled engine (numerics.criteria).  Dataset attrs `well`, `well_potential`,
+        `well_barriers`, `escape_criteria` name it.
+    xi_max : energy thresholds in (0, barrier energy]: H0 = p^2/2 + V(q) > xi_max means escape
+        (eq 7).  q beyond a barrier (quartic: |q| > 1; in general q > q_right or q < q_left; a
+        side without barrier never escapes that way) also counts as energy escape.
+    q_max : symmetric displacement thresholds, |q| > q_max means escape (q_max(xi_max): eq 4),
+        q_max up to the nearest barrier.
+    q_bounds : asymmetric displacement bounds, pairs (lo, hi) (shape (n, 2); one pair may be
+        given as (lo, hi)): q < lo or q > hi means escape; lo < 0 < hi, inside the barriers.
+        The energy-level bounds of a well are its turning points,
+        q_bounds = numerics.displacement_bounds(xi, well) = (q_minus(xi), q_plus(xi)).  All
+        displacement thresholds (q_max as (-q_max, q_max) and q_bounds) must be nested.
     cycles : horizon in forcing cycles (integer).
     steps_per_cycle : fixed steps per forcing period.
     integrator : "srkn6b" (default: Blanes-Moan SRKN6b, order 4, symplectic) or "rk4" (classic
@@ -61,7 +88,9 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000
 
     Returns
     -------
-    xr.Dataset with escape_cycle_energy (xi_max, ...), escape_cycle_displacement (q_max, ...):
+    xr.Dataset with escape_cycle_energy (xi_max, ...), escape_cycle_displacement (q_max, ...) and,
+    when q_bounds are given, escape_cycle_bounds (q_bounds, ...) with coords q_lower(q_bounds),
+    q_upper(q_bounds) (q_bounds = pair index):
     step of first crossing / steps_per_cycle (exact to one step), 0 if the IC is already beyond,
     +inf if no crossing within `cycles`.  Safe basin for (threshold, t_eval): escape_cycle > t_eval.
     One integration serves every threshold and every t_eval <= cycles; a trajectory stops once
@@ -71,20 +100,18 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000
     F = checks.check_scalar("F", F, checks.check_nonnegative)
     Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
-    xi = engine.thresholds("xi_max", xi_max, QUARTIC.check_threshold)
-    qm = engine.thresholds("q_max", q_max, QUARTIC.check_displacement)
-    if xi.size == 0 and qm.size == 0:
-        raise ValueError("xi_max and q_max: at least one threshold is required")
+    ew = criteria.resolve_well(well)
+    xi, qm, qb = _thresholds(ew, xi_max, q_max, q_bounds)
     cycles = engine.check_cycles("cycles", cycles)
     spc = engine.check_steps_per_cycle(steps_per_cycle)
     threads = engine.check_threads(threads)
     kernels.check_integrator(integrator)
 
     sE, sQ = engine.integrate(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
-                              cycles=cycles, steps_per_cycle=spc, threads=threads, integrator=integrator,
-                              backend=backend)
+                              q_bounds=qb, cycles=cycles, steps_per_cycle=spc, threads=threads, integrator=integrator,
+                              backend=backend, well=well)
     tE = engine.steps_to_cycles(sE, spc).T   # (nE, N)
-    tQ = engine.steps_to_cycles(sQ, spc).T
+    tQ = engine.steps_to_cycles(sQ, spc).T   # (nQ + nB, N)
     if is_grid:
         shape, dims = (qa.size, pa.size), ("q0", "p0")
         coords = {"q0": ("q0", qa, cf.attrs("q0")), "p0": ("p0", pa, cf.attrs("p0"))}
@@ -94,26 +121,31 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000
                   "p0": ("sample", P, cf.attrs("p0"))}
     coords["xi_max"] = ("xi_max", xi, cf.attrs("xi_max"))
     coords["q_max"] = ("q_max", qm, cf.attrs("q_max"))
-    ds = xr.Dataset(
-        {
-            "escape_cycle_energy": (("xi_max",) + dims, tE.reshape((xi.size,) + shape),
-                                    cf.attrs("escape_cycle_energy")),
-            "escape_cycle_displacement": (("q_max",) + dims, tQ.reshape((qm.size,) + shape),
-                                          cf.attrs("escape_cycle_displacement")),
-        },
-        coords=coords,
-    )
+    data = {
+        "escape_cycle_energy": (("xi_max",) + dims, tE.reshape((xi.size,) + shape), cf.attrs("escape_cycle_energy")),
+        "escape_cycle_displacement": (("q_max",) + dims, tQ[:qm.size].reshape((qm.size,) + shape),
+                                      cf.attrs("escape_cycle_displacement")),
+    }
+    if qb.shape[0]:
+        coords.update(_bounds_coords(qb))
+        data["escape_cycle_bounds"] = (("q_bounds",) + dims, tQ[qm.size:].reshape((qb.shape[0],) + shape),
+                                       cf.attrs("escape_cycle_bounds"))
+    ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(
         F=F, Omega=Omega, Psi=Psi, cycles=cycles, steps_per_cycle=spc, integrator=kernels.INTEGRATORS[integrator],
-        grid=int(is_grid),
-        escape_criteria=("energy: H0 = p^2/2 + q^2/2 - q^4/4 > xi_max or |q| > 1; displacement: |q| > q_max; "
-                         "checked after every step; escape_cycle = step / steps_per_cycle"),
-        safe_basin="escape_cycle > t_eval (t_eval <= cycles)",
+        grid=int(is_grid), escape_criteria=_criteria_text(ew),
+        safe_basin="escape_cycle > t_eval (t_eval <= cycles)", **ew.attrs(),
     )
     return ds
 
 
-def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000,
+def _bounds_coords(qb):
+    return {"q_bounds": ("q_bounds", np.arange(qb.shape[0]), cf.attrs("q_bounds")),
+            "q_lower": ("q_bounds", qb[:, 0], cf.attrs("q_lower")),
+            "q_upper": ("q_bounds", qb[:, 1], cf.attrs("q_upper"))}
+
+
+def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=(), well=None, cycles=3000,
                        steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None,
                        integrator=engine.DEFAULT_INTEGRATOR, backend="cpu"):
     """Escape charts of one IC grid for several control points ``(F[k], Omega[k])`` in ONE ensemble.
@@ -121,9 +153,10 @@ def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycle
     Every trajectory carries its control point (the lanes refill across charts, so a control
     point whose ICs escape early frees its lanes for the others); each chart is bitwise the
     :func:`escape_chart` of its control point.  ``q0``, ``p0``: 1-D grid axes; ``F``, ``Omega``:
-    1-D of equal length K.  Returns a Dataset with ``escape_cycle_energy (control, xi_max, q0,
-    p0)``, ``escape_cycle_displacement (control, q_max, q0, p0)`` and coordinates ``F(control)``,
-    ``Omega(control)``.
+    1-D of equal length K; ``well``, ``xi_max``, ``q_max``, ``q_bounds`` as :func:`escape_chart`.
+    Returns a Dataset with ``escape_cycle_energy (control, xi_max, q0, p0)``,
+    ``escape_cycle_displacement (control, q_max, q0, p0)`` (and ``escape_cycle_bounds (control,
+    q_bounds, q0, p0)`` when q_bounds are given) and coordinates ``F(control)``, ``Omega(control)``.
     """
     is_grid, qa, pa, Q, P = _ic_arrays(q0, p0, True)
     F = checks.check_1d("F", F, checks.check_nonnegative)
@@ -131,28 +164,32 @@ def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycle
     if F.size != Omega.size or F.size == 0:
         raise ValueError(f"F and Omega must be 1-D of the same non-zero length, got {F.size} and {Omega.size}")
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
-    xi = engine.thresholds("xi_max", xi_max, QUARTIC.check_threshold)
-    qm = engine.thresholds("q_max", q_max, QUARTIC.check_displacement)
-    if xi.size == 0 and qm.size == 0:
-        raise ValueError("xi_max and q_max: at least one threshold is required")
+    ew = criteria.resolve_well(well)
+    xi, qm, qb = _thresholds(ew, xi_max, q_max, q_bounds)
     cycles = engine.check_cycles("cycles", cycles)
     spc = engine.check_steps_per_cycle(steps_per_cycle)
     threads = engine.check_threads(threads)
     kernels.check_integrator(integrator)
     K, n = F.size, Q.size
     sE, sQ = engine.integrate(np.tile(Q, K), np.tile(P, K), np.repeat(np.arange(K), n), Omega, F, Psi,
-                              xi_max=xi, q_max=qm, cycles=cycles, steps_per_cycle=spc, threads=threads,
-                              integrator=integrator, backend=backend)
+                              xi_max=xi, q_max=qm, q_bounds=qb, cycles=cycles, steps_per_cycle=spc, threads=threads,
+                              integrator=integrator, backend=backend, well=well)
     shape = (K, qa.size, pa.size)
+    nQ, nB = qm.size, qb.shape[0]
     tE = np.moveaxis(engine.steps_to_cycles(sE, spc).reshape(shape + (xi.size,)), -1, 1)
-    tQ = np.moveaxis(engine.steps_to_cycles(sQ, spc).reshape(shape + (qm.size,)), -1, 1)
-    ds = xr.Dataset(
-        {"escape_cycle_energy": (("control", "xi_max", "q0", "p0"), tE, cf.attrs("escape_cycle_energy")),
-         "escape_cycle_displacement": (("control", "q_max", "q0", "p0"), tQ, cf.attrs("escape_cycle_displacement"))},
-        coords={"control": ("control", np.arange(K), {"long_name": "control-point index"}),
-                "F": ("control", F, cf.attrs("F")), "Omega": ("control", Omega, cf.attrs("Omega")),
-                "q0": ("q0", qa, cf.attrs("q0")), "p0": ("p0", pa, cf.attrs("p0")),
-                "xi_max": ("xi_max", xi, cf.attrs("xi_max")), "q_max": ("q_max", qm, cf.attrs("q_max"))})
+    tQ = np.moveaxis(engine.steps_to_cycles(sQ, spc).reshape(shape + (nQ + nB,)), -1, 1)
+    data = {"escape_cycle_energy": (("control", "xi_max", "q0", "p0"), tE, cf.attrs("escape_cycle_energy")),
+            "escape_cycle_displacement": (("control", "q_max", "q0", "p0"), tQ[:, :nQ],
+                                          cf.attrs("escape_cycle_displacement"))}
+    coords = {"control": ("control", np.arange(K), {"long_name": "control-point index"}),
+              "F": ("control", F, cf.attrs("F")), "Omega": ("control", Omega, cf.attrs("Omega")),
+              "q0": ("q0", qa, cf.attrs("q0")), "p0": ("p0", pa, cf.attrs("p0")),
+              "xi_max": ("xi_max", xi, cf.attrs("xi_max")), "q_max": ("q_max", qm, cf.attrs("q_max"))}
+    if nB:
+        coords.update(_bounds_coords(qb))
+        data["escape_cycle_bounds"] = (("control", "q_bounds", "q0", "p0"), tQ[:, nQ:], cf.attrs("escape_cycle_bounds"))
+    ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(Psi=Psi, cycles=cycles, steps_per_cycle=spc, integrator=kernels.INTEGRATORS[integrator],
-                    safe_basin="escape_cycle > t_eval (t_eval <= cycles)")
+                    escape_criteria=_criteria_text(ew), safe_basin="escape_cycle > t_eval (t_eval <= cycles)",
+                    **ew.attrs())
     return ds

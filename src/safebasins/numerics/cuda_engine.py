@@ -17,7 +17,9 @@ import time
 import numpy as np
 from numba import cuda
 
+from safebasins.numerics import criteria
 from safebasins.numerics import cuda_kernels
+from safebasins.numerics import engine
 from safebasins.numerics import kernels
 
 SIMULATOR_BLOCK = 32      # threads per block under the simulator (one Python thread each)
@@ -71,14 +73,17 @@ def launch_grid(kernel, n, block, smem):
     return max(1, min(need, overload.max_cooperative_grid_blocks(block, smem)))
 
 
-def run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), cycles, steps_per_cycle,
-                      stop_any=False, integrator="srkn6b", block=None, grid=None, timing=None):
+def run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bounds=(), cycles, steps_per_cycle,
+                      stop_any=False, integrator="srkn6b", well=None, block=None, grid=None, timing=None):
     """Integrate trajectories i from (q0[i], p0[i]) with Omega[pidx[i]], F[pidx[i]] on the GPU.
 
     Returns (steps_E (N, nE), steps_Q (N, nQ)): int64 step of first crossing of each threshold,
     in the order given (-1: not within `cycles` periods, 0: the initial condition is beyond),
-    bitwise equal to engine.run_ensemble's.  A trajectory stops once every threshold is crossed
-    (stop_any: once any is).  integrator: "srkn6b" (default) or "rk4".
+    bitwise equal to engine.run_ensemble's; the displacement columns are the q_max thresholds
+    then the q_bounds pairs (nested: engine.displacement_pairs).  A trajectory stops once every
+    threshold is crossed (stop_any: once any is).  integrator: "srkn6b" (default) or "rk4";
+    well: None (the quartic) or a polynomial well (criteria.resolve_well), the kernel flag as on
+    the CPU.
 
     block, grid: threads per block (default 128, simulator 32) and blocks (default: as many as
     stay resident; the simulator: 2); results do not depend on them.  timing: a dict to receive
@@ -87,6 +92,7 @@ def run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), cycle
     """
     require_cuda()
     kernels.check_integrator(integrator)
+    ew = criteria.resolve_well(well)
     t_wall = time.perf_counter()
     q0 = np.ascontiguousarray(q0, dtype=float).ravel()
     p0 = np.ascontiguousarray(p0, dtype=float).ravel()
@@ -94,7 +100,8 @@ def run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), cycle
     Omega = np.atleast_1d(np.asarray(Omega, dtype=float)).ravel()
     F = np.atleast_1d(np.asarray(F, dtype=float)).ravel()
     xi = np.asarray(xi_max, dtype=float).ravel()
-    qm = np.asarray(q_max, dtype=float).ravel()
+    lo, hi, oQ, signed = engine.displacement_pairs(q_max, q_bounds)
+    flag = ew.flag(signed)
     N = q0.size
     if p0.size != N or pidx.size != N:
         raise ValueError(f"q0, p0 and pidx must have the same size, got {q0.size}, {p0.size}, {pidx.size}")
@@ -104,9 +111,8 @@ def run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), cycle
         raise ValueError(f"pidx must index the {Omega.size} parameter set(s)")
     cycles = _positive_int("cycles", cycles)
     S = _positive_int("steps_per_cycle", steps_per_cycle)
-    nE, nQ = xi.size, qm.size
+    nE, nQ = xi.size, hi.size
     oE = np.argsort(xi, kind="stable")
-    oQ = np.argsort(qm, kind="stable")
     outE = np.full((N, nE), -1, dtype=np.int64)
     outQ = np.full((N, nQ), -1, dtype=np.int64)
     if N:
@@ -116,20 +122,23 @@ def run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), cycle
         FS = np.ascontiguousarray(F[:, None, None] * sintab[None, :, :]).ravel()
         thrE2 = np.zeros(max(nE, 1))
         thrE2[:nE] = 2.0 * xi[oE]
-        thrQ = np.zeros(max(nQ, 1))
-        thrQ[:nQ] = qm[oQ]
+        thrHi = np.zeros(max(nQ, 1))
+        thrHi[:nQ] = hi[oQ]
+        thrLo = np.zeros(max(nQ, 1))
+        thrLo[:nQ] = lo[oQ]
         blk = int(block) if block is not None else (SIMULATOR_BLOCK if cuda_kernels.SIMULATOR else cuda_kernels.BLOCK)
         shared = FS.nbytes <= cuda_kernels.SHARED_TABLE_BYTES
         smem = FS.nbytes if shared else 0
         warp = SIMULATOR_WARP if cuda_kernels.SIMULATOR else cuda_kernels.WARP
-        kernel = cuda_kernels.ensemble_kernel(integrator, shared, blk, math.gcd(blk, warp))
+        kernel = cuda_kernels.ensemble_kernel(integrator, shared, blk, math.gcd(blk, warp), flag)
         nblk = int(grid) if grid is not None else launch_grid(kernel, N, blk, smem)
 
         d_outE = cuda.to_device(np.full(max(N * nE, 1), -1, dtype=np.int64))
         d_outQ = cuda.to_device(np.full(max(N * nQ, 1), -1, dtype=np.int64))
         args = (cuda.to_device(q0), cuda.to_device(p0), cuda.to_device(pidx), cuda.to_device(coef),
-                cuda.to_device(FS), cuda.to_device(thrE2), nE, cuda.to_device(thrQ), nQ, N, S, cycles,
-                bool(stop_any), scramble_multiplier(N), cuda.to_device(np.zeros(1, np.int64)), d_outE, d_outQ)
+                cuda.to_device(FS), cuda.to_device(thrE2), nE, cuda.to_device(thrLo), cuda.to_device(thrHi), nQ, N, S,
+                cycles, bool(stop_any), scramble_multiplier(N), cuda.to_device(np.zeros(1, np.int64)), d_outE, d_outQ,
+                cuda.to_device(np.ascontiguousarray(ew.wpar)))
         if cuda_kernels.SIMULATOR:
             t0 = time.perf_counter()
             kernel[nblk, blk, 0, smem](*args)

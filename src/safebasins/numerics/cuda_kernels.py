@@ -1,8 +1,10 @@
-"""CUDA kernels (numba-cuda) for the escape ensembles of eq (1): q'' + q - q^3 = F sin(Omega t + Psi).
+"""CUDA kernels (numba-cuda) for the escape ensembles of q'' + V'(q) = F sin(Omega t + Psi).
 
 The GPU twin of kernels.py: same schemes (Blanes-Moan SRKN6b by default, classic RK4), same
-forcing tables, same escape criteria, and the SAME SEQUENCE OF IEEE OPERATIONS per trajectory,
-so the recorded first-crossing steps are bitwise equal to the CPU engine's.
+wells (the kernel flag of steps.py: the quartic in closed form, QUARTIC_SIGNED, the polynomial
+classes POLY4 / POLY8 by Horner from run-time coefficients), same forcing tables, same escape
+criteria, and the SAME SEQUENCE OF IEEE OPERATIONS per trajectory, so the recorded
+first-crossing steps are bitwise equal to the CPU engine's.
 
 Bitwise equality: fused multiply-adds and contraction
 ------------------------------------------------------
@@ -21,7 +23,8 @@ operand is the result of a multiply; this module leaves no such pair:
   array);
 * the products that remain in the kernel, q*q in the force and q*q, p*p in the energy, feed
   only explicit fma instructions (as a multiplicand or as the addend), never an add: an fma
-  cannot absorb a further product, so nothing can be fused;
+  cannot absorb a further product, so nothing can be fused (the polynomial force is a chain
+  of fma only, its energy fma(h, q*q, p*p));
 * RK4's sums (p2 + p3 etc.) contain no product.  LLVM may rewrite s + s as s * 2.0 and NVVM
   then fuse that into fma(s, 2, x): doubling is exact, so round(x + 2 s) is the same number
   either way (short of overflow, long after escape).
@@ -58,9 +61,11 @@ Kernel organisation (one thread = one trajectory at a time)
   another lane does not change its arithmetic.
 * Forcing table in shared memory when it fits (one parameter set: S * 7 doubles); many
   parameter sets (bisection) read it from global memory (cached).
-* The force is a device function force(q, f) handed to the kernel factory: other wells
-  (a polynomial -V'(q) evaluated by Horner with fma) plug in there.  The escape criteria
-  (energy2, the barrier |q| = 1) are those of the quartic well, as in kernels.py.
+* The well is the kernel factory's `well` flag (steps.py): its force -V'(q) + f and energy
+  2 H0 (make_well, the coefficients w loaded from `wpar` once per thread) and its escape tests
+  (make_criteria): QUARTIC compares |q| with the q_max thresholds and the barrier 1, the signed
+  flags compare q with the bound pairs (lo, hi) and the barriers (q_left, q_right), as
+  kernels._check_state.
 """
 from __future__ import annotations
 
@@ -72,6 +77,7 @@ from numba import cuda, float64, int32, int64, njit, uint64
 from numba.cuda.core import config as cuda_config
 
 from safebasins.numerics import kernels
+from safebasins.numerics.steps import POLY4, POLY8, QUARTIC, WELL_FLAGS
 
 SIMULATOR = bool(cuda_config.ENABLE_CUDASIM)
 Q_BARRIER = kernels.Q_BARRIER
@@ -123,42 +129,86 @@ def energy2(q, p):
     return fma(q2, fma(-0.5, q2, 1.0), p * p)
 
 
+def make_well(well):
+    """(force(q, f, w), energy2(q, p, w)) for a kernel flag (steps.py), w = the 14 coefficients
+    of wpar (steps.wtuple): the operations of steps.well_force / steps.well_energy2."""
+    if well == POLY4:
+        @_device
+        def force(q, f, w):
+            return fma(fma(fma(w[2], q, w[1]), q, w[0]), q, f)
+
+        @_device
+        def energy2w(q, p, w):
+            h = fma(fma(w[9], q, w[8]), q, w[7])
+            return fma(h, q * q, p * p)
+    elif well == POLY8:
+        @_device
+        def force(q, f, w):
+            a = fma(w[6], q, w[5])
+            a = fma(a, q, w[4])
+            a = fma(a, q, w[3])
+            a = fma(a, q, w[2])
+            a = fma(a, q, w[1])
+            a = fma(a, q, w[0])
+            return fma(a, q, f)
+
+        @_device
+        def energy2w(q, p, w):
+            h = fma(w[13], q, w[12])
+            h = fma(h, q, w[11])
+            h = fma(h, q, w[10])
+            h = fma(h, q, w[9])
+            h = fma(h, q, w[8])
+            h = fma(h, q, w[7])
+            return fma(h, q * q, p * p)
+    else:
+        @_device
+        def force(q, f, w):
+            return fma(q * q, q, f - q)
+
+        @_device
+        def energy2w(q, p, w):
+            q2 = q * q
+            return fma(q2, fma(-0.5, q2, 1.0), p * p)
+    return force, energy2w
+
+
 # ------------------------------------------------------------------------------- schemes
 def make_steps(force):
-    """Device steps for a force(q, f): (bm6_step, rk4_step), each
-    step(q, p, c1, ..., c7, tab, o) -> (q, p) with the forcing values tab[o], tab[o+1], ...
-    (already multiplied by F; o unsigned) and c1..c7 as kernels.lane_coefficients.  Same operations in the
-    same order as kernels.bm6_step / kernels.rk4_step."""
+    """Device steps for a force(q, f, w) (make_well): (bm6_step, rk4_step), each
+    step(q, p, c1, ..., c7, tab, o, w) -> (q, p) with the forcing values tab[o], tab[o+1], ...
+    (already multiplied by F; o unsigned), c1..c7 as kernels.lane_coefficients and w the well's
+    coefficients.  Same operations in the same order as steps.well_bm6_step / well_rk4_step."""
     @_device
-    def bm6_step(q, p, a1, a2, a3, b1, b2, b3, b4, tab, o):
-        p = fma(b1, force(q, tab[o]), p)
+    def bm6_step(q, p, a1, a2, a3, b1, b2, b3, b4, tab, o, w):
+        p = fma(b1, force(q, tab[o], w), p)
         q = fma(a1, p, q)
-        p = fma(b2, force(q, tab[o + U1]), p)
+        p = fma(b2, force(q, tab[o + U1], w), p)
         q = fma(a2, p, q)
-        p = fma(b3, force(q, tab[o + U2]), p)
+        p = fma(b3, force(q, tab[o + U2], w), p)
         q = fma(a3, p, q)
-        p = fma(b4, force(q, tab[o + U3]), p)
+        p = fma(b4, force(q, tab[o + U3], w), p)
         q = fma(a3, p, q)
-        p = fma(b3, force(q, tab[o + U4]), p)
+        p = fma(b3, force(q, tab[o + U4], w), p)
         q = fma(a2, p, q)
-        p = fma(b2, force(q, tab[o + U5]), p)
+        p = fma(b2, force(q, tab[o + U5], w), p)
         q = fma(a1, p, q)
-        p = fma(b1, force(q, tab[o + U6]), p)
+        p = fma(b1, force(q, tab[o + U6], w), p)
         return q, p
 
     @_device
-    def rk4_step(q, p, hh, h, h6, c4, c5, c6, c7, tab, o):
+    def rk4_step(q, p, hh, h, h6, c4, c5, c6, c7, tab, o, w):
         f2 = tab[o + U1]
-        k1 = force(q, tab[o])
+        k1 = force(q, tab[o], w)
         q2 = fma(hh, p, q)
         p2 = fma(hh, k1, p)
-        k2 = force(q2, f2)
+        k2 = force(q2, f2, w)
         q3 = fma(hh, p2, q)
         p3 = fma(hh, k2, p)
-        k3 = force(q3, f2)
+        k3 = force(q3, f2, w)
         q4 = fma(h, p3, q)
         p4 = fma(h, k3, p)
-        k4 = force(q4, tab[o + U2])
+        k4 = force(q4, tab[o + U2], w)
         sq = p2 + p3
         sp = k2 + k3
         q = fma(h6, (p + p4) + (sq + sq), q)
@@ -169,17 +219,76 @@ def make_steps(force):
 
 
 # ------------------------------------------------------------------------------- escape bookkeeping
-@_device
-def check_state(i, e, aq, step, thrE2, nE, thrQ, nQ, iE, iQ, outE, outQ):
-    """kernels._check_state with e = energy2(q, p), aq = |q|: record `step` for every next
-    uncrossed threshold the state is beyond (outE, outQ flat, row i)."""
-    while iE < nE and (e > thrE2[iE] or aq > Q_BARRIER):
-        outE[i * nE + iE] = step
-        iE += 1
-    while iQ < nQ and aq > thrQ[iQ]:
-        outQ[i * nQ + iQ] = step
-        iQ += 1
-    return iE, iQ
+def make_criteria(well):
+    """(crossed, check_state, next_filters) for a kernel flag:
+
+    crossed(e, q, tE, tQ, tN): the branch-free filter (2 H0 above the next uncrossed 2 xi_max, q
+    beyond the next uncrossed bound or, while an energy threshold is uncrossed, a barrier);
+    check_state(i, e, q, step, thrE2, nE, thrLo, thrHi, nQ, iE, iQ, outE, outQ, qL, qR):
+    kernels._check_state with e = energy2(q, p): record `step` for every next uncrossed threshold
+    the state is beyond (outE, outQ flat, row i);
+    next_filters(iE, iQ, thrE2, nE, thrLo, thrHi, nQ, qL, qR) -> (tE, tQ, tN) as kernels._filters.
+    QUARTIC compares |q| with thrHi (the q_max) and the barrier 1; the signed flags compare q
+    with (thrLo, thrHi) and the barriers (qL, qR)."""
+    if well == QUARTIC:
+        @_device
+        def crossed(e, q, tE, tQ, tN):
+            return e > tE or abs(q) > tQ
+
+        @_device
+        def check_state(i, e, q, step, thrE2, nE, thrLo, thrHi, nQ, iE, iQ, outE, outQ, qL, qR):
+            aq = abs(q)
+            while iE < nE and (e > thrE2[iE] or aq > Q_BARRIER):
+                outE[i * nE + iE] = step
+                iE += 1
+            while iQ < nQ and aq > thrHi[iQ]:
+                outQ[i * nQ + iQ] = step
+                iQ += 1
+            return iE, iQ
+
+        @_device
+        def next_filters(iE, iQ, thrE2, nE, thrLo, thrHi, nQ, qL, qR):
+            tE = math.inf
+            tQ = math.inf
+            if iQ < nQ:
+                tQ = thrHi[iQ]
+            if iE < nE:
+                tE = thrE2[iE]
+                if Q_BARRIER < tQ:
+                    tQ = Q_BARRIER
+            return tE, tQ, math.inf
+    else:
+        @_device
+        def crossed(e, q, tE, tQ, tN):
+            return e > tE or q > tQ or -q > tN
+
+        @_device
+        def check_state(i, e, q, step, thrE2, nE, thrLo, thrHi, nQ, iE, iQ, outE, outQ, qL, qR):
+            out = q > qR or q < qL
+            while iE < nE and (e > thrE2[iE] or out):
+                outE[i * nE + iE] = step
+                iE += 1
+            while iQ < nQ and (q > thrHi[iQ] or q < thrLo[iQ]):
+                outQ[i * nQ + iQ] = step
+                iQ += 1
+            return iE, iQ
+
+        @_device
+        def next_filters(iE, iQ, thrE2, nE, thrLo, thrHi, nQ, qL, qR):
+            tE = math.inf
+            tQ = math.inf
+            tN = math.inf
+            if iQ < nQ:
+                tQ = thrHi[iQ]
+                tN = -thrLo[iQ]
+            if iE < nE:
+                tE = thrE2[iE]
+                if qR < tQ:
+                    tQ = qR
+                if -qL < tN:
+                    tN = -qL
+            return tE, tQ, tN
+    return crossed, check_state, next_filters
 
 
 @_device
@@ -187,41 +296,33 @@ def finished(iE, iQ, nE, nQ, stop_any):
     return (iE == nE and iQ == nQ) or (stop_any and (iE > 0 or iQ > 0))
 
 
-@_device
-def next_filters(iE, iQ, thrE2, nE, thrQ, nQ):
-    """(tE, tQ): the next uncrossed 2 xi_max (inf: none) and the next uncrossed q_max, or the
-    barrier while an energy threshold is uncrossed (|q| > 1 crosses them all)."""
-    tE = math.inf
-    tQ = math.inf
-    if iQ < nQ:
-        tQ = thrQ[iQ]
-    if iE < nE:
-        tE = thrE2[iE]
-        if Q_BARRIER < tQ:
-            tQ = Q_BARRIER
-    return tE, tQ
-
-
 # ------------------------------------------------------------------------------- the kernel
 @functools.lru_cache(maxsize=None)
-def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WARP, force=None):
-    """The compiled ensemble kernel for one scheme (cached per argument set).
+def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WARP, well=QUARTIC):
+    """The compiled ensemble kernel for one scheme and well (cached per argument set).
 
     integrator: "srkn6b" | "rk4"; shared_table: copy the forcing table into dynamic shared
     memory (launch with its size in bytes); block: threads per block (static shared buffers);
     warp: compaction granularity (32 on a GPU; smaller values exercise compaction in the
-    simulator); force: a device function force(q, f) (None: the quartic well).
+    simulator); well: the kernel flag (steps.WELL_FLAGS; default the quartic).
 
     Launch: kernel[grid, block, 0, table_bytes if shared_table else 0](
-        q0, p0, pidx, coef, FS, thrE2, nE, thrQ, nQ, N, S, cycles, stop_any, A, counter, outE, outQ)
+        q0, p0, pidx, coef, FS, thrE2, nE, thrLo, thrHi, nQ, N, S, cycles, stop_any, A, counter,
+        outE, outQ, wpar)
     q0, p0 (N,) float64; pidx (N,) int64; coef (P*7,) lane_coefficients; FS (P*S*W,) the
     forcing products F[k] * sine_table (W = 7 or 3); thrE2 (>= max(nE, 1),) sorted 2*xi_max;
-    thrQ (>= max(nQ, 1),) sorted q_max; A: scrambling multiplier (coprime to N); counter (1,)
-    int64 = 0; outE (N*nE,), outQ (N*nQ,) int64 pre-filled with -1.
+    thrLo, thrHi (>= max(nQ, 1),) the nested displacement bounds, inside out (QUARTIC: thrHi
+    = sorted q_max, thrLo unused); A: scrambling multiplier (coprime to N); counter (1,) int64
+    = 0; outE (N*nE,), outQ (N*nQ,) int64 pre-filled with -1; wpar (steps.N_WPAR,) the well's
+    barriers and coefficients (steps.well_parameters).
     """
     W = WIDTHS[kernels.check_integrator(integrator)]
     UW = np.uint64(W)
-    bm6_step, rk4_step = make_steps(make_force_quartic() if force is None else force)
+    if well not in WELL_FLAGS:
+        raise ValueError(f"well must be one of the kernel flags {WELL_FLAGS}, got {well!r}")
+    force, energy2w = make_well(well)
+    crossed, check_state, next_filters = make_criteria(well)
+    bm6_step, rk4_step = make_steps(force)
     step = rk4_step if integrator == "rk4" else bm6_step
     SHARED = bool(shared_table)
     BLK = int(block)
@@ -229,9 +330,13 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
     if BLK % WRP:
         raise ValueError(f"block ({BLK}) must be a multiple of warp ({WRP})")
 
-    def ensemble(q0, p0, pidx, coef, FS, thrE2, nE, thrQ, nQ, N, S, cycles, stop_any, A, counter,
-                 outE, outQ):
+    def ensemble(q0, p0, pidx, coef, FS, thrE2, nE, thrLo, thrHi, nQ, N, S, cycles, stop_any, A, counter,
+                 outE, outQ, wpar):
         tid = cuda.threadIdx.x
+        qL = wpar[0]
+        qR = wpar[1]
+        w = (wpar[2], wpar[3], wpar[4], wpar[5], wpar[6], wpar[7], wpar[8],
+             wpar[9], wpar[10], wpar[11], wpar[12], wpar[13], wpar[14], wpar[15])
         # compaction buffers (one slot per lane) and the slot counter
         bq = cuda.shared.array(BLK, float64)
         bp = cuda.shared.array(BLK, float64)
@@ -264,6 +369,7 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
         p = 0.0
         tE = math.inf
         tQ = math.inf
+        tN = math.inf
         c1 = c2 = c3 = c4 = c5 = c6 = c7 = 0.0
         reload = False
         while True:
@@ -277,8 +383,8 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
                     i = (c * A) % N
                     q = q0[i]
                     p = p0[i]
-                    iE, iQ = check_state(i, energy2(q, p), abs(q), 0, thrE2, nE, thrQ, nQ, 0, 0,
-                                         outE, outQ)
+                    iE, iQ = check_state(i, energy2w(q, p, w), q, 0, thrE2, nE, thrLo, thrHi, nQ, 0, 0,
+                                         outE, outQ, qL, qR)
                     if finished(iE, iQ, nE, nQ, stop_any):
                         continue
                     k = pidx[i]
@@ -328,27 +434,28 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
                 c5 = coef[o + 4]
                 c6 = coef[o + 5]
                 c7 = coef[o + 6]
-                tE, tQ = next_filters(iE, iQ, thrE2, nE, thrQ, nQ)
+                tE, tQ, tN = next_filters(iE, iQ, thrE2, nE, thrLo, thrHi, nQ, qL, qR)
                 reload = False
             # ---------------------------------------------- one forcing period
             o = uint64(k) * uSW
             base = per * S
             for s in range(S):
-                q, p = step(q, p, c1, c2, c3, c4, c5, c6, c7, tab, o)
+                q, p = step(q, p, c1, c2, c3, c4, c5, c6, c7, tab, o, w)
                 o += UW
-                e = energy2(q, p)
-                aq = abs(q)
-                if e > tE or aq > tQ:
-                    iE, iQ = check_state(i, e, aq, base + s + 1, thrE2, nE, thrQ, nQ, iE, iQ, outE, outQ)
+                e = energy2w(q, p, w)
+                if crossed(e, q, tE, tQ, tN):
+                    iE, iQ = check_state(i, e, q, base + s + 1, thrE2, nE, thrLo, thrHi, nQ, iE, iQ, outE, outQ,
+                                         qL, qR)
                     if finished(iE, iQ, nE, nQ, stop_any):
                         live = False
                         break
-                    tE, tQ = next_filters(iE, iQ, thrE2, nE, thrQ, nQ)
+                    tE, tQ, tN = next_filters(iE, iQ, thrE2, nE, thrLo, thrHi, nQ, qL, qR)
             if live:
                 per += 1
                 if per >= cycles:
                     live = False
 
     sig = ("void(float64[::1], float64[::1], int64[::1], float64[::1], float64[::1], float64[::1], int64, "
-           "float64[::1], int64, int64, int64, int64, boolean, int64, int64[::1], int64[::1], int64[::1])")
+           "float64[::1], float64[::1], int64, int64, int64, int64, boolean, int64, int64[::1], int64[::1], "
+           "int64[::1], float64[::1])")
     return cuda.jit(sig)(ensemble)

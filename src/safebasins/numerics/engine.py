@@ -8,6 +8,7 @@ import numba
 import numpy as np
 
 from safebasins import checks
+from safebasins.numerics import criteria
 from safebasins.numerics import kernels
 
 DEFAULT_STEPS_PER_CYCLE = 32
@@ -61,27 +62,50 @@ def thresholds(name, values, check):
     return a
 
 
-def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), cycles, steps_per_cycle,
-                 threads=None, stop_any=False, store=False, integrator=DEFAULT_INTEGRATOR):
-    """Integrate trajectories i from (q0[i], p0[i]) with Omega[pidx[i]], F[pidx[i]].
+def displacement_pairs(q_max=(), q_bounds=()):
+    """The displacement thresholds as bound pairs (lo, hi): q_max -> (-q_max, q_max), then the
+    q_bounds pairs; returns (lo, hi, order, signed): `order` sorts them nested from the inside
+    out (hi ascending, lo descending; stable), `signed` = some pair is not symmetric.
+    ValueError naming q_max / q_bounds when two pairs are not nested (neither contains the
+    other: the engine watches only the next uncrossed bound of each trajectory)."""
+    qm = np.asarray(q_max, dtype=float).ravel()
+    qb = np.asarray(q_bounds, dtype=float).reshape(-1, 2) if np.size(q_bounds) else np.zeros((0, 2))
+    lo = np.concatenate([-qm, qb[:, 0]])
+    hi = np.concatenate([qm, qb[:, 1]])
+    order = np.lexsort((-lo, hi))
+    if lo.size and not (np.diff(lo[order]) <= 0).all():
+        name = "q_bounds" if qb.shape[0] else "q_max"
+        pairs = [(float(a), float(b)) for a, b in zip(lo[order], hi[order])]
+        raise ValueError(f"{name}: the displacement bounds (q_max as (-q_max, q_max) and q_bounds) must be nested, "
+                         f"each pair inside the next; got {pairs}")
+    return lo, hi, order, bool((lo != -hi).any())
+
+
+def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bounds=(), cycles, steps_per_cycle,
+                 threads=None, stop_any=False, store=False, integrator=DEFAULT_INTEGRATOR, well=None):
+    """Integrate trajectories i from (q0[i], p0[i]) with Omega[pidx[i]], F[pidx[i]] in `well`.
 
     Returns (steps_E (N, nE), steps_Q (N, nQ), store or None): int64 first-crossing steps in the
-    order of the given thresholds (-1: not within `cycles`), and period-map iterates.
-    integrator: "srkn6b" (default) or "rk4" (kernels.INTEGRATORS).
+    order of the given thresholds (-1: not within `cycles`), and period-map iterates.  The
+    displacement columns are the q_max thresholds (|q| > q_max) followed by the q_bounds pairs
+    (q < lo or q > hi); all of them must be nested (displacement_pairs).
+    integrator: "srkn6b" (default) or "rk4" (kernels.INTEGRATORS); well: None (the quartic) or a
+    supported well (criteria.resolve_well).  Thresholds are not checked against the well here
+    (the public functions do that).
     """
     kernels.check_integrator(integrator)
+    ew = criteria.resolve_well(well)
     q0 = np.ascontiguousarray(q0, dtype=float).ravel()
     p0 = np.ascontiguousarray(p0, dtype=float).ravel()
     pidx = np.ascontiguousarray(pidx, dtype=np.int64).ravel()
     Omega = np.atleast_1d(np.asarray(Omega, dtype=float))
     F = np.atleast_1d(np.asarray(F, dtype=float))
     xi = np.asarray(xi_max, dtype=float).ravel()
-    qm = np.asarray(q_max, dtype=float).ravel()
+    lo, hi, oQ_sorted, signed = displacement_pairs(q_max, q_bounds)
     N = q0.size
     oE_sorted = np.argsort(xi, kind="stable")
-    oQ_sorted = np.argsort(qm, kind="stable")
     outE = np.full((N, xi.size), -1, dtype=np.int64)
-    outQ = np.full((N, qm.size), -1, dtype=np.int64)
+    outQ = np.full((N, hi.size), -1, dtype=np.int64)
     st = np.full((N, cycles + 1, 2), np.nan) if store else np.empty((0, 0, 2))
     if N:
         coef = np.ascontiguousarray(kernels.lane_coefficients(Omega, steps_per_cycle, integrator))
@@ -91,8 +115,9 @@ def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), cycles, st
             # task gets a statistically equal share of long-lived ones and its lanes stay full
             n_tasks = max(1, min(math.ceil(N / LANES), nthreads))
             kernels.ensemble(q0, p0, pidx, coef, kernels.step_sizes(Omega, steps_per_cycle), np.ascontiguousarray(F), sintab,
-                       np.ascontiguousarray(2.0 * xi[oE_sorted]), np.ascontiguousarray(qm[oQ_sorted]),
-                       int(cycles), bool(stop_any), int(n_tasks), LANES, outE, outQ, st, bool(store))
+                       np.ascontiguousarray(2.0 * xi[oE_sorted]), np.ascontiguousarray(hi[oQ_sorted]),
+                       int(cycles), bool(stop_any), int(n_tasks), LANES, outE, outQ, st, bool(store),
+                       well=ew.flag(signed), wpar=ew.wpar, thrQlo=np.ascontiguousarray(lo[oQ_sorted]))
     # back to the caller's threshold order
     steps_E = np.empty_like(outE)
     steps_E[:, oE_sorted] = outE

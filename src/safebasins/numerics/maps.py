@@ -6,25 +6,30 @@ import xarray as xr
 
 from safebasins import checks
 from safebasins.io import cf
-from safebasins.wells.quartic import QUARTIC
+from safebasins.numerics import criteria
 from safebasins.numerics import engine
 from safebasins.numerics import kernels
 
 
-def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=None,
+def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=None, q_bounds=None, well=None,
                      steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None, integrator=engine.DEFAULT_INTEGRATOR):
     """Period-map iterates (q(nT), p(nT)), T = 2 pi / Omega, n = 0..n_iter, of paired ICs.
 
     q0, p0 : paired initial conditions of equal shape (flattened in C order to dim 'sample').
     xi_max : energy threshold (None: no energy criterion); q_max: displacement threshold
-        (None: none).  A trajectory has escaped once it crosses ANY given threshold (energy:
-        H0 > xi_max or |q| > 1; displacement: |q| > q_max); its iterates from that period on
-        are NaN and it is no longer integrated.
+        (None: none); q_bounds: one asymmetric displacement bound pair (lo, hi) (None: none).
+        A trajectory has escaped once it crosses ANY given threshold (energy: H0 > xi_max or
+        q beyond a barrier; displacement: |q| > q_max, q < lo or q > hi); its iterates from
+        that period on are NaN and it is no longer integrated.  q_max and q_bounds must be
+        nested.
+    well : None (the quartic) or a polynomial well (see escape_chart).
     integrator : "srkn6b" (default) or "rk4" (see escape_chart).
 
     Returns xr.Dataset with q, p (sample, iteration) (iteration 0 = the IC), escaped (sample,
     bool), escape_cycle (sample; step / steps_per_cycle, +inf = not within n_iter cycles),
-    q0, p0 (sample); attrs F, Omega, Psi, xi_max, q_max, n_iter, steps_per_cycle, integrator.
+    q0, p0 (sample); attrs F, Omega, Psi, xi_max, q_max, n_iter, steps_per_cycle, integrator,
+    well (name), well_potential, well_barriers, escape_criteria, and q_lower, q_upper when
+    q_bounds is given.
     """
     qa = checks.check_finite("q0", q0)
     pa = checks.check_finite("p0", p0)
@@ -35,17 +40,22 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
     Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
     n_iter = engine.check_cycles("n_iter", n_iter)
-    xi = () if xi_max is None else (checks.check_scalar("xi_max", xi_max, QUARTIC.check_threshold),)
-    qm = () if q_max is None else (checks.check_scalar("q_max", q_max, QUARTIC.check_displacement),)
-    if not xi and not qm:
-        raise ValueError("xi_max and q_max: at least one escape threshold is required")
+    ew = criteria.resolve_well(well)
+    xi = () if xi_max is None else (checks.check_scalar("xi_max", xi_max, ew.check_xi_max),)
+    qm = () if q_max is None else (checks.check_scalar("q_max", q_max, ew.check_q_max),)
+    qb = np.zeros((0, 2)) if q_bounds is None else ew.check_q_bounds("q_bounds", q_bounds)
+    if qb.shape[0] > 1:
+        raise ValueError(f"q_bounds must be one pair (lo, hi) for the map, got {qb.tolist()}")
+    if not xi and not qm and not qb.shape[0]:
+        raise ValueError("xi_max, q_max and q_bounds: at least one escape threshold is required")
+    engine.displacement_pairs(qm, qb)
     spc = engine.check_steps_per_cycle(steps_per_cycle)
     threads = engine.check_threads(threads)
     kernels.check_integrator(integrator)
 
     sE, sQ, st = engine.run_ensemble(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
-                                cycles=n_iter, steps_per_cycle=spc, threads=threads, stop_any=True,
-                                store=True, integrator=integrator)
+                                     q_bounds=qb, cycles=n_iter, steps_per_cycle=spc, threads=threads, stop_any=True,
+                                     store=True, integrator=integrator, well=well)
     steps = np.concatenate([sE, sQ], axis=1).astype(float)
     steps[steps < 0] = np.inf
     first = steps.min(axis=1)
@@ -67,5 +77,9 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
     )
     ds.attrs.update(F=F, Omega=Omega, Psi=Psi, xi_max=xi[0] if xi else np.nan, q_max=qm[0] if qm else np.nan,
                     n_iter=n_iter, steps_per_cycle=spc, integrator=kernels.INTEGRATORS[integrator],
-                    map="eq (29): (q(t), p(t)) -> (q(t + T), p(t + T)), T = 2 pi / Omega; NaN after escape")
+                    map="eq (29): (q(t), p(t)) -> (q(t + T), p(t + T)), T = 2 pi / Omega; NaN after escape",
+                    escape_criteria=f"energy ({ew.energy_criterion()}); displacement: |q| > q_max, q < q_lower or "
+                                    "q > q_upper", **ew.attrs())
+    if qb.shape[0]:
+        ds.attrs.update(q_lower=float(qb[0, 0]), q_upper=float(qb[0, 1]))
     return ds
