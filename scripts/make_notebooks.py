@@ -33,10 +33,20 @@ def outputs():
         yield ROOT / fig.notebook, notebook_text(fig)
 
 
+def rst_to_markdown(text: str) -> str:
+    """A report caption (results/captions/<name>.rst: reST inside a Jinja raw block) as Markdown."""
+    text = text.replace("{% raw %}", "").replace("{% endraw %}", "").strip()
+    return text.replace("``", "`")  # reST's backslash escapes (\\*, \\|) mean the same in Markdown
+
+
 def gallery_entries(src: Path):
-    """(section, heading, file stem, caption) of every gallery image in report order."""
+    """(section, heading, file stem, caption) of every gallery image in report order; the caption
+    is the one the figure's notebook wrote with the numbers of the run (results/captions/), else
+    the paper's."""
     for fig in packaged_figures():
-        yield (None if fig.category == "Figures" else fig.category), fig.label, fig.name, fig.caption
+        cap = src.parent / "captions" / f"{fig.name}.rst"
+        text = rst_to_markdown(cap.read_text()) if cap.exists() else fig.caption
+        yield (None if fig.category == "Figures" else fig.category), fig.label, fig.name, text
 
 
 def write_gallery(src: Path, width: int = 800):

@@ -254,7 +254,7 @@ def test_period_map_criteria_dsb_area(tmp_path):
     assert fig.axes[0].get_xscale() == "log" and fig.axes[0].get_xlim()[0] == 1.0  # the early transient shows
     ec = chart["escape_cycle_energy"].values
     last = ec[np.isfinite(ec)].max()
-    assert f"loses its last pixel at {fmt_value(last)} EC and keeps {int(np.isinf(ec).sum()):,} pixels" in \
+    assert f"loses its last pixel at {charts.ec(last)} and keeps {int(np.isinf(ec).sum()):,} pixels" in \
         " ".join(notes(fig))
     render(fig, tmp_path, "area")
 

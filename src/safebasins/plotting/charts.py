@@ -253,6 +253,12 @@ def _t_evals(params, t_evals):
     return [float(t) for t in np.atleast_1d(vals)]
 
 
+def ec(t):
+    """A time in forcing cycles for captions: "11,000 EC", "145 EC", "9,697 EC"."""
+    t = float(t)
+    return f"{t:,.0f} EC" if abs(t) >= 10 or t == round(t) else f"{t:.3g} EC"
+
+
 def _area_curves(chart, t):
     """Safe pixels of the energy (ESB) and displacement (DSB) criteria at evaluation times t."""
     area = safe_area(chart, np.asarray(t, float))
@@ -304,15 +310,17 @@ def figure_dsb_esb(numeric, params, *, t_evals=None, title=None, figsize=None):
     outside = int(max(((esc > t) & ~(dsc > t)).sum() for t in t_evals))
     n = esc.size
     add_note(fig, "Safe pixels of " + f"{n:,}: " + "; ".join(
-        f"t_eval = {fmt_value(t)} EC: ESB {int(e):,}, DSB {int(d):,}" for t, e, d in zip(t_evals, nE, nD)) + ".")
-    add_note(fig, f"Between t_eval = {fmt_value(t0)} and {fmt_value(t1)} EC {count(changed_E, 'ESB pixel')} and "
-                  f"{count(changed_D, 'DSB pixel')} change; the last energy escape in the chart is at "
-                  f"{fmt_value(_last_escape(chart, 'escape_cycle_energy', 'xi_max'))} EC, the last displacement "
-                  f"escape at {fmt_value(_last_escape(chart, 'escape_cycle_displacement', 'q_max'))} EC.")
+        f"t_eval = {ec(t)}: ESB {int(e):,}, DSB {int(d):,}" for t, e, d in zip(t_evals, nE, nD)) + ".")
+    add_note(fig, f"Paper: at the short t_eval both boundaries are irregular (transients), at the long one smoother. "
+                  f"Ours: between t_eval = {ec(t0)} and {ec(t1)} {count(changed_E, 'ESB pixel')} "
+                  f"({100 * changed_E / max(nE[0], 1):.2g}% of the ESB) and {count(changed_D, 'DSB pixel')} "
+                  f"({100 * changed_D / max(nD[0], 1):.2g}% of the DSB) change"
+                  + (", the ESB is the same set of pixels at both" if changed_E == 0 else "")
+                  + f"; the last energy escape in the chart is at {ec(_last_escape(chart, 'escape_cycle_energy', 'xi_max'))}"
+                  f", the last displacement escape at "
+                  f"{ec(_last_escape(chart, 'escape_cycle_displacement', 'q_max'))}.")
     add_note(fig, f"ESB pixels outside the DSB: {outside} (the DSB contains the ESB"
-                  + (")." if outside == 0 else " except for these).")
-                  + (" Paper: both boundaries irregular at the short t_eval, smoother at the long one; ours: the "
-                     "ESB is the same set of pixels at both t_eval." if changed_E == 0 else ""))
+                  + (")." if outside == 0 else " except for these)."))
     return fig
 
 
@@ -349,20 +357,19 @@ def figure_area_vs_time(numeric, params, *, t_evals=None, title=None, figsize=(6
                            f", resolution {resolution(chart)}"))
     iD = np.interp(t_cfg, t, nD)
     t_short = float(np.atleast_1d(param(chart, "t_eval"))[0])
-    ec = "{:,.0f} EC".format
-    add_note(fig, f"Read from the chart of {resolution(chart)} ICs over {fmt_value(horizon)} EC, at the "
-                  f"{t_cfg.size} configured t_eval ({fmt_value(t_cfg.min())} ... {fmt_value(t_cfg.max())} EC) and "
-                  f"{n_log} log-spaced ones from 1 EC.")
+    add_note(fig, f"Read from the chart of {resolution(chart)} ICs over {ec(horizon)}, at the "
+                  f"{t_cfg.size} configured t_eval ({ec(t_cfg.min())} ... {ec(t_cfg.max())}) and "
+                  f"{n_log} log-spaced ones from {ec(1)}.")
     add_note(fig, f"Paper: the area shrinks rapidly for about 2000 EC and then hardly changes. Ours: the ESB loses "
-                  f"its last pixel at {fmt_value(tE)} EC and keeps {int(nE[-1]):,} pixels from there to "
-                  f"{fmt_value(horizon)} EC (identical at every later t_eval); the DSB falls from "
-                  f"{int(iD[0]):,} pixels at {fmt_value(t_cfg[0])} EC to {int(nD[-1]):,} at {fmt_value(horizon)} EC "
+                  f"its last pixel at {ec(tE)} and keeps {int(nE[-1]):,} pixels from there to "
+                  f"{ec(horizon)} (identical at every later t_eval); the DSB falls from "
+                  f"{int(iD[0]):,} pixels at {ec(t_cfg[0])} to {int(nD[-1]):,} at {ec(horizon)} "
                   f"and stays within 1% of its final value from {ec(tD)} on "
                   f"(within 5% from {ec(settle_time(t, nD, 0.05))}, within 0.1% from "
                   f"{ec(settle_time(t, nD, 0.001))}); the displacement escapes after "
-                  f"{fmt_value(t_cfg[0])} EC are {count(iD[0] - nD[-1], 'pixel')}, "
+                  f"{ec(t_cfg[0])} are {count(iD[0] - nD[-1], 'pixel')}, "
                   f"{100 * (iD[0] - np.interp(t_short, t, nD)) / max(iD[0] - nD[-1], 1):.0f}% of them by "
-                  f"{fmt_value(t_short)} EC (the short t_eval of the chart's own figure).")
+                  f"{ec(t_short)} (the short t_eval of the chart's own figure).")
     return fig
 
 

@@ -236,7 +236,7 @@ def _fcr_notes(fig, ds, seen, branches, color_by):
         k = int(np.nanargmin(F))
         mech = sorted({int(m) for m in _mechanism_array(var(d, "mechanism")) if m})
         parts.append(f"{_plain(labels[i])}: minimum F_cr = {F[k]:.4g} at Ω = {Om[k]:.3g}, mechanisms "
-                     + "/".join(MECHANISMS[m]["name"] for m in mech))
+                     + ", ".join(_mechanism_text(m, None).rsplit(" ", 1)[0] for m in mech))
     add_note(fig, "; ".join(parts) + ".")
 
 
