@@ -15,6 +15,12 @@ flags, cores, GPU name and SMs) and
      Omega = 0.95, Psi = pi, xi_max = 0.25, q_max = 1, 11,000 cycles of 32 steps: GPU kernel time
      (CUDA events) and wall time, CPU time (all rows, or --cpu-sample rows), and the number of
      escape steps that differ between CPU and GPU (must be 0).
+--wells adds (c): the kernel per well flag (steps.py) on the GPU: the dense job (F = 0, nothing
+escapes) in the quartic (QUARTIC; QUARTIC_SIGNED with asymmetric bounds), the cubic
+V = q^2/2 - q^3/3 (POLY4) and a degree-6 well (POLY8), trajectory-steps/s and the ratio to the
+quartic, PTX contractible pairs of the polynomial kernel, and a --wells-n x --wells-n cubic chart
+(energy + asymmetric bounds, --wells-cycles cycles) whose escape steps are compared with the CPU
+engine's (must be equal).
 --json PATH writes every figure as JSON as well.  Targets on one H100: >= 2e11 trajectory-steps/s
 dense (FP64), Fig 21 in <= 0.2 s of kernel time.
 
@@ -45,7 +51,20 @@ import numba
 import numpy as np
 from numba import cuda
 
-from safebasins.numerics import cuda_engine, cuda_kernels, engine
+from safebasins.numerics import cuda_engine, cuda_kernels, engine, steps
+
+# wells of section (c), duck-typed for numerics.criteria.resolve_well
+CUBIC = dict(name="cubic", coefficients=[0.0, 0.0, 0.5, -1.0 / 3.0], barriers=(-np.inf, 1.0), barrier_energy=1.0 / 6.0)
+
+
+def sextic():
+    """V = q^2/2 - q^4/4 + 0.01 q^6 (kernel class POLY8): barriers at the roots of V'."""
+    c = np.array([0.0, 0.0, 0.5, 0.0, -0.25, 0.0, 0.01])
+    dc = np.polynomial.polynomial.polyder(c)
+    r = np.polynomial.polynomial.polyroots(dc)
+    qb = float(np.min(r[(np.abs(r.imag) < 1e-12) & (r.real > 0)].real))
+    return dict(name="sextic", coefficients=c.tolist(), barriers=(-qb, qb),
+                barrier_energy=float(np.polynomial.polynomial.polyval(qb, c)))
 
 FIG21 = dict(F=0.0876, Omega=0.95, Psi=np.pi, xi_max=[0.25], q_max=[1.0], cycles=11000, steps_per_cycle=32)
 
@@ -75,11 +94,12 @@ def machine():
     return info
 
 
-def ptx_report(integrator="srkn6b"):
+def ptx_report(integrator="srkn6b", well=steps.QUARTIC):
     """f64 instruction counts of the compiled kernel and contractible mul -> add/sub pairs."""
     if cuda_kernels.SIMULATOR:
-        return dict(integrator=integrator, ptx_f64_ops="simulator: no PTX", contractible_pairs=None, sass=None)
-    kernel = cuda_kernels.ensemble_kernel(integrator, True, cuda_kernels.BLOCK, cuda_kernels.WARP)
+        return dict(integrator=integrator, well=well, ptx_f64_ops="simulator: no PTX", contractible_pairs=None,
+                    sass=None)
+    kernel = cuda_kernels.ensemble_kernel(integrator, True, cuda_kernels.BLOCK, cuda_kernels.WARP, well)
     asm = kernel.inspect_asm()
     ptx = next(iter(asm.values())) if isinstance(asm, dict) else asm
     ops = collections.Counter()
@@ -94,7 +114,8 @@ def ptx_report(integrator="srkn6b"):
             mul_dst.add(dst)
         elif op.startswith(("add", "sub")):
             uses.extend(re.findall(r"%fd\d+", srcs))
-    rep = dict(integrator=integrator, ptx_f64_ops=dict(ops), contractible_pairs=sum(u in mul_dst for u in uses))
+    rep = dict(integrator=integrator, well=well, ptx_f64_ops=dict(ops),
+               contractible_pairs=sum(u in mul_dst for u in uses))
     try:
         sass = kernel.inspect_sass()
         sass = next(iter(sass.values())) if isinstance(sass, dict) else sass
@@ -192,6 +213,60 @@ def fig21(n=300, cpu_sample=None, cpu_result=None, cycles=FIG21["cycles"], integ
     return out
 
 
+def wells_section(n_dense, cycles, chart_n, chart_cycles, cpu_rows, integrator="srkn6b"):
+    """(c): dense steps/s per well flag on the GPU (and the CPU engine), a cubic chart CPU vs GPU."""
+    from types import SimpleNamespace
+    S = 32
+    rng = np.random.default_rng(3)
+    q = rng.uniform(-0.25, 0.25, n_dense)
+    p = rng.uniform(-0.25, 0.25, n_dense)      # H0 < 0.07 in all three wells: nothing escapes with F = 0
+    pidx = np.zeros(n_dense, np.int64)
+    sx = sextic()
+    jobs = [("quartic (QUARTIC)", None, dict(xi_max=[0.25], q_max=[1.0])),
+            ("quartic, asymmetric bounds (QUARTIC_SIGNED)", None, dict(xi_max=[0.25], q_bounds=[[-0.9, 1.0]])),
+            ("cubic (POLY4)", CUBIC, dict(xi_max=[1.0 / 6.0], q_bounds=[[-0.5, 1.0]])),
+            ("sextic (POLY8)", sx, dict(xi_max=[0.2], q_max=[1.0]))]
+    out = dict(integrator=integrator, n=n_dense, cycles=cycles, steps_per_cycle=S, dense={}, ptx=[])
+    steps_n = n_dense * cycles * S
+    for name, w, thr in jobs:
+        well = None if w is None else SimpleNamespace(**w)
+        kw = dict(cycles=cycles, steps_per_cycle=S, integrator=integrator, well=well, **thr)
+        cuda_engine.run_ensemble_cuda(q[:256], p[:256], pidx[:256], [0.95], [0.0], np.pi, **dict(kw, cycles=2))
+        tm = {}
+        gE, gQ = cuda_engine.run_ensemble_cuda(q, p, pidx, [0.95], [0.0], np.pi, timing=tm, **kw)
+        engine.run_ensemble(q[:256], p[:256], pidx[:256], [0.95], [0.0], np.pi, **dict(kw, cycles=2))
+        t = time.perf_counter()
+        cE, cQ, _ = engine.run_ensemble(q, p, pidx, [0.95], [0.0], np.pi, **kw)
+        cpu_s = time.perf_counter() - t
+        out["dense"][name] = dict(kernel_s=tm["kernel_s"], gpu_steps_per_s=steps_n / tm["kernel_s"],
+                                  regs=tm.get("regs_per_thread"), cpu_s=cpu_s, cpu_steps_per_s=steps_n / cpu_s,
+                                  escaped=int((gE >= 0).sum() + (gQ >= 0).sum()), E=compare(cE, gE), Q=compare(cQ, gQ))
+    for flag in (steps.POLY4, steps.QUARTIC_SIGNED):
+        out["ptx"].append(ptx_report(integrator, flag))
+    # the cubic chart: energy thresholds and asymmetric bounds, CPU vs GPU escape steps
+    qa = np.linspace(-0.6, 1.0, chart_n)
+    pa = np.linspace(-0.6, 0.6, chart_n)
+    Q, P = (a.ravel() for a in np.meshgrid(qa, pa, indexing="ij"))
+    well = SimpleNamespace(**CUBIC)
+    kw = dict(xi_max=[0.12, 1.0 / 6.0], q_bounds=[[-0.43, 0.65], [-np.inf, 0.9]], cycles=chart_cycles,
+              steps_per_cycle=S, integrator=integrator, well=well)
+    args = ([0.85], [0.02], 0.3)
+    runs = []
+    for _ in range(2):
+        tm = {}
+        gE, gQ = cuda_engine.run_ensemble_cuda(Q, P, np.zeros(Q.size, np.int64), *args, timing=tm, **kw)
+        runs.append(tm["kernel_s"])
+    rows = np.unique(np.linspace(0, chart_n - 1, min(cpu_rows, chart_n)).round().astype(int))
+    sel = (rows[:, None] * chart_n + np.arange(chart_n)[None, :]).ravel()
+    t = time.perf_counter()
+    cE, cQ, _ = engine.run_ensemble(Q[sel], P[sel], np.zeros(sel.size, np.int64), *args, **kw)
+    cpu_s = time.perf_counter() - t
+    out["cubic_chart"] = dict(n=chart_n, cycles=chart_cycles, kernel_s=min(runs), cpu_rows=int(rows.size), cpu_s=cpu_s,
+                              escaped_fraction=float((gE[:, 1] >= 0).mean()), E=compare(cE, gE[sel]),
+                              Q=compare(cQ, gQ[sel]))
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--dense-n", type=int, default=100_000)
@@ -204,6 +279,11 @@ def main():
                     "(srkn6b; other integrators get the suffix _<integrator>)")
     ap.add_argument("--integrators", default="srkn6b", help="comma-separated: srkn6b,rk4")
     ap.add_argument("--blocks", default="", help="comma-separated threads per block to sweep on the dense job (GPU)")
+    ap.add_argument("--wells", action="store_true", help="section (c): the kernel per well flag")
+    ap.add_argument("--wells-only", action="store_true", help="only section (c)")
+    ap.add_argument("--wells-n", type=int, default=200, help="cubic chart of (c): n x n ICs")
+    ap.add_argument("--wells-cycles", type=int, default=2000)
+    ap.add_argument("--wells-cpu-rows", type=int, default=40)
     ap.add_argument("--json", default=None)
     a = ap.parse_args()
     if not cuda_engine.cuda_available():
@@ -213,6 +293,29 @@ def main():
     print(f"machine: CPU {m['cpu']} ({m['cores']} cores, numba threads {m['numba_threads']}, AVX2 {m['avx2']}, "
           f"AVX-512 {m['avx512f']}); GPU {m['gpu']} (cc {m.get('compute_capability')}, {m.get('sms')} SMs, "
           f"{m.get('gpu_clock_mhz')} MHz); numba {m['numba']}, numba-cuda {m['numba_cuda']}")
+    if a.wells or a.wells_only:
+        res["wells"] = []
+        for integrator in a.integrators.split(","):
+            w = wells_section(a.dense_n, a.dense_cycles, a.wells_n, a.wells_cycles, a.wells_cpu_rows, integrator)
+            res["wells"].append(w)
+            print(f"(c) wells [{integrator}], dense {w['n']} x {w['cycles']} cycles x {w['steps_per_cycle']} steps, F = 0:")
+            ref = w["dense"]["quartic (QUARTIC)"]["gpu_steps_per_s"]
+            for name, d in w["dense"].items():
+                print(f"    {name:44s} GPU {d['gpu_steps_per_s']:.3g} steps/s ({ref / d['gpu_steps_per_s']:.2f}x the "
+                      f"quartic's time per step, {d['regs']} regs); CPU {d['cpu_steps_per_s']:.3g} steps/s; "
+                      f"crossings {d['escaped']}; CPU == GPU: E {d['E']['bitwise_equal']}, Q {d['Q']['bitwise_equal']}")
+            for r in w["ptx"]:
+                print(f"    PTX well flag {r['well']}: f64 ops {r['ptx_f64_ops']}; contractible pairs "
+                      f"{r['contractible_pairs']}; SASS {r['sass']}")
+            c = w["cubic_chart"]
+            print(f"    cubic chart {c['n']}x{c['n']}, {c['cycles']} cycles: GPU kernel {c['kernel_s']:.4f} s, "
+                  f"{100 * c['escaped_fraction']:.1f}% escape (barrier energy); CPU {c['cpu_s']:.2f} s on "
+                  f"{c['cpu_rows']} rows; CPU vs GPU steps: E {c['E']}, Q {c['Q']}")
+        if a.wells_only:
+            if a.json:
+                with open(a.json, "w") as fh:
+                    json.dump(res, fh, indent=1, default=str)
+            return
     res["ptx"] = [ptx_report(i) for i in ("srkn6b", "rk4")]
     for r in res["ptx"]:
         print(f"kernel {r['integrator']}: PTX f64 ops {r['ptx_f64_ops']}; contractible mul->add/sub pairs: "

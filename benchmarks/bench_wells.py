@@ -59,11 +59,15 @@ def machine():
             f"load average {la[0]:.2f} {la[1]:.2f} {la[2]:.2f}")
 
 
-def load_before(rev):
-    """The kernels module of git revision `rev`, imported from a temporary directory (its numba
-    cache lives there too, so a second run does not recompile)."""
-    src = subprocess.run(["git", "show", f"{rev}:src/safebasins/numerics/kernels.py"], cwd=ROOT, check=True,
-                         capture_output=True, text=True).stdout
+def load_before(rev, path=None):
+    """The kernels module of git revision `rev` (or the file `path`, e.g. where there is no git
+    history), imported from a temporary directory (its numba cache lives there too, so a second
+    run does not recompile)."""
+    if path:
+        src, rev = Path(path).read_text(), Path(path).stem
+    else:
+        src = subprocess.run(["git", "show", f"{rev}:src/safebasins/numerics/kernels.py"], cwd=ROOT, check=True,
+                             capture_output=True, text=True).stdout
     if any(line.startswith(("from safebasins", "import safebasins")) for line in src.splitlines()):
         raise SystemExit(f"kernels.py of {rev} imports safebasins: not the self-contained module this "
                          "benchmark expects (pick the revision before the well flag)")
@@ -155,6 +159,7 @@ def bench(jobs, repeat):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--before", default="f85d441", help="git revision of the kernels before the well flag")
+    ap.add_argument("--before-file", default=None, help="the old kernels.py as a file (instead of --before)")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--integrators", nargs="+", default=["srkn6b", "rk4"])
@@ -171,8 +176,8 @@ def main(argv=None):
     print(f"numba {numba.__version__}, threads {args.threads}, steps_per_cycle {args.steps_per_cycle}, "
           f"best of {args.repeat} interleaved runs, kernel only (kernels.ensemble)")
     t = time.perf_counter()
-    before = load_before(args.before)
-    print(f"before: kernels.py of {args.before} (loaded in {time.perf_counter() - t:.1f} s)")
+    before = load_before(args.before, args.before_file)
+    print(f"before: kernels.py of {args.before_file or args.before} (loaded in {time.perf_counter() - t:.1f} s)")
     S = args.steps_per_cycle
     qd, pd = disc_ics(args.dense_n, H_quartic, 0.2)
     cd_q, cd_p = disc_ics(args.dense_n, H_cubic, 0.14, seed=1)

@@ -1,14 +1,20 @@
 """Compiled ensemble integrator for eq (1) in any supported well: q'' + V'(q) = F sin(Omega t + Psi).
 
 The step (schemes, forcing tables, the well's force and energy, the well flags) lives in
-steps.py; this module holds the lane machinery: escape detection, replay, refill, compaction.
+steps.py, the vectorised period loops over the lanes in periods.py; this module holds the lane
+machinery: escape detection, replay, refill, compaction, and the entry points.
 
 Schemes and wells are compile-time constants of the inline period bodies: `rk4` (the width of
 the forcing table: 3 RK4, 7 SRKN6b) and `well` (steps.QUARTIC, QUARTIC_SIGNED, POLY4, POLY8).
 Each well flag has its own entry point (_ENSEMBLE) passing the flag down as a global
 constant, which numba types as a literal: every flag value is its own compiled, cached
 kernel, compiled on first use, so the quartic kernel is today's code and a polynomial well
-costs no compile time until one is integrated.
+costs no compile time until one is integrated.  The force, the energy and the period bodies
+of a flag are chosen at typing time (numba @overload on the literal): a kernel holds only its
+own well's code.
+
+Numba's on-disk cache checks only the file that defines a function: after editing steps.py or
+periods.py, touch this file (or delete __pycache__/*.nbi) so that the cached kernels are rebuilt.
 
 Every lane's arithmetic is written with explicit fused multiply-adds (llvm.fma), no
 fast-math flags: the vector loop and the scalar replay produce bitwise identical numbers
@@ -42,14 +48,14 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit, prange
-from numba.extending import overload
 
 from safebasins.numerics.steps import (  # noqa: F401  (re-exported: the step API of the engine)
     BM6_DRIFT, BM6_KICK, BM6_KICK_TIMES, DRIFT1, DRIFT2, DRIFT3, INTEGRATOR, INTEGRATORS, KICK1, KICK2, KICK3,
     KICK4, N_KICKS, N_WPAR, POLY4, POLY8, POLY_DEGREES, Q_BARRIER, QUARTIC, QUARTIC_SIGNED, RK4_C1, RK4_C2, RK4_C3,
-    RK4_COEF, RK4_TIMES, WELL_FLAGS, _literal_flag, bm6_step, check_integrator, energy, energy2, fma, force, lane_coefficients,
+    RK4_COEF, RK4_TIMES, WELL_FLAGS, bm6_step, check_integrator, energy, energy2, fma, force, lane_coefficients,
     lane_coefs, rk4_step, row, sine_table, step, step_sizes, well_bm6_step, well_energy2, well_force,
     well_parameters, well_rk4_step, wtuple)
+from safebasins.numerics.periods import _period_lanes, _period_shared
 
 # smallest lane segment of the 4-chain vector loop (lanes run: 4 * segment)
 MIN_SEGMENT = 16
@@ -133,179 +139,6 @@ def _replay(well, wpar, i, q, p, period, s0, s1, sintab, c, F, thrE2, thrLo, thr
         if _finished(iE, iQ, nE, nQ, stop_any):
             break
     return iE, iQ
-
-
-@njit(cache=True, inline="always")
-def _keep_abs(well, w, l, q, p, Q, P, ME, MQ, MN):
-    """Store lane l's new state and update its maxima of 2*H0 and |q| (branch free)."""
-    Q[l] = q
-    P[l] = p
-    e = well_energy2(well, w, q, p)
-    x = abs(q)
-    m = ME[l]
-    ME[l] = e if e > m else m
-    m = MQ[l]
-    MQ[l] = x if x > m else m
-
-
-@njit(cache=True, inline="always")
-def _keep_signed(well, w, l, q, p, Q, P, ME, MQ, MN):
-    """Store lane l's new state and update its maxima of 2*H0, q and -q (branch free)."""
-    Q[l] = q
-    P[l] = p
-    _maxima_signed(well, w, l, q, p, ME, MQ, MN)
-
-
-@njit(cache=True, inline="always")
-def _maxima_signed(well, w, l, q, p, ME, MQ, MN):
-    e = well_energy2(well, w, q, p)
-    m = ME[l]
-    ME[l] = e if e > m else m
-    m = MQ[l]
-    MQ[l] = q if q > m else m
-    y = -q
-    m = MN[l]
-    MN[l] = y if y > m else m
-
-
-@njit(cache=True, inline="always")
-def _reset(well, n, ME, MQ, MN):
-    for l in range(n):
-        ME[l] = -np.inf
-        MQ[l] = -np.inf
-    if well != QUARTIC:
-        for l in range(n):
-            MN[l] = -np.inf
-
-
-def _shared_fused(rk4, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
-    """QUARTIC: steps [s0, s1) of the forcing period for lanes [0, 4M), all sharing one
-    parameter set; ME, MQ = max 2*H0 and max |q| over these steps.
-
-    The lane loop (j) vectorises; its body advances 4 independent lanes j, M+j, 2M+j, 3M+j
-    so that 4 dependency chains are in flight (the step is latency bound otherwise)."""
-    c1 = c[0]; c2 = c[1]; c3 = c[2]; c4 = c[3]; c5 = c[4]; c6 = c[5]; c7 = c[6]
-    w = wtuple(wpar)
-    _reset(well, 4 * M, ME, MQ, MN)
-    for s in range(s0, s1):
-        f1, f2, f3, f4, f5, f6, f7 = row(FS, s, rk4)
-        for j in range(M):
-            l0 = 0 * M + j
-            l1 = 1 * M + j
-            l2 = 2 * M + j
-            l3 = 3 * M + j
-            q0, p0 = step(rk4, well, w, Q[l0], P[l0], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
-            q1, p1 = step(rk4, well, w, Q[l1], P[l1], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
-            q2, p2 = step(rk4, well, w, Q[l2], P[l2], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
-            q3, p3 = step(rk4, well, w, Q[l3], P[l3], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
-            _keep_abs(well, w, l0, q0, p0, Q, P, ME, MQ, MN)
-            _keep_abs(well, w, l1, q1, p1, Q, P, ME, MQ, MN)
-            _keep_abs(well, w, l2, q2, p2, Q, P, ME, MQ, MN)
-            _keep_abs(well, w, l3, q3, p3, Q, P, ME, MQ, MN)
-
-
-def _shared_split(rk4, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
-    """The signed flags: as _shared_fused, with the maxima of 2*H0, q and -q updated in a
-    second lane loop per step.  (Fused, the 4 chains x 5 arrays need 190 runtime alias checks,
-    over LLVM's limit of 128 -vectorize-memory-check-threshold, and the loop stays scalar: 7x
-    slower.  Split, the step loop has 2 arrays x 4 chains and the maxima loop 5 arrays x 1
-    chain; the energy is recomputed from the stored state: the same numbers.)"""
-    c1 = c[0]; c2 = c[1]; c3 = c[2]; c4 = c[3]; c5 = c[4]; c6 = c[5]; c7 = c[6]
-    w = wtuple(wpar)
-    n = 4 * M
-    _reset(well, n, ME, MQ, MN)
-    for s in range(s0, s1):
-        f1, f2, f3, f4, f5, f6, f7 = row(FS, s, rk4)
-        for j in range(M):
-            l0 = 0 * M + j
-            l1 = 1 * M + j
-            l2 = 2 * M + j
-            l3 = 3 * M + j
-            q0, p0 = step(rk4, well, w, Q[l0], P[l0], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
-            q1, p1 = step(rk4, well, w, Q[l1], P[l1], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
-            q2, p2 = step(rk4, well, w, Q[l2], P[l2], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
-            q3, p3 = step(rk4, well, w, Q[l3], P[l3], c1, c2, c3, c4, c5, c6, c7, f1, f2, f3, f4, f5, f6, f7)
-            Q[l0] = q0
-            P[l0] = p0
-            Q[l1] = q1
-            P[l1] = p1
-            Q[l2] = q2
-            P[l2] = p2
-            Q[l3] = q3
-            P[l3] = p3
-        for l in range(n):
-            _maxima_signed(well, w, l, Q[l], P[l], ME, MQ, MN)
-
-
-def _period_shared_body(rk4, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
-    """Steps [s0, s1) of the forcing period for lanes [0, 4M), all sharing one parameter set;
-    ME, MQ (, MN) = the maxima over these steps (see _keep).  rk4 and well are compile-time
-    constants at every call site (inline body): one specialised loop per scheme and well."""
-    raise NotImplementedError("compiled code (numba)")
-
-
-@overload(_period_shared_body)
-def _ol_period_shared_body(rk4, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
-    return _shared_fused if _literal_flag(well) == QUARTIC else _shared_split
-
-
-@njit(cache=True)
-def _period_shared(well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
-    """_period_shared_body for the scheme of the table FS (width 3: RK4, 7: SRKN6b)."""
-    if FS.shape[1] == 3:
-        _period_shared_body(True, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1)
-    else:
-        _period_shared_body(False, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1)
-
-
-def _lanes_abs(rk4, well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1):
-    n = 4 * M
-    w = wtuple(wpar)
-    _reset(well, n, ME, MQ, MN)
-    for s in range(s0, s1):
-        t1, t2, t3, t4, t5, t6, t7 = row(sintab, s, rk4)
-        for l in range(n):
-            F = FL[l]
-            c1, c2, c3, c4, c5, c6, c7 = lane_coefs(rk4, HL[l])
-            q, p = step(rk4, well, w, Q[l], P[l], c1, c2, c3, c4, c5, c6, c7,
-                        F * t1, F * t2, F * t3, F * t4, F * t5, F * t6, F * t7)
-            _keep_abs(well, w, l, q, p, Q, P, ME, MQ, MN)
-
-
-def _lanes_signed(rk4, well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1):
-    n = 4 * M
-    w = wtuple(wpar)
-    _reset(well, n, ME, MQ, MN)
-    for s in range(s0, s1):
-        t1, t2, t3, t4, t5, t6, t7 = row(sintab, s, rk4)
-        for l in range(n):
-            F = FL[l]
-            c1, c2, c3, c4, c5, c6, c7 = lane_coefs(rk4, HL[l])
-            q, p = step(rk4, well, w, Q[l], P[l], c1, c2, c3, c4, c5, c6, c7,
-                        F * t1, F * t2, F * t3, F * t4, F * t5, F * t6, F * t7)
-            _keep_signed(well, w, l, q, p, Q, P, ME, MQ, MN)
-
-
-def _period_lanes_body(rk4, well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1):
-    """As _period_shared for lanes [0, 4M) with per-lane parameters: step h = HL[l] and
-    amplitude F = FL[l].  The coefficients h*c_k and forcing values F*sin_k are formed in the
-    loop: the same IEEE products as the precomputed ones of the shared path, so both paths
-    give bitwise identical trajectories.  (One chain per iteration: with 4 chains and six
-    arrays LLVM's runtime alias checks exceed its budget and the loop stays scalar.)"""
-    raise NotImplementedError("compiled code (numba)")
-
-
-@overload(_period_lanes_body)
-def _ol_period_lanes_body(rk4, well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1):
-    return _lanes_abs if _literal_flag(well) == QUARTIC else _lanes_signed
-
-
-@njit(cache=True)
-def _period_lanes(well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1):
-    if sintab.shape[1] == 3:
-        _period_lanes_body(True, well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1)
-    else:
-        _period_lanes_body(False, well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1)
 
 
 @njit(cache=True)

@@ -26,7 +26,8 @@ Wells (the compile-time flag ``well``)
 The well enters the step through the force -V'(q) + f and the escape test through
 2 H0 = p^2 + 2 V(q).  Both are inline functions specialised on a compile-time constant flag,
 like the scheme (kernels.py threads it through as a numba literal: each flag value is its own
-compiled, cached kernel, compiled on first use):
+compiled, cached kernel, compiled on first use; well_force / well_energy2 pick the flag's
+arithmetic at typing time):
 
 * ``QUARTIC`` (0): the paper's V = q^2/2 - q^4/4 in closed form, force fma(q*q, q, f - q),
   2 H0 = fma(q2, fma(-0.5, q2, 1.0), p*p) (q2 = q*q); the lanes track max |q| (symmetric
@@ -41,6 +42,9 @@ compiled, cached kernel, compiled on first use):
   explicit fma over the class's full length (the missing top coefficients are zeros, and a
   leading zero leaves the Horner value bitwise unchanged: fma(0, q, g) = g for finite q).
   Signed maxima (max q, max -q) as QUARTIC_SIGNED.
+
+Numba's on-disk cache of the kernels (kernels.py) does not see edits of this file: touch
+kernels.py after changing it.
 
 ``wpar`` (float64, ``N_WPAR``): [q_left, q_right, g_1 .. g_7, e_2 .. e_8]; the barriers
 (+-inf where there is none) are used by the signed flags, the coefficients by the POLY flags.
