@@ -39,9 +39,14 @@ from scipy import optimize
 
 from safebasins.checks import check_finite, check_nonnegative, check_positive, check_positive_int
 from safebasins.theory.slow_flow import SlowFlowProfile, _scalar
-from safebasins.wells.quartic import _G, _J, _phase_point, check_fourier, QUARTIC
+from safebasins.wells import resolve_well
 
 __all__ = ["safe_basin_boundaries"]
+
+
+def _unshear(g, shift):
+    """The slow phase gamma (in (-pi, pi]) of a point at gamma' = g on the sheared rays."""
+    return np.pi - np.mod(np.pi - (g - shift), 2.0 * np.pi)
 
 
 def _runs(mask):
@@ -71,7 +76,7 @@ def _root(fun, lo, hi):
 
 def _side_curves(prof, side, n_points):
     """Boundary curves on one side (0: gamma = 0 side via a/A*, 1: gamma = pi side via b/B*)."""
-    F, Om, fourier = prof.F, prof.Omega, prof.fourier
+    F, Om, w = prof.F, prof.Omega, prof.well
     xi = prof.xi
     f_own = prof.a if side == 0 else prof.b            # the side's own ray function
     f_opp = prof.b if side == 0 else prof.a
@@ -83,13 +88,13 @@ def _side_curves(prof, side, n_points):
     n = xi.size
 
     def own(x, L):
-        h = x - Om * _J(x)
-        g = F * _G(x, fourier)
+        h = x - Om * w.J(x)
+        g = F * w.harmonic_amplitude(x)
         return float((h - g if side == 0 else h + g) - L)
 
     def opp(x, L):
-        h = x - Om * _J(x)
-        g = F * _G(x, fourier)
+        h = x - Om * w.J(x)
+        g = F * w.harmonic_amplitude(x)
         return float((h + g if side == 0 else h - g) - L)
 
     curves = []
@@ -116,8 +121,8 @@ def _side_curves(prof, side, n_points):
             if hi <= lo:
                 continue
             x = _cheb(lo, hi, n_points)
-            h = x - Om * _J(x)
-            g = F * _G(x, fourier)
+            h = x - Om * w.J(x)
+            g = F * w.harmonic_amplitude(x)
             with np.errstate(divide="ignore", invalid="ignore"):
                 cg = np.where(g > 0, (h - L) / g, 0.0)
             gam = np.arccos(np.clip(cg, -1.0, 1.0))
@@ -138,7 +143,7 @@ def _side_curves(prof, side, n_points):
     return curves
 
 
-def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier="paper", n_points=400):
+def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier=None, n_points=400, well=None):
     """Boundaries of the analytic safe basin (paper Sec. 2.3, eqs 27-28).
 
     Parameters
@@ -146,7 +151,11 @@ def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier="paper", n_points=400):
     F, Omega, Psi, xi_max : float
         Forcing amplitude (>= 0), frequency (> 0), phase, truncation energy in (0, 1/4].
     fourier : "paper" | "exact"
-        Which G (eq 20).
+        Which G (eq 20) of the quartic (default "paper").
+    well : safebasins.wells.Well
+        The potential (default: the paper's quartic).  Curves are traced on the sheared rays
+        gamma + delta(xi) = 0, pi of a well whose first harmonic has a phase delta(xi) and
+        returned in the slow phase gamma itself.
     n_points : int
         Samples in xi per branch of each curve (each curve has 2 * n_points vertices, plus
         NaN separator rows where it crosses gamma = +-pi).
@@ -166,15 +175,15 @@ def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier="paper", n_points=400):
       whose level bounds the basin, else the lowest saddle below xi_max, else NaN; located by
       Brent's method on dC/dxi = 0 along the ray, cf. Newton-Raphson in Sec. 3.2).
     """
-    check_fourier(fourier)
+    w = resolve_well(well, fourier)
     F = _scalar("F", F, check_nonnegative)
     Om = _scalar("Omega", Omega, check_positive)
     Psi = _scalar("Psi", Psi, check_finite)
-    xm = _scalar("xi_max", xi_max, QUARTIC.check_threshold)
+    xm = _scalar("xi_max", xi_max, w.check_threshold)
     n_points = check_positive_int("n_points", n_points)
     if n_points < 3:
         raise ValueError("n_points must be >= 3")
-    prof = SlowFlowProfile(F, Om, xm, fourier)
+    prof = SlowFlowProfile(F, Om, xm, w)
     curves = []
     if F > 0:
         curves = _side_curves(prof, 0, n_points) + _side_curves(prof, 1, n_points)
@@ -189,10 +198,16 @@ def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier="paper", n_points=400):
         sg, sx = min(sad, key=lambda t: t[1])
     else:
         sg, sx = np.nan, np.nan
+    if np.isfinite(sx) and w.harmonic_shift(sx) != 0:
+        sg = _unshear(sg, w.harmonic_shift(sx))
 
     gam, xis, idx = [], [], []
     for k, c in enumerate(curves):
         g, x = c["gamma"], c["xi"]
+        shift = w.harmonic_shift(np.minimum(x, w.barrier_energy))
+        if np.any(shift != 0):  # back from the sheared rays to the slow phase
+            g = _unshear(g, shift)
+            c["ray"] = float(_unshear(c["ray"], w.harmonic_shift(c["xi_top"])))
         jump = np.nonzero(np.abs(np.diff(g)) > np.pi)[0]
         if jump.size:
             g = np.insert(g, jump + 1, np.nan)
@@ -208,7 +223,7 @@ def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier="paper", n_points=400):
     q0 = np.full(gam.shape, np.nan)
     p0 = np.full(gam.shape, np.nan)
     if fin.any():
-        q0[fin], p0[fin] = _phase_point(gam[fin] + Psi, np.minimum(xis[fin], np.nextafter(0.25, 0)))
+        q0[fin], p0[fin] = w.phase_point(gam[fin] + Psi, np.minimum(xis[fin], np.nextafter(w.barrier_energy, 0)))
 
     ds = xr.Dataset(
         {
@@ -229,7 +244,7 @@ def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier="paper", n_points=400):
             "p0_vertex": ("vertex", p0, {"units": "1", "long_name": "initial momentum"}),
             "curve_index": ("vertex", idx, {"long_name": "index of the curve a vertex belongs to"}),
         },
-        attrs={"F": F, "Omega": Om, "Psi": Psi, "xi_max": xm, "fourier": fourier,
+        attrs={"F": F, "Omega": Om, "Psi": Psi, "xi_max": xm, "fourier": w.fourier, "well": w.name,
                "saddle_gamma": float(sg), "saddle_xi": float(sx),
                "description": "analytic safe-basin boundaries, Karmi et al. Sec. 2.3 (eqs 27-28)"},
     )

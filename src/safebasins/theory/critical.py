@@ -44,7 +44,7 @@ import xarray as xr
 
 from safebasins.checks import check_finite, check_positive
 from safebasins.theory.slow_flow import _scalar, _xi_grid
-from safebasins.wells.quartic import QUARTIC, XI_SEPARATRIX, _G, _J, _dG_dxi, _omega, check_fourier
+from safebasins.wells import resolve_well
 
 __all__ = ["critical_forcing", "MECHANISMS"]
 
@@ -98,7 +98,7 @@ def _interior_max(L, valid, xi, refine_fun, n_iter=60):
     return x_out, v_out, exists
 
 
-def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier="paper", n_grid=2001):
+def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_grid=2001, well=None):
     """Critical forcing amplitude F_cr(Omega) of the slow flow (eqs 22-26).
 
     Parameters
@@ -110,7 +110,11 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier="paper", 
     xi_ini, gamma_ini : float
         Initial point on the RM (``0 <= xi_ini < xi_max``; gamma_ini = theta0 - Psi).  Zero IC by default.
     fourier : "paper" | "exact"
-        Which G (eq 20) to use.
+        Which G (eq 20) of the quartic to use (default "paper").
+    well : safebasins.wells.Well
+        The potential (default: the paper's quartic).  For a well whose first harmonic has a
+        phase delta(xi) the tangencies and saddles lie on gamma + delta(xi) = 0, pi and the
+        initial point enters through cos(gamma_ini + delta(xi_ini)).
     n_grid : int
         Nodes of the xi grid used to bracket the maxima (refined by bisection).
 
@@ -129,14 +133,15 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier="paper", 
       ``xi_saddle``, ``gamma_saddle`` the saddle of the F_SM branch (gamma 0 or pi),
       ``xi_saddle_smm`` the saddle above xi_max on the F_SMM branch.
     F_cr equals the largest existing branch, provided no upper-bound constraint excludes it.
-    Attributes: xi_max, xi_ini, gamma_ini, fourier.
+    Attributes: xi_max, xi_ini, gamma_ini, fourier, well.
     """
-    check_fourier(fourier)
+    well = resolve_well(well, fourier)
+    w, fourier, E_b = well, well.fourier, well.barrier_energy
     Om = np.atleast_1d(check_positive("Omega", Omega)).astype(float)
     if Om.ndim != 1:
         raise ValueError("Omega must be a scalar or 1-D array")
-    xm = _scalar("xi_max", xi_max, QUARTIC.check_threshold)
-    x0 = _scalar("xi_ini", xi_ini, QUARTIC.check_energy)
+    xm = _scalar("xi_max", xi_max, w.check_threshold)
+    x0 = _scalar("xi_ini", xi_ini, w.check_energy)
     if x0 >= xm:
         raise ValueError(f"xi_ini must be < xi_max ({xm}), got {x0}")
     g0 = _scalar("gamma_ini", gamma_ini, check_finite)
@@ -145,9 +150,9 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier="paper", 
 
     nO = Om.size
     xi = _xi_grid(x0, xm, int(n_grid))
-    Jg, Gg = _J(xi), _G(xi, fourier)
-    J0, G0 = float(_J(np.asarray(x0))), float(_G(np.asarray(x0), fourier))
-    c = np.cos(g0)
+    Jg, Gg = w.J(xi), w.harmonic_amplitude(xi)
+    J0, G0 = float(w.J(np.asarray(x0))), float(w.harmonic_amplitude(np.asarray(x0)))
+    c = np.cos(g0 + float(w.harmonic_shift(np.asarray(x0))))
     h = xi[None, :] - Om[:, None] * Jg[None, :]
     h0 = x0 - Om * J0
     numA = h - h0[:, None]
@@ -178,7 +183,7 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier="paper", 
         infeasible |= np.any(zB[None, :] & (numB > 1e-13), axis=1)
 
     # --- endpoint tangencies, eq (24)
-    end_ok = xm < XI_SEPARATRIX
+    end_ok = xm < E_b
     FA_end = np.where(posA[-1] & end_ok, LA[:, -1], np.nan)
     FB_end = np.where(posB[-1] & end_ok, LB[:, -1], np.nan)
     FA_end = np.where(FA_end > 0, FA_end, np.nan)
@@ -187,30 +192,30 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier="paper", 
     # --- interior maxima (saddle mechanism), refined on the sign of dL/dxi
     def dLA(rows, x):
         om = Om[rows]
-        hp = 1.0 - om / _omega(x)
-        num = x - om * _J(x) - h0[rows]
-        return hp * (_G(x, fourier) - G0 * c) - num * _dG_dxi(x, fourier)
+        hp = 1.0 - om / w.omega(x)
+        num = x - om * w.J(x) - h0[rows]
+        return hp * (w.harmonic_amplitude(x) - G0 * c) - num * w.harmonic_amplitude_derivative(x)
 
     def dLB(rows, x):
         om = Om[rows]
-        hp = 1.0 - om / _omega(x)
-        num = h0[rows] - (x - om * _J(x))
-        return -hp * (_G(x, fourier) + G0 * c) - num * _dG_dxi(x, fourier)
+        hp = 1.0 - om / w.omega(x)
+        num = h0[rows] - (x - om * w.J(x))
+        return -hp * (w.harmonic_amplitude(x) + G0 * c) - num * w.harmonic_amplitude_derivative(x)
 
     def L_at(x, rows, which):
         om = Om[rows]
-        hh = x - om * _J(x)
-        Gx = _G(x, fourier)
+        hh = x - om * w.J(x)
+        Gx = w.harmonic_amplitude(x)
         if which == 0:
             return (hh - h0[rows]) / (Gx - G0 * c)
         return (h0[rows] - hh) / (Gx + G0 * c)
 
     xA, vA, eA = _interior_max(LA, posA[None, :] & np.ones((nO, 1), bool), xi, dLA)
     xB, vB, eB = _interior_max(LB, posB[None, :] & np.ones((nO, 1), bool), xi, dLB)
-    for xs, vs, es, w in ((xA, vA, eA, 0), (xB, vB, eB, 1)):
+    for xs, vs, es, side in ((xA, vA, eA, 0), (xB, vB, eB, 1)):
         r = np.nonzero(es)[0]
         if r.size:
-            vs[r] = np.maximum(vs[r], L_at(xs[r], r, w))
+            vs[r] = np.maximum(vs[r], L_at(xs[r], r, side))
     vA = np.where(eA & (vA > 0), vA, np.nan)
     vB = np.where(eB & (vB > 0), vB, np.nan)
     useB = np.nan_to_num(vB, nan=-np.inf) > np.nan_to_num(vA, nan=-np.inf)
@@ -222,10 +227,10 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier="paper", 
     xi_smm = np.full(nO, np.nan)
     has_smm = np.zeros(nO, bool)
     rows = np.nonzero(np.isfinite(FA_end))[0]
-    if rows.size and xm < XI_SEPARATRIX:
-        up = _xi_grid(xm, XI_SEPARATRIX, 600)[:-1]
-        dG_up = _dG_dxi(up, fourier)
-        w_up = _omega(up)
+    if rows.size and xm < E_b:
+        up = _xi_grid(xm, E_b, 600)[:-1]
+        dG_up = w.harmonic_amplitude_derivative(up)
+        w_up = w.omega(up)
         ap = (1.0 - Om[rows, None] / w_up[None, :]) - FA_end[rows, None] * dG_up[None, :]
         sgn = ap > 0
         change = sgn[:, :-1] & ~sgn[:, 1:]
@@ -236,7 +241,7 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier="paper", 
             Fr = FA_end[rr]
 
             def dap(x, rr=rr, Fr=Fr):
-                return 1.0 - Om[rr] / _omega(x) - Fr * _dG_dxi(x, fourier)
+                return 1.0 - Om[rr] / w.omega(x) - Fr * w.harmonic_amplitude_derivative(x)
 
             xi_smm[rr] = _bisect(dap, up[j], up[j + 1])
             has_smm[rr] = True
@@ -273,7 +278,7 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier="paper", 
             "xi_saddle_smm": var(xi_smm, "averaged energy of the saddle above xi_max on the F_SMM branch"),
         },
         coords={"Omega": ("Omega", Om, {"units": "1", "long_name": "forcing frequency"})},
-        attrs={"xi_max": xm, "xi_ini": x0, "gamma_ini": g0, "fourier": fourier,
+        attrs={"xi_max": xm, "xi_ini": x0, "gamma_ini": g0, "fourier": fourier, "well": w.name,
                "description": "slow-flow (isolated 1:1 resonance) escape threshold, Karmi et al. eqs 18-26"},
     )
     return ds

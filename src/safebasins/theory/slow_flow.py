@@ -36,8 +36,8 @@ import numpy as np
 from scipy import optimize
 
 from safebasins.checks import check_finite, check_nonnegative, check_positive
-from safebasins.wells.quartic import (QUARTIC, XI_SEPARATRIX, _G, _H0, _J, _angle_energy, _dG_dxi,
-                                      _ell, _omega, check_fourier)
+from safebasins.wells import resolve_well
+from safebasins.wells.quartic import XI_SEPARATRIX, _G, _J, _dG_dxi, _ell, _omega
 
 __all__ = ["first_integral", "escapes_on_manifold", "slow_flow_escapes", "slow_flow_profile",
            "slow_flow_rhs", "xi_from_J", "saddles"]
@@ -50,29 +50,32 @@ def _scalar(name, value, check):
     return float(a)
 
 
-def first_integral(gamma, xi, F, Omega, fourier="paper"):
-    """First integral of the slow flow, eq (18): ``C = xi - Omega J(xi) - F G(xi) cos(gamma)``.
+def first_integral(gamma, xi, F, Omega, fourier=None, well=None):
+    """First integral of the slow flow, eq (18): ``C = xi - Omega J(xi) - F G(xi) cos(gamma)``;
+    for any well ``C = xi - Omega J(xi) - F A(xi) cos(gamma + delta(xi))`` with
+    ``q_1 = -i A e^{i delta}`` (wells.base).
 
-    Broadcasts all array arguments.  ``0 <= xi <= 1/4`` (G(1/4) = 0 limit), ``F >= 0``,
-    ``Omega > 0``.
+    Broadcasts all array arguments.  ``0 <= xi <= barrier energy`` (1/4 for the quartic, where
+    G(1/4) = 0), ``F >= 0``, ``Omega > 0``.  ``well``: the quartic by default; ``fourier``
+    ("paper" | "exact") selects the quartic's G.
     """
-    check_fourier(fourier)
+    w = resolve_well(well, fourier)
     gamma = check_finite("gamma", gamma)
-    xi = QUARTIC.check_energy("xi", xi, allow_separatrix=True)
+    xi = w.check_energy("xi", xi, allow_separatrix=True)
     F = check_nonnegative("F", F)
     Omega = check_positive("Omega", Omega)
-    return xi - Omega * _J(xi) - F * _G(xi, fourier) * np.cos(gamma)
+    return xi - Omega * w.J(xi) - F * w.harmonic_amplitude(xi) * np.cos(gamma + w.harmonic_shift(xi))
 
 
 # ----------------------------------------------------------------------------- profile
-def _h_prime(xi, Omega):
+def _h_prime(xi, Omega, well):
     with np.errstate(divide="ignore"):
-        return 1.0 - Omega / _omega(xi)
+        return 1.0 - Omega / well.omega(xi)
 
 
-def _ab_prime(xi, F, Omega, fourier):
-    hp = _h_prime(xi, Omega)
-    gp = _dG_dxi(xi, fourier)
+def _ab_prime(xi, F, Omega, well):
+    hp = _h_prime(xi, Omega, well)
+    gp = well.harmonic_amplitude_derivative(xi)
     return hp - F * gp, hp + F * gp
 
 
@@ -84,21 +87,21 @@ def _xi_grid(lo, hi, n):
     return x
 
 
-def _critical_points(xi, F, Omega, fourier, which):
+def _critical_points(xi, F, Omega, well, which):
     """Roots of a'(xi) (which=0) or b'(xi) (which=1) on the open interval of the grid.
 
     Returns (roots, kinds) with kind +1 for a local max, -1 for a local min.
     """
-    inner = xi[1:-1] if xi[-1] >= XI_SEPARATRIX else xi[1:]
+    inner = xi[1:-1] if xi[-1] >= well.barrier_energy else xi[1:]
     if inner.size < 2:
         return np.empty(0), np.empty(0, int)
-    d = _ab_prime(inner, F, Omega, fourier)[which]
+    d = _ab_prime(inner, F, Omega, well)[which]
     s = np.sign(d)
     idx = np.nonzero(s[:-1] * s[1:] < 0)[0]
     roots, kinds = [], []
 
     def f(x):
-        return float(_ab_prime(np.asarray(x), F, Omega, fourier)[which])
+        return float(_ab_prime(np.asarray(x), F, Omega, well)[which])
 
     for i in idx:
         r = optimize.brentq(f, inner[i], inner[i + 1], xtol=1e-15, rtol=1e-15, maxiter=200)
@@ -112,20 +115,21 @@ class SlowFlowProfile:
 
     Attributes: ``xi``, ``h``, ``a``, ``b``, ``A`` (suffix max of a), ``B`` (suffix min of b),
     ``a_max``/``b_min`` (xi of interior local maxima of a / minima of b: saddles on
-    gamma = 0 / pi), ``a_min``/``b_max`` (centres).
+    gamma = 0 / pi), ``a_min``/``b_max`` (centres).  For a well whose first harmonic has a
+    phase delta(xi), a and b are C on the sheared rays gamma + delta(xi) = 0, pi.
     """
 
-    def __init__(self, F, Omega, xi_max, fourier="paper", n=1500, lo=0.0):
-        self.F, self.Omega, self.xi_max, self.fourier = F, Omega, xi_max, fourier
+    def __init__(self, F, Omega, xi_max, well, n=1500, lo=0.0):
+        self.F, self.Omega, self.xi_max, self.well = F, Omega, xi_max, well
         base = _xi_grid(lo, xi_max, n)
-        ra, ka = _critical_points(base, F, Omega, fourier, 0)
-        rb, kb = _critical_points(base, F, Omega, fourier, 1)
+        ra, ka = _critical_points(base, F, Omega, well, 0)
+        rb, kb = _critical_points(base, F, Omega, well, 1)
         self.a_max, self.a_min = ra[ka > 0], ra[ka < 0]
         self.b_min, self.b_max = rb[kb < 0], rb[kb > 0]
         xi = np.unique(np.concatenate([base, ra, rb]))
         self.xi = xi
-        self.J = _J(xi)
-        self.Gv = _G(xi, fourier)
+        self.J = well.J(xi)
+        self.Gv = well.harmonic_amplitude(xi)
         self.h = xi - Omega * self.J
         self.a = self.h - F * self.Gv
         self.b = self.h + F * self.Gv
@@ -139,26 +143,30 @@ class SlowFlowProfile:
         return self.A[j], self.B[j]
 
 
-def slow_flow_profile(F, Omega, xi_max, fourier="paper", n=1500):
+def slow_flow_profile(F, Omega, xi_max, fourier=None, n=1500, well=None):
     """Build the :class:`SlowFlowProfile` (a, b, suffix extrema, critical points) for one
     parameter set; see the module docstring."""
-    check_fourier(fourier)
+    w = resolve_well(well, fourier)
     F = _scalar("F", F, check_nonnegative)
     Omega = _scalar("Omega", Omega, check_positive)
-    xi_max = _scalar("xi_max", xi_max, QUARTIC.check_threshold)
+    xi_max = _scalar("xi_max", xi_max, w.check_threshold)
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 16:
         raise ValueError(f"n must be an integer >= 16 (nodes of the xi grid of the profile), got {n!r}")
-    return SlowFlowProfile(F, Omega, xi_max, fourier, n)
+    return SlowFlowProfile(F, Omega, xi_max, w, n)
 
 
-def saddles(F, Omega, xi_max=XI_SEPARATRIX, fourier="paper"):
+def saddles(F, Omega, xi_max=None, fourier=None, well=None):
     """Saddles of the slow flow below xi_max (eq 25), as a list of ``(gamma, xi)``.
 
     gamma = 0 saddles are interior maxima of ``a(xi)``, gamma = pi saddles interior minima of
     ``b(xi)``; each root of ``a'`` / ``b'`` is bracketed on a fine grid and polished by Brent's
-    method (the paper uses Newton-Raphson, Sec. 3.2).
+    method (the paper uses Newton-Raphson, Sec. 3.2).  ``xi_max``: the barrier energy by
+    default.  For a well with a phase delta(xi), the returned gamma is 0 or pi of the sheared
+    rays (the saddle's slow phase is gamma - delta(xi)).
     """
-    prof = slow_flow_profile(F, Omega, xi_max, fourier)
+    w = resolve_well(well, fourier)
+    xi_max = w.barrier_energy if xi_max is None else xi_max
+    prof = slow_flow_profile(F, Omega, xi_max, n=1500, well=w)
     out = [(0.0, float(x)) for x in prof.a_max if x < xi_max]
     out += [(np.pi, float(x)) for x in prof.b_min if x < xi_max]
     return sorted(out, key=lambda t: t[1])
@@ -174,44 +182,45 @@ def _escapes_rm(gamma, xi, prof):
         out[inside] = False
         return out
     g, x = gamma[inside], xi[inside]
-    c0 = x - Omega * _J(x) - F * _G(x, prof.fourier) * np.cos(g)
+    w = prof.well
+    c0 = x - Omega * w.J(x) - F * w.harmonic_amplitude(x) * np.cos(g + w.harmonic_shift(x))
     A, B = prof.suffix(x)
     out[inside] = (A <= c0) & (c0 <= B)
     return out
 
 
-def escapes_on_manifold(gamma, xi, F, Omega, xi_max, fourier="paper"):
+def escapes_on_manifold(gamma, xi, F, Omega, xi_max, fourier=None, well=None):
     """Does the slow-flow level curve (21) through ``(gamma, xi)`` reach ``xi = xi_max``?
 
     Boolean array (True = escapes), broadcast over gamma and xi; points with
     ``xi >= xi_max`` escape.  F, Omega, xi_max are scalars.  Criterion: see module docstring
     (``max a <= C(gamma, xi) <= min b`` over ``[xi, xi_max]``).
     """
-    check_fourier(fourier)
+    w = resolve_well(well, fourier)
     gamma = check_finite("gamma", gamma)
-    xi = QUARTIC.check_energy("xi", xi, allow_separatrix=True)
-    prof = slow_flow_profile(F, Omega, xi_max, fourier)
+    xi = w.check_energy("xi", xi, allow_separatrix=True)
+    prof = slow_flow_profile(F, Omega, xi_max, well=w)
     return _escapes_rm(gamma, xi, prof)
 
 
-def slow_flow_escapes(q0, p0, F, Omega, Psi, xi_max, fourier="paper"):
+def slow_flow_escapes(q0, p0, F, Omega, Psi, xi_max, fourier=None, well=None):
     """Analytic escape prediction for initial conditions ``(q0, p0)`` at tau = 0.
 
     Each IC is mapped to ``(theta0, xi_ini)`` (eqs 7, 14), ``gamma_ini = theta0 - Psi``, and
     classified by whether the level curve of C (eq 18) through ``(gamma_ini, xi_ini)`` reaches
-    ``xi_max`` (eq 21).  ICs with ``H0 >= xi_max`` or ``|q0| >= 1`` escape.  Broadcasts q0 and
-    p0; F, Omega, Psi, xi_max are scalars.  Returns a bool array (True = escapes).
+    ``xi_max`` (eq 21).  ICs with ``H0 >= xi_max`` or beyond a barrier escape.  Broadcasts q0
+    and p0; F, Omega, Psi, xi_max are scalars.  Returns a bool array (True = escapes).
     """
-    check_fourier(fourier)
+    w = resolve_well(well, fourier)
     q0 = check_finite("q0", q0)
     p0 = check_finite("p0", p0)
     _scalar("Psi", Psi, check_finite)
-    prof = slow_flow_profile(F, Omega, xi_max, fourier)
+    prof = slow_flow_profile(F, Omega, xi_max, well=w)
     q0, p0 = np.broadcast_arrays(q0, p0)
-    H = _H0(q0, p0)
-    inside = (np.abs(q0) < 1.0) & (H < prof.xi_max)
+    H = w.H0(q0, p0)
+    inside = w.in_well(q0) & (H < prof.xi_max)
     out = np.ones(q0.shape, dtype=bool)
-    theta, xi = _angle_energy(q0[inside], p0[inside])
+    theta, xi = w.angle_energy(q0[inside], p0[inside])
     out[inside] = _escapes_rm(theta - float(Psi), xi, prof)
     return out
 

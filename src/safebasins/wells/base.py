@@ -44,6 +44,9 @@ class Well(abc.ABC):
 
     #: short name used in datasets and configs ("quartic", "cubic", "polynomial", ...)
     name: str = "well"
+    #: which first harmonic the slow flow uses: the exact one (the quartic can also use the
+    #: paper's truncated eq (20): "paper")
+    fourier: str = "exact"
 
     # ------------------------------------------------------------------ the potential
     @abc.abstractmethod
@@ -101,3 +104,47 @@ class Well(abc.ABC):
     @abc.abstractmethod
     def first_harmonic(self, E):
         """Complex first Fourier coefficient ``q_1(E)`` of ``q(theta)`` (eq 12)."""
+
+    # ------------------------------------------------------------------ what the slow flow needs
+    # With q_1 = -i A e^{i delta}, q(theta) = 2 A sin(theta + delta) + ... and the averaged
+    # forcing term is F A cos(gamma + delta): the first integral (eq 18 generalised) is
+    # C(gamma, xi) = xi - Omega J(xi) - F A(xi) cos(gamma + delta(xi)).  The shear
+    # gamma -> gamma + delta(xi) is a homeomorphism of the resonance-manifold cylinder that keeps
+    # every circle xi = const, so the escape classification, the critical points and the
+    # tangencies of the quartic carry over with G -> A and gamma -> gamma + delta(xi).
+    @abc.abstractmethod
+    def harmonic_amplitude(self, E):
+        """``A(E) = |q_1(E)|`` (the quartic's G of eq 20)."""
+
+    @abc.abstractmethod
+    def harmonic_amplitude_derivative(self, E):
+        """``dA/dE`` for ``0 < E < barrier_energy``."""
+
+    @abc.abstractmethod
+    def harmonic_phase(self, E):
+        """``arg q_1(E)``, continuous in E (``-pi/2`` for a symmetric well)."""
+
+    def harmonic_shift(self, E):
+        """``delta(E) = arg q_1(E) + pi/2``: the slow phase shift of the first harmonic (0 for a
+        symmetric well)."""
+        return self.harmonic_phase(E) + 0.5 * np.pi
+
+    def in_well(self, q):
+        """``q`` strictly between the barriers (everything on a side without a barrier)."""
+        lo, hi = self.barriers
+        q = np.asarray(q, dtype=float)
+        return (q > lo) & (q < hi)
+
+    def check_threshold(self, name, xi_max):
+        """Energy truncation level in ``(0, barrier_energy]``."""
+        from safebasins.checks import as_array, value_repr
+
+        a = as_array(name, xi_max)
+        if ((a <= 0) | (a > self.barrier_energy)).any():
+            raise ValueError(f"{name} must lie in (0, {self.barrier_energy!r}] (the barrier energy of the "
+                             f"{self.name} well), got {value_repr(a)}")
+        return a
+
+    def unforced_safe(self, q, p, xi_max):
+        """The unforced safe set of a threshold: ``H0 < xi_max`` inside the well."""
+        return (self.H0(q, p) < xi_max) & self.in_well(q)

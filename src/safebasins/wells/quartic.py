@@ -284,6 +284,23 @@ class QuarticWell(Well):
         """``q_1 = -i G`` (``q(theta) = 2 G sin(theta) + ...``), G of this well's ``fourier``."""
         return -1j * _G(self.check_energy("E", E, allow_separatrix=True), self.fourier)
 
+    def harmonic_amplitude(self, E):
+        """G of eq (20) (this well's ``fourier``): ``|q_1|``."""
+        return _G(self.check_energy("E", E, allow_separatrix=True), self.fourier)
+
+    def harmonic_amplitude_derivative(self, E):
+        xi = self.check_energy("E", E)
+        if (xi <= 0).any():
+            raise ValueError("E must be > 0 for dG/dxi (G ~ sqrt(xi/2) at the well bottom)")
+        return _dG_dxi(xi, self.fourier)
+
+    def harmonic_phase(self, E):
+        return np.full(np.shape(self.check_energy("E", E, allow_separatrix=True)), -0.5 * np.pi)
+
+    def harmonic_shift(self, E):
+        """Exactly 0: the quartic is symmetric, ``q(theta)`` is odd."""
+        return np.zeros(np.shape(self.check_energy("E", E, allow_separatrix=True)))
+
 
 #: the paper's well with the paper's first harmonic
 QUARTIC = QuarticWell("paper")

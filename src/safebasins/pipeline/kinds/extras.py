@@ -148,7 +148,7 @@ class Erosion(Kind):
                       "type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1, "default": 0.5},
             "analytic_n": {"description": "ICs per axis of the analytic (slow-flow) profile on the grid's window "
                                           "(null: the chart grid); finer than the chart: smooth analytic curves",
-                           "oneOf": [{"type": "null"}, {"type": "integer", "minimum": 3}], "default": None},
+                           "oneOf": [{"type": "null"}, {"type": "integer", "minimum": 3}], "default": 481},
         },
     }
 
