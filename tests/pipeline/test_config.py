@@ -10,6 +10,7 @@ import yaml
 from jsonschema import Draft202012Validator
 from safebasins.pipeline.config import merge_config as update_config
 
+from safebasins import wells
 from safebasins.pipeline import catalog
 from safebasins.pipeline.config import REPO_ROOT, ConfigError, build_schema, load_yaml, validate_config
 from safebasins.pipeline.plan import plan
@@ -118,9 +119,9 @@ def test_tile_slices_cover_exactly():
 # ---------------------------------------------------------------- bad configurations
 # (override merged into the paper config, key that the message must name)
 BAD = [
-    ({"figures": {"fig13": {"xi_max": [0.1, 0.3]}}}, "figures.fig13.xi_max[1]", "maximum"),
-    ({"figures": {"fig05": {"xi_max": 0.26}}}, "figures.fig05.xi_max", "maximum"),
-    ({"figures": {"fig20": {"xi_max": [0.2501]}}}, "figures.fig20.xi_max[0]", "maximum"),
+    ({"figures": {"fig13": {"xi_max": [0.1, 0.3]}}}, "figures.fig13.xi_max[1]", "barrier energy 0.25 of the quartic"),
+    ({"figures": {"fig05": {"xi_max": 0.26}}}, "figures.fig05.xi_max", "barrier energy"),
+    ({"figures": {"fig20": {"xi_max": [0.2501]}}}, "figures.fig20.xi_max[0]", "barrier energy"),
     ({"figures": {"fig05": {"F": -0.1}}}, "figures.fig05.F", "minimum"),
     ({"figures": {"fig16": {"F": [0.01, -0.01]}}}, "figures.fig16.F[1]", "minimum"),
     ({"figures": {"fig19": {"F": {"start": -0.01, "stop": 0.07, "step": 0.005}}}}, "figures.fig19.F.start", ">= 0"),
@@ -168,7 +169,7 @@ BAD = [
     ({"experiments": {"toy": {"kind": "no_such_kind"}}}, "experiments.toy.kind", ""),
     ({"experiments": {"fig13": {"kind": "chart"}}}, "experiments.fig13", "already an experiment"),
     ({"experiments": {"zoom": {"kind": "chart", "F": 0.01, "Omega": 0.9, "Psi": 0, "xi_max": 0.3,
-                               "grid": {"q0": [-1, 1], "p0": [-1, 1], "n": 10}}}}, "experiments.zoom.xi_max", "maximum"),
+                               "grid": {"q0": [-1, 1], "p0": [-1, 1], "n": 10}}}}, "experiments.zoom.xi_max", "barrier energy"),
     ({"extensions": ["no.such.module"]}, "extensions[0]", "cannot import"),
     ({"figures": {"fig10": {"numeric": {"F_bracket": [0.3, 0.1]}}}}, "figures.fig10.numeric.F_bracket", "empty bracket"),
     ({"figures": {"fig10": {"numeric": {"tol": 0}}}}, "figures.fig10.numeric.tol", ""),
@@ -189,6 +190,20 @@ BAD = [
     ({"figures": {"fig19": {"F": {"start": 0.001, "stop": 0.07, "step": 0.005}}}}, "figures.fig19.F",
      "not reached by whole steps"),
     ({"figures": {"fig01": {"Omega": {"step": 0.01}}}}, "figures.fig01.Omega", "set the other one to null"),
+    # issue 12: the well of an experiment
+    ({"figures": {"fig05": {"well": "sextic"}}}, "figures.fig05.well", ""),
+    ({"figures": {"fig05": {"well": {"polynomial": [0, 0.1, 0.5, 0, -0.25]}}}}, "figures.fig05.well", "V'(0) = 0"),
+    ({"figures": {"fig05": {"well": {"polynomial": [0, 0, -0.5, 0, 1]}}}}, "figures.fig05.well", "c_2"),
+    ({"figures": {"fig05": {"well": {"polynomial": [0, 0, 0.5, 0, 0.25]}}}}, "figures.fig05.well", "no barrier"),
+    ({"figures": {"fig05": {"well": "cubic", "xi_max": 0.2}}}, "figures.fig05.xi_max", "barrier energy 0.166667 of the cubic"),
+    ({"figures": {"fig01": {"well": "cubic", "xi_max": [0.1, 0.15, 0.17]}}}, "figures.fig01.xi_max[2]", "cubic"),
+    ({"figures": {"fig04": {"well": "cubic", "xi_max": [0.1, wells.cubic().barrier_energy]}}}, "figures.fig04.xi_max[1]", "separatrix"),
+    ({"figures": {"fig19": {"well": "cubic"}}}, "figures.fig19.well", "quartic only"),
+    ({"figures": {"fig18": {"well": "cubic", "xi_max": 0.1}}}, "figures.fig18.well", "quartic only"),
+    ({"extras": {"erosion": {"well": "cubic", "xi_max": [0.1]}}}, "extras.erosion.fourier", "exact first harmonic"),
+    ({"experiments": {"c": {"kind": "chart", "well": "cubic", "F": 0.01, "Omega": 0.9, "Psi": 0, "xi_max": 0.1,
+                            "q_max": 0.5, "grid": {"q0": [-1, 1], "p0": [-1, 1], "n": 10}}}}, "experiments.c.q_max",
+     "symmetric displacement"),
 ]
 
 

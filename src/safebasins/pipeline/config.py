@@ -22,7 +22,7 @@ import yaml
 
 from safebasins.pipeline import catalog
 from safebasins.pipeline.registry import KINDS
-from safebasins.pipeline.validation import CheckContext, ConfigError, fail, key_path
+from safebasins.pipeline.validation import CheckContext, ConfigError, fail, indexed, key_path
 
 REPO_ROOT = Path(__file__).resolve().parents[3]
 SCHEMA_PATH = REPO_ROOT / "workflow" / "schemas" / "config.schema.yaml"
@@ -62,6 +62,8 @@ def build_schema(base=None) -> dict:
     defs = schema.setdefault("$defs", {})
     for name, kind in KINDS.items():
         defs[name] = copy.deepcopy(kind.schema)
+        # every experiment may name its well (issue 12); the quartic keeps the paper's results
+        defs[name].setdefault("properties", {})["well"] = {"$ref": "#/$defs/well", "default": "quartic"}
     props = schema["properties"]
     for d in catalog.DECLARATIONS:
         block, key = d.key
@@ -198,7 +200,35 @@ def validate_config(config: dict) -> dict:
         sub["$defs"] = schema["$defs"]
         _schema_check(_default_filling_validator(sub), blk, ("experiments", name))
     exps = experiment_blocks(config)
-    ctx = CheckContext(config, kinds={n: k for n, k, *_ in exps}, blocks={n: b for n, _, _, b, _ in exps})
+    ctx = CheckContext(config, kinds={n: k for n, k, *_ in exps}, blocks={n: b for n, _, _, b, _ in exps},
+                       keys={n: key for n, _, key, _, _ in exps})
     for name, kind, key, blk, _ in exps:
+        _check_well(blk, key, ctx.well(name), KINDS[kind])
         KINDS[kind].check(blk, key, ctx)
     return config
+
+
+def _check_well(block, key, well, kind):
+    """What depends on the experiment's well: the kind accepts it; every ``xi_max`` (truncation
+    level) at most, every ``xi_ini`` below, its barrier energy (the schema only knows they are
+    positive); the paper's first harmonic and symmetric displacement bounds only for the quartic."""
+    if well.name != "quartic" and not kind.any_well:
+        fail(f"{key}.well", f"kind {kind.name!r} is written for the paper's quartic only, not the {well.name} well")
+    if well.name != "quartic" and block.get("q_max") not in (None, []):
+        fail(f"{key}.q_max", f"q_max is a symmetric displacement bound |q| < q_max (eq 4); the {well.name} well "
+                             "escapes through its own barriers: use the energy criterion (xi_max)")
+    if well.name != "quartic" and "paper" in (block["fourier"] if isinstance(block.get("fourier"), list)
+                                               else [block.get("fourier")]):
+        fail(f"{key}.fourier", f"'paper' is the quartic's truncated first harmonic (eq 20); the {well.name} well "
+                               "uses its exact first harmonic: set fourier to exact (or [exact])")
+    top = well.barrier_energy
+    for sub, blk in [("", block)] + [(f".{k}", v) for k, v in block.items() if isinstance(v, dict)]:
+        for name, strict in (("xi_max", False), ("xi_ini", True)):
+            vals = blk.get(name)
+            for i, x in enumerate(vals if isinstance(vals, list) else [] if vals is None else [vals]):
+                if not isinstance(x, (int, float)):
+                    continue
+                if x > top or (strict and x >= top):
+                    what = "below" if strict else "at most"
+                    fail(indexed(f"{key}{sub}.{name}", vals, i),
+                         f"{x} must be {what} the barrier energy {top:.6g} of the {well.name} well")

@@ -13,6 +13,7 @@ import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
+from safebasins import wells
 from safebasins.pipeline.config import experiment_blocks, load_yaml, merge_config, validate_config
 from safebasins.pipeline.registry import (KINDS, PARTS_DIR, Experiment, FigureSpec, Product, params_path)
 
@@ -23,7 +24,8 @@ __all__ = ["Plan", "ResolveContext", "plan", "tile_path", "load_config"]
 class ResolveContext:
     """Global settings a kind's ``resolve`` may use."""
 
-    fourier: str
+    fourier: str         # the config's fourier for the quartic; "exact" for every other well
+    well: dict           # the experiment's well spec (safebasins.wells.spec_of)
     steps_per_cycle: int
     seed: int            # the config seed plus this experiment's offset
 
@@ -64,10 +66,12 @@ class Plan:
         self._products: dict[str, tuple[Experiment, Product]] = {}
         for name, kind_name, key, blk, decl in experiment_blocks(config):
             kind = KINDS[kind_name]
-            ctx = ResolveContext(fourier=config["fourier"], steps_per_cycle=int(num["steps_per_cycle"]),
+            well = wells.spec_of(blk["well"])
+            ctx = ResolveContext(fourier=config["fourier"] if well["name"] == "quartic" else "exact", well=well,
+                                 steps_per_cycle=int(num["steps_per_cycle"]),
                                  seed=int(config["seed"]) + _seed_offset(name, decl))
             title = decl.title if decl is not None else blk.get("title", f"{name} ({kind_name})")
-            params = {"experiment": name, "kind": kind_name, "title": title, **kind.resolve(blk, ctx)}
+            params = {"experiment": name, "kind": kind_name, "title": title, "well": well, **kind.resolve(blk, ctx)}
             exp = Experiment(name=name, kind=kind, key=key, params=params, figure=_figure(name, kind, params, decl),
                              products=tuple(kind.products(name, params)), tasks=tuple(kind.tasks(params)))
             self.experiments[name] = exp

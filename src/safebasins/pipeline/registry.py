@@ -122,6 +122,9 @@ class Kind:
     schema: ClassVar[dict]
     #: plotting function of its figure, "safebasins.plotting.<module>:<function>" (None: no figure)
     builder: ClassVar[str | None] = None
+    #: False: the kind is written for the paper's quartic only (a config naming another well
+    #: for it is rejected); True: it takes the experiment's ``well:`` (params["well"])
+    any_well: ClassVar[bool] = True
 
     def check(self, block: dict, key: str, ctx) -> None:
         """Checks beyond the schema; raise ``ctx.fail(key + ".field", message)``."""

@@ -5,7 +5,7 @@ Messages read ``config key figures.fig13.xi_max[2]: <what is wrong and what to d
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 
 class ConfigError(ValueError):
@@ -40,9 +40,29 @@ class CheckContext:
     config: dict
     kinds: dict          # experiment name -> kind name
     blocks: dict         # experiment name -> its (default-filled) config block
+    keys: dict           # experiment name -> its dotted config key
+    _wells: dict = field(default_factory=dict)   # well spec -> well object (built once)
 
     def block(self, experiment: str) -> dict:
         return self.blocks[experiment]
+
+    def well(self, experiment: str):
+        """The experiment's well (safebasins.wells); an invalid well is an error naming ``<key>.well``."""
+        from safebasins import wells
+
+        spec = wells.spec_of(self.blocks[experiment]["well"])
+        key = repr(spec)
+        if key not in self._wells:
+            try:
+                self._wells[key] = wells.from_spec(spec, self.config["fourier"])
+            except ValueError as exc:
+                fail(f"{self.keys[experiment]}.well", f"not a potential well: {exc}")
+        return self._wells[key]
+
+    def well_at(self, key: str):
+        """The well of the experiment at dotted config key ``key`` (what a kind's ``check`` gets)."""
+        (name,) = [n for n, k in self.keys.items() if k == key]
+        return self.well(name)
 
     @property
     def tiles(self) -> int:
@@ -94,11 +114,14 @@ class CheckContext:
         if self.tiles > nq:
             fail("numerics.tiles", f"{self.tiles} tiles but {key} has only {nq} q0 rows")
 
-    def check_thresholds_below_separatrix(self, key, values, what):
+    def check_thresholds_below_separatrix(self, key, values, what, well):
+        """Analytic products need xi_max strictly below the well's barrier energy."""
+        top = well.barrier_energy
         for i, x in enumerate(values if isinstance(values, (list, tuple)) else [values]):
-            if x >= 0.25:
+            if x >= top:
                 fail(indexed(key, values, i),
-                     f"{what} needs xi_max < 0.25 (the action-angle map is singular on the separatrix), got {x}")
+                     f"{what} needs xi_max < {top:.6g}, the barrier energy of the {well.name} well (the "
+                     f"action-angle map is singular on the separatrix), got {x}")
 
     def check_t_eval_within(self, key, t_eval, cycles):
         t = t_eval if isinstance(t_eval, (list, tuple)) else [t_eval]

@@ -89,3 +89,12 @@ def tile_slice(n: int, tiles: int, tile: int) -> slice:
         raise ValueError(f"tile must lie in [0, {tiles}), got {tile}")
     edges = np.linspace(0, n, tiles + 1).round().astype(int)
     return slice(int(edges[tile]), int(edges[tile + 1]))
+
+
+def well(params, fourier=None):
+    """The well object of resolved parameters (``params["well"]``, a spec of
+    :func:`safebasins.wells.spec_of`) with the experiment's first harmonic (``fourier``: one
+    variant of a list-valued ``params["fourier"]``)."""
+    from safebasins import wells
+
+    return wells.from_spec(params["well"], params["fourier"] if fourier is None else fourier)

@@ -80,7 +80,7 @@ def nome(xi):
     return _nome(QUARTIC.check_energy("xi", xi, allow_separatrix=True))
 
 
-def angle_energy(q, p):
+def angle_energy(q, p, well=None):
     """Angle and energy ``(theta, xi)`` of a phase point, eqs (7) and (14).
 
     ``xi = H0(q, p)``; ``theta = pi F(phi|m) / (2 K)`` with the Jacobi amplitude ``phi`` taken
@@ -88,29 +88,40 @@ def angle_energy(q, p):
     covered: eq (14) alone (``phi = arcsin(q/A)``) gives only the half orbit with ``p >= 0``.
     ``theta`` is in ``[0, 2 pi)``; ``theta = 0`` at the well bottom (angle immaterial).
     Points must lie inside the well: ``|q| < 1`` and ``H0 < 1/4``.
+    ``well``: another well (safebasins.wells) with the same angle convention (theta = 0 at
+    q = 0 with p > 0); the default is the quartic.
     """
-    return QUARTIC.angle_energy(q, p)
+    return (QUARTIC if well is None else _well(well)).angle_energy(q, p)
 
 
-def phase_point(theta, xi):
+def phase_point(theta, xi, well=None):
     """Phase point ``(q, p)`` of angle theta on the free orbit of energy xi, eqs (15), (17).
 
     ``q = sqrt(1 - mu) sn(2 K theta / pi | m)``,
-    ``p = sqrt((1 - mu^2)/2) cn(.) dn(.)``.  Inverse of :func:`angle_energy`.
+    ``p = sqrt((1 - mu^2)/2) cn(.) dn(.)``.  Inverse of :func:`angle_energy`; ``well``: another
+    well's orbit (numeric action-angle for wells without closed forms).
     """
     theta = check_finite("theta", theta)
+    if well is not None:
+        return _well(well).phase_point(theta, xi)
     xi = QUARTIC.check_energy("xi", xi)
     theta, xi = np.broadcast_arrays(theta, xi)
     return _phase_point(theta, xi)
 
 
-def initial_condition(xi_ini, gamma_ini, Psi):
+def initial_condition(xi_ini, gamma_ini, Psi, well=None):
     """IC ``(q0, p0)`` with averaged energy xi_ini and slow phase gamma_ini at tau = 0.
 
     ``gamma = theta - Psi - Omega tau`` so ``theta0 = gamma_ini + Psi``:
-    returns ``phase_point(gamma_ini + Psi, xi_ini)``.
+    returns ``phase_point(gamma_ini + Psi, xi_ini)`` (of ``well``; default the quartic).
     """
-    xi = QUARTIC.check_energy("xi_ini", xi_ini)
+    xi = (QUARTIC if well is None else _well(well)).check_energy("xi_ini", xi_ini)
     g = check_finite("gamma_ini", gamma_ini)
     ps = check_finite("Psi", Psi)
-    return phase_point(g + ps, xi)
+    return phase_point(g + ps, xi, well)
+
+
+def _well(well):
+    from safebasins.wells import resolve_well
+
+    return resolve_well(well)

@@ -7,22 +7,10 @@ wells.numeric, wells.polynomial).  :func:`resolve_well` is how the theory reads 
 """
 from safebasins.wells.base import Well
 from safebasins.wells.quartic import FOURIER_VARIANTS, QUARTIC, QuarticWell
+# (bound here, after the submodule import, so the package attribute is the function)
+from safebasins.wells.polynomial import cubic, polynomial  # noqa: E402
 
 __all__ = ["Well", "QuarticWell", "QUARTIC", "resolve_well", "from_spec", "spec_of", "cubic", "polynomial"]
-
-
-def cubic():
-    """The escape equation q'' + q - q^2 = F sin(Omega t + Psi): V = q^2/2 - q^3/3, one barrier at q = 1."""
-    from safebasins.wells.polynomial import cubic as _cubic
-
-    return _cubic()
-
-
-def polynomial(coefficients):
-    """The well V(q) = sum_k c_k q^k (c_0 = c_1 = 0, c_2 > 0)."""
-    from safebasins.wells.polynomial import polynomial as _polynomial
-
-    return _polynomial(coefficients)
 
 
 def resolve_well(well=None, fourier=None) -> Well:

@@ -46,8 +46,9 @@ def _one_basin(params, F, Omega, Psi, xi_max):
     qa, pa = values.grid_axes(params["grid"])
     Q, P = np.meshgrid(qa, pa, indexing="ij")
     print(f"{params['experiment']}: basin F={F} Omega={Omega} Psi={Psi} xi_max={xi_max}")
-    b = safe_basin_boundaries(F, Omega, Psi, xi_max, fourier=params["fourier"], n_points=params["n_points"])
-    esc = slow_flow_escapes(Q, P, F, Omega, Psi, xi_max, fourier=params["fourier"])
+    w = values.well(params)
+    b = safe_basin_boundaries(F, Omega, Psi, xi_max, well=w, n_points=params["n_points"])
+    esc = slow_flow_escapes(Q, P, F, Omega, Psi, xi_max, well=w)
     b["escapes"] = xr.DataArray(np.asarray(esc, dtype=bool), dims=("q0", "p0"))
     return b.assign_coords(q0=("q0", qa), p0=("p0", pa))
 
@@ -71,8 +72,9 @@ def build_basin_single(params, inputs, job):
         g = np.linspace(-np.pi, np.pi, m["n_gamma"])
         x = np.linspace(0.0, m["xi_top"], m["n_xi"])
         G, X = np.meshgrid(g, x, indexing="ij")
-        C = first_integral(G, X, params["F"], params["Omega"], fourier=params["fourier"])
-        E = escapes_on_manifold(G, X, params["F"], params["Omega"], params["xi_max"], fourier=params["fourier"])
+        w = values.well(params)
+        C = first_integral(G, X, params["F"], params["Omega"], well=w)
+        E = escapes_on_manifold(G, X, params["F"], params["Omega"], params["xi_max"], well=w)
         out = out.assign_coords(gamma_rm=("gamma_rm", g), xi_rm=("xi_rm", x))
         out["C"] = (("gamma_rm", "xi_rm"), np.asarray(C, dtype=float))
         out["escapes_rm"] = (("gamma_rm", "xi_rm"), np.asarray(E, dtype=bool))
@@ -93,7 +95,7 @@ def _numeric_check(out, params, job):
     if safe.any():
         ch = escape_chart(Q[safe], P[safe], params["F"], params["Omega"], params["Psi"], xi_max=(params["xi_max"],),
                           cycles=params["check_cycles"], steps_per_cycle=params["steps_per_cycle"],
-                          threads=job.threads, grid=False)
+                          threads=job.threads, grid=False, well=values.well(params))
         ec[safe] = np.asarray(ch["escape_cycle_energy"].isel(xi_max=0).values, float)
     lab, size, frac = confirm_regions(safe, ec, params["check_cycles"])
     out["escape_cycle_numeric"] = (("q0", "p0"), ec, {
@@ -289,7 +291,7 @@ class BasinRM(Kind):
 
     def check(self, block, key, ctx):
         ctx.check_grid(f"{key}.grid", block["grid"])
-        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin")
+        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key))
         if block["manifold"]["xi_top"] <= 0:
             ctx.fail(f"{key}.manifold.xi_top", "must be > 0")
 
@@ -339,7 +341,7 @@ class BasinChart(Kind):
 
     def check(self, block, key, ctx):
         ctx.check_grid(f"{key}.grid", block["grid"])
-        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin")
+        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key))
         if isinstance(block["F"], list) and isinstance(block["xi_max"], list):
             ctx.fail(f"{key}.F", "only one of F and xi_max may be a list (the scanned parameter)")
         ctx.check_unique(f"{key}.F", block["F"])
@@ -381,6 +383,7 @@ class BasinChart(Kind):
 @register
 class Strobe(Kind):
     name = "strobe"
+    any_well = False
     description = ("stroboscopic map of non-escaping trajectories (a line of ICs, then seeded random ones), "
                    "classified into main-island tori, island chains and chaotic orbits, with the analytic basin")
     builder = "safebasins.plotting.maps:figure_period_map"
@@ -423,7 +426,7 @@ class Strobe(Kind):
 
     def check(self, block, key, ctx):
         ctx.check_grid(f"{key}.grid", block["grid"])
-        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin")
+        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key))
         if "box" in block:
             ctx.check_interval(f"{key}.box[0]", block["box"][0])
             ctx.check_interval(f"{key}.box[1]", block["box"][1])

@@ -54,6 +54,7 @@ def build_chart(params, inputs, job):
 @register
 class Criteria(Kind):
     name = "criteria"
+    any_well = False
     description = "energy versus displacement escape criterion: safe counts of seeded random ICs"
     builder = "safebasins.plotting.charts:figure_criteria"
     schema = {

@@ -109,7 +109,7 @@ def build_fourier(params, inputs, job, *, what, source):
 
 def _check_grid_block(block, key, ctx):
     ctx.check_grid(f"{key}.grid", block["grid"])
-    ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "the analytic criterion")
+    ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "the analytic criterion", ctx.well_at(key))
     ctx.check_t_eval_within(f"{key}.t_eval", block["t_eval"], block["cycles"])
     for k in ("xi_max", "t_eval"):
         ctx.check_unique(f"{key}.{k}", block[k])
@@ -264,6 +264,7 @@ class TrueBasin(Kind):
 @register
 class FourierCompare(Kind):
     name = "fourier_compare"
+    any_well = False
     description = ("paper vs exact first harmonic against existing numerics (nothing is re-integrated): "
                    "F_cr of the listed fcr_compare experiments, safe-basin IoU of the listed basin_chart ones")
     builder = "safebasins.plotting.extras:figure_fourier"

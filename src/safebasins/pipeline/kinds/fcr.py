@@ -36,7 +36,7 @@ def _check_curves(block, key, ctx):
     for k, m in lens.items():
         if m not in (1, n):
             ctx.fail(f"{key}.{k}", f"has {m} values but another curve list has {n}: lists must have equal length")
-    ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "analytic F_cr")
+    ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "analytic F_cr", ctx.well_at(key))
     xm = values.as_list(block["xi_max"]) * (n // lens["xi_max"])
     xi = values.as_list(block["xi_ini"]) * (n // lens["xi_ini"])
     ga = values.as_list(block["gamma_ini"]) * (n // lens["gamma_ini"])
@@ -62,7 +62,7 @@ def build_fcr_analytic(params, inputs, job):
     for c in curves:
         print(f"{params['experiment']}: critical_forcing for {c['label']}")
         parts.append(critical_forcing(Omega, c["xi_max"], xi_ini=c["xi_ini"], gamma_ini=c["gamma_ini"],
-                                      fourier=params["fourier"]))
+                                      well=values.well(params)))
     coords = {k: [c[k] for c in curves] for k in ("xi_max", "xi_ini", "gamma_ini", "label")}
     if all("Psi" in c for c in curves):
         coords["Psi"] = [c["Psi"] for c in curves]
@@ -78,17 +78,18 @@ def build_fcr_numeric(params, inputs, job):
     from safebasins.theory import initial_condition
 
     num = params["numeric"]
+    w = values.well(params)
     Omega = np.asarray(num["Omega"], dtype=float)
     parts, q0s, p0s = [], [], []
     for c in params["curves"]:
-        q0, p0 = (float(v) for v in initial_condition(c["xi_ini"], c["gamma_ini"], c["Psi"]))
+        q0, p0 = (float(v) for v in initial_condition(c["xi_ini"], c["gamma_ini"], c["Psi"], well=w))
         q0s.append(q0)
         p0s.append(p0)
         print(f"{params['experiment']}: {c['label']}: IC (q0, p0) = ({q0:.6f}, {p0:.6f})", flush=True)
         parts.append(critical_forcing_numeric(
             Omega, c["xi_max"], q0=q0, p0=p0, Psi=c["Psi"], cycles=num["cycles"], tol=num["tol"],
             F_bracket=tuple(num["F_bracket"]), criterion=num["criterion"], n_scan=num["n_scan"],
-            steps_per_cycle=num["steps_per_cycle"], threads=job.threads, backend=job.backend))
+            steps_per_cycle=num["steps_per_cycle"], threads=job.threads, backend=job.backend, well=w))
     coords = {k: [c[k] for c in params["curves"]] for k in ("xi_max", "xi_ini", "gamma_ini", "Psi", "label")}
     coords.update(q0=q0s, p0=p0s)
     return stack(parts, "curve", coords=coords)

@@ -82,7 +82,7 @@ class IntegrityMap(Kind):
         ctx.check_range(f"{key}.F", block["F"])
         if block["F"]["start"] < 0:
             ctx.fail(f"{key}.F.start", f"must be >= 0 (a forcing amplitude), got {block['F']['start']}")
-        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "the analytic map")
+        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "the analytic map", ctx.well_at(key))
         if "t_eval" in block:
             ctx.check_t_eval_within(f"{key}.t_eval", block["t_eval"], block["cycles"])
             ctx.check_unique(f"{key}.t_eval", block["t_eval"])
@@ -112,7 +112,7 @@ class IntegrityMap(Kind):
               f"{params['cycles']} cycles ({job.backend})", flush=True)
         charts = escape_chart_batch(q0, p0, Fs, np.full(Fs.size, t["Omega"]), params["Psi"], xi_max=tuple(t["xi_max"]),
                                     cycles=params["cycles"], steps_per_cycle=params["steps_per_cycle"],
-                                    threads=job.threads, backend=job.backend)
+                                    threads=job.threads, backend=job.backend, well=values.well(params))
         m = integrity_from_batch(charts, params["t_eval"])
         return m.swap_dims(control="F").drop_vars("control").assign_coords(Omega=t["Omega"])
 
