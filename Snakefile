@@ -4,6 +4,7 @@
 #
 #   snakemake -j2                                        # all datasets, figures, archive
 #   snakemake -j2 --configfile config/quick.yaml         # the same DAG at coarse resolution
+#   snakemake -j2 escape_equation                       # the cubic-well study only (issue 12)
 #   snakemake -j2 archive                                # results/archive/*.tar.gz
 #   snakemake --report results/report.html               # HTML report
 import os
@@ -44,6 +45,13 @@ rule datasets:
     input:
         PARAM_FILES,
         DATASETS,
+
+
+rule escape_equation:
+    """The escape-equation study (cubic well, config block `escape_equation`): datasets and figures."""
+    input:
+        [p for e in RUN.experiments.values() if e.key.startswith("escape_equation.") for p in e.dataset_files()],
+        [p for e in RUN.experiments.values() if e.key.startswith("escape_equation.") for p in (e.figure.png, e.figure.pdf)],
 
 
 rule experiments:

@@ -14,21 +14,19 @@ from safebasins.pipeline import values
 from safebasins.pipeline.registry import Kind, Product, dataset_path, register
 
 
-def unforced_basin(q0, p0, xi_max):
-    """The library call: H0(q0, p0) and the unforced safe set {H0 < xi_max, |q0| < q_max}."""
+def unforced_basin(q0, p0, xi_max, well):
+    """The library call: H0(q0, p0) and the unforced safe set {H0 < xi_max inside the well}."""
     import xarray as xr
 
-    from safebasins.wells.quartic import QUARTIC
-
     Q, P = np.meshgrid(q0, p0, indexing="ij")
-    return xr.Dataset({"H0": (("q0", "p0"), QUARTIC.H0(Q, P)),
-                       "safe": (("q0", "p0"), QUARTIC.unforced_safe(Q, P, xi_max))},
+    return xr.Dataset({"H0": (("q0", "p0"), well.H0(Q, P)),
+                       "safe": (("q0", "p0"), well.unforced_safe(Q, P, xi_max))},
                       coords={"q0": q0, "p0": p0}, attrs={"xi_max": xi_max})
 
 
 def build(params, inputs, job):
     q0, p0 = values.grid_axes(params["grid"])
-    return unforced_basin(q0, p0, params["xi_max"])
+    return unforced_basin(q0, p0, params["xi_max"], values.well(params))
 
 
 def figure_unforced_basin(analytic, *, title=None):
@@ -36,14 +34,14 @@ def figure_unforced_basin(analytic, *, title=None):
     import matplotlib.pyplot as plt
 
     from safebasins.plotting.basins import draw_well, safe_fill, xy_grid
-    from safebasins.plotting.data import open_dataset, param, var
+    from safebasins.plotting.data import open_dataset, param, var, well
 
     ds = open_dataset(analytic)
     fig, ax = plt.subplots(figsize=(5, 4), layout="constrained")
     q, p, safe = xy_grid(var(ds, "safe"))
     safe_fill(ax, q, p, safe.astype(bool))
     ax.contour(q, p, np.asarray(var(ds, "H0").transpose("p0", "q0")), levels=12, colors="k", linewidths=0.4)
-    draw_well(ax, float(param(ds, "xi_max")))
+    draw_well(ax, float(param(ds, "xi_max")), well(ds))
     ax.set_title(title or f"unforced safe set, xi_max = {param(ds, 'xi_max')}")
     return fig
 

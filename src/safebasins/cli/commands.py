@@ -13,6 +13,9 @@ from safebasins.cli.options import (DISPLACEMENT, ENERGY, FINITE, OPTION_OF, POS
                                     library_errors, numerics_options, out_option)
 from safebasins.cli.output import chatter, describe, draw, finish, fmt, job, progress, write_outputs
 
+#: the command line works on the paper's quartic well (the pipeline config names any well)
+QUARTIC_SPEC = {"name": "quartic"}
+
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
 @click.version_option(package_name="safebasins")
@@ -63,7 +66,7 @@ def chart(F, Omega, Psi, xi_max, q_max, grid, n, cycles, steps_per_cycle, thread
     if tiles > n[0]:
         raise click.BadParameter(f"{tiles} tiles but only {n[0]} q0 rows", param_hint="'--tiles'")
     name = Path(out).name
-    params = dict(command="chart", kind="basin_chart", experiment=name, fourier=fourier, scan="xi_max", F=F,
+    params = dict(command="chart", kind="basin_chart", experiment=name, fourier=fourier, well=QUARTIC_SPEC, scan="xi_max", F=F,
                   xi_max=xi_max, q_max=q_max, Omega=Omega, Psi=Psi, grid=grid_params(grid, n), cycles=cycles,
                   t_eval=[t_eval], n_points=n_points, steps_per_cycle=steps_per_cycle,
                   tasks=[{"F": F, "xi_max": xi_max, "q_max": q_max}])
@@ -172,7 +175,7 @@ def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cyc
             raise click.BadParameter(f"initial energy {c['xi_ini']} must be below the truncation level xi_max = "
                                      f"{c['xi_max']}", param_hint="'--xi-ini'")
     name = Path(out).name
-    params = dict(command="fcr", kind="fcr_compare" if numeric else "fcr_theory", experiment=name, fourier=fourier,
+    params = dict(command="fcr", kind="fcr_compare" if numeric else "fcr_theory", experiment=name, fourier=fourier, well=QUARTIC_SPEC,
                   Omega=values.range_values(Omega_range), curves=curves)
     if numeric:
         params["numeric"] = {"Omega": values.range_values(numeric_Omega or Omega_range), "cycles": cycles,
@@ -269,7 +272,7 @@ def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, fouri
     if not xi_top > 0:
         raise click.BadParameter(f"must be > 0, got {xi_top}", param_hint="'--xi-top'")
     name = Path(out).name
-    params = dict(command="basin", kind="basin_rm", experiment=name, fourier=fourier, F=F, Omega=Omega, Psi=Psi,
+    params = dict(command="basin", kind="basin_rm", experiment=name, fourier=fourier, well=QUARTIC_SPEC, F=F, Omega=Omega, Psi=Psi,
                   xi_max=xi_max, grid=grid_params(grid, n), n_points=n_points,
                   manifold={"n_gamma": n_gamma, "n_xi": n_xi, "xi_top": xi_top})
     params["title"] = (f"Analytic safe basin, F = {fmt(F)}, Omega = {fmt(Omega)}, Psi = {fmt(Psi, angle=True)}, "

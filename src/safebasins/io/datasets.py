@@ -98,6 +98,10 @@ def finalize(ds: xr.Dataset, *, title: str, params: dict | None = None, config_h
         attrs["experiment"] = params["experiment"]
     if "fourier" in params:
         attrs.setdefault("fourier", params["fourier"])
+    if "well" in params:
+        from safebasins.wells import spec_attrs
+
+        attrs.update(spec_attrs(params["well"]))
     seeds = _collect_seeds(params)
     if seeds:
         attrs["seeds"] = np.asarray(seeds, dtype=np.int64)

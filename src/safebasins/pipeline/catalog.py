@@ -291,4 +291,70 @@ DECLARATIONS = (
               'the harmonic enters multiplied by F.')),
 )
 
+# ---------------------------------------------------------------- the escape equation (issue 12)
+# The same kinds, rules and plotting on the cubic well V = q^2/2 - q^3/3 (config block
+# `escape_equation`, every entry with `well: cubic`): the paper's open problem, a well without
+# closed-form action-angle variables (numeric action-angle, safebasins.wells.numeric).
+_CUBIC = "Escape equation (cubic well)"
+_CUBIC_NOTE = ("Escape equation q'' + q - q² = F sin(Ωt + Ψ) (V = q²/2 - q³/3, barrier energy 1/6 at q = 1, "
+               "no barrier for q < 0): the isolated-resonance method with numeric action-angle variables "
+               "and the exact first harmonic q₁(ξ) (complex: the well is asymmetric).")
+DECLARATIONS += (
+    Declaration(
+        name="cubic_fcr_zero", kind="fcr_compare", key=("escape_equation", "fcr_zero"), stem="cubic_fcr_zero_ic",
+        label="Escape equation: F_cr(Ω), zero IC", category=_CUBIC,
+        options={'layout': 'panels', 'bracket': True, 'F_max': None},
+        title="Escape equation: analytic versus numeric F_cr(Omega), zero IC, three truncation levels",
+        caption=_CUBIC_NOTE + " Escape threshold versus forcing frequency for three truncation levels "
+                "below the barrier energy and the zero IC (the analogue of Figure 10).",
+        look=("One panel per ξ_max. Line: slow-flow theory; dots: numeric bisection F_cr of the escape "
+              "equation (energy criterion). Black bars with caps mark non-monotone escape brackets.")),
+    Declaration(
+        name="cubic_fcr_ic", kind="fcr_compare", key=("escape_equation", "fcr_ic"), stem="cubic_fcr_nonzero_ic",
+        label="Escape equation: F_cr(Ω), non-zero IC", category=_CUBIC,
+        options={'layout': 'panels', 'bracket': True, 'F_max': None},
+        title="Escape equation: analytic versus numeric F_cr(Omega), non-zero IC, three truncation levels",
+        caption=_CUBIC_NOTE + " Escape threshold versus forcing frequency for a non-zero initial "
+                "condition (ξ_ini, γ_ini, Ψ) at three truncation levels (the analogue of Figures 11-12).",
+        look=("One panel per ξ_max. The IC is the phase point of the unforced orbit of energy ξ_ini at "
+              "angle γ_ini + Ψ (numeric action-angle). Line: theory; dots: numerics.")),
+    Declaration(
+        name="cubic_basins_xi", kind="basin_chart", key=("escape_equation", "basins_xi"), stem="cubic_sb_xi_max",
+        label="Escape equation: safe basins versus ξ_max", category=_CUBIC, options={},
+        title="Escape equation: safe basins versus xi_max, analytic and numeric",
+        caption=_CUBIC_NOTE + " Safe basins for several truncation levels at one forcing (the analogue "
+                "of Figures 13-15).",
+        look=_NESTED + " The basins are not symmetric under (q, p) -> (-q, -p): the well is not."),
+    Declaration(
+        name="cubic_basins_small_F", kind="basin_chart", key=("escape_equation", "basins_small_F"),
+        stem="cubic_sb_forcing_small", label="Escape equation: safe basins at small F", category=_CUBIC,
+        options={}, title="Escape equation: safe basins versus small F, analytic and numeric",
+        caption=_CUBIC_NOTE + " Safe basins for small forcing amplitudes (the analogue of Figure 16).",
+        look=_NESTED),
+    Declaration(
+        name="cubic_basins_large_F", kind="basin_chart", key=("escape_equation", "basins_large_F"),
+        stem="cubic_sb_forcing_large", label="Escape equation: safe basins at larger F", category=_CUBIC,
+        options={}, title="Escape equation: safe basins versus larger F, analytic and numeric",
+        caption=_CUBIC_NOTE + " Safe basins for larger forcing amplitudes (the analogue of Figure 17).",
+        look=_NESTED + " Erosion shows where the numeric basins lose pixels the theory keeps (lower IoU)."),
+    Declaration(
+        name="cubic_erosion", kind="erosion", key=("escape_equation", "erosion"), stem="cubic_erosion",
+        label="Escape equation: erosion profiles", category=_CUBIC,
+        options={'measures': ['GIM', 'LIM', 'IF'], 'xi_max': None, 't_eval': None},
+        title="Escape equation: erosion profiles GIM, LIM and IF versus F, analytic and numeric",
+        caption=_CUBIC_NOTE + " Integrity measures of the safe basin versus the forcing amplitude, "
+                "normalised by the unforced well H0 < ξ_max.",
+        look=("Lines: slow-flow profiles (exact first harmonic) on a finer IC grid; markers: numeric "
+              "profiles from one escape chart per F, one shade per evaluation time.")),
+    Declaration(
+        name="cubic_true_basin", kind="true_basin", key=("escape_equation", "true_basin"), stem="cubic_true_basin",
+        label="Escape equation: phase-invariant safe basin", category=_CUBIC,
+        options={'xi_max': None, 't_eval': None, 'fourier': 'exact'},
+        title="Escape equation: phase-invariant (true) safe basin, intersection over Psi",
+        caption=_CUBIC_NOTE + " Initial conditions safe whatever the forcing phase Ψ, slow flow (left) "
+                "and numerics (right).",
+        look=("Green: safe for every sampled phase; thin outlines: the per-phase basins coloured by Ψ; "
+              "dotted oval: the analytic all-phase basin H0 = ξ_true.")),
+)
+
 BY_NAME = {d.name: d for d in DECLARATIONS}

@@ -71,7 +71,7 @@ def build_schema(base=None) -> dict:
         if block == "extras":
             ref["default"] = {}
         props[block].setdefault("properties", {})[key] = ref
-        if block == "figures":
+        if block != "extras":  # the figures and the escape-equation study are spelled out in config.yaml
             props[block].setdefault("required", []).append(key)
     props["experiments"]["additionalProperties"] = {
         "type": "object", "required": ["kind"],

@@ -94,7 +94,8 @@ def tile_slice(n: int, tiles: int, tile: int) -> slice:
 def well(params, fourier=None):
     """The well object of resolved parameters (``params["well"]``, a spec of
     :func:`safebasins.wells.spec_of`) with the experiment's first harmonic (``fourier``: one
-    variant of a list-valued ``params["fourier"]``)."""
+    variant of a list-valued ``params["fourier"]``; numeric-only kinds have none)."""
     from safebasins import wells
 
-    return wells.from_spec(params["well"], params["fourier"] if fourier is None else fourier)
+    # kinds without a first harmonic (numerics only: no "fourier" parameter) get the default one
+    return wells.from_spec(params["well"], params.get("fourier") if fourier is None else fourier)

@@ -15,18 +15,19 @@ from matplotlib.colors import ListedColormap
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
+from safebasins.plotting import data
 from safebasins.plotting.data import open_dataset, param, var
 from safebasins.plotting.style import LABELS, SB_EDGE, SB_FACE, TRUNC_COLOR, fmt_value, param_text, pi_ticks
 
 UNCONFIRMED_COLOR = "tab:orange"  # parts of the analytic basin where no IC stays in the numerics
-from safebasins.wells.quartic import QUARTIC
 
 
-def draw_well(ax, xi_max, *, n=400, **kw):
-    """Dashed outline of the unforced well ``H0(q, p) = xi_max`` on a (q, p) axes."""
-    qm = float(QUARTIC.q_max(xi_max))
-    qq = np.linspace(-qm, qm, n)
-    pp = np.sqrt(np.clip(2 * (xi_max - QUARTIC.V(qq)), 0, None))
+def draw_well(ax, xi_max, well, *, n=400, **kw):
+    """Dashed outline of the unforced well ``H0(q, p) = xi_max`` on a (q, p) axes, between the
+    turning points of the level (``-+q_max`` of eq (4) for the quartic)."""
+    lo, hi = (float(np.ravel(t)[0]) for t in well.turning_points(xi_max))
+    qq = np.linspace(lo, hi, n)
+    pp = np.sqrt(np.clip(2 * (xi_max - well.V(qq)), 0, None))
     x = np.r_[qq, qq[::-1], qq[:1]]
     y = np.r_[pp, -pp[::-1], pp[:1]]
     style = dict(color="0.35", lw=0.9, ls=(0, (4, 2)), zorder=4)
@@ -161,7 +162,7 @@ def draw_ic_basin(ax, ds, *, well=True, unconfirmed=(), unconfirmed_mask=None):
         else:
             plot_curve(ax, xs, ys, color=SB_EDGE, lw=1.8, zorder=6, **IC_LINE)
     if well:
-        draw_well(ax, float(param(ds, "xi_max")))
+        draw_well(ax, float(param(ds, "xi_max")), data.well(ds))
     ax.set_aspect("equal")
     ax.set_xlabel(LABELS["q0"])
     ax.set_ylabel(LABELS["p0"])

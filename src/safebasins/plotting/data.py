@@ -46,6 +46,15 @@ def param(ds, name):
     raise KeyError(f"{source(ds)}: no attribute or single-valued coordinate {name!r}")
 
 
+def well(ds):
+    """The potential well of a dataset (its ``well`` attributes, safebasins.wells.spec_attrs)."""
+    from safebasins.wells import from_attrs
+
+    if "well" not in ds.attrs:
+        raise KeyError(f"{source(ds)}: no attribute 'well' (datasets name their potential well)")
+    return from_attrs(ds.attrs)
+
+
 def load_params(src):
     """Resolved parameter file (results/params/<experiment>.yaml) -> dict."""
     with open(src) as fh:

@@ -25,6 +25,7 @@ from matplotlib.patches import Circle, Patch
 
 from safebasins.plotting.basins import draw_well, plot_curve, separates_mask
 from safebasins.plotting.captions import add_note, fmt_range
+from safebasins.plotting import data
 from safebasins.plotting.data import open_dataset, param, var
 from safebasins.plotting.fcr import curve_labels, ic_text
 from safebasins.plotting.style import LABELS, fmt_value, param_text
@@ -174,7 +175,7 @@ def _draw_basin_panel(ax, ds, sel, label):
                        colors=[col], zorder=2)
     tv = true.transpose("q0", "p0").values
     ax.contourf(q, p, tv.T.astype(float), levels=[0.5, 1.5], colors=["tab:green"], alpha=0.55)
-    draw_well(ax, float(sel["xi_max"]))
+    draw_well(ax, float(sel["xi_max"]), data.well(ds))
     g = {k: float(_sel(ds[f"{k}_true"], **sel)) for k in ("GIM", "LIM", "IF")}
     rl = float(_sel(ds["r_local_true"], **sel))
     rg = float(_sel(ds["r_global_true"], **sel))
@@ -213,7 +214,7 @@ def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, 
         if analytic is not None:  # the analytic all-phase basin on every panel (the numeric one is compared to it)
             xt = float(_sel(var(analytic, "xi_true"), xi_max=x, fourier=fourier))
             if xt > 0:
-                draw_well(ax, xt, color=XI_TRUE_COLOR, ls=":", lw=1.4, zorder=9)
+                draw_well(ax, xt, data.well(analytic), color=XI_TRUE_COLOR, ls=":", lw=1.4, zorder=9)
     axes[0, 0].set_ylabel(LABELS["p0"])
     ref = panels[0][0]
     handles = [Patch(color="0.9", label="safe for some phase"),

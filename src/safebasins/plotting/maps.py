@@ -17,6 +17,7 @@ from matplotlib.lines import Line2D
 
 from safebasins.plotting.basins import analytic_safe, draw_boundaries, draw_well
 from safebasins.plotting.captions import add_note, count, fmt_range
+from safebasins.plotting import data
 from safebasins.plotting.data import open_dataset, param, var
 from safebasins.plotting.style import LABELS, fmt_value, param_text
 
@@ -107,7 +108,7 @@ def figure_period_map(analytic, numeric, *, title=None, figsize=(8.2, 7.4), s=0.
         handles.append(Line2D([], [], marker="o", ls="none", mfc="none", mec="tab:green", ms=4,
                               label=f"{count(line.sum(), 'IC')} on a line (the rest seeded random)"))
     blines = draw_boundaries(ax, basin, color="k", ls="--", lw=1.6, safe=analytic_safe(basin))
-    draw_well(ax, xi_max, color="0.5", lw=0.8, ls=":")
+    draw_well(ax, xi_max, data.well(basin), color="0.5", lw=0.8, ls=":")
     handles += [Line2D([], [], color="k", ls="--", lw=1.6, label="theory: SB boundary"),
                 Line2D([], [], color="0.5", ls=":", lw=0.8, label=r"well edge $H_0 = \xi_{max}$")]
     # frame the portrait and the predicted boundary (not the whole, mostly empty, well)

@@ -10,7 +10,7 @@ from safebasins.wells.quartic import FOURIER_VARIANTS, QUARTIC, QuarticWell
 # (bound here, after the submodule import, so the package attribute is the function)
 from safebasins.wells.polynomial import cubic, polynomial  # noqa: E402
 
-__all__ = ["Well", "QuarticWell", "QUARTIC", "resolve_well", "from_spec", "spec_of", "cubic", "polynomial"]
+__all__ = ["Well", "QuarticWell", "QUARTIC", "resolve_well", "from_spec", "from_attrs", "spec_attrs", "well_attrs", "spec_of", "cubic", "polynomial"]
 
 
 def resolve_well(well=None, fourier=None) -> Well:
@@ -42,6 +42,31 @@ def from_spec(spec, fourier=None) -> Well:
     if name == "polynomial":
         return polynomial(spec["coefficients"])
     raise ValueError(f"unknown well {name!r} (quartic, cubic, polynomial)")
+
+
+def spec_attrs(spec) -> dict:
+    """Dataset attributes naming a well spec: ``well`` and, for a polynomial, ``well_coefficients``."""
+    out = {"well": spec["name"]}
+    if spec["name"] == "polynomial":
+        out["well_coefficients"] = [float(c) for c in spec["coefficients"]]
+    return out
+
+
+def well_attrs(well: Well) -> dict:
+    """Dataset attributes naming a well object (as :func:`spec_attrs` of its spec)."""
+    out = {"well": well.name}
+    if well.name == "polynomial":
+        out["well_coefficients"] = [float(c) for c in well.coefficients]
+    return out
+
+
+def from_attrs(attrs) -> Well:
+    """The well a dataset was made with (its :func:`spec_attrs` attributes)."""
+    name = attrs["well"]
+    spec = {"name": name}
+    if name == "polynomial":
+        spec["coefficients"] = [float(c) for c in attrs["well_coefficients"]]
+    return from_spec(spec)
 
 
 def spec_of(config_value) -> dict:
