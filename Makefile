@@ -6,7 +6,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 JOBS   ?= 2
 
-.PHONY: reproduce test quick report archive lock clean-results
+.PHONY: reproduce test quick report archive lock clean-results unlock
 
 $(STAMP): environment.lock pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -17,8 +17,15 @@ $(STAMP): environment.lock pyproject.toml
 
 ## Full reproduction at paper resolution: every dataset, figure, the archive and the HTML report.
 reproduce: $(STAMP)
-	$(BIN)/snakemake -j$(JOBS) --rerun-incomplete all archive
+	@$(BIN)/snakemake -j$(JOBS) --rerun-incomplete all archive || { \
+	  if [ -n "$$(ls -A .snakemake/locks 2>/dev/null)" ]; then \
+	    echo "A killed run left Snakemake's lock on results/. Run:  make unlock  then  make reproduce"; fi; \
+	  exit 1; }
 	$(BIN)/snakemake -j$(JOBS) --report results/report.html
+
+## After a killed run: release Snakemake's lock on the working directory (nothing is deleted).
+unlock: $(STAMP)
+	$(BIN)/snakemake --unlock
 
 ## Test suite (theory, numerics, config validation, one quick end-to-end pipeline run).
 test: $(STAMP)
@@ -31,3 +38,9 @@ quick: $(STAMP)
 ## Regenerate environment.lock from requirements/requirements.in (needs `uv`).
 lock:
 	uv pip compile --generate-hashes --python-version 3.11 --python-platform x86_64-manylinux_2_28 requirements/requirements.in -o environment.lock
+
+## Real single-node SLURM run (needs root: installs slurm-wlm + munge when missing): the quick
+## datasets through workflow/profiles/slurm must equal a local -j2 run (tests/cluster/).
+.PHONY: test-cluster
+test-cluster: $(STAMP)
+	tests/cluster/run_cluster_check.sh

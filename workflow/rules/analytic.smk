@@ -17,5 +17,7 @@ rule analytic_dataset:
         extensions=EXTENSIONS,
         backend=BACKEND,
     threads: dataset_threads("analytic")
+    resources:
+        **job_resources("analytic"),
     script:
         "../../scripts/dataset.py"

@@ -6,6 +6,8 @@ import sys
 from pathlib import Path
 
 from safebasins.pipeline.cost import guard as _cost_guard
+from safebasins.pipeline.cost import job_cost as _job_cost
+from safebasins.pipeline.cost import resources as _job_resources
 from safebasins.pipeline.plan import plan as _plan
 from safebasins.pipeline.registry import STAGES
 
@@ -40,6 +42,21 @@ def dataset_inputs(stage):
 
 def dataset_threads(stage):
     return lambda wildcards: NUM_THREADS if RUN.product(dataset_path(stage, wildcards)).heavy else 1
+
+
+def job_resources(stage=None):
+    """`resources: **job_resources(stage)` of a heavy rule: runtime (minutes) and mem_mb of each
+    job from the cost estimate (safebasins.pipeline.cost.job_cost / resources), for a cluster
+    scheduler (workflow/profiles/slurm); a local run ignores them. stage None: chart tiles."""
+
+    def resource(key):
+        def of_job(wildcards, threads):
+            job = {"tile_of": wildcards.experiment} if stage is None else {"dataset": dataset_path(stage, wildcards)}
+            return _job_resources(*_job_cost(RUN, **job), threads)[key]
+
+        return of_job
+
+    return {"runtime": resource("runtime"), "mem_mb": resource("mem_mb")}
 
 
 def figure_targets(category):

@@ -18,6 +18,8 @@ rule extras_dataset:
         extensions=EXTENSIONS,
         backend=BACKEND,
     threads: dataset_threads("extras")
+    resources:
+        **job_resources("extras"),
     script:
         "../../scripts/dataset.py"
 

@@ -21,6 +21,8 @@ rule chart_tile:
         extensions=EXTENSIONS,
         backend=BACKEND,
     threads: NUM_THREADS
+    resources:
+        **job_resources(),
     script:
         "../../scripts/chart_tile.py"
 
@@ -42,5 +44,7 @@ rule numeric_dataset:
         extensions=EXTENSIONS,
         backend=BACKEND,
     threads: dataset_threads("numeric")
+    resources:
+        **job_resources("numeric"),
     script:
         "../../scripts/dataset.py"

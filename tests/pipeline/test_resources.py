@@ -1,0 +1,116 @@
+"""Cluster resources of the heavy rules (runtime, mem_mb) from the cost estimate: positive, growing
+with the cost, and what the workflow hands the scheduler (dry run)."""
+from __future__ import annotations
+
+import re
+
+import pytest
+import yaml
+
+from safebasins.pipeline.config import REPO_ROOT, merge_config
+from safebasins.pipeline.cost import (MEM_BASE_MB, RATE_PER_CORE, RUNTIME_FLOOR_MIN, RUNTIME_SAFETY, exp_cost,
+                                      job_cost, resources)
+from safebasins.pipeline.plan import load_config, plan
+from tests.pipeline.sandbox import run_snakemake
+
+HEAVY_RULES = ("chart_tile", "analytic_dataset", "numeric_dataset", "extras_dataset")
+#: Fig 13 made expensive: 24 x 24 ICs x 1e8 cycles x 16 steps, split over 2 tiles (runtime above the floor)
+EXPENSIVE = {"numerics": {"tiles": 2, "allow_expensive": True}, "figures": {"fig13": {"cycles": 100_000_000}}}
+
+
+def _plan(*overrides):
+    """The quick configuration's plan, with overrides merged as `--configfile` does."""
+    cfg = load_config([REPO_ROOT / "config" / "config.yaml", REPO_ROOT / "config" / "quick.yaml"])
+    for extra in overrides:
+        merge_config(cfg, extra)
+    return plan(cfg)
+
+
+def _jobs(run):
+    """(rule, job_cost keyword) of every heavy job of a plan."""
+    jobs = [("chart_tile", {"tile_of": e}) for e in run.chart_experiments()]
+    jobs += [(f"{run.product(d).stage}_dataset", {"dataset": d}) for d in run.datasets()]
+    return jobs
+
+
+@pytest.mark.parametrize("quick", [True, False])
+def test_resources_positive_for_every_job(quick):
+    run = _plan() if quick else plan(REPO_ROOT / "config" / "config.yaml")
+    for _, job in _jobs(run):
+        steps, points = job_cost(run, **job)
+        assert steps >= 0 and points >= 0, job
+        res = resources(steps, points, run.threads)
+        assert res["runtime"] >= RUNTIME_FLOOR_MIN and res["mem_mb"] >= MEM_BASE_MB, (job, res)
+        assert all(isinstance(v, int) for v in res.values())
+
+
+def test_job_costs_add_up_to_the_estimate():
+    """Tiles and integrating datasets share each experiment's cost; gathering datasets cost 0."""
+    run = _plan()
+    for name, exp in run.experiments.items():
+        if exp.tasks:
+            total = job_cost(run, tile_of=name)[0] * len(exp.tasks) * run.tiles
+            assert job_cost(run, dataset=exp.products[-1].path)[0] == 0
+        else:
+            total = sum(job_cost(run, dataset=p.path)[0] for p in exp.products if p.heavy) \
+                or sum(job_cost(run, dataset=p.path)[0] for p in exp.products)
+        assert total == pytest.approx(exp_cost(exp)), name
+    with pytest.raises(ValueError):
+        job_cost(run)
+
+
+def test_resources_scale_with_cost():
+    assert resources(0, 0) == {"runtime": RUNTIME_FLOOR_MIN, "mem_mb": MEM_BASE_MB}
+    steps = 1e3 * RATE_PER_CORE          # 1000 s on one core
+    one, two = resources(steps, 0, threads=1), resources(steps, 0, threads=2)
+    assert one["runtime"] == round(RUNTIME_SAFETY * 1000 / 60) and two["runtime"] < one["runtime"]
+    assert resources(10 * steps, 0)["runtime"] > one["runtime"]
+    assert resources(0, 10**7)["mem_mb"] > resources(0, 10**5)["mem_mb"] > MEM_BASE_MB
+    # more cycles -> longer tiles; more tiles -> shorter tiles with fewer trajectories each
+    cheap, dear = _plan(), _plan(EXPENSIVE)
+    s1, p1 = job_cost(cheap, tile_of="fig13")
+    s2, p2 = job_cost(dear, tile_of="fig13")
+    assert s2 > 1e5 * s1 and p2 == -(-p1 // 2)
+    assert resources(s2, p2)["runtime"] > RUNTIME_FLOOR_MIN
+
+
+def _dry_run_resources(text):
+    """output path -> (rule, {resource: value}) of every job block of `snakemake -n` output."""
+    jobs, rule, output = {}, None, None
+    for line in text.splitlines():
+        m = re.match(r"^(?:local)?rule (\w+):$", line)
+        if m:
+            rule, output = m.group(1), None
+            continue
+        m = re.match(r"^\s+output: (\S+?),?$", line) or re.match(r"^\s+output: (\S+?), ", line)
+        if m and rule:
+            output = m.group(1)
+            continue
+        m = re.match(r"^\s+resources: (.*)$", line)
+        if m and rule and output:
+            jobs[output] = (rule, dict(kv.split("=", 1) for kv in m.group(1).split(", ")))
+    return jobs
+
+
+def test_dry_run_hands_the_cost_resources_to_the_scheduler(sandbox):
+    over = sandbox / "expensive.yaml"
+    over.write_text(yaml.safe_dump(EXPENSIVE))
+    r = run_snakemake(sandbox, "-n", "datasets", configfiles=("config/quick.yaml", over))
+    assert r.returncode == 0, r.stderr[-3000:]
+    jobs = _dry_run_resources(r.stdout + r.stderr)
+    run = _plan(EXPENSIVE)
+    seen, expensive_tiles = set(), 0
+    for output, (rule, res) in jobs.items():
+        if rule not in HEAVY_RULES:
+            continue
+        if rule == "chart_tile":
+            job = {"tile_of": output.split("/")[4]}
+        else:
+            job = {"dataset": output}
+        expected = resources(*job_cost(run, **job), run.threads)
+        assert int(res["runtime"]) == expected["runtime"] and int(res["mem_mb"]) == expected["mem_mb"], output
+        seen.add(rule)
+        if output.startswith("results/data/numeric/parts/fig13/"):
+            assert int(res["runtime"]) > RUNTIME_FLOOR_MIN
+            expensive_tiles += 1
+    assert seen == set(HEAVY_RULES) and expensive_tiles == 2
