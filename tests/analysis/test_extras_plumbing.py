@@ -17,17 +17,19 @@ from safebasins.wells.quartic import QUARTIC
 K = {"paper": 1.0, "exact": 1.1}
 
 
-def _angle_energy(q, p):
+def _angle_energy(q, p, well=None):
     q = np.asarray(q, float)
     p = np.asarray(p, float)
     return np.mod(np.arctan2(-p, q), 2 * np.pi), QUARTIC.H0(q, p)
 
 
-def _escapes_on_manifold(gamma, xi, F, Omega, xi_max, fourier="paper"):
+def _escapes_on_manifold(gamma, xi, F, Omega, xi_max, fourier="paper", well=None):
+    fourier = fourier if well is None else well.fourier
     return np.asarray(xi) + K[fourier] * F * (1 + np.cos(gamma)) >= xi_max
 
 
-def _slow_flow_escapes(q0, p0, F, Omega, Psi, xi_max, fourier="paper"):
+def _slow_flow_escapes(q0, p0, F, Omega, Psi, xi_max, fourier="paper", well=None):
+    fourier = fourier if well is None else well.fourier
     q0, p0 = np.broadcast_arrays(np.asarray(q0, float), np.asarray(p0, float))
     th, xi = _angle_energy(q0, p0)
     inside = integrity.unforced_safe_mask(np.array([0.0, 1.0]), np.array([0.0, 1.0]), xi_max)  # noqa: F841
@@ -42,12 +44,8 @@ def _critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier="paper")
     return xr.Dataset({"F_cr": ("Omega", F)}, coords={"Omega": Om})
 
 
-def _J(xi):
-    return np.asarray(xi, float) * 1.0
-
-
 def _escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000, steps_per_cycle=32,
-                  threads=None):
+                  threads=None, well=None):
     Q, P = np.meshgrid(q0, p0, indexing="ij")
     th, h = _angle_energy(Q, P)
     xi = np.asarray(xi_max, float)[:, None, None]
@@ -58,7 +56,7 @@ def _escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=300
     return xr.Dataset({"escape_cycle_energy": (("xi_max", "q0", "p0"), cyc)},
                       coords={"xi_max": list(xi_max), "q0": q0, "p0": p0},
                       attrs={"F": F, "Omega": Omega, "Psi": Psi, "cycles": cycles,
-                             "steps_per_cycle": steps_per_cycle, "integrator": "toy"})
+                             "steps_per_cycle": steps_per_cycle, "integrator": "toy", "well": "quartic"})
 
 
 def _critical_forcing_numeric(Omega, xi_max, *, q0=0, p0=0, Psi=0, cycles=3000, tol=5e-5, **kw):
@@ -74,7 +72,7 @@ def toy(monkeypatch):
     """Replace the theory and numerics functions each analysis module imports by the toys."""
     toys = {
         "angle_energy": _angle_energy, "escapes_on_manifold": _escapes_on_manifold,
-        "slow_flow_escapes": _slow_flow_escapes, "critical_forcing": _critical_forcing, "J": _J,
+        "slow_flow_escapes": _slow_flow_escapes, "critical_forcing": _critical_forcing,
         "initial_condition": lambda xi, g, Psi: (np.sqrt(2 * xi) * np.cos(g + Psi), -np.sqrt(2 * xi) * np.sin(g + Psi)),
         "escape_chart": _escape_chart, "critical_forcing_numeric": _critical_forcing_numeric,
     }

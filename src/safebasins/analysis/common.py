@@ -21,6 +21,20 @@ def fourier_list(fourier):
     return items, scalar
 
 
+def variant_well(well, fourier):
+    """The well of one first-harmonic variant: for the quartic (``well`` None or a QuarticWell)
+    ``fourier`` picks eq (20) as printed ("paper") or exact; any other well carries only its exact
+    first harmonic, so its one variant is "exact"."""
+    from safebasins.wells import QuarticWell, resolve_well
+
+    if well is None or isinstance(well, QuarticWell):
+        return resolve_well(well, fourier)
+    if fourier != "exact":
+        raise ValueError(f"fourier {fourier!r}: the {well.name} well has only its exact first harmonic "
+                         "(the paper's truncated G of eq 20 is the quartic's): use fourier='exact'")
+    return resolve_well(well)
+
+
 def as_1d(name, values, check=checks.as_array):
     """``check(name, values)`` as a 1-D float array."""
     return checks.check_1d(name, values, check)

@@ -26,12 +26,13 @@ import xarray as xr
 
 from safebasins import checks
 from safebasins.io import cf
-from safebasins.analysis.common import as_1d, fourier_list, mesh, stack_charts
+from safebasins.analysis.common import as_1d, fourier_list, mesh, stack_charts, variant_well
 from safebasins.analysis.integrity import integrity_measures, unforced_safe_mask
 from safebasins.analysis.safe import safe_stack
 from safebasins.io.cf import annotate
 from safebasins.numerics import escape_chart
 from safebasins.theory import slow_flow_escapes
+from safebasins.wells import from_attrs, well_attrs
 from safebasins.wells.quartic import QUARTIC
 
 __all__ = [
@@ -45,25 +46,28 @@ __all__ = [
 
 
 # --------------------------------------------------------------------------- analytic
-def analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier="paper"):
+def analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier="paper", well=None):
     """Analytic safe masks ``~slow_flow_escapes`` stacked as DataArray (fourier?, F, xi_max, q0, p0).
 
-    ``fourier`` may be a string (scalar coordinate) or a list (dimension ``fourier``).
+    ``fourier`` may be a string (scalar coordinate) or a list (dimension ``fourier``); ``well``
+    (None: the quartic) any well of safebasins.wells, whose only variant is "exact"
+    (:func:`~safebasins.analysis.common.variant_well`).
     Points outside the unforced set S0 are never safe (theory returns True there; the
     mask is intersected with S0 anyway so that GIM <= 1 exactly).
     """
     F = as_1d("F_values", F_values, checks.check_nonnegative)
-    xi = as_1d("xi_max", xi_max, QUARTIC.check_threshold)
+    fl, scalar = fourier_list(fourier)
+    wl = [variant_well(well, f) for f in fl]
+    xi = as_1d("xi_max", xi_max, wl[0].check_threshold)
     Omega = float(checks.check_positive("Omega", Omega))
     Psi = float(checks.check_finite("Psi", Psi))
-    fl, scalar = fourier_list(fourier)
     q, p, Q, P = mesh(q0, p0)
-    S0 = unforced_safe_mask(q, p, xi)
+    S0 = unforced_safe_mask(q, p, xi, wl[0])
     out = np.zeros((len(fl), F.size, xi.size, q.size, p.size), dtype=bool)
     for a, f in enumerate(fl):
         for i, Fi in enumerate(F):
             for j, x in enumerate(xi):
-                e = np.asarray(slow_flow_escapes(Q, P, float(Fi), Omega, Psi, float(x), fourier=f), dtype=bool)
+                e = np.asarray(slow_flow_escapes(Q, P, float(Fi), Omega, Psi, float(x), well=wl[a]), dtype=bool)
                 out[a, i, j] = ~e & S0[j]
     da = xr.DataArray(out, dims=("fourier", "F", "xi_max", "q0", "p0"),
                       coords={"fourier": fl, "F": F, "xi_max": xi, "q0": q, "p0": p},
@@ -71,7 +75,7 @@ def analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier="paper"):
     return da.isel(fourier=0) if scalar else da
 
 
-def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier="paper", *, keep_masks=False):
+def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier="paper", *, keep_masks=False, well=None):
     """Analytic erosion profile: GIM/LIM/IF versus F from the slow flow on the (q0, p0) grid.
 
     Parameters
@@ -81,6 +85,7 @@ def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier="pape
     xi_max : energy threshold(s) (dimension ``xi_max``).
     q0, p0 : 1-D uniform grid axes (cover the well: |q0| <= 1, |p0| <= 1/sqrt(2)).
     fourier : "paper" | "exact" | list of both (adds dimension ``fourier``).
+    well : the potential well (None: the paper's quartic); another well's only variant is "exact".
     keep_masks : also return the masks as variable ``safe`` (..., q0, p0).
 
     Returns
@@ -88,12 +93,13 @@ def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier="pape
     xr.Dataset over (fourier?, F, xi_max) with ``GIM``, ``LIM``, ``IF`` and the raw
     measures (see :func:`safebasins.analysis.integrity.integrity_measures`).
     """
-    masks = analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier)
-    ds = integrity_measures(masks)
+    masks = analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier, well)
+    w = variant_well(well, fourier_list(fourier)[0][0])
+    ds = integrity_measures(masks, well=w)
     if keep_masks:
         ds["safe"] = masks
     ds.attrs.update({"kind": "analytic", "Omega": float(Omega), "Psi": float(Psi),
-                     "method": "safebasins.theory.slow_flow_escapes on the grid"})
+                     "method": "safebasins.theory.slow_flow_escapes on the grid", **well_attrs(w)})
     if isinstance(fourier, str):
         ds.attrs["fourier"] = fourier
     return annotate(ds)
@@ -119,8 +125,9 @@ def profile_from_charts(charts, t_eval=None, *, criterion="energy", stack_dim="F
     xr.Dataset over (stack_dim?, threshold, t_eval) with the integrity variables.
     """
     chart = stack_charts(charts, stack_dim)
+    well = from_attrs(chart.attrs)    # the well the charts were integrated in (escape_chart's attributes)
     safe, xi_norm = safe_stack(chart, t_eval, criterion)
-    parts = [integrity_measures(safe.isel(t_eval=k), xi_max=xi_norm) for k in range(safe.sizes["t_eval"])]
+    parts = [integrity_measures(safe.isel(t_eval=k), xi_max=xi_norm, well=well) for k in range(safe.sizes["t_eval"])]
     ds = xr.concat(parts, dim="t_eval", coords="minimal", compat="override", join="override")
     thr = "xi_max" if criterion == "energy" else "q_max"
     lead = [d for d in (stack_dim, thr) if d in ds.dims]
@@ -128,13 +135,14 @@ def profile_from_charts(charts, t_eval=None, *, criterion="energy", stack_dim="F
     ds["t_eval"].attrs.update(cf.attrs("t_eval"))
     ds.attrs.update({k: v for k, v in chart.attrs.items() if k in ("Omega", "Psi", "F", "cycles",
                                                                        "steps_per_cycle", "integrator")})
+    ds.attrs.update(well_attrs(well))
     ds.attrs.update({"kind": "numeric", "criterion": criterion,
                      "method": "safe = escape_cycle > t_eval from safebasins.numerics.escape_chart"})
     return annotate(ds)
 
 
 def erosion_profile_numeric(F_values, Omega, Psi, xi_max, q0, p0, t_eval=None, cycles=3000, *,
-                            q_max=(), keep_charts=False, **chart_kwargs):
+                            q_max=(), keep_charts=False, well=None, **chart_kwargs):
     """Numeric erosion profile: ONE escape chart per F, all thresholds and t_eval read from it.
 
     Parameters
@@ -145,6 +153,7 @@ def erosion_profile_numeric(F_values, Omega, Psi, xi_max, q0, p0, t_eval=None, c
     q_max : displacement thresholds also integrated (profile variables for them are
         not returned here; use :func:`profile_from_charts` on the kept charts).
     keep_charts : return the stacked charts too: ``(profile, charts)``.
+    well : the potential well (None: the paper's quartic; numerics: a polynomial well).
     chart_kwargs : passed to ``numerics.escape_chart`` (``steps_per_cycle``, ``threads``).
 
     Returns
@@ -152,13 +161,13 @@ def erosion_profile_numeric(F_values, Omega, Psi, xi_max, q0, p0, t_eval=None, c
     xr.Dataset over (F, xi_max, t_eval) (and the charts stacked over F if ``keep_charts``).
     """
     F = as_1d("F_values", F_values, checks.check_nonnegative)
-    xi = as_1d("xi_max", xi_max, QUARTIC.check_threshold)
+    xi = as_1d("xi_max", xi_max, (QUARTIC if well is None else well).check_threshold)
     checks.check_positive_int("cycles", cycles)
     q, p, _, _ = mesh(q0, p0)
     charts = []
     for Fi in F:
         c = escape_chart(q, p, float(Fi), float(Omega), float(Psi), xi_max=tuple(xi.tolist()),
-                         q_max=tuple(np.atleast_1d(q_max).tolist()), cycles=cycles, **chart_kwargs)
+                         q_max=tuple(np.atleast_1d(q_max).tolist()), cycles=cycles, well=well, **chart_kwargs)
         charts.append(c.assign_attrs(F=float(Fi)))
     stacked = stack_charts(charts, "F")
     prof = profile_from_charts(stacked, t_eval)

@@ -110,15 +110,17 @@ def grid_spacing(q0, p0):
     return q, p, dq, dp
 
 
-def unforced_safe_mask(q0, p0, xi_max):
-    """Unforced safe set S0 = {H0 < xi_max, |q0| < q_max(xi_max)} on the grid.
+def unforced_safe_mask(q0, p0, xi_max, well=None):
+    """Unforced safe set S0 = {H0 < xi_max, |q0| < q_max(xi_max)} on the grid (of ``well``:
+    H0 < xi_max inside its barriers; None: the paper's quartic).
 
     ``xi_max`` may be an array: the result has shape ``xi_max.shape + (n_q0, n_p0)``.
     """
     q, p, _, _ = grid_spacing(q0, p0)
-    xi = QUARTIC.check_threshold("xi_max", xi_max)
+    w = QUARTIC if well is None else well
+    xi = w.check_threshold("xi_max", xi_max)
     Q, P = np.meshgrid(q, p, indexing="ij")
-    return QUARTIC.unforced_safe(Q, P, xi[..., None, None])
+    return w.unforced_safe(Q, P, xi[..., None, None])
 
 
 # --------------------------------------------------------------------------- core
@@ -166,7 +168,7 @@ def _ratio(a, b):
         return np.where(b > 0, a / np.where(b > 0, b, 1.0), np.nan)
 
 
-def _measures_numpy(safe, q0, p0, xi_max, bottom):
+def _measures_numpy(safe, q0, p0, xi_max, bottom, well=None):
     safe = np.asarray(safe)
     if safe.dtype != bool:
         raise ValueError(f"safe must be a boolean mask, got dtype {safe.dtype}")
@@ -179,13 +181,13 @@ def _measures_numpy(safe, q0, p0, xi_max, bottom):
     out = {k: v.reshape(lead) for k, v in raw.items()}
 
     if xi_max is not None:
-        xi = QUARTIC.check_threshold("xi_max", xi_max)
+        xi = (QUARTIC if well is None else well).check_threshold("xi_max", xi_max)
         try:
             xi_b = np.broadcast_to(xi, lead)
         except ValueError as exc:
             raise ValueError(f"xi_max with shape {xi.shape} does not broadcast to the leading mask shape {lead}") from exc
         uniq, inv = np.unique(xi_b, return_inverse=True)
-        ref = _raw_measures(unforced_safe_mask(q, p, uniq), q, p, dq, dp, bottom)
+        ref = _raw_measures(unforced_safe_mask(q, p, uniq, well), q, p, dq, dp, bottom)
         inv = inv.reshape(lead)
         out["area_unforced"] = ref["area"][inv]
         out["r_local_unforced"] = ref["r_local"][inv]
@@ -196,7 +198,7 @@ def _measures_numpy(safe, q0, p0, xi_max, bottom):
     return out
 
 
-def integrity_measures(safe, q0=None, p0=None, xi_max=None, *, bottom=(0.0, 0.0)):
+def integrity_measures(safe, q0=None, p0=None, xi_max=None, *, bottom=(0.0, 0.0), well=None):
     """GIM, LIM and IF of safe-basin masks (see the module docstring for definitions and errors).
 
     Parameters
@@ -210,6 +212,8 @@ def integrity_measures(safe, q0=None, p0=None, xi_max=None, *, bottom=(0.0, 0.0)
         DataArray it defaults to its ``xi_max`` coordinate (a dimension or a scalar
         coordinate).  ``None`` with numpy input: only the raw measures are returned.
     bottom : the well bottom (centre of the LIM disk), default ``(0, 0)``.
+    well : the potential well of the normalising unforced set (safebasins.wells; None: the
+        paper's quartic).
 
     Returns
     -------
@@ -220,13 +224,13 @@ def integrity_measures(safe, q0=None, p0=None, xi_max=None, *, bottom=(0.0, 0.0)
     (normalisers on the same grid).  Radii are accurate to one pixel diagonal.
     """
     if isinstance(safe, xr.DataArray):
-        return _measures_xarray(safe, q0, p0, xi_max, bottom)
+        return _measures_xarray(safe, q0, p0, xi_max, bottom, well)
     if q0 is None or p0 is None:
         raise ValueError("q0 and p0 are required for a numpy mask")
-    return _measures_numpy(safe, q0, p0, xi_max, bottom)
+    return _measures_numpy(safe, q0, p0, xi_max, bottom, well)
 
 
-def _measures_xarray(safe, q0, p0, xi_max, bottom):
+def _measures_xarray(safe, q0, p0, xi_max, bottom, well):
     for d in ("q0", "p0"):
         if d not in safe.dims:
             raise ValueError(f"safe must have dims (..., 'q0', 'p0'), got {safe.dims}")
@@ -248,7 +252,7 @@ def _measures_xarray(safe, q0, p0, xi_max, bottom):
         raise ValueError("xi_max is required: pass it or give the mask an xi_max coordinate")
     else:
         xi_np = xi_max
-    res = _measures_numpy(safe.values.astype(bool, copy=False), q, p, xi_np, bottom)
+    res = _measures_numpy(safe.values.astype(bool, copy=False), q, p, xi_np, bottom, well)
     coords = {k: v for k, v in template.coords.items()}
     ds = xr.Dataset(
         {k: xr.DataArray(v, dims=lead_dims, attrs=dict(MEASURE_ATTRS[k])) for k, v in res.items()},

@@ -19,15 +19,15 @@ import numpy as np
 import xarray as xr
 
 from safebasins import checks
-from safebasins.analysis.common import as_1d, mesh
+from safebasins.analysis.common import as_1d, mesh, variant_well
 from safebasins.analysis.erosion import level_crossing
 from safebasins.analysis.integrity import integrity_measures, unforced_safe_mask
 from safebasins.analysis.phase_invariant import xi_true_analytic
 from safebasins.analysis.safe import safe_stack
 from safebasins.io.cf import annotate
 from safebasins.numerics import escape_chart_batch
-from safebasins.theory import J, slow_flow_escapes
-from safebasins.wells.quartic import QUARTIC
+from safebasins.theory import slow_flow_escapes
+from safebasins.wells import from_attrs, well_attrs
 
 __all__ = ["integrity_map_analytic", "integrity_map_numeric", "integrity_from_batch", "erosion_front"]
 
@@ -40,29 +40,32 @@ def _control(Omega, F):
     return Om, Fv
 
 
-def integrity_map_analytic(Omega, F, Psi, xi_max, q0, p0, *, fourier="paper", n_gamma=128, n_xi=64):
+def integrity_map_analytic(Omega, F, Psi, xi_max, q0, p0, *, fourier="paper", n_gamma=128, n_xi=64, well=None):
     """Analytic integrity map over (Omega, F): GIM, LIM, IF of the slow-flow basin for phase Psi,
-    and ``xi_true``, ``GIM_true``, ``LIM_true`` of the basin safe for every phase."""
+    and ``xi_true``, ``GIM_true``, ``LIM_true`` of the basin safe for every phase.  ``well``: any
+    well (None: the quartic; another well's only ``fourier`` is "exact")."""
     Om, Fv = _control(Omega, F)
+    w = variant_well(well, fourier)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
-    xi = checks.check_scalar("xi_max", xi_max, QUARTIC.check_threshold)
+    xi = checks.check_scalar("xi_max", xi_max, w.check_threshold)
     q, p, Q, P = mesh(q0, p0)
-    S0 = unforced_safe_mask(q, p, xi)
+    S0 = unforced_safe_mask(q, p, xi, w)
     safe = np.zeros((Om.size, Fv.size, q.size, p.size), bool)
     xt = np.zeros((Om.size, Fv.size))
     for i, om in enumerate(Om):
         for j, f in enumerate(Fv):
-            safe[i, j] = ~np.asarray(slow_flow_escapes(Q, P, f, om, Psi, xi, fourier=fourier), bool) & S0
-            xt[i, j] = xi_true_analytic(f, om, xi, fourier, n_gamma=n_gamma, n_xi=n_xi)
+            safe[i, j] = ~np.asarray(slow_flow_escapes(Q, P, f, om, Psi, xi, well=w), bool) & S0
+            xt[i, j] = xi_true_analytic(f, om, xi, fourier, n_gamma=n_gamma, n_xi=n_xi, well=w)
     da = xr.DataArray(safe, dims=("Omega", "F", "q0", "p0"), coords={"Omega": Om, "F": Fv, "q0": q, "p0": p})
-    m = integrity_measures(da, xi_max=xi)
+    m = integrity_measures(da, xi_max=xi, well=w)
     ds = m[list(MEASURES)].copy()
     ds["xi_true"] = (("Omega", "F"), xt, {"units": "1", "long_name": "energy radius of the basin safe for every "
                                                                       "phase (H0 < xi_true)"})
-    ds["GIM_true"] = (("Omega", "F"), np.where(xt > 0, J(xt) / J(xi), 0.0),
+    ds["GIM_true"] = (("Omega", "F"), np.where(xt > 0, w.J(xt) / w.J(xi), 0.0),
                       {"units": "1", "long_name": "GIM of the all-phase basin, J(xi_true)/J(xi_max)"})
     ds["LIM_true"] = (("Omega", "F"), np.sqrt(xt / xi),
                       {"units": "1", "long_name": "LIM = IF of the all-phase basin, sqrt(xi_true/xi_max)"})
+    ds.attrs.update(well_attrs(w))
     ds.attrs.update(kind="analytic", Psi=Psi, xi_max=xi, fourier=fourier, n_gamma=int(n_gamma), n_xi=int(n_xi),
                     method="slow_flow_escapes on the grid per control point; xi_true_analytic for all phases")
     return annotate(ds)
@@ -74,17 +77,17 @@ def integrity_from_batch(charts, t_eval=None):
     if charts.sizes["xi_max"] != 1:
         raise ValueError(f"an integrity map uses one energy threshold, the charts have {charts.sizes['xi_max']}")
     safe, xi_norm = safe_stack(charts, t_eval, "energy")
-    m = integrity_measures(safe.isel(xi_max=0), xi_max=float(xi_norm.values[0]))
+    m = integrity_measures(safe.isel(xi_max=0), xi_max=float(xi_norm.values[0]), well=from_attrs(charts.attrs))
     return m[list(MEASURES)].transpose("control", "t_eval")
 
 
-def integrity_map_numeric(Omega, F, Psi, xi_max, q0, p0, *, cycles=1000, t_eval=None, **chart_kwargs):
+def integrity_map_numeric(Omega, F, Psi, xi_max, q0, p0, *, cycles=1000, t_eval=None, well=None, **chart_kwargs):
     """Numeric integrity map over (Omega, F, t_eval): one escape chart per control point (all
     control points in one ensemble), safe = escape_cycle > t_eval."""
     Om, Fv = _control(Omega, F)
     OO, FF = np.meshgrid(Om, Fv, indexing="ij")
     charts = escape_chart_batch(q0, p0, FF.ravel(), OO.ravel(), Psi, xi_max=(float(xi_max),), cycles=cycles,
-                                **chart_kwargs)
+                                well=well, **chart_kwargs)
     m = integrity_from_batch(charts, t_eval)
     ds = xr.Dataset({k: (("Omega", "F", "t_eval"), m[k].values.reshape(Om.size, Fv.size, -1), m[k].attrs)
                      for k in MEASURES},

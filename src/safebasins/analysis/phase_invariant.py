@@ -38,12 +38,13 @@ import numpy as np
 import xarray as xr
 
 from safebasins import checks
-from safebasins.analysis.common import as_1d, fourier_list, mesh, stack_charts
+from safebasins.analysis.common import as_1d, fourier_list, mesh, stack_charts, variant_well
 from safebasins.analysis.integrity import MEASURE_ATTRS, integrity_measures, unforced_safe_mask
 from safebasins.analysis.safe import safe_stack
 from safebasins.io.cf import annotate
 from safebasins.numerics import escape_chart
-from safebasins.theory import J, angle_energy, escapes_on_manifold
+from safebasins.theory import angle_energy, escapes_on_manifold
+from safebasins.wells import from_attrs, well_attrs
 from safebasins.wells.quartic import QUARTIC
 
 __all__ = [
@@ -64,10 +65,10 @@ def default_phases(n_psi=16):
     return 2 * np.pi * np.arange(n) / n
 
 
-def _first_escaping_circle(lo, hi, n_xi, F, Omega, xi_max, fourier, gamma):
+def _first_escaping_circle(lo, hi, n_xi, F, Omega, xi_max, well, gamma):
     """Grid search on [lo, hi]: (last all-safe xi, first xi with an escaping point) or None."""
     xs = np.linspace(lo, hi, n_xi)
-    e = np.asarray(escapes_on_manifold(gamma[:, None], xs[None, :], F, Omega, xi_max, fourier=fourier), dtype=bool).any(axis=0)
+    e = np.asarray(escapes_on_manifold(gamma[:, None], xs[None, :], F, Omega, xi_max, well=well), dtype=bool).any(axis=0)
     k = np.flatnonzero(e)
     if k.size == 0:
         return None
@@ -75,7 +76,7 @@ def _first_escaping_circle(lo, hi, n_xi, F, Omega, xi_max, fourier, gamma):
     return (xs[k - 1] if k > 0 else None), xs[k]
 
 
-def xi_true_analytic(F, Omega, xi_max, fourier="paper", *, n_gamma=512, n_xi=400, levels=3):
+def xi_true_analytic(F, Omega, xi_max, fourier="paper", *, n_gamma=512, n_xi=400, levels=3, well=None):
     """Largest xi such that every circle ``xi' < xi`` of the resonance manifold is safe.
 
     The predicate "some point of the circle escapes" is monotone in xi (module
@@ -83,18 +84,19 @@ def xi_true_analytic(F, Omega, xi_max, fourier="paper", *, n_gamma=512, n_xi=400
     gamma = 0 and pi where the level curves turn are included) and refined ``levels``
     times on ``n_xi``-point xi grids, giving a resolution of about
     ``xi_max / (n_xi - 1)**levels``.  Returns 0 if the well bottom (the limiting phase
-    trajectory) escapes and ``xi_max`` if nothing below xi_max escapes.
+    trajectory) escapes and ``xi_max`` if nothing below xi_max escapes.  ``well``: any well
+    (None: the quartic; another well's only ``fourier`` is "exact").
     """
     F = float(checks.check_nonnegative("F", F))
     Omega = float(checks.check_positive("Omega", Omega))
-    xi_max = float(QUARTIC.check_threshold("xi_max", xi_max))
-    fourier_list(fourier)
+    w = variant_well(well, fourier_list(fourier)[0][0])
+    xi_max = float(w.check_threshold("xi_max", xi_max))
     n_gamma = checks.check_positive_int("n_gamma", n_gamma)
     n_gamma += n_gamma % 2
     gamma = 2 * np.pi * np.arange(n_gamma) / n_gamma
     lo, hi = 0.0, xi_max * (1 - 1e-12)
     for _ in range(checks.check_positive_int("levels", levels)):
-        r = _first_escaping_circle(lo, hi, checks.check_positive_int("n_xi", n_xi), F, Omega, xi_max, fourier, gamma)
+        r = _first_escaping_circle(lo, hi, checks.check_positive_int("n_xi", n_xi), F, Omega, xi_max, w, gamma)
         if r is None:
             return hi if hi >= xi_max * (1 - 1e-9) else lo
         if r[0] is None:
@@ -103,24 +105,27 @@ def xi_true_analytic(F, Omega, xi_max, fourier="paper", *, n_gamma=512, n_xi=400
     return lo
 
 
-def _one_analytic(F, Omega, xi_max, q, p, Psi, fourier, n_gamma):
+def _one_analytic(F, Omega, xi_max, q, p, Psi, well, n_gamma):
+    """Per-phase basins, the all-phase basin {H0 < xi_true} and its closed-form measures, for
+    one well object (one first-harmonic variant)."""
     Q, P = np.meshgrid(q, p, indexing="ij")
-    S0 = unforced_safe_mask(q, p, xi_max)
+    S0 = unforced_safe_mask(q, p, xi_max, well)
     theta = np.zeros(Q.shape)
     xi_ini = np.zeros(Q.shape)
-    th, x = angle_energy(Q[S0], P[S0])
+    th, x = angle_energy(Q[S0], P[S0], well=well)
     theta[S0], xi_ini[S0] = th, x
     safe = np.zeros((Psi.size,) + Q.shape, dtype=bool)
     for k, ps in enumerate(Psi):
         gamma = np.mod(theta[S0] - ps, 2 * np.pi)
-        safe[k][S0] = ~np.asarray(escapes_on_manifold(gamma, xi_ini[S0], F, Omega, xi_max, fourier=fourier), dtype=bool)
-    xt = xi_true_analytic(F, Omega, xi_max, fourier, n_gamma=n_gamma)
+        safe[k][S0] = ~np.asarray(escapes_on_manifold(gamma, xi_ini[S0], F, Omega, xi_max, well=well), dtype=bool)
+    xt = xi_true_analytic(F, Omega, xi_max, well.fourier, n_gamma=n_gamma, well=well)
     cont = S0 & (xi_ini < xt)
-    closed_gim = float(J(xt) / J(xi_max)) if xt > 0 else 0.0
+    # area of {H0 < E} = 2 pi J(E) (eq 19) for any well
+    closed_gim = float(well.J(xt) / well.J(xi_max)) if xt > 0 else 0.0
     return safe, cont, xt, closed_gim, float(np.sqrt(xt / xi_max))
 
 
-def _assemble(safe, q, p, Psi, lead_dims, lead_coords, xi_norm):
+def _assemble(safe, q, p, Psi, lead_dims, lead_coords, xi_norm, well):
     """Common Dataset layout: per-phase masks, true mask, integrity of both."""
     dims_psi = ("Psi",) + lead_dims + ("q0", "p0")
     coords = {"Psi": Psi, "q0": q, "p0": p, **lead_coords}
@@ -128,8 +133,8 @@ def _assemble(safe, q, p, Psi, lead_dims, lead_coords, xi_norm):
                            attrs={"long_name": "safe basin for forcing phase Psi", "units": "1"})
     da_true = da_safe.all("Psi").assign_attrs(long_name="phase-invariant safe basin (intersection over Psi)",
                                               units="1")
-    per = integrity_measures(da_safe, xi_max=xi_norm)
-    tru = integrity_measures(da_true, xi_max=xi_norm)
+    per = integrity_measures(da_safe, xi_max=xi_norm, well=well)
+    tru = integrity_measures(da_true, xi_max=xi_norm, well=well)
     ds = xr.Dataset({"safe": da_safe, "true_safe": da_true})
     for k in _KEEP:
         ds[k] = per[k]
@@ -137,8 +142,10 @@ def _assemble(safe, q, p, Psi, lead_dims, lead_coords, xi_norm):
             units=MEASURE_ATTRS[k]["units"], long_name=MEASURE_ATTRS[k]["long_name"] + " of the true basin")
     # energy radius of the true basin: largest E with {H0 < E} (inside S0) contained in it, the grid
     # counterpart of xi_true (compare analytic xi_true with the numeric xi_inscribed_true)
-    Hq = xr.DataArray(QUARTIC.H0(*np.meshgrid(q, p, indexing="ij")), dims=("q0", "p0"), coords={"q0": q, "p0": p})
-    s0 = QUARTIC.unforced_safe(Hq["q0"], Hq["p0"], xi_norm)
+    Q, P = np.meshgrid(q, p, indexing="ij")
+    Hq = xr.DataArray(well.H0(Q, P), dims=("q0", "p0"), coords={"q0": q, "p0": p})
+    s0 = xr.DataArray(np.stack([well.unforced_safe(Q, P, x) for x in np.ravel(xi_norm.values)]).reshape(
+        xi_norm.shape + Q.shape), dims=xi_norm.dims + ("q0", "p0"), coords={**xi_norm.coords, **Hq.coords})
     bad = s0 & ~da_true
     ds["xi_inscribed_true"] = Hq.where(bad).min(("q0", "p0")).fillna(xi_norm).assign_attrs(
         units="1", long_name="largest energy E with {H0 < E} inside the true basin (grid value, one-node accuracy)")
@@ -150,7 +157,7 @@ def _assemble(safe, q, p, Psi, lead_dims, lead_coords, xi_norm):
 
 
 def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fourier="paper", n_psi=16,
-                             n_gamma=512):
+                             n_gamma=512, well=None):
     """Analytic phase-invariant safe basin and its integrity.
 
     Parameters
@@ -161,6 +168,7 @@ def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fouri
     Psi_values : phases to intersect over (default ``default_phases(n_psi)``).
     fourier : "paper" | "exact" | list (dimension ``fourier``).
     n_gamma : gamma resolution of the continuous-phase limit ``xi_true``.
+    well : the potential well (None: the paper's quartic); another well's only variant is "exact".
 
     Returns
     -------
@@ -178,9 +186,10 @@ def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fouri
     """
     F = float(checks.check_nonnegative("F", F))
     Omega = float(checks.check_positive("Omega", Omega))
-    xi = as_1d("xi_max", xi_max, QUARTIC.check_threshold)
-    Psi = default_phases(n_psi) if Psi_values is None else as_1d("Psi_values", Psi_values, checks.check_finite)
     fl, scalar = fourier_list(fourier)
+    wl = [variant_well(well, f) for f in fl]
+    xi = as_1d("xi_max", xi_max, wl[0].check_threshold)
+    Psi = default_phases(n_psi) if Psi_values is None else as_1d("Psi_values", Psi_values, checks.check_finite)
     q, p, _, _ = mesh(q0, p0)
     nf, nx = len(fl), xi.size
     safe = np.zeros((Psi.size, nf, nx, q.size, p.size), bool)
@@ -190,17 +199,17 @@ def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fouri
     lim_c = np.zeros((nf, nx))
     for a, f in enumerate(fl):
         for j, x in enumerate(xi):
-            s, c, t, g, l = _one_analytic(F, Omega, float(x), q, p, Psi, f, n_gamma)
+            s, c, t, g, l = _one_analytic(F, Omega, float(x), q, p, Psi, wl[a], n_gamma)
             safe[:, a, j], cont[a, j], xt[a, j], gim_c[a, j], lim_c[a, j] = s, c, t, g, l
     lead_dims = ("fourier", "xi_max")
     lead_coords = {"fourier": fl, "xi_max": xi}
     xi_norm = xr.DataArray(xi, dims="xi_max", coords={"xi_max": xi})
-    ds = _assemble(safe, q, p, Psi, lead_dims, lead_coords, xi_norm)
+    ds = _assemble(safe, q, p, Psi, lead_dims, lead_coords, xi_norm, wl[0])
     da_cont = xr.DataArray(cont, dims=lead_dims + ("q0", "p0"), coords={**lead_coords, "q0": q, "p0": p},
                            attrs={"long_name": "safe basin for every phase Psi in [0, 2 pi): H0 < xi_true",
                                   "units": "1"})
     ds["true_safe_continuous"] = da_cont
-    cm = integrity_measures(da_cont, xi_max=xi_norm)
+    cm = integrity_measures(da_cont, xi_max=xi_norm, well=wl[0])
     for k in _KEEP:
         ds[f"{k}_continuous"] = cm[k]
     ds["xi_true"] = xr.DataArray(xt, dims=lead_dims, attrs={
@@ -211,6 +220,7 @@ def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fouri
         "units": "1", "long_name": "closed-form LIM = IF of the all-phase basin, sqrt(xi_true/xi_max)"})
     if scalar:
         ds = ds.isel(fourier=0)
+    ds.attrs.update(well_attrs(wl[0]))
     ds.attrs.update({"kind": "analytic", "F": F, "Omega": Omega, "n_gamma": int(n_gamma),
                      "method": "rotation of the Psi = 0 manifold classification: gamma_ini = theta0 - Psi"})
     return annotate(ds)
@@ -225,13 +235,15 @@ def true_safe_basin_from_charts(charts, t_eval=None, *, criterion="energy"):
     ``xi_true``) and ``contained``.
     """
     chart = stack_charts(charts, "Psi")
+    well = from_attrs(chart.attrs)    # the well the charts were integrated in
     safe, xi_norm = safe_stack(chart, t_eval, criterion)
     thr = "xi_max" if criterion == "energy" else "q_max"
     safe = safe.transpose("Psi", thr, "t_eval", "q0", "p0")
     lead_dims = (thr, "t_eval")
     lead_coords = {thr: safe[thr].values, "t_eval": safe["t_eval"].values}
     ds = _assemble(safe.values, safe["q0"].values, safe["p0"].values, safe["Psi"].values,
-                   lead_dims, lead_coords, xi_norm)
+                   lead_dims, lead_coords, xi_norm, well)
+    ds.attrs.update(well_attrs(well))
     ds.attrs.update({k: v for k, v in chart.attrs.items() if k in ("F", "Omega", "cycles", "steps_per_cycle",
                                                                        "integrator")})
     ds.attrs.update({"kind": "numeric", "criterion": criterion,
@@ -240,7 +252,7 @@ def true_safe_basin_from_charts(charts, t_eval=None, *, criterion="energy"):
 
 
 def true_safe_basin_numeric(F, Omega, xi_max, q0, p0, Psi_values=None, t_eval=None, cycles=3000, *,
-                            n_psi=16, keep_charts=False, **chart_kwargs):
+                            n_psi=16, keep_charts=False, well=None, **chart_kwargs):
     """Numeric phase-invariant safe basin: one ``numerics.escape_chart`` per phase.
 
     Parameters as in :func:`true_safe_basin_analytic`, plus ``t_eval`` (cycles, each <=
@@ -250,18 +262,18 @@ def true_safe_basin_numeric(F, Omega, xi_max, q0, p0, Psi_values=None, t_eval=No
     """
     F = float(checks.check_nonnegative("F", F))
     Omega = float(checks.check_positive("Omega", Omega))
-    xi = as_1d("xi_max", xi_max, QUARTIC.check_threshold)
+    xi = as_1d("xi_max", xi_max, (QUARTIC if well is None else well).check_threshold)
     Psi = default_phases(n_psi) if Psi_values is None else as_1d("Psi_values", Psi_values, checks.check_finite)
     checks.check_positive_int("cycles", cycles)
     q, p, _, _ = mesh(q0, p0)
-    charts = [escape_chart(q, p, F, Omega, float(ps), xi_max=tuple(xi.tolist()), cycles=cycles,
+    charts = [escape_chart(q, p, F, Omega, float(ps), xi_max=tuple(xi.tolist()), cycles=cycles, well=well,
                            **chart_kwargs).assign_attrs(Psi=float(ps)) for ps in Psi]
     stacked = stack_charts(charts, "Psi")
     ds = true_safe_basin_from_charts(stacked, t_eval)
     return (ds, stacked) if keep_charts else ds
 
 
-def phase_boundaries(F, Omega, xi_max, Psi_values, *, fourier="paper", n_points=400):
+def phase_boundaries(F, Omega, xi_max, Psi_values, *, fourier="paper", n_points=400, well=None):
     """Boundary curves of the analytic per-phase basins on the IC plane, from the slow flow
     itself (:func:`safebasins.theory.safe_basin_boundaries` for every phase), not from a grid.
 
@@ -271,14 +283,15 @@ def phase_boundaries(F, Omega, xi_max, Psi_values, *, fourier="paper", n_points=
     """
     from safebasins.theory import safe_basin_boundaries
 
-    xi = as_1d("xi_max", xi_max, QUARTIC.check_threshold)
-    Psi = as_1d("Psi_values", Psi_values, checks.check_finite)
     fl, scalar = fourier_list(fourier)
+    wl = [variant_well(well, f) for f in fl]
+    xi = as_1d("xi_max", xi_max, wl[0].check_threshold)
+    Psi = as_1d("Psi_values", Psi_values, checks.check_finite)
     parts = {}
     for k, ps in enumerate(Psi):
         for a, f in enumerate(fl):
             for j, x in enumerate(xi):
-                b = safe_basin_boundaries(F, Omega, float(ps), float(x), fourier=f, n_points=n_points)
+                b = safe_basin_boundaries(F, Omega, float(ps), float(x), well=wl[a], n_points=n_points)
                 parts[k, a, j] = (np.asarray(b["q0_vertex"], float), np.asarray(b["p0_vertex"], float),
                                   np.asarray(b["curve_index"], float))
     nv = max(v[0].size for v in parts.values())

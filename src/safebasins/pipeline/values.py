@@ -99,3 +99,12 @@ def well(params, fourier=None):
 
     # kinds without a first harmonic (numerics only: no "fourier" parameter) get the default one
     return wells.from_spec(params["well"], params.get("fourier") if fourier is None else fourier)
+
+
+def base_well(params):
+    """The well of resolved parameters for library calls that loop over the first-harmonic
+    variants of a list-valued ``params["fourier"]`` themselves (the quartic with eq (20) as
+    printed; safebasins.analysis.common.variant_well picks each variant)."""
+    from safebasins import wells
+
+    return wells.from_spec(params["well"])

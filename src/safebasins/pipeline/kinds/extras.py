@@ -50,7 +50,7 @@ def build_erosion_analytic(params, inputs, job):
     print(f"{params['experiment']}: {len(params['F'])} F x {len(params['xi_max'])} xi_max x {params['fourier']} "
           f"on {q0.size} x {p0.size} ICs")
     ds = erosion_profile_analytic(params["F"], params["Omega"], params["Psi"], params["xi_max"], q0, p0,
-                                  fourier=params["fourier"])
+                                  fourier=params["fourier"], well=values.base_well(params))
     ds = _level_crossings(ds, params["level"])
     ds.attrs.update(level=params["level"], xi_max=params["xi_max"], grid_n=np.array([q0.size, p0.size]))
     return ds
@@ -75,10 +75,11 @@ def build_true_basin_analytic(params, inputs, job):
     q0, p0 = values.grid_axes(params["grid"])
     print(f"{params['experiment']}: F={params['F']} Omega={params['Omega']} xi_max={params['xi_max']} "
           f"{len(params['Psi'])} phases {params['fourier']}")
+    w = values.base_well(params)
     ds = true_safe_basin_analytic(params["F"], params["Omega"], params["xi_max"], q0, p0, params["Psi"],
-                                  fourier=params["fourier"], n_gamma=params["n_gamma"])
+                                  fourier=params["fourier"], n_gamma=params["n_gamma"], well=w)
     b = phase_boundaries(params["F"], params["Omega"], params["xi_max"], params["Psi"], fourier=params["fourier"],
-                         n_points=params["n_points"])
+                         n_points=params["n_points"], well=w)
     return ds.merge(b.assign_coords({c: ds[c] for c in b.coords if c in ds.coords}))
 
 

@@ -23,7 +23,8 @@ def build_analytic(params, inputs, job):
     q0, p0 = values.grid_axes(params["grid"])
     print(f"{params['experiment']}: analytic map {len(params['Omega'])} x {len(params['F'])}", flush=True)
     ds = integrity_map_analytic(params["Omega"], params["F"], params["Psi"], params["xi_max"], q0, p0,
-                                fourier=params["fourier"], n_gamma=params["n_gamma"], n_xi=params["n_xi"])
+                                fourier=params["fourier"], n_gamma=params["n_gamma"], n_xi=params["n_xi"],
+                                well=values.well(params))
     fronts = erosion_front(ds, params["level"], measures=(*MEASURES, "GIM_true", "LIM_true"))
     ds.update(fronts)
     ds.attrs.update(level=params["level"])
