@@ -38,15 +38,10 @@ import xarray as xr
 from scipy import optimize
 
 from safebasins.checks import check_finite, check_nonnegative, check_positive, check_positive_int
-from safebasins.theory.slow_flow import SlowFlowProfile, _scalar
+from safebasins.theory.slow_flow import SlowFlowProfile, _scalar, unshear
 from safebasins.wells import resolve_well
 
 __all__ = ["safe_basin_boundaries"]
-
-
-def _unshear(g, shift):
-    """The slow phase gamma (in (-pi, pi]) of a point at gamma' = g on the sheared rays."""
-    return np.pi - np.mod(np.pi - (g - shift), 2.0 * np.pi)
 
 
 def _runs(mask):
@@ -199,15 +194,15 @@ def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier=None, n_points=400, wel
     else:
         sg, sx = np.nan, np.nan
     if np.isfinite(sx) and w.harmonic_shift(sx) != 0:
-        sg = _unshear(sg, w.harmonic_shift(sx))
+        sg = unshear(sg, w.harmonic_shift(sx))
 
     gam, xis, idx = [], [], []
     for k, c in enumerate(curves):
         g, x = c["gamma"], c["xi"]
         shift = w.harmonic_shift(np.minimum(x, w.barrier_energy))
         if np.any(shift != 0):  # back from the sheared rays to the slow phase
-            g = _unshear(g, shift)
-            c["ray"] = float(_unshear(c["ray"], w.harmonic_shift(c["xi_top"])))
+            g = unshear(g, shift)
+            c["ray"] = float(unshear(c["ray"], w.harmonic_shift(c["xi_top"])))
         jump = np.nonzero(np.abs(np.diff(g)) > np.pi)[0]
         if jump.size:
             g = np.insert(g, jump + 1, np.nan)

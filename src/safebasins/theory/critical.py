@@ -43,7 +43,7 @@ import numpy as np
 import xarray as xr
 
 from safebasins.checks import check_finite, check_positive
-from safebasins.theory.slow_flow import _scalar, _xi_grid
+from safebasins.theory.slow_flow import _scalar, _xi_grid, unshear
 from safebasins.wells import resolve_well
 
 __all__ = ["critical_forcing", "MECHANISMS"]
@@ -130,7 +130,7 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
                  F_MM_0 and F_SMM are disjoint; their union is eq (24) with gamma* = 0),
       ``F_MM_pi`` eq (24) through gamma* = pi,
       ``F_SM``   largest F of eqs (25)-(26) with the saddle in (xi_ini, xi_max) (NaN if none),
-      ``xi_saddle``, ``gamma_saddle`` the saddle of the F_SM branch (gamma 0 or pi),
+      ``xi_saddle``, ``gamma_saddle`` the saddle of the F_SM branch (gamma 0 or pi; -delta(xi) or pi - delta(xi) for an asymmetric well),
       ``xi_saddle_smm`` the saddle above xi_max on the F_SMM branch.
     F_cr equals the largest existing branch, provided no upper-bound constraint excludes it.
     Attributes: xi_max, xi_ini, gamma_ini, fourier, well.
@@ -222,6 +222,9 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
     F_SM = np.where(useB, vB, vA)
     xi_saddle = np.where(np.isnan(F_SM), np.nan, np.where(useB, xB, xA))
     gamma_saddle = np.where(np.isnan(F_SM), np.nan, np.where(useB, np.pi, 0.0))
+    fin = np.isfinite(gamma_saddle)
+    if fin.any():     # gamma' = 0 or pi on the sheared rays: the saddle sits at gamma = gamma' - delta(xi)
+        gamma_saddle[fin] = unshear(gamma_saddle[fin], w.harmonic_shift(xi_saddle[fin]))
 
     # --- SMM: does a(xi) = h - F G have a local max in (xi_max, 1/4) at F = FA_end?
     xi_smm = np.full(nO, np.nan)

@@ -79,6 +79,12 @@ def _ab_prime(xi, F, Omega, well):
     return hp - F * gp, hp + F * gp
 
 
+def unshear(g, shift):
+    """The slow phase gamma (in (-pi, pi]) of a point at gamma' = g on the sheared rays
+    gamma' = gamma + delta(xi) (``shift`` = delta; 0 for a symmetric well: g itself)."""
+    return np.pi - np.mod(np.pi - (g - shift), 2.0 * np.pi)
+
+
 def _xi_grid(lo, hi, n):
     """Grid on [lo, hi] clustered at both ends (Chebyshev-Lobatto spacing)."""
     t = np.linspace(0.0, 1.0, n)
