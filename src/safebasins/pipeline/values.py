@@ -102,9 +102,9 @@ def well(params, fourier=None):
 
 
 def base_well(params):
-    """The well of resolved parameters for library calls that loop over the first-harmonic
-    variants of a list-valued ``params["fourier"]`` themselves (the quartic with eq (20) as
-    printed; safebasins.analysis.common.variant_well picks each variant)."""
+    """The well of resolved parameters for the numerics (which have no first harmonic) and for
+    library calls that loop over the variants of a list-valued ``params["fourier"]`` themselves
+    (the quartic with eq (20) as printed; safebasins.analysis.common.variant_well picks each)."""
     from safebasins import wells
 
     return wells.from_spec(params["well"])

@@ -113,7 +113,7 @@ class IntegrityMap(Kind):
               f"{params['cycles']} cycles ({job.backend})", flush=True)
         charts = escape_chart_batch(q0, p0, Fs, np.full(Fs.size, t["Omega"]), params["Psi"], xi_max=tuple(t["xi_max"]),
                                     cycles=params["cycles"], steps_per_cycle=params["steps_per_cycle"],
-                                    threads=job.threads, backend=job.backend, well=values.well(params))
+                                    threads=job.threads, backend=job.backend, well=values.base_well(params))
         m = integrity_from_batch(charts, params["t_eval"])
         return m.swap_dims(control="F").drop_vars("control").assign_coords(Omega=t["Omega"])
 
