@@ -51,13 +51,17 @@ def _rst_escape(text):
     return text.replace("*", r"\*").replace("`", r"\`").replace("|", r"\|")
 
 
-def caption_rst(*, label, paper, look, data_notes=(), notebook=None, datasets=()):
+def caption_rst(*, label, look, paper=None, shows=None, data_notes=(), notebook=None, datasets=()):
     """The report caption (reStructuredText inside a Jinja2 ``raw`` block).
 
-    label : "Fig. 18" (report label); paper : the paper's caption (quoted) or what the figure
-    shows; look : what is drawn; data_notes : sentences read from the datasets.
+    label : "Fig. 18" (report label); paper : the paper's caption (quoted), or shows : what a
+    figure beyond the paper shows (exactly one of the two); look : what is drawn; data_notes :
+    sentences read from the datasets.
     """
-    parts = [f"{label}. **Paper:** {_rst_escape(paper)}", f"**Drawn:** {_rst_escape(look)}"]
+    if (paper is None) == (shows is None):
+        raise ValueError("give exactly one of paper (the paper's caption) and shows (a figure beyond the paper)")
+    lead = f"**Paper:** {_rst_escape(paper)}" if paper is not None else f"**Shows:** {_rst_escape(shows)}"
+    parts = [f"{label}. {lead}", f"**Drawn:** {_rst_escape(look)}"]
     if data_notes:
         parts.append("**In our data:**\n\n" + "\n".join(f"- {_rst_escape(n)}" for n in data_notes))
     files = [str(d) for d in datasets if d is not None]
@@ -67,14 +71,14 @@ def caption_rst(*, label, paper, look, data_notes=(), notebook=None, datasets=()
     return "{% raw %}\n" + "\n\n".join(parts) + "\n{% endraw %}\n"
 
 
-def write_caption(path, fig, *, label, paper, look, notebook=None, datasets=()):
+def write_caption(path, fig, *, label, look, paper=None, shows=None, notebook=None, datasets=()):
     """Write the caption of ``fig`` (its :func:`notes`) to ``path`` (parent folders created)."""
     if not path:
         return None
     flat = []
     for d in datasets:
         flat += list(d) if isinstance(d, (list, tuple)) else [d]
-    text = caption_rst(label=label, paper=paper, look=look, data_notes=notes(fig), notebook=notebook,
+    text = caption_rst(label=label, paper=paper, shows=shows, look=look, data_notes=notes(fig), notebook=notebook,
                        datasets=[os.fspath(d) for d in flat if isinstance(d, (str, os.PathLike))])
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     Path(path).write_text(text)

@@ -52,7 +52,8 @@ def build_notebook(fig) -> nbformat.NotebookNode:
                           f"from {module} import {function}\n\n"
                           f"apply_style()\ndescribe({inputs});")
     draw = new_code_cell(f"fig = {function}({inputs}{opts}, title=title)\nsave_figure(fig, png, pdf, dpi=dpi)\n"
-                         f"write_caption(caption, fig, label={fig.label!r}, paper={fig.caption!r},\n"
+                         f"write_caption(caption, fig, label={fig.label!r}, "
+                         f"{'paper' if fig.category == 'Figures' else 'shows'}={fig.caption!r},\n"
                          f"              look={fig.look!r},\n"
                          f"              notebook={fig.notebook!r}, datasets=[{', '.join(fig.inputs)}])\n"
                          "print('\\n'.join(notes(fig)))")
