@@ -16,6 +16,7 @@
 # Needs root (installs slurm-wlm and munge with apt-get when missing). Environment:
 #   SB_CLUSTER_TARGETS  snakemake targets (default: the subset above)
 #   SB_CLUSTER_TILES    numerics.tiles of both runs (default 2)
+#   SB_CLUSTER_CONFIG   config file merged over config/config.yaml (default config/quick.yaml)
 #   SB_CLUSTER_WORK  sandboxes and logs (default /tmp/safebasins-cluster-check, wiped at start)
 #   SB_SLURM_DIR     the cluster's files (default /tmp/safebasins-slurm)
 #   SB_VENV          the Python environment (default .venv of this checkout)
@@ -46,9 +47,29 @@ run_failed() {
 RUN_TIMEOUT=${SB_RUN_TIMEOUT:-600}
 STATUS=1
 CLUSTER_UP=0
+RUN_PID=
+# run_in DIR ARGS...: snakemake ARGS in sandbox DIR, log DIR.log, stopped after RUN_TIMEOUT s (SIGTERM:
+# Snakemake cancels its SLURM jobs; SIGKILL 30 s later). In the background, so that a signal to this
+# script is handled at once (on_exit stops the run).
+run_in() {
+    local dir=$1 rc=0
+    shift
+    (cd "$dir" && exec timeout -k 30 "$RUN_TIMEOUT" "$BIN/snakemake" -d "$dir" -s "$dir/Snakefile" "$@") >"$dir.log" 2>&1 &
+    RUN_PID=$!
+    wait "$RUN_PID" || rc=$?
+    RUN_PID=
+    return "$rc"
+}
 on_exit() {
     local rc=$?
+    set +e   # diagnostics and shutdown must run to the end, whatever fails in them
     [ "$STATUS" = 0 ] && rc=0
+    if [ -n "$RUN_PID" ] && kill -0 "$RUN_PID" 2>/dev/null; then
+        log "stopping the running snakemake (pid $RUN_PID)"
+        kill -TERM "$RUN_PID" 2>/dev/null
+        for _ in $(seq 300); do kill -0 "$RUN_PID" 2>/dev/null || break; sleep 0.1; done
+        kill -KILL "$RUN_PID" 2>/dev/null
+    fi
     if [ "$rc" != 0 ]; then
         log "FAILED (exit $rc): diagnostics follow"
         for f in "$LOCAL.log" "$SLURM.log"; do
@@ -67,13 +88,17 @@ on_exit() {
     fi
     exit "$rc"
 }
+# one check at a time on this machine (a second one would stop the first one's cluster); the lock
+# goes with this process, so a killed check never blocks the next one
+exec 9>"$SB_SLURM_DIR.lock"
+flock -n 9 || { log "another cluster check holds $SB_SLURM_DIR.lock: not starting"; exit 1; }
 trap on_exit EXIT
 trap 'exit 130' INT TERM
 
 [ -x "$BIN/snakemake" ] || { log "no $BIN/snakemake: run 'make test' (creates .venv) first"; exit 1; }
 
 T0=$(now)
-"$HERE/slurm_up.sh"
+"$HERE/slurm_up.sh" 9>&-   # (the daemons must not inherit the lock)
 CLUSTER_UP=1
 T_UP=$(($(now) - T0))
 
@@ -83,14 +108,13 @@ mkdir -p "$WORK"
 (cd "$ROOT" && "$BIN/python" -c 'import sys; from pathlib import Path; from tests.pipeline.sandbox import make_sandbox
 for p in sys.argv[1:]: make_sandbox(Path(p))' "$LOCAL" "$SLURM")
 printf 'numerics: {tiles: %d}\n' "$TILES" >"$WORK/tiles.yaml"
-CONFIGS="config/quick.yaml $WORK/tiles.yaml"
+CONFIGS="${SB_CLUSTER_CONFIG:-config/quick.yaml} $WORK/tiles.yaml"
 
 # targets before --configfile (it takes every following word)
 # ($TARGETS and $CONFIGS unquoted: split into words on purpose)
-log "local run: snakemake -j2 <$(wc -w <<<"$TARGETS") targets> (tiles $TILES, log $LOCAL.log)"
+log "local run: snakemake -j2 <$(wc -w <<<"$TARGETS") targets> --configfile $CONFIGS (tiles $TILES, log $LOCAL.log)"
 T1=$(now)
-(cd "$LOCAL" && timeout -k 30 "$RUN_TIMEOUT" "$BIN/snakemake" -d "$LOCAL" -s "$LOCAL/Snakefile" -j2 $TARGETS \
-    --configfile $CONFIGS) >"$LOCAL.log" 2>&1 || { run_failed local $?; exit 1; }
+run_in "$LOCAL" -j2 $TARGETS --configfile $CONFIGS || { run_failed local $?; exit 1; }
 T_LOCAL=$(($(now) - T1))
 log "local run done in ${T_LOCAL} s"
 
@@ -98,10 +122,8 @@ log "local run done in ${T_LOCAL} s"
 NODE_CPUS=$(sinfo -h -o %c | head -n 1)
 log "SLURM run: snakemake --workflow-profile workflow/profiles/slurm --cores $NODE_CPUS <same targets> (log $SLURM.log)"
 T2=$(now)
-# (on timeout snakemake gets SIGTERM and cancels its SLURM jobs)
-(cd "$SLURM" && timeout -k 30 "$RUN_TIMEOUT" "$BIN/snakemake" -d "$SLURM" -s "$SLURM/Snakefile" --workflow-profile "$PROFILE" \
-    --cores "$NODE_CPUS" $TARGETS \
-    --configfile $CONFIGS) >"$SLURM.log" 2>&1 || { run_failed SLURM $?; exit 1; }
+run_in "$SLURM" --workflow-profile "$PROFILE" --cores "$NODE_CPUS" $TARGETS --configfile $CONFIGS \
+    || { run_failed SLURM $?; exit 1; }
 T_SLURM=$(($(now) - T2))
 n_sub=$(grep -c 'has been submitted with SLURM jobid' "$SLURM.log" || true)
 log "SLURM run done in ${T_SLURM} s (${n_sub} SLURM jobs)"
