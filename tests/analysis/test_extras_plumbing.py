@@ -64,7 +64,8 @@ def _critical_forcing_numeric(Omega, xi_max, *, q0=0, p0=0, Psi=0, cycles=3000, 
     F = xi_max / (2 * 1.05) * (1 + (Om - 0.9) ** 2)
     return xr.Dataset({"F_cr": ("Omega", F), "non_monotone": ("Omega", np.zeros(Om.size, bool))},
                       coords={"Omega": Om},
-                      attrs={"xi_max": xi_max, "q0": q0, "p0": p0, "Psi": Psi, "cycles": cycles, "tol": tol})
+                      attrs={"xi_max": xi_max, "q0": q0, "p0": p0, "Psi": Psi, "cycles": cycles, "tol": tol,
+                             "well": "quartic"})
 
 
 @pytest.fixture

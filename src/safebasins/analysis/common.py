@@ -22,17 +22,36 @@ def fourier_list(fourier):
 
 
 def variant_well(well, fourier):
-    """The well of one first-harmonic variant: for the quartic (``well`` None or a QuarticWell)
-    ``fourier`` picks eq (20) as printed ("paper") or exact; any other well carries only its exact
-    first harmonic, so its one variant is "exact"."""
+    """The well of one first-harmonic variant.
+
+    The rule for ``fourier`` (every analysis function that takes ``well=`` and ``fourier=``):
+
+    * the quartic (``well`` None or a QuarticWell): ``fourier`` picks G of eq (20) as printed
+      ("paper") or exact ("exact"); ``None`` keeps the well's own (the paper's for ``None``);
+    * any other well has only its exact first harmonic (eq 12 from its own orbit): its one
+      variant is "exact", so ``fourier`` must be None or "exact" (stored as "exact"); "paper"
+      (the quartic's truncated eq 20) raises ValueError.
+    """
     from safebasins.wells import QuarticWell, resolve_well
 
     if well is None or isinstance(well, QuarticWell):
         return resolve_well(well, fourier)
-    if fourier != "exact":
-        raise ValueError(f"fourier {fourier!r}: the {well.name} well has only its exact first harmonic "
-                         "(the paper's truncated G of eq 20 is the quartic's): use fourier='exact'")
-    return resolve_well(well)
+    w = resolve_well(well)      # ValueError for something that is not a Well
+    if fourier not in (None, "exact"):
+        raise ValueError(f"fourier {fourier!r}: the {w.name} well has only its exact first harmonic "
+                         "(the paper's truncated G of eq 20 is the quartic's): leave fourier out or use 'exact'")
+    return w
+
+
+def well_variants(well, fourier):
+    """``(names, wells, scalar)`` of a ``fourier`` argument (None, one variant or a list) for
+    ``well`` (:func:`variant_well` gives the rule): ``None`` is the well's own single variant
+    ("paper" for the default quartic, "exact" for any other well)."""
+    if fourier is None:
+        w = variant_well(well, None)
+        return [w.fourier], [w], True
+    names, scalar = fourier_list(fourier)
+    return names, [variant_well(well, f) for f in names], scalar
 
 
 def as_1d(name, values, check=checks.as_array):

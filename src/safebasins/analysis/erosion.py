@@ -26,14 +26,13 @@ import xarray as xr
 
 from safebasins import checks
 from safebasins.io import cf
-from safebasins.analysis.common import as_1d, fourier_list, mesh, stack_charts, variant_well
+from safebasins.analysis.common import as_1d, mesh, stack_charts, well_variants
 from safebasins.analysis.integrity import integrity_measures, unforced_safe_mask
-from safebasins.analysis.safe import safe_stack
+from safebasins.analysis.safe import chart_well, safe_stack
 from safebasins.io.cf import annotate
 from safebasins.numerics import escape_chart
 from safebasins.theory import slow_flow_escapes
-from safebasins.wells import from_attrs, well_attrs
-from safebasins.wells.quartic import QUARTIC
+from safebasins.wells import resolve_well, well_attrs
 
 __all__ = [
     "analytic_safe_masks",
@@ -46,18 +45,18 @@ __all__ = [
 
 
 # --------------------------------------------------------------------------- analytic
-def analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier="paper", well=None):
+def analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier=None, well=None):
     """Analytic safe masks ``~slow_flow_escapes`` stacked as DataArray (fourier?, F, xi_max, q0, p0).
 
-    ``fourier`` may be a string (scalar coordinate) or a list (dimension ``fourier``); ``well``
-    (None: the quartic) any well of safebasins.wells, whose only variant is "exact"
-    (:func:`~safebasins.analysis.common.variant_well`).
-    Points outside the unforced set S0 are never safe (theory returns True there; the
-    mask is intersected with S0 anyway so that GIM <= 1 exactly).
+    ``fourier`` may be None (the well's own first harmonic: eq (20) as printed for the default
+    quartic, "exact" for any other well), a string (scalar coordinate) or a list (dimension
+    ``fourier``); ``well`` (None: the quartic) any well of safebasins.wells, whose only variant
+    is "exact" (:func:`~safebasins.analysis.common.variant_well` states the rule).
+    Points outside the unforced set S0 (eqs 4, 7; the well's ``unforced_safe``) are never safe
+    (theory returns True there; the mask is intersected with S0 anyway so that GIM <= 1 exactly).
     """
     F = as_1d("F_values", F_values, checks.check_nonnegative)
-    fl, scalar = fourier_list(fourier)
-    wl = [variant_well(well, f) for f in fl]
+    fl, wl, scalar = well_variants(well, fourier)
     xi = as_1d("xi_max", xi_max, wl[0].check_threshold)
     Omega = float(checks.check_positive("Omega", Omega))
     Psi = float(checks.check_finite("Psi", Psi))
@@ -75,7 +74,7 @@ def analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier="paper", w
     return da.isel(fourier=0) if scalar else da
 
 
-def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier="paper", *, keep_masks=False, well=None):
+def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier=None, *, keep_masks=False, well=None):
     """Analytic erosion profile: GIM/LIM/IF versus F from the slow flow on the (q0, p0) grid.
 
     Parameters
@@ -83,9 +82,12 @@ def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier="pape
     F_values : 1-D forcing amplitudes (include 0 for the unforced reference point).
     Omega, Psi : forcing frequency and phase.
     xi_max : energy threshold(s) (dimension ``xi_max``).
-    q0, p0 : 1-D uniform grid axes (cover the well: |q0| <= 1, |p0| <= 1/sqrt(2)).
-    fourier : "paper" | "exact" | list of both (adds dimension ``fourier``).
-    well : the potential well (None: the paper's quartic); another well's only variant is "exact".
+    q0, p0 : 1-D uniform grid axes (cover the unforced set S0(xi_max); for the quartic
+        |q0| <= 1, |p0| <= 1/sqrt(2)).
+    fourier : None (the well's own: "paper" for the default quartic) | "paper" | "exact" |
+        list of both (adds dimension ``fourier``); a well other than the quartic has only
+        "exact" (:func:`~safebasins.analysis.common.variant_well`).
+    well : the potential well (None: the paper's quartic).
     keep_masks : also return the masks as variable ``safe`` (..., q0, p0).
 
     Returns
@@ -94,14 +96,15 @@ def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier="pape
     measures (see :func:`safebasins.analysis.integrity.integrity_measures`).
     """
     masks = analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier, well)
-    w = variant_well(well, fourier_list(fourier)[0][0])
+    names, wl, scalar = well_variants(well, fourier)
+    w = wl[0]
     ds = integrity_measures(masks, well=w)
     if keep_masks:
         ds["safe"] = masks
     ds.attrs.update({"kind": "analytic", "Omega": float(Omega), "Psi": float(Psi),
                      "method": "safebasins.theory.slow_flow_escapes on the grid", **well_attrs(w)})
-    if isinstance(fourier, str):
-        ds.attrs["fourier"] = fourier
+    if scalar:
+        ds.attrs["fourier"] = names[0]
     return annotate(ds)
 
 
@@ -116,20 +119,22 @@ def profile_from_charts(charts, t_eval=None, *, criterion="energy", stack_dim="F
         ``stack_dim`` using each chart's attribute of that name.
     t_eval : evaluation times in forcing cycles (default: the chart horizon
         ``cycles``); each <= ``cycles``.  Adds dimension ``t_eval``.
-    criterion : "energy" (``escape_cycle_energy``, thresholds ``xi_max``) or
-        "displacement" (``escape_cycle_displacement``, thresholds ``q_max``,
-        normalised by the unforced set of energy V(q_max)).
+    criterion : "energy" (``escape_cycle_energy``, thresholds ``xi_max``),
+        "displacement" (``escape_cycle_displacement``, thresholds ``q_max``) or "bounds"
+        (``escape_cycle_bounds``, pairs ``q_bounds``); a displacement criterion is normalised by
+        the unforced set of its energy in the charts' well
+        (:func:`safebasins.analysis.safe.displacement_energy`: V(q_max) for the quartic).
 
     Returns
     -------
     xr.Dataset over (stack_dim?, threshold, t_eval) with the integrity variables.
     """
     chart = stack_charts(charts, stack_dim)
-    well = from_attrs(chart.attrs)    # the well the charts were integrated in (escape_chart's attributes)
+    well = chart_well(chart)    # the well the charts were integrated in (escape_chart's attributes)
     safe, xi_norm = safe_stack(chart, t_eval, criterion)
     parts = [integrity_measures(safe.isel(t_eval=k), xi_max=xi_norm, well=well) for k in range(safe.sizes["t_eval"])]
     ds = xr.concat(parts, dim="t_eval", coords="minimal", compat="override", join="override")
-    thr = "xi_max" if criterion == "energy" else "q_max"
+    thr = xi_norm.dims[0]
     lead = [d for d in (stack_dim, thr) if d in ds.dims]
     ds = ds.transpose(*lead, "t_eval", ...)
     ds["t_eval"].attrs.update(cf.attrs("t_eval"))
@@ -161,7 +166,7 @@ def erosion_profile_numeric(F_values, Omega, Psi, xi_max, q0, p0, t_eval=None, c
     xr.Dataset over (F, xi_max, t_eval) (and the charts stacked over F if ``keep_charts``).
     """
     F = as_1d("F_values", F_values, checks.check_nonnegative)
-    xi = as_1d("xi_max", xi_max, (QUARTIC if well is None else well).check_threshold)
+    xi = as_1d("xi_max", xi_max, resolve_well(well).check_threshold)
     checks.check_positive_int("cycles", cycles)
     q, p, _, _ = mesh(q0, p0)
     charts = []

@@ -12,7 +12,9 @@ function; the exact first harmonic is G / (1 - nome) (``theory.G(..., fourier=
   a numeric escape chart (``chart_fig13-17.nc``): IoU and pixel agreement.
 
 Both return Datasets with a ``fourier`` dimension ("paper", "exact") side by side and
-summary variables telling which is closer.
+summary variables telling which is closer.  The comparison is the quartic's (only its G has a
+truncated variant): numerics made in another well (the ``well`` attribute of the chart or F_cr
+dataset), or ``well=`` another well, raise ValueError.
 """
 from __future__ import annotations
 
@@ -23,15 +25,23 @@ from safebasins import checks
 from safebasins.analysis.agreement import iou, pixel_agreement
 from safebasins.analysis.common import as_1d, chart_param, mesh
 from safebasins.analysis.integrity import integrity_measures, unforced_safe_mask
-from safebasins.analysis.safe import safe_stack
+from safebasins.analysis.safe import chart_well, safe_stack
 from safebasins.io.cf import annotate
 from safebasins.numerics import critical_forcing_numeric
 from safebasins.theory import angle_energy, critical_forcing, initial_condition, slow_flow_escapes
-from safebasins.wells.quartic import FOURIER_VARIANTS, QUARTIC
+from safebasins.wells.quartic import FOURIER_VARIANTS, QUARTIC, QuarticWell
 
 __all__ = ["fcr_fourier_comparison", "fcr_fourier_comparison_from_numeric", "iou_fourier_comparison"]
 
 _FOURIER = list(FOURIER_VARIANTS)
+
+
+def _check_quartic(well, what):
+    """ValueError unless ``well`` is the quartic (None or a QuarticWell)."""
+    if not (well is None or isinstance(well, QuarticWell)):
+        raise ValueError(f"{what}: the paper/exact first-harmonic comparison is the quartic's (eq 20 as printed vs "
+                         f"the exact sn coefficient); the {getattr(well, 'name', well)!r} well has only its exact "
+                         "first harmonic, nothing to compare")
 
 
 def _analytic_fcr(Omega, xi_max, xi_ini, gamma_ini):
@@ -78,7 +88,7 @@ def _fcr_dataset(Omega, F_num, F_an, extra=None, attrs=None):
 
 
 def fcr_fourier_comparison(Omega, xi_max, *, xi_ini=0.0, gamma_ini=0.0, Psi=0.0, cycles=3000, tol=5e-5,
-                           **numeric_kwargs):
+                           well=None, **numeric_kwargs):
     """F_cr(Omega): paper vs exact first harmonic against the numeric bisection.
 
     The numeric IC is ``(q0, p0) = theory.initial_condition(xi_ini, gamma_ini, Psi)`` so that
@@ -91,7 +101,9 @@ def fcr_fourier_comparison(Omega, xi_max, *, xi_ini=0.0, gamma_ini=0.0, Psi=0.0,
     1 exact, -1 undecided); summaries ``rms_rel_error(fourier)``,
     ``mean_abs_rel_error(fourier)`` and attribute ``closer_overall``.  Numeric
     diagnostics ``non_monotone``, ``F_escape_low``, ``F_escape_all`` are carried over.
+    ``well``: None or the quartic (any other well raises ValueError: it has one first harmonic).
     """
+    _check_quartic(well, "well")
     Om = as_1d("Omega", Omega, checks.check_positive)
     xi_max = float(QUARTIC.check_threshold("xi_max", xi_max))
     xi_ini = float(QUARTIC.check_energy("xi_ini", xi_ini))
@@ -124,8 +136,10 @@ def fcr_fourier_comparison_from_numeric(numeric, *, xi_ini=None, gamma_ini=None)
     per-curve coordinates ``xi_max``, ``xi_ini``, ``gamma_ini``, ``Psi``); the result then has a
     ``curve`` dimension.  Without ``xi_ini``/``gamma_ini`` (coordinates or arguments) the IC
     ``(q0, p0)`` of the numeric run is converted with ``theory.angle_energy``
-    (gamma_ini = theta0 - Psi).
+    (gamma_ini = theta0 - Psi).  ``numeric`` must have been made in the quartic (its ``well``
+    attribute).
     """
+    _check_quartic(chart_well(numeric), "numeric")
     if "curve" in numeric.dims:
         parts = [fcr_fourier_comparison_from_numeric(numeric.isel(curve=k), xi_ini=xi_ini, gamma_ini=gamma_ini)
                  for k in range(numeric.sizes["curve"])]
@@ -171,6 +185,7 @@ def iou_fourier_comparison(chart, t_eval=None, *, criterion="energy"):
     """
     if criterion != "energy":
         raise ValueError("criterion must be 'energy': the analytic basin uses the energy threshold xi_max")
+    _check_quartic(chart_well(chart), "chart")
     safe_num, _ = safe_stack(chart, t_eval, "energy")
     q, p = safe_num["q0"].values, safe_num["p0"].values
     _, _, Q, P = mesh(q, p)

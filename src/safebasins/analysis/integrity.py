@@ -14,21 +14,29 @@ IF   integrity factor: radius of the largest disk centred *anywhere* that fits i
 
 Normalisation
 -------------
-Each measure is divided by its value for the *unforced* safe set
+Each measure is divided by its value for the *unforced* safe set of the well
+(``well.unforced_safe``; None: the paper's quartic)
 
-    S0(xi_max) = {H0(q0, p0) < xi_max,  |q0| < q_max(xi_max)}      (eqs 4, 7)
+    S0(xi_max) = {H0(q0, p0) < xi_max,  q_minus(xi_max) < q0 < q_plus(xi_max)}   (eqs 4, 7)
 
-computed on the *same grid with the same estimator*, so resolution biases largely
-cancel and ``GIM = LIM = IF = 1`` at ``F = 0``.  Analytic unforced values:
-the inscribed radius of S0 about the origin is ``sqrt(2 xi_max)`` (the nearest
-boundary points are ``(0, +-sqrt(2 xi_max))``: along a ray at angle ``phi`` the
-boundary radius solves ``r^2/2 - r^4 cos^4(phi)/4 = xi_max`` and is smallest at
-``cos phi = 0``); the half-width ``sqrt(2 xi - q^2 + q^4/2)`` of S0 decreases
-with ``|q|``, so no disk elsewhere is larger and the unforced IF radius is also
-``sqrt(2 xi_max)``.  The unforced area is ``2 * pi * J(xi_max)`` (eq 19: the
-action is the enclosed area over 2 pi).  For a displacement criterion with
-threshold ``q_max`` use ``xi_max = QUARTIC.xi_from_q_max(q_max)`` (= V(q_max)): the unforced
-set ``{max |q(t)| < q_max}`` is exactly ``S0(V(q_max))``.
+(for the quartic ``q_plus = -q_minus = q_max(xi_max)``), computed on the *same grid with the
+same estimator*, so resolution biases largely cancel and ``GIM = LIM = IF = 1`` at ``F = 0``.
+Analytic unforced values (:func:`unforced_radii2`): the boundary of S0 is the orbit
+``p = +-sqrt(2 (xi - V(q)))``, so the squared distance from ``(c, 0)`` to it is
+``(q - c)^2 + 2 xi - 2 V(q)`` and
+
+    r_local^2  = 2 xi - max_q (2 V(q) - q^2),
+    r_global^2 = 2 xi - min_c max_q (2 V(q) - (q - c)^2)     (q, c in [q_minus, q_plus])
+
+(S0 is symmetric in p with interval slices, so the largest disk has its centre on p = 0).  For
+the quartic ``2 V(q) - q^2 = -q^4/2 <= 0``: both radii are ``sqrt(2 xi_max)`` (the half-width
+``sqrt(2 xi - q^2 + q^4/2)`` of S0 decreases with ``|q|``); for an asymmetric well (the cubic)
+the nearest boundary point can be a turning point and the largest disk sits off the bottom.
+The unforced area is ``2 * pi * J(xi_max)`` (eq 19: the action is the enclosed area over
+2 pi).  For a displacement criterion ``q_lower < q < q_upper`` (``|q| < q_max``: the pair
+``(-q_max, q_max)``) use ``xi_max = safebasins.analysis.safe.displacement_energy(well, q_lower,
+q_upper)`` (= min V(q_lower), V(q_upper); V(q_max) for the quartic): the unforced set of the
+criterion is exactly ``S0`` of that energy.
 
 Estimators and grid-resolution error
 ------------------------------------
@@ -65,10 +73,11 @@ import xarray as xr
 from scipy import ndimage
 
 from safebasins import checks
-from safebasins.wells.quartic import QUARTIC
+from safebasins.wells import resolve_well
 
 __all__ = [
     "unforced_safe_mask",
+    "unforced_radii2",
     "integrity_measures",
     "grid_spacing",
     "MEASURE_ATTRS",
@@ -111,16 +120,47 @@ def grid_spacing(q0, p0):
 
 
 def unforced_safe_mask(q0, p0, xi_max, well=None):
-    """Unforced safe set S0 = {H0 < xi_max, |q0| < q_max(xi_max)} on the grid (of ``well``:
-    H0 < xi_max inside its barriers; None: the paper's quartic).
+    """Unforced safe set S0 = {H0 < xi_max, q_minus < q0 < q_plus} (eqs 4, 7) on the grid: the
+    well's ``unforced_safe`` (None: the paper's quartic, ``|q0| < q_max(xi_max)``).
 
     ``xi_max`` may be an array: the result has shape ``xi_max.shape + (n_q0, n_p0)``.
     """
     q, p, _, _ = grid_spacing(q0, p0)
-    w = QUARTIC if well is None else well
+    w = resolve_well(well)
     xi = w.check_threshold("xi_max", xi_max)
     Q, P = np.meshgrid(q, p, indexing="ij")
     return w.unforced_safe(Q, P, xi[..., None, None])
+
+
+def unforced_radii2(xi, well=None, *, n=1001):
+    """Squared LIM and IF radii ``(r_local^2, r_global^2)`` of the unforced set S0(xi) of
+    ``well`` (None: the quartic) from the orbit curve, not from a grid (module docstring).
+
+    ``q`` runs over ``n`` equally spaced points of ``[q_minus(xi), q_plus(xi)]`` plus the bottom
+    ``q = 0``; the centre ``c`` over the same points, then over ``n`` points within one spacing
+    of the best one: ``r_local^2`` is accurate to ``O(h^2)``, ``r_global^2`` to
+    ``O(h / n)`` (``h`` the spacing).  Both are exactly ``2 xi`` for the quartic (then
+    ``2 V(q) - q^2 <= 0`` in floating point too, with equality at the bottom).  ``xi`` is a
+    scalar in ``[0, barrier_energy]``.
+    """
+    w = resolve_well(well)
+    xi = float(checks.check_scalar("xi", xi, checks.check_nonnegative))
+    if xi > w.barrier_energy:
+        raise ValueError(f"xi must be <= {w.barrier_energy!r} (the barrier energy of the {w.name} well), got {xi!r}")
+    n = checks.check_positive_int("n", n)
+    lo, hi = (float(np.asarray(t)) for t in w.turning_points(xi))
+    q = np.union1d(np.linspace(lo, hi, n), [0.0])
+    V2 = 2.0 * np.asarray(w.V(q), float)
+    r_local2 = 2.0 * xi - float(np.max(V2 - q * q))
+
+    def worst(c):            # max_q (2 V(q) - (q - c)^2) for every centre c
+        return np.max(V2[None, :] - (q[None, :] - c[:, None]) ** 2, axis=1)
+
+    m = worst(q)
+    k = int(np.argmin(m))
+    c_fine = np.union1d(np.linspace(q[max(k - 1, 0)], q[min(k + 1, q.size - 1)], n), [q[k]])
+    r_global2 = 2.0 * xi - float(min(m[k], np.min(worst(c_fine))))
+    return r_local2, r_global2
 
 
 # --------------------------------------------------------------------------- core
@@ -181,7 +221,7 @@ def _measures_numpy(safe, q0, p0, xi_max, bottom, well=None):
     out = {k: v.reshape(lead) for k, v in raw.items()}
 
     if xi_max is not None:
-        xi = (QUARTIC if well is None else well).check_threshold("xi_max", xi_max)
+        xi = resolve_well(well).check_threshold("xi_max", xi_max)
         try:
             xi_b = np.broadcast_to(xi, lead)
         except ValueError as exc:

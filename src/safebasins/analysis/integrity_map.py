@@ -6,8 +6,11 @@ normalised by the unforced basin) form a map over (Omega, F).
 
 * analytic: every IC classified by the slow flow (``theory.slow_flow_escapes``) -- seconds;
   plus the phase-invariant basin of each control point in closed form, ``GIM_true =
-  J(xi_true)/J(xi_max)``, ``LIM_true = IF_true = sqrt(xi_true/xi_max)``
-  (:func:`safebasins.analysis.phase_invariant.xi_true_analytic`);
+  J(xi_true)/J(xi_max)``, ``LIM_true``, ``IF_true`` (radius ratios; both ``sqrt(xi_true/xi_max)``
+  for the quartic) (:func:`safebasins.analysis.phase_invariant.xi_true_analytic`,
+  :func:`~safebasins.analysis.phase_invariant.closed_measures`);
+* any well of safebasins.wells (``well=``, None: the paper's quartic); ``fourier`` follows
+  :func:`safebasins.analysis.common.variant_well` (another well has only "exact");
 * numeric: one escape chart per control point (``numerics.escape_chart_batch``: the control
   points of a block share one ensemble), safe = ``escape_cycle > t_eval`` for every t_eval;
 * :func:`erosion_front`: the F at which a measure first falls below a level, per Omega (the
@@ -22,12 +25,12 @@ from safebasins import checks
 from safebasins.analysis.common import as_1d, mesh, variant_well
 from safebasins.analysis.erosion import level_crossing
 from safebasins.analysis.integrity import integrity_measures, unforced_safe_mask
-from safebasins.analysis.phase_invariant import xi_true_analytic
-from safebasins.analysis.safe import safe_stack
+from safebasins.analysis.phase_invariant import closed_measures, xi_true_analytic
+from safebasins.analysis.safe import chart_well, safe_stack
 from safebasins.io.cf import annotate
 from safebasins.numerics import escape_chart_batch
 from safebasins.theory import slow_flow_escapes
-from safebasins.wells import from_attrs, well_attrs
+from safebasins.wells import well_attrs
 
 __all__ = ["integrity_map_analytic", "integrity_map_numeric", "integrity_from_batch", "erosion_front"]
 
@@ -40,10 +43,11 @@ def _control(Omega, F):
     return Om, Fv
 
 
-def integrity_map_analytic(Omega, F, Psi, xi_max, q0, p0, *, fourier="paper", n_gamma=128, n_xi=64, well=None):
+def integrity_map_analytic(Omega, F, Psi, xi_max, q0, p0, *, fourier=None, n_gamma=128, n_xi=64, well=None):
     """Analytic integrity map over (Omega, F): GIM, LIM, IF of the slow-flow basin for phase Psi,
-    and ``xi_true``, ``GIM_true``, ``LIM_true`` of the basin safe for every phase.  ``well``: any
-    well (None: the quartic; another well's only ``fourier`` is "exact")."""
+    and ``xi_true``, ``GIM_true``, ``LIM_true``, ``IF_true`` of the basin safe for every phase.
+    ``well``: any well (None: the quartic); ``fourier``: one variant (None: the well's own, "paper"
+    for the default quartic; another well's only variant is "exact")."""
     Om, Fv = _control(Omega, F)
     w = variant_well(well, fourier)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
@@ -55,7 +59,9 @@ def integrity_map_analytic(Omega, F, Psi, xi_max, q0, p0, *, fourier="paper", n_
     for i, om in enumerate(Om):
         for j, f in enumerate(Fv):
             safe[i, j] = ~np.asarray(slow_flow_escapes(Q, P, f, om, Psi, xi, well=w), bool) & S0
-            xt[i, j] = xi_true_analytic(f, om, xi, fourier, n_gamma=n_gamma, n_xi=n_xi, well=w)
+            xt[i, j] = xi_true_analytic(f, om, xi, n_gamma=n_gamma, n_xi=n_xi, well=w)
+    closed = {x: closed_measures(x, xi, w) for x in np.unique(xt)}
+    cm = np.array([closed[x] for x in xt.ravel()]).reshape(xt.shape + (3,))
     da = xr.DataArray(safe, dims=("Omega", "F", "q0", "p0"), coords={"Omega": Om, "F": Fv, "q0": q, "p0": p})
     m = integrity_measures(da, xi_max=xi, well=w)
     ds = m[list(MEASURES)].copy()
@@ -63,10 +69,14 @@ def integrity_map_analytic(Omega, F, Psi, xi_max, q0, p0, *, fourier="paper", n_
                                                                       "phase (H0 < xi_true)"})
     ds["GIM_true"] = (("Omega", "F"), np.where(xt > 0, w.J(xt) / w.J(xi), 0.0),
                       {"units": "1", "long_name": "GIM of the all-phase basin, J(xi_true)/J(xi_max)"})
-    ds["LIM_true"] = (("Omega", "F"), np.sqrt(xt / xi),
-                      {"units": "1", "long_name": "LIM = IF of the all-phase basin, sqrt(xi_true/xi_max)"})
+    ds["LIM_true"] = (("Omega", "F"), cm[..., 1],
+                      {"units": "1", "long_name": "LIM of the all-phase basin, r_local(xi_true)/r_local(xi_max) "
+                                                  "(sqrt(xi_true/xi_max) for the quartic)"})
+    ds["IF_true"] = (("Omega", "F"), cm[..., 2],
+                     {"units": "1", "long_name": "IF of the all-phase basin, r_global(xi_true)/r_global(xi_max) "
+                                                 "(sqrt(xi_true/xi_max) for the quartic)"})
     ds.attrs.update(well_attrs(w))
-    ds.attrs.update(kind="analytic", Psi=Psi, xi_max=xi, fourier=fourier, n_gamma=int(n_gamma), n_xi=int(n_xi),
+    ds.attrs.update(kind="analytic", Psi=Psi, xi_max=xi, fourier=w.fourier, n_gamma=int(n_gamma), n_xi=int(n_xi),
                     method="slow_flow_escapes on the grid per control point; xi_true_analytic for all phases")
     return annotate(ds)
 
@@ -77,7 +87,7 @@ def integrity_from_batch(charts, t_eval=None):
     if charts.sizes["xi_max"] != 1:
         raise ValueError(f"an integrity map uses one energy threshold, the charts have {charts.sizes['xi_max']}")
     safe, xi_norm = safe_stack(charts, t_eval, "energy")
-    m = integrity_measures(safe.isel(xi_max=0), xi_max=float(xi_norm.values[0]), well=from_attrs(charts.attrs))
+    m = integrity_measures(safe.isel(xi_max=0), xi_max=float(xi_norm.values[0]), well=chart_well(charts))
     return m[list(MEASURES)].transpose("control", "t_eval")
 
 
@@ -92,6 +102,7 @@ def integrity_map_numeric(Omega, F, Psi, xi_max, q0, p0, *, cycles=1000, t_eval=
     ds = xr.Dataset({k: (("Omega", "F", "t_eval"), m[k].values.reshape(Om.size, Fv.size, -1), m[k].attrs)
                      for k in MEASURES},
                     coords={"Omega": Om, "F": Fv, "t_eval": m["t_eval"].values})
+    ds.attrs.update(well_attrs(chart_well(charts)))
     ds.attrs.update(kind="numeric", Psi=float(Psi), xi_max=float(xi_max), cycles=int(cycles),
                     steps_per_cycle=charts.attrs["steps_per_cycle"], integrator=charts.attrs["integrator"],
                     method="escape_chart_batch per block of control points; safe = escape_cycle > t_eval")

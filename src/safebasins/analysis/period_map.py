@@ -236,9 +236,10 @@ def _island_period(q, p, max_period, confine):
     return 0
 
 
-def strobe_step(F, Omega, Psi, *, xi_max=None, q_max=None, steps_per_cycle=None, integrator=None):
+def strobe_step(F, Omega, Psi, *, xi_max=None, q_max=None, steps_per_cycle=None, integrator=None, well=None):
     """The period map of eq (29) as ``step(q, p) -> (q', p')`` (NaN once a threshold is crossed),
-    for :func:`periodic_orbit` and :func:`minimal_period`."""
+    for :func:`periodic_orbit` and :func:`minimal_period`; ``well``: the well of eq (1) (None: the
+    paper's quartic; see ``numerics.stroboscopic_map``)."""
     from safebasins.numerics import stroboscopic_map
 
     kw = {k: v for k, v in (("steps_per_cycle", steps_per_cycle), ("integrator", integrator)) if v is not None}
@@ -248,7 +249,8 @@ def strobe_step(F, Omega, Psi, *, xi_max=None, q_max=None, steps_per_cycle=None,
         qn, pn = np.full(q.shape, np.nan), np.full(p.shape, np.nan)
         ok = np.isfinite(q) & np.isfinite(p)
         if ok.any():
-            d = stroboscopic_map(q[ok], p[ok], F, Omega, Psi, n_iter=1, xi_max=xi_max, q_max=q_max, **kw)
+            d = stroboscopic_map(q[ok], p[ok], F, Omega, Psi, n_iter=1, xi_max=xi_max, q_max=q_max, well=well,
+                                 **kw)
             qn[ok], pn[ok] = d["q"].values[:, 1], d["p"].values[:, 1]
         return qn, pn
 
@@ -322,12 +324,14 @@ def chain_orbits(step, q, p, period, *, max_period=40, same_tol=1e-6):
 
 def period_map_portrait(q0, p0, F, Omega, Psi, *, n_keep, n_iter=3000, xi_max=None, q_max=None,
                         steps_per_cycle=None, threads=None, min_digits=5.0, max_period=40, confine=0.5,
-                        rational_tol=1e-6):
+                        rational_tol=1e-6, well=None):
     """Stroboscopic map of the first ``n_keep`` non-escaping candidates, classified.
 
     q0, p0 : candidate ICs in priority order (e.g. a line of ICs first, then seeded random ones).
-    xi_max, q_max : escape thresholds of the map (energy H0 > xi_max or |q| > 1; displacement
-             |q| > q_max); at least one.
+    xi_max, q_max : escape thresholds of the map (energy H0 > xi_max or q beyond a barrier;
+             displacement |q| > q_max); at least one.
+    well : the well of eq (1) (None: the paper's quartic; a polynomial well, see
+             ``numerics.stroboscopic_map``).
 
     The centre of the main island is the elliptic fixed point of the map found by Newton's
     method (:func:`periodic_orbit`, period 1) from the median centroid of the kept orbits (then
@@ -352,7 +356,8 @@ def period_map_portrait(q0, p0, F, Omega, Psi, *, n_keep, n_iter=3000, xi_max=No
 
     n_keep = checks.check_positive_int("n_keep", n_keep)
     kw = {} if steps_per_cycle is None else {"steps_per_cycle": steps_per_cycle}
-    ds = stroboscopic_map(q0, p0, F, Omega, Psi, n_iter=n_iter, xi_max=xi_max, q_max=q_max, threads=threads, **kw)
+    ds = stroboscopic_map(q0, p0, F, Omega, Psi, n_iter=n_iter, xi_max=xi_max, q_max=q_max, threads=threads,
+                          well=well, **kw)
     safe = np.flatnonzero(~np.asarray(ds["escaped"].values, dtype=bool))
     if safe.size < n_keep:
         raise ValueError(f"only {safe.size} of {ds.sizes['sample']} candidates never escape in {n_iter} "
@@ -362,7 +367,7 @@ def period_map_portrait(q0, p0, F, Omega, Psi, *, n_keep, n_iter=3000, xi_max=No
     out = out.assign_coords(candidate=("sample", keep), sample=np.arange(keep.size))
     q = np.asarray(out["q"].values, float)
     p = np.asarray(out["p"].values, float)
-    step = strobe_step(F, Omega, Psi, xi_max=xi_max, q_max=q_max, **kw)
+    step = strobe_step(F, Omega, Psi, xi_max=xi_max, q_max=q_max, well=well, **kw)
     # Newton from the median orbit centroid, then from the centroids of the orbits, smallest first
     cq, cp = q.mean(axis=1), p.mean(axis=1)
     size = np.hypot(np.ptp(q, axis=1), np.ptp(p, axis=1))

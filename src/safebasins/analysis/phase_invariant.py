@@ -20,8 +20,13 @@ all-safe circles is an interval ``[0, xi_true)``.  Hence
 
     true basin (all phases) = {H0(q0, p0) < xi_true(F, Omega, xi_max)}
 
-and its integrity has a closed form: ``GIM = J(xi_true) / J(xi_max)`` (area = 2 pi J),
-``LIM = IF = sqrt(xi_true / xi_max)`` (inscribed radius sqrt(2 xi)).  ``xi_true`` is
+and its integrity has a closed form: ``GIM = J(xi_true) / J(xi_max)`` (area = 2 pi J, eq 19),
+``LIM = r_local(xi_true) / r_local(xi_max)`` and ``IF = r_global(xi_true) / r_global(xi_max)``
+with the radii of the unforced set from its orbit curve
+(:func:`safebasins.analysis.integrity.unforced_radii2`); for the quartic both radii are
+``sqrt(2 xi)`` and ``LIM = IF = sqrt(xi_true / xi_max)``.  Any well of safebasins.wells
+(``well=``; the slow flow of the well's own first harmonic, the quartic's "paper" or "exact"
+G).  ``xi_true`` is
 found by nested grid refinement of "some gamma of the circle escapes" (monotone in xi
 by the same argument) with a fine gamma grid; if the LPT through the well bottom escapes,
 ``xi_true = 0``.  A finite set of phases gives a superset of this disk.
@@ -38,18 +43,18 @@ import numpy as np
 import xarray as xr
 
 from safebasins import checks
-from safebasins.analysis.common import as_1d, fourier_list, mesh, stack_charts, variant_well
-from safebasins.analysis.integrity import MEASURE_ATTRS, integrity_measures, unforced_safe_mask
-from safebasins.analysis.safe import safe_stack
+from safebasins.analysis.common import as_1d, mesh, stack_charts, variant_well, well_variants
+from safebasins.analysis.integrity import MEASURE_ATTRS, integrity_measures, unforced_radii2, unforced_safe_mask
+from safebasins.analysis.safe import chart_well, safe_stack
 from safebasins.io.cf import annotate
 from safebasins.numerics import escape_chart
 from safebasins.theory import angle_energy, escapes_on_manifold
-from safebasins.wells import from_attrs, well_attrs
-from safebasins.wells.quartic import QUARTIC
+from safebasins.wells import resolve_well, well_attrs
 
 __all__ = [
     "default_phases",
     "xi_true_analytic",
+    "closed_measures",
     "true_safe_basin_analytic",
     "true_safe_basin_numeric",
     "true_safe_basin_from_charts",
@@ -76,7 +81,7 @@ def _first_escaping_circle(lo, hi, n_xi, F, Omega, xi_max, well, gamma):
     return (xs[k - 1] if k > 0 else None), xs[k]
 
 
-def xi_true_analytic(F, Omega, xi_max, fourier="paper", *, n_gamma=512, n_xi=400, levels=3, well=None):
+def xi_true_analytic(F, Omega, xi_max, fourier=None, *, n_gamma=512, n_xi=400, levels=3, well=None):
     """Largest xi such that every circle ``xi' < xi`` of the resonance manifold is safe.
 
     The predicate "some point of the circle escapes" is monotone in xi (module
@@ -85,11 +90,12 @@ def xi_true_analytic(F, Omega, xi_max, fourier="paper", *, n_gamma=512, n_xi=400
     times on ``n_xi``-point xi grids, giving a resolution of about
     ``xi_max / (n_xi - 1)**levels``.  Returns 0 if the well bottom (the limiting phase
     trajectory) escapes and ``xi_max`` if nothing below xi_max escapes.  ``well``: any well
-    (None: the quartic; another well's only ``fourier`` is "exact").
+    (None: the quartic); ``fourier`` one variant (None: the well's own; another well's only
+    variant is "exact", :func:`~safebasins.analysis.common.variant_well`).
     """
     F = float(checks.check_nonnegative("F", F))
     Omega = float(checks.check_positive("Omega", Omega))
-    w = variant_well(well, fourier_list(fourier)[0][0])
+    w = variant_well(well, fourier)
     xi_max = float(w.check_threshold("xi_max", xi_max))
     n_gamma = checks.check_positive_int("n_gamma", n_gamma)
     n_gamma += n_gamma % 2
@@ -103,6 +109,19 @@ def xi_true_analytic(F, Omega, xi_max, fourier="paper", *, n_gamma=512, n_xi=400
             return lo
         lo, hi = r
     return lo
+
+
+def closed_measures(xi_true, xi_max, well=None):
+    """Closed-form ``(GIM, LIM, IF)`` of the all-phase basin {H0 < xi_true} (module docstring):
+    ``J(xi_true)/J(xi_max)`` (eq 19) and the ratios of the unforced radii
+    (:func:`~safebasins.analysis.integrity.unforced_radii2`); ``sqrt(xi_true/xi_max)`` for both
+    radii of the quartic."""
+    w = resolve_well(well)
+    if xi_true <= 0:
+        return 0.0, 0.0, 0.0
+    loc_t, glob_t = unforced_radii2(xi_true, w)
+    loc_m, glob_m = unforced_radii2(xi_max, w)
+    return float(w.J(xi_true) / w.J(xi_max)), float(np.sqrt(loc_t / loc_m)), float(np.sqrt(glob_t / glob_m))
 
 
 def _one_analytic(F, Omega, xi_max, q, p, Psi, well, n_gamma):
@@ -120,9 +139,7 @@ def _one_analytic(F, Omega, xi_max, q, p, Psi, well, n_gamma):
         safe[k][S0] = ~np.asarray(escapes_on_manifold(gamma, xi_ini[S0], F, Omega, xi_max, well=well), dtype=bool)
     xt = xi_true_analytic(F, Omega, xi_max, well.fourier, n_gamma=n_gamma, well=well)
     cont = S0 & (xi_ini < xt)
-    # area of {H0 < E} = 2 pi J(E) (eq 19) for any well
-    closed_gim = float(well.J(xt) / well.J(xi_max)) if xt > 0 else 0.0
-    return safe, cont, xt, closed_gim, float(np.sqrt(xt / xi_max))
+    return (safe, cont, xt) + closed_measures(xt, xi_max, well)
 
 
 def _assemble(safe, q, p, Psi, lead_dims, lead_coords, xi_norm, well):
@@ -156,7 +173,7 @@ def _assemble(safe, q, p, Psi, lead_dims, lead_coords, xi_norm, well):
     return ds
 
 
-def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fourier="paper", n_psi=16,
+def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fourier=None, n_psi=16,
                              n_gamma=512, well=None):
     """Analytic phase-invariant safe basin and its integrity.
 
@@ -166,9 +183,11 @@ def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fouri
     xi_max : energy threshold(s) (dimension ``xi_max``).
     q0, p0 : 1-D uniform grid axes.
     Psi_values : phases to intersect over (default ``default_phases(n_psi)``).
-    fourier : "paper" | "exact" | list (dimension ``fourier``).
+    fourier : None (the well's own: "paper" for the default quartic) | "paper" | "exact" | list
+        (dimension ``fourier``); a well other than the quartic has only "exact"
+        (:func:`~safebasins.analysis.common.variant_well`).
     n_gamma : gamma resolution of the continuous-phase limit ``xi_true``.
-    well : the potential well (None: the paper's quartic); another well's only variant is "exact".
+    well : the potential well (None: the paper's quartic).
 
     Returns
     -------
@@ -179,15 +198,15 @@ def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fouri
       ``xi_true([fourier,] xi_max)``                energy radius of the all-phase basin,
       ``GIM, LIM, IF, r_local, r_global, area, if_q0, if_p0`` over (Psi, ...) and the
       same with suffix ``_true`` (intersection over Psi_values) and ``_continuous``
-      (grid values for {H0 < xi_true}); ``GIM_closed``, ``LIM_closed`` (= IF_closed):
-      the closed forms J(xi_true)/J(xi_max) and sqrt(xi_true/xi_max);
+      (grid values for {H0 < xi_true}); ``GIM_closed``, ``LIM_closed``, ``IF_closed``:
+      the closed forms J(xi_true)/J(xi_max) and the radius ratios (:func:`closed_measures`;
+      sqrt(xi_true/xi_max) for both radii of the quartic);
       ``xi_inscribed_true`` (largest energy disk inside ``true_safe``, grid value) and
       ``contained`` (true basin inside every per-phase basin).
     """
     F = float(checks.check_nonnegative("F", F))
     Omega = float(checks.check_positive("Omega", Omega))
-    fl, scalar = fourier_list(fourier)
-    wl = [variant_well(well, f) for f in fl]
+    fl, wl, scalar = well_variants(well, fourier)
     xi = as_1d("xi_max", xi_max, wl[0].check_threshold)
     Psi = default_phases(n_psi) if Psi_values is None else as_1d("Psi_values", Psi_values, checks.check_finite)
     q, p, _, _ = mesh(q0, p0)
@@ -197,10 +216,11 @@ def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fouri
     xt = np.zeros((nf, nx))
     gim_c = np.zeros((nf, nx))
     lim_c = np.zeros((nf, nx))
+    if_c = np.zeros((nf, nx))
     for a, f in enumerate(fl):
         for j, x in enumerate(xi):
-            s, c, t, g, l = _one_analytic(F, Omega, float(x), q, p, Psi, wl[a], n_gamma)
-            safe[:, a, j], cont[a, j], xt[a, j], gim_c[a, j], lim_c[a, j] = s, c, t, g, l
+            s, c, t, g, l, r = _one_analytic(F, Omega, float(x), q, p, Psi, wl[a], n_gamma)
+            safe[:, a, j], cont[a, j], xt[a, j], gim_c[a, j], lim_c[a, j], if_c[a, j] = s, c, t, g, l, r
     lead_dims = ("fourier", "xi_max")
     lead_coords = {"fourier": fl, "xi_max": xi}
     xi_norm = xr.DataArray(xi, dims="xi_max", coords={"xi_max": xi})
@@ -217,7 +237,11 @@ def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fouri
     ds["GIM_closed"] = xr.DataArray(gim_c, dims=lead_dims, attrs={
         "units": "1", "long_name": "closed-form GIM of the all-phase basin, J(xi_true)/J(xi_max)"})
     ds["LIM_closed"] = xr.DataArray(lim_c, dims=lead_dims, attrs={
-        "units": "1", "long_name": "closed-form LIM = IF of the all-phase basin, sqrt(xi_true/xi_max)"})
+        "units": "1", "long_name": "closed-form LIM of the all-phase basin, r_local(xi_true)/r_local(xi_max) "
+                                   "(sqrt(xi_true/xi_max) for the quartic)"})
+    ds["IF_closed"] = xr.DataArray(if_c, dims=lead_dims, attrs={
+        "units": "1", "long_name": "closed-form IF of the all-phase basin, r_global(xi_true)/r_global(xi_max) "
+                                   "(sqrt(xi_true/xi_max) for the quartic)"})
     if scalar:
         ds = ds.isel(fourier=0)
     ds.attrs.update(well_attrs(wl[0]))
@@ -235,9 +259,9 @@ def true_safe_basin_from_charts(charts, t_eval=None, *, criterion="energy"):
     ``xi_true``) and ``contained``.
     """
     chart = stack_charts(charts, "Psi")
-    well = from_attrs(chart.attrs)    # the well the charts were integrated in
+    well = chart_well(chart)    # the well the charts were integrated in
     safe, xi_norm = safe_stack(chart, t_eval, criterion)
-    thr = "xi_max" if criterion == "energy" else "q_max"
+    thr = xi_norm.dims[0]
     safe = safe.transpose("Psi", thr, "t_eval", "q0", "p0")
     lead_dims = (thr, "t_eval")
     lead_coords = {thr: safe[thr].values, "t_eval": safe["t_eval"].values}
@@ -262,7 +286,7 @@ def true_safe_basin_numeric(F, Omega, xi_max, q0, p0, Psi_values=None, t_eval=No
     """
     F = float(checks.check_nonnegative("F", F))
     Omega = float(checks.check_positive("Omega", Omega))
-    xi = as_1d("xi_max", xi_max, (QUARTIC if well is None else well).check_threshold)
+    xi = as_1d("xi_max", xi_max, resolve_well(well).check_threshold)
     Psi = default_phases(n_psi) if Psi_values is None else as_1d("Psi_values", Psi_values, checks.check_finite)
     checks.check_positive_int("cycles", cycles)
     q, p, _, _ = mesh(q0, p0)
@@ -273,9 +297,10 @@ def true_safe_basin_numeric(F, Omega, xi_max, q0, p0, Psi_values=None, t_eval=No
     return (ds, stacked) if keep_charts else ds
 
 
-def phase_boundaries(F, Omega, xi_max, Psi_values, *, fourier="paper", n_points=400, well=None):
+def phase_boundaries(F, Omega, xi_max, Psi_values, *, fourier=None, n_points=400, well=None):
     """Boundary curves of the analytic per-phase basins on the IC plane, from the slow flow
     itself (:func:`safebasins.theory.safe_basin_boundaries` for every phase), not from a grid.
+    ``well``, ``fourier`` as in :func:`true_safe_basin_analytic`.
 
     Returns an xr.Dataset over (``Psi``, [``fourier``,] ``xi_max``, ``vertex``) with
     ``boundary_q0``, ``boundary_p0`` (NaN-padded; NaN rows also split a curve) and
@@ -283,8 +308,7 @@ def phase_boundaries(F, Omega, xi_max, Psi_values, *, fourier="paper", n_points=
     """
     from safebasins.theory import safe_basin_boundaries
 
-    fl, scalar = fourier_list(fourier)
-    wl = [variant_well(well, f) for f in fl]
+    fl, wl, scalar = well_variants(well, fourier)
     xi = as_1d("xi_max", xi_max, wl[0].check_threshold)
     Psi = as_1d("Psi_values", Psi_values, checks.check_finite)
     parts = {}

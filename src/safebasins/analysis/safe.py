@@ -14,11 +14,14 @@ import xarray as xr
 from safebasins import checks
 from safebasins.io import cf
 
-__all__ = ["is_safe", "check_t_eval", "safe_mask", "safe_area", "safe_stack", "escape_variable"]
+__all__ = ["is_safe", "check_t_eval", "safe_mask", "safe_area", "safe_stack", "escape_variable", "chart_well",
+           "displacement_energy", "q_max_energy"]
 
 #: escape-time variable and threshold dimension of each criterion
 CRITERIA = {"energy": ("escape_cycle_energy", "xi_max"),
             "displacement": ("escape_cycle_displacement", "q_max")}
+#: the asymmetric displacement criterion q_lower < q < q_upper (charts made with ``q_bounds``)
+BOUNDS = ("escape_cycle_bounds", "q_bounds")
 
 
 def is_safe(escape_cycle, t_eval):
@@ -27,11 +30,62 @@ def is_safe(escape_cycle, t_eval):
 
 
 def escape_variable(chart, criterion):
-    """(escape-time DataArray, threshold dimension) of ``criterion`` ("energy" | "displacement")."""
-    if criterion not in CRITERIA:
-        raise ValueError(f"criterion must be one of {sorted(CRITERIA)}, got {criterion!r}")
-    var, thr = CRITERIA[criterion]
+    """(escape-time DataArray, threshold dimension) of ``criterion`` ("energy" | "displacement" |
+    "bounds": the asymmetric displacement bounds ``q_bounds`` of the chart)."""
+    known = {**CRITERIA, "bounds": BOUNDS}
+    if criterion not in known:
+        raise ValueError(f"criterion must be one of {sorted(known)}, got {criterion!r}")
+    var, thr = known[criterion]
+    if var not in chart:
+        raise ValueError(f"criterion {criterion!r}: the chart has no {var!r} (make it with the thresholds "
+                         f"{thr!r} of numerics.escape_chart)")
     return chart[var], thr
+
+
+def chart_well(chart):
+    """The well an escape chart was integrated in (its ``well`` attributes, written by
+    ``numerics.escape_chart``); ValueError when the chart does not name one."""
+    from safebasins.wells import from_attrs
+
+    if "well" not in chart.attrs:
+        raise ValueError("the chart names no well (attribute 'well', written by numerics.escape_chart): "
+                         "cannot tell its unforced safe set")
+    return from_attrs(chart.attrs)
+
+
+def displacement_energy(well, q_lower, q_upper):
+    """Energy of the unforced safe set of a displacement criterion ``q_lower < q < q_upper``.
+
+    An unforced orbit of energy E stays inside the bounds iff its turning points do,
+    ``q_lower < q_minus(E)`` and ``q_plus(E) < q_upper``; V increases away from the bottom up to
+    each barrier, so this is ``E < min(V(q_lower), V(q_upper))``: the set is S0 of that energy.
+    The symmetric ``|q| < q_max`` is ``(-q_max, q_max)``; for the quartic it is V(q_max), the
+    inverse of eq (4).  Bounds must satisfy ``q_left <= q_lower < 0 < q_upper <= q_right`` (the
+    barriers of the well).
+    """
+    lo = checks.check_finite("q_lower", q_lower)
+    hi = checks.check_finite("q_upper", q_upper)
+    if not ((lo < 0).all() and (hi > 0).all()):
+        raise ValueError(f"displacement bounds must satisfy q_lower < 0 < q_upper (the well bottom inside), "
+                         f"got q_lower={lo.tolist()}, q_upper={hi.tolist()}")
+    ql, qr = well.barriers
+    if (lo < ql).any() or (hi > qr).any():
+        raise ValueError(f"displacement bounds must lie inside the barriers ({ql!r}, {qr!r}) of the {well.name} "
+                         f"well, got q_lower={lo.tolist()}, q_upper={hi.tolist()}")
+    return np.minimum(well.V(lo), well.V(hi))
+
+
+def q_max_energy(well, q_max):
+    """Energy of the unforced safe set of the symmetric criterion ``|q| < q_max``:
+    :func:`displacement_energy` of ``(-q_max, q_max)``; for the quartic its closed form
+    ``V(q_max)`` (eq (4) inverted, ``QuarticWell.xi_from_q_max``: both sides are equal, and
+    evaluating V(-q_max) separately could differ from V(q_max) in the last bit)."""
+    from safebasins.wells import QuarticWell
+
+    if isinstance(well, QuarticWell):
+        return well.xi_from_q_max(well.check_displacement("q_max", q_max))
+    qm = checks.as_array("q_max", q_max)
+    return displacement_energy(well, -qm, qm)
 
 
 def check_t_eval(t_eval, cycles):
@@ -114,11 +168,11 @@ def safe_stack(chart, t_eval=None, criterion="energy"):
     """Safe masks with a leading dimension ``t_eval`` (default: the chart horizon).
 
     Returns ``(safe (t_eval, ..., q0, p0), xi_norm)`` where ``xi_norm`` is the energy that
-    normalises integrity measures: the ``xi_max`` coordinate, or the energy ``V(q_max)`` of the
-    displacement thresholds (the unforced set {max |q(t)| < q_max} is S0(V(q_max))).
+    normalises integrity measures: the ``xi_max`` coordinate, or the energy of the unforced set
+    of the displacement thresholds in the chart's well (:func:`q_max_energy`,
+    :func:`displacement_energy`: V(q_max) for the quartic; the set {max |q(t)| < q_max} is
+    S0(V(q_max))).
     """
-    from safebasins.wells.quartic import QUARTIC
-
     esc, thr = escape_variable(chart, criterion)
     cycles = chart.attrs.get("cycles")
     t = np.atleast_1d(check_t_eval(float(cycles) if t_eval is None else t_eval, cycles)).astype(float)
@@ -127,7 +181,11 @@ def safe_stack(chart, t_eval=None, criterion="energy"):
     safe = is_safe(esc, tda).transpose("t_eval", ..., "q0", "p0")
     if thr == "xi_max":
         xi_norm = safe["xi_max"]
+    elif thr == "q_max":
+        qm = safe["q_max"].values
+        xi_norm = xr.DataArray(q_max_energy(chart_well(chart), qm), dims=safe["q_max"].dims,
+                               coords={"q_max": safe["q_max"]})
     else:
-        qm = QUARTIC.check_displacement("q_max", safe["q_max"].values)
-        xi_norm = xr.DataArray(QUARTIC.xi_from_q_max(qm), dims=safe["q_max"].dims, coords={"q_max": safe["q_max"]})
+        e = displacement_energy(chart_well(chart), chart["q_lower"].values, chart["q_upper"].values)
+        xi_norm = xr.DataArray(e, dims=("q_bounds",), coords={"q_bounds": safe["q_bounds"]})
     return safe, xi_norm
