@@ -315,6 +315,6 @@ def _grid_attrs(q, p, bottom):
         "integrity_method": "area = node count * dq * dp; LIM = distance from the well bottom to the nearest "
                             "unsafe node; IF = max scipy.ndimage.distance_transform_edt(sampling=(dq, dp)); "
                             "grid padded by unsafe nodes; normalised by the unforced set H0 < xi_max, "
-                            "|q0| < q_max on the same grid",
+                            "q_minus < q0 < q_plus (the well's unforced_safe) on the same grid",
         "well_bottom": list(map(float, bottom)),
     }
