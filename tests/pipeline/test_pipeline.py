@@ -158,8 +158,15 @@ def test_nothing_to_do_and_param_change_reruns_only_own_chain(quick, tmp_path):
     # job blocks of the dry run, without the target rule (its input lists every dataset)
     blocks = re.split(r"^(?:local)?rule ", dry.stdout + dry.stderr, flags=re.M)[1:]
     out = "".join(b for b in blocks if not b.startswith("datasets:"))
-    jobs = set(re.findall(r"experiment=(\w+)", out)) | {RUN.experiment_of(f).name for f in DATASETS if f in out}
-    assert jobs == {"fig16"}, jobs
+    outputs = {f for line in re.findall(r"^\s+output: (.+)$", out, re.M) for f in line.split(", ")}
+    # fig16's chain: its parameters, tiles and datasets, and the datasets that read them
+    # (extra_fourier's IoU comparison of fig16), nothing else
+    own = set(RUN.experiments["fig16"].dataset_files())
+    downstream = {p for p in DATASETS if p not in own and any(
+        f in own for v in RUN.product_inputs(p).values() for f in ([v] if isinstance(v, str) else v))}
+    chain = own | downstream | {"results/params/fig16.yaml"} | set(RUN.tile_files("fig16"))
+    assert outputs and outputs <= chain, sorted(outputs - chain)
+    assert own <= outputs and downstream == {"results/data/extras/extra_fourier_iou_fig16.nc"}, (own, downstream)
     # redrawing a figure (a plotting change) reruns its notebook only, never a dataset
     fig = run_snakemake(wd, "-n", "results/figures/fig05.png", "--forcerun", "fig05")
     assert fig.returncode == 0, fig.stderr[-2000:]
