@@ -12,7 +12,8 @@ from safebasins.pipeline.plan import plan as _plan
 from safebasins.pipeline.registry import STAGES
 
 RUN = _plan(config)
-print(_cost_guard(RUN, workflow.cores), file=sys.stderr)
+# (cores: None for `--unlock`, `--report`, `-n` without --cores, where workflow.cores raises)
+print(_cost_guard(RUN, workflow.resource_settings.cores or 1), file=sys.stderr)
 PARAMS_JSON = {e: json.dumps(p, sort_keys=True) for e, p in RUN.params().items()}
 NUM_THREADS = RUN.threads
 BACKEND = config["numerics"]["backend"]
@@ -49,9 +50,14 @@ def job_resources(stage=None):
     job from the cost estimate (safebasins.pipeline.cost.job_cost / resources), for a cluster
     scheduler (workflow/profiles/slurm); a local run ignores them. stage None: chart tiles."""
 
+    # (threads from the plan, not snakemake's `threads` argument: that would need --cores to
+    # evaluate, and `--unlock` / `--report` run without it)
     def resource(key):
-        def of_job(wildcards, threads):
-            job = {"tile_of": wildcards.experiment} if stage is None else {"dataset": dataset_path(stage, wildcards)}
+        def of_job(wildcards):
+            if stage is None:
+                job, threads = {"tile_of": wildcards.experiment}, NUM_THREADS
+            else:
+                job, threads = {"dataset": dataset_path(stage, wildcards)}, dataset_threads(stage)(wildcards)
             return _job_resources(*_job_cost(RUN, **job), threads)[key]
 
         return of_job
