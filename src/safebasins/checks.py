@@ -30,7 +30,7 @@ def check_nonnegative(name, value):
     """Finite and >= 0 (an amplitude, a time)."""
     a = check_finite(name, value)
     if (a < 0).any():
-        raise ValueError(f"{name} must be >= 0, got min {a.min()!r}")
+        raise ValueError(f"{name} must be >= 0, got min {float(a.min())!r}")
     return a
 
 
@@ -38,7 +38,7 @@ def check_positive(name, value):
     """Finite and > 0 (a frequency, a tolerance)."""
     a = check_finite(name, value)
     if (a <= 0).any():
-        raise ValueError(f"{name} must be > 0, got min {a.min()!r}")
+        raise ValueError(f"{name} must be > 0, got min {float(a.min())!r}")
     return a
 
 

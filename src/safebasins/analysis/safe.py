@@ -95,7 +95,7 @@ def check_t_eval(t_eval, cycles):
         raise ValueError(f"t_eval must be a scalar or 1-D, got shape {t.shape}")
     if cycles is not None and (t > float(cycles) * (1 + 1e-12)).any():
         raise ValueError(f"t_eval must be <= the chart's horizon cycles = {cycles} (the chart knows nothing "
-                         f"beyond it), got max {t.max()!r}")
+                         f"beyond it), got max {float(t.max())!r}")
     return t
 
 

@@ -264,13 +264,13 @@ class NumericWell(Well):
         """Energy in ``[0, E_b)`` (or ``[0, E_b]`` with ``allow_separatrix``), as float array."""
         a = as_array(name, E)
         if (a < 0).any():
-            raise ValueError(f"{name} must be >= 0 (energy measured from the well bottom), got min {a.min()!r}")
+            raise ValueError(f"{name} must be >= 0 (energy measured from the well bottom), got min {float(a.min())!r}")
         if allow_separatrix:
             if (a > self._E_b).any():
-                raise ValueError(f"{name} must be <= the barrier energy {self._E_b!r}, got max {a.max()!r}")
+                raise ValueError(f"{name} must be <= the barrier energy {self._E_b!r}, got max {float(a.max())!r}")
         elif (a >= self._E_b).any():
             raise ValueError(f"{name} must be < the barrier energy {self._E_b!r} (no periodic orbit on or "
-                             f"above the separatrix), got max {a.max()!r}")
+                             f"above the separatrix), got max {float(a.max())!r}")
         return a
 
     def _check_positive_energy(self, name, E):

@@ -39,11 +39,11 @@ def _check_coefficients(coefficients):
     if not np.isfinite(c).all():
         raise ValueError("coefficients must be finite (no NaN / inf)")
     if c[0] != 0.0:
-        raise ValueError(f"coefficients: c_0 = {c[0]!r}, must be 0 (V(0) = 0: energies from the well bottom)")
+        raise ValueError(f"coefficients: c_0 = {float(c[0])!r}, must be 0 (V(0) = 0: energies from the well bottom)")
     if c[1] != 0.0:
-        raise ValueError(f"coefficients: c_1 = {c[1]!r}, must be 0 (V'(0) = 0: the minimum at q = 0)")
+        raise ValueError(f"coefficients: c_1 = {float(c[1])!r}, must be 0 (V'(0) = 0: the minimum at q = 0)")
     if not c[2] > 0.0:
-        raise ValueError(f"coefficients: c_2 = {c[2]!r}, must be > 0 (V''(0) = 2 c_2 > 0: q = 0 a minimum)")
+        raise ValueError(f"coefficients: c_2 = {float(c[2])!r}, must be > 0 (V''(0) = 2 c_2 > 0: q = 0 a minimum)")
     return np.trim_zeros(c, "b")
 
 

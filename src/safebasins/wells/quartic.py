@@ -201,13 +201,13 @@ class QuarticWell(Well):
         """Energy in [0, 1/4) (or [0, 1/4] with allow_separatrix)."""
         a = as_array(name, xi)
         if (a < 0).any():
-            raise ValueError(f"{name} must be >= 0 (energy measured from the well bottom), got min {a.min()!r}")
+            raise ValueError(f"{name} must be >= 0 (energy measured from the well bottom), got min {float(a.min())!r}")
         if allow_separatrix:
             if (a > XI_SEPARATRIX).any():
-                raise ValueError(f"{name} must be <= 1/4 (separatrix energy), got max {a.max()!r}")
+                raise ValueError(f"{name} must be <= 1/4 (separatrix energy), got max {float(a.max())!r}")
         elif (a >= XI_SEPARATRIX).any():
             raise ValueError(
-                f"{name} must be < 1/4: the action-angle map is singular on the separatrix, got max {a.max()!r}")
+                f"{name} must be < 1/4: the action-angle map is singular on the separatrix, got max {float(a.max())!r}")
         return a
 
     def check_threshold(self, name, xi_max):
