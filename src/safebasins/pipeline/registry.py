@@ -165,6 +165,20 @@ class Kind:
         return self.description, self.description
 
 
+class GridChartKind(Kind):
+    """A kind whose chart tasks all integrate the experiment's (q0, p0) grid ``params["grid"]``."""
+
+    def chart_ics(self, params: dict):
+        from safebasins.pipeline.values import grid_axes
+
+        q0, p0 = grid_axes(params["grid"])
+        return q0, p0, True
+
+    def cost(self, params: dict) -> int:
+        nq, np_ = params["grid"]["n"]
+        return len(params["tasks"]) * nq * np_ * params["cycles"] * params["steps_per_cycle"]
+
+
 KINDS: dict[str, Kind] = {}
 
 

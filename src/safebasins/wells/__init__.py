@@ -53,11 +53,11 @@ def spec_attrs(spec) -> dict:
 
 
 def well_attrs(well: Well) -> dict:
-    """Dataset attributes naming a well object (as :func:`spec_attrs` of its spec)."""
-    out = {"well": well.name}
+    """Dataset attributes naming a well object (:func:`spec_attrs` of its spec)."""
+    spec = {"name": well.name}
     if well.name == "polynomial":
-        out["well_coefficients"] = [float(c) for c in well.coefficients]
-    return out
+        spec["coefficients"] = well.coefficients
+    return spec_attrs(spec)
 
 
 def from_attrs(attrs) -> Well:

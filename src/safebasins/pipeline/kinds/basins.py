@@ -16,7 +16,7 @@ import math
 import numpy as np
 
 from safebasins.pipeline import values
-from safebasins.pipeline.registry import Kind, Product, dataset_path, register
+from safebasins.pipeline.registry import GridChartKind, Kind, Product, dataset_path, register
 
 N_POINTS = {"type": "integer", "minimum": 16, "default": 2000}
 
@@ -319,7 +319,7 @@ class BasinRM(Kind):
 
 
 @register
-class BasinChart(Kind):
+class BasinChart(GridChartKind):
     name = "basin_chart"
     description = ("numeric escape chart with its analytic counterpart; exactly one of F / xi_max may be a "
                    "list (the scanned parameter: one chart serves every xi_max, one chart per F)")
@@ -356,14 +356,6 @@ class BasinChart(Kind):
                     Psi=values.angle(block["Psi"]), grid=values.grid(block["grid"]), cycles=int(block["cycles"]),
                     n_points=int(block["n_points"]), steps_per_cycle=ctx.steps_per_cycle,
                     tasks=[{"F": f, "xi_max": xis, "q_max": []} for f in Fs])
-
-    def chart_ics(self, params):
-        q0, p0 = values.grid_axes(params["grid"])
-        return q0, p0, True
-
-    def cost(self, params):
-        nq, np_ = params["grid"]["n"]
-        return len(params["tasks"]) * nq * np_ * params["cycles"] * params["steps_per_cycle"]
 
     def products(self, experiment, params):
         scan = (params["scan"],)

@@ -10,7 +10,7 @@ import numpy as np
 
 from safebasins.pipeline import values
 from safebasins.pipeline.kinds.basins import chart_contract, gather_chart
-from safebasins.pipeline.registry import Kind, Product, dataset_path, params_path, register
+from safebasins.pipeline.registry import GridChartKind, Kind, Product, dataset_path, params_path, register
 
 Q_MAX = {"type": "number", "exclusiveMinimum": 0, "maximum": 1}
 
@@ -123,7 +123,7 @@ class Criteria(Kind):
 
 
 @register
-class Chart(Kind):
+class Chart(GridChartKind):
     name = "chart"
     description = "escape chart on an IC grid with energy and displacement thresholds (DSB / ESB)"
     builder = "safebasins.plotting.charts:figure_dsb_esb"
@@ -159,14 +159,6 @@ class Chart(Kind):
                     t_eval=[float(t) for t in block.get("t_eval", [block["cycles"]])],
                     steps_per_cycle=ctx.steps_per_cycle,
                     tasks=[{"F": float(block["F"]), "xi_max": xis, "q_max": qms}])
-
-    def chart_ics(self, params):
-        q0, p0 = values.grid_axes(params["grid"])
-        return q0, p0, True
-
-    def cost(self, params):
-        nq, np_ = params["grid"]["n"]
-        return len(params["tasks"]) * nq * np_ * params["cycles"] * params["steps_per_cycle"]
 
     def products(self, experiment, params):
         return [Product(dataset_path("numeric", f"chart_{experiment}"), "numeric", build_chart, tiles=True,

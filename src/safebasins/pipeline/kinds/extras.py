@@ -12,7 +12,7 @@ from functools import partial
 import numpy as np
 
 from safebasins.pipeline import values
-from safebasins.pipeline.registry import Kind, Product, dataset_path, register
+from safebasins.pipeline.registry import GridChartKind, Kind, Product, dataset_path, register
 
 FOURIER_LIST = {"description": "first-harmonic variants of the analytic products (\"paper\", \"exact\")",
                 "oneOf": [{"enum": ["paper", "exact"]},
@@ -116,18 +116,14 @@ def _check_grid_block(block, key, ctx):
         ctx.check_unique(f"{key}.{k}", block[k])
 
 
-def _chart_cost(params):
-    nq, np_ = params["grid"]["n"]
-    return len(params["tasks"]) * nq * np_ * params["cycles"] * params["steps_per_cycle"]
-
-
-def _grid_ics(params):
-    q0, p0 = values.grid_axes(params["grid"])
-    return q0, p0, True
+def _analytic_numeric_inputs(experiment):
+    """Figure inputs of a kind with an analytic and a numeric product."""
+    return {"analytic": dataset_path("extras", f"{experiment}_analytic"),
+            "numeric": dataset_path("extras", f"{experiment}_numeric")}
 
 
 @register
-class Erosion(Kind):
+class Erosion(GridChartKind):
     name = "erosion"
     description = "GIM / LIM / IF versus F; one escape chart per F serves every xi_max and t_eval"
     builder = "safebasins.plotting.extras:figure_erosion"
@@ -171,8 +167,6 @@ class Erosion(Kind):
                     analytic_n=None if block["analytic_n"] is None else int(block["analytic_n"]),
                     tasks=[{"F": f, "xi_max": xis, "q_max": []} for f in Fs])
 
-    chart_ics = staticmethod(_grid_ics)
-    cost = staticmethod(_chart_cost)
 
     def products(self, experiment, params):
         return [
@@ -190,12 +184,11 @@ class Erosion(Kind):
         ]
 
     def figure_inputs(self, experiment, params):
-        return {"analytic": dataset_path("extras", f"{experiment}_analytic"),
-                "numeric": dataset_path("extras", f"{experiment}_numeric")}
+        return _analytic_numeric_inputs(experiment)
 
 
 @register
-class TrueBasin(Kind):
+class TrueBasin(GridChartKind):
     name = "true_basin"
     description = "intersection over n_psi equispaced forcing phases of the safe basins (one chart per phase)"
     builder = "safebasins.plotting.extras:figure_true_basin"
@@ -235,8 +228,6 @@ class TrueBasin(Kind):
                     n_gamma=int(block["n_gamma"]), n_points=int(block["n_points"]), steps_per_cycle=ctx.steps_per_cycle,
                     tasks=[{"F": float(block["F"]), "Psi": ps, "xi_max": xis, "q_max": []} for ps in psis])
 
-    chart_ics = staticmethod(_grid_ics)
-    cost = staticmethod(_chart_cost)
 
     def products(self, experiment, params):
         return [
@@ -258,8 +249,7 @@ class TrueBasin(Kind):
         ]
 
     def figure_inputs(self, experiment, params):
-        return {"analytic": dataset_path("extras", f"{experiment}_analytic"),
-                "numeric": dataset_path("extras", f"{experiment}_numeric")}
+        return _analytic_numeric_inputs(experiment)
 
 
 @register
