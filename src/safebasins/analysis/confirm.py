@@ -15,14 +15,22 @@ __all__ = ["confirm_regions"]
 def confirm_regions(safe_analytic, escape_cycle, t_eval):
     """Connected parts of an analytic safe mask and the fraction of each that the numerics keep.
 
-    safe_analytic : bool array (q0, p0), True = safe in the slow flow.
-    escape_cycle  : numeric escape cycles of the same grid (only the analytic-safe entries are
-                    read; ``inf`` = no escape within the horizon).
-    t_eval        : evaluation time (forcing cycles): numerically safe = ``escape_cycle > t_eval``.
+    Parameters
+    ----------
+    safe_analytic
+        Bool array (q0, p0), True = safe in the slow flow.
+    escape_cycle
+        Numeric escape cycles of the same grid (only the analytic-safe entries are
+        read; ``inf`` = no escape within the horizon).
+    t_eval
+        Evaluation time (forcing cycles): numerically safe = ``escape_cycle > t_eval``.
 
-    Returns ``(labels, size, fraction)``: region label per grid point (0 = analytic escape,
-    1..n = regions, 8-connected, numbered by decreasing size), the pixel count and the
-    numerically safe fraction of each region (arrays of length n).
+    Returns
+    -------
+    labels, size, fraction
+        Region label per grid point (0 = analytic escape, 1..n = regions, 8-connected,
+        numbered by decreasing size), the pixel count and the numerically safe fraction of
+        each region (arrays of length n).
     """
     from scipy import ndimage
 

@@ -83,7 +83,7 @@ def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier=None,
     Omega, Psi : forcing frequency and phase.
     xi_max : energy threshold(s) (dimension ``xi_max``).
     q0, p0 : 1-D uniform grid axes (cover the unforced set S0(xi_max); for the quartic
-        |q0| <= 1, |p0| <= 1/sqrt(2)).
+        ``|q0| <= 1``, ``|p0| <= 1/sqrt(2)``).
     fourier : None (the well's own: "paper" for the default quartic) | "paper" | "exact" |
         list of both (adds dimension ``fourier``); a well other than the quartic has only
         "exact" (:func:`~safebasins.analysis.common.variant_well`).

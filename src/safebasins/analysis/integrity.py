@@ -6,11 +6,14 @@ conditions ``(q0, p0)`` (``ij`` indexing: first grid axis ``q0``), analytic
 ``numerics.escape_chart``).  Three integrity measures (Soliman & Thompson; Lenci &
 Rega) quantify how much of it is left:
 
-GIM  global integrity measure: the safe *area*.
-LIM  local integrity measure: radius of the largest disk centred at the well bottom
-     ``(0, 0)`` that fits in the basin (0 if the bottom itself is not safe).
-IF   integrity factor: radius of the largest disk centred *anywhere* that fits in
-     the basin (robust against thin fractal fingers, unlike GIM).
+GIM
+    global integrity measure: the safe *area*.
+LIM
+    local integrity measure: radius of the largest disk centred at the well bottom
+    ``(0, 0)`` that fits in the basin (0 if the bottom itself is not safe).
+IF
+    integrity factor: radius of the largest disk centred *anywhere* that fits in
+    the basin (robust against thin fractal fingers, unlike GIM).
 
 Normalisation
 -------------

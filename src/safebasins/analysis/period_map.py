@@ -29,7 +29,7 @@ the whole curve).
 Periodic orbits
 ---------------
 :func:`periodic_orbit` solves ``P^k(x) = x`` by Newton's method with a central-difference
-Jacobian; its monodromy trace tells elliptic (|tr| < 2) from hyperbolic points, and
+Jacobian; its monodromy trace tells elliptic (``|tr| < 2``) from hyperbolic points, and
 :func:`minimal_period` checks that no j < k already closes the orbit.  :func:`chain_orbits`
 confirms every chain found from orbit statistics by an elliptic periodic orbit of the same
 minimal period found this way (independent route), started at the island centroid.
@@ -87,13 +87,19 @@ def _orbits(q, p):
 def rotation_numbers(q, p, center):
     """Rotation number about ``center`` and its convergence digits, per orbit.
 
-    q, p   : iterates, shape (orbits, N + 1) (or (N + 1,) for one orbit); orbits containing NaN
-             (escaped) give NaN.
-    center : (q_c, p_c), e.g. the elliptic fixed point of the main island.
+    Parameters
+    ----------
+    q, p
+        Iterates, shape (orbits, N + 1) (or (N + 1,) for one orbit); orbits containing NaN
+        (escaped) give NaN.
+    center
+        (q_c, p_c), e.g. the elliptic fixed point of the main island.
 
-    Returns ``(rho, digits)``: clockwise turns per iteration (weighted Birkhoff average over the
-    whole orbit) and ``-log10`` of the difference of the averages over the two halves (capped
-    at 16).
+    Returns
+    -------
+    rho, digits
+        Clockwise turns per iteration (weighted Birkhoff average over the whole orbit) and
+        ``-log10`` of the difference of the averages over the two halves (capped at 16).
     """
     q, p = _orbits(q, p)
     c = checks.check_finite("center", center).ravel()
@@ -168,13 +174,20 @@ def _iterate(step, x, k):
 def periodic_orbit(step, x0, period, *, h=1e-7, tol=1e-11, max_iter=40):
     """Newton's method for ``P^period(x) = x``.
 
-    step   : the map, ``step(q, p) -> (q', p')`` on arrays (vectorised: the five points of the
-             central-difference Jacobian go through one call per iteration).
-    x0     : starting point (q, p).
+    Parameters
+    ----------
+    step
+        The map, ``step(q, p) -> (q', p')`` on arrays (vectorised: the five points of the
+        central-difference Jacobian go through one call per iteration).
+    x0
+        Starting point (q, p).
 
-    Returns ``(x, trace, residual)`` (``trace`` of the monodromy matrix D P^period at x: elliptic
-    if |trace| < 2) or None if Newton does not converge (or the orbit leaves the map's domain:
-    NaN iterates).
+    Returns
+    -------
+    tuple or None
+        ``(x, trace, residual)`` (``trace`` of the monodromy matrix D P^period at x: elliptic
+        if ``|trace| < 2``) or None if Newton does not converge (or the orbit leaves the map's
+        domain: NaN iterates).
     """
     period = checks.check_positive_int("period", period)
     x = checks.check_finite("x0", x0).ravel().astype(float)
@@ -327,12 +340,6 @@ def period_map_portrait(q0, p0, F, Omega, Psi, *, n_keep, n_iter=3000, xi_max=No
                         rational_tol=1e-6, well=None):
     """Stroboscopic map of the first ``n_keep`` non-escaping candidates, classified.
 
-    q0, p0 : candidate ICs in priority order (e.g. a line of ICs first, then seeded random ones).
-    xi_max, q_max : escape thresholds of the map (energy H0 > xi_max or q beyond a barrier;
-             displacement |q| > q_max); at least one.
-    well : the well of eq (1) (None: the paper's quartic; a polynomial well, see
-             ``numerics.stroboscopic_map``).
-
     The centre of the main island is the elliptic fixed point of the map found by Newton's
     method (:func:`periodic_orbit`, period 1) from the median centroid of the kept orbits (then
     from each orbit's centroid, smallest orbit first).
@@ -340,15 +347,29 @@ def period_map_portrait(q0, p0, F, Omega, Psi, *, n_keep, n_iter=3000, xi_max=No
     period / winding and its class (:func:`classify_orbits`); chains are confirmed by the
     Newton route (:func:`chain_orbits`).
 
-    Returns an xr.Dataset over (``sample``, ``iteration``): ``q``, ``p``, ``q0``, ``p0``,
-    ``candidate`` (index into the candidates), ``escape_cycle``, ``rotation_number``,
-    ``birkhoff_digits``, ``period``, ``winding``, ``orbit_class``, ``chain_index``; over
-    ``chain`` (and ``island``): ``chain_period``, ``chain_winding``, ``chain_trace``,
-    ``chain_minimal_period``, ``chain_n_orbits``, ``chain_q``, ``chain_p`` (the elliptic
-    periodic orbit, NaN-padded); attributes ``center_q``, ``center_p``, ``center_trace``,
-    ``center_rotation`` (rotation number of the linearised map at the centre), the counts
-    ``n_candidates``, ``n_non_escaping``, ``n_main``, ``n_chain``, ``n_chaotic`` and the
-    classification settings.
+    Parameters
+    ----------
+    q0, p0
+        Candidate ICs in priority order (e.g. a line of ICs first, then seeded random ones).
+    xi_max, q_max
+        Escape thresholds of the map (energy H0 > xi_max or q beyond a barrier;
+        displacement ``|q| > q_max``); at least one.
+    well
+        The well of eq (1) (None: the paper's quartic; a polynomial well, see
+        ``numerics.stroboscopic_map``).
+
+    Returns
+    -------
+    xr.Dataset
+        Over (``sample``, ``iteration``): ``q``, ``p``, ``q0``, ``p0``,
+        ``candidate`` (index into the candidates), ``escape_cycle``, ``rotation_number``,
+        ``birkhoff_digits``, ``period``, ``winding``, ``orbit_class``, ``chain_index``; over
+        ``chain`` (and ``island``): ``chain_period``, ``chain_winding``, ``chain_trace``,
+        ``chain_minimal_period``, ``chain_n_orbits``, ``chain_q``, ``chain_p`` (the elliptic
+        periodic orbit, NaN-padded); attributes ``center_q``, ``center_p``, ``center_trace``,
+        ``center_rotation`` (rotation number of the linearised map at the centre), the counts
+        ``n_candidates``, ``n_non_escaping``, ``n_main``, ``n_chain``, ``n_chaotic`` and the
+        classification settings.
     """
     import xarray as xr
 

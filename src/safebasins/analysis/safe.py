@@ -170,7 +170,7 @@ def safe_stack(chart, t_eval=None, criterion="energy"):
     Returns ``(safe (t_eval, ..., q0, p0), xi_norm)`` where ``xi_norm`` is the energy that
     normalises integrity measures: the ``xi_max`` coordinate, or the energy of the unforced set
     of the displacement thresholds in the chart's well (:func:`q_max_energy`,
-    :func:`displacement_energy`: V(q_max) for the quartic; the set {max |q(t)| < q_max} is
+    :func:`displacement_energy`: V(q_max) for the quartic; the set ``{max |q(t)| < q_max}`` is
     S0(V(q_max))).
     """
     esc, thr = escape_variable(chart, criterion)

@@ -58,10 +58,15 @@ def figure_erosion(analytic=None, numeric=None, *, measures=("GIM", "LIM", "IF")
                    t_eval=None, title=None):
     """GIM / LIM / IF versus F: analytic lines vs numeric markers, several t_eval shades.
 
-    analytic : Dataset over ([fourier,] F, xi_max) (``erosion_profile_analytic``) or None.
-    numeric  : Dataset over (F, xi_max, t_eval) (``erosion_profile_numeric`` /
-               ``profile_from_charts``) or None.
-    xi_max, t_eval : subsets to draw (default: all).
+    Parameters
+    ----------
+    analytic
+        Dataset over ([fourier,] F, xi_max) (``erosion_profile_analytic``) or None.
+    numeric
+        Dataset over (F, xi_max, t_eval) (``erosion_profile_numeric`` /
+        ``profile_from_charts``) or None.
+    xi_max, t_eval
+        Subsets to draw (default: all).
     """
     analytic, numeric = open_dataset(analytic), open_dataset(numeric)
     if analytic is None and numeric is None:
@@ -326,9 +331,13 @@ def figure_fourier(fcr=None, iou=None, *, title=None):
     IoU of the analytic and numeric safe basins per chart, paired bars grouped by source figure.
     The overall RMS error and mean IoU are in the title.
 
-    fcr : Dataset(s) of ``fcr_fourier_comparison`` (optionally with a ``curve`` dim), or a list.
-    iou : Dataset(s) of ``iou_fourier_comparison``, or a list (one per chart file); each
-          combination of its non-singleton dims becomes one pair of bars.
+    Parameters
+    ----------
+    fcr
+        Dataset(s) of ``fcr_fourier_comparison`` (optionally with a ``curve`` dim), or a list.
+    iou
+        Dataset(s) of ``iou_fourier_comparison``, or a list (one per chart file); each
+        combination of its non-singleton dims becomes one pair of bars.
     """
     fcrs = [open_dataset(d) for d in (fcr if isinstance(fcr, (list, tuple)) else [fcr]) if d is not None]
     ious = [open_dataset(d) for d in (iou if isinstance(iou, (list, tuple)) else [iou]) if d is not None]

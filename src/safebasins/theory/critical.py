@@ -120,20 +120,24 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
 
     Returns
     -------
-    xarray.Dataset over ``Omega`` with
-      ``F_cr``   smallest F at which the level curve through (gamma_ini, xi_ini) reaches xi_max
-                 (NaN if it never does),
-      ``mechanism`` int8, flag_values [0..4], flag_meanings "none MM_0 MM_pi SM SMM",
-      ``F_MM_0`` eq (24) through gamma* = 0 where no gamma = 0 saddle lies above xi_max
-                 (NaN otherwise, and where the tangency value is not a positive lower bound),
-      ``F_SMM``  the same eq (24) value where such a saddle exists above xi_max (the branches
-                 F_MM_0 and F_SMM are disjoint; their union is eq (24) with gamma* = 0),
-      ``F_MM_pi`` eq (24) through gamma* = pi,
-      ``F_SM``   largest F of eqs (25)-(26) with the saddle in (xi_ini, xi_max) (NaN if none),
-      ``xi_saddle``, ``gamma_saddle`` the saddle of the F_SM branch (gamma 0 or pi; -delta(xi) or pi - delta(xi) for an asymmetric well),
-      ``xi_saddle_smm`` the saddle above xi_max on the F_SMM branch.
-    F_cr equals the largest existing branch, provided no upper-bound constraint excludes it.
-    Attributes: xi_max, xi_ini, gamma_ini, fourier, well.
+    xarray.Dataset
+        Over ``Omega``, with
+
+        * ``F_cr``: smallest F at which the level curve through (gamma_ini, xi_ini) reaches
+          xi_max (NaN if it never does);
+        * ``mechanism``: int8, flag_values [0..4], flag_meanings "none MM_0 MM_pi SM SMM";
+        * ``F_MM_0``: eq (24) through gamma* = 0 where no gamma = 0 saddle lies above xi_max
+          (NaN otherwise, and where the tangency value is not a positive lower bound);
+        * ``F_SMM``: the same eq (24) value where such a saddle exists above xi_max (the branches
+          F_MM_0 and F_SMM are disjoint; their union is eq (24) with gamma* = 0);
+        * ``F_MM_pi``: eq (24) through gamma* = pi;
+        * ``F_SM``: largest F of eqs (25)-(26) with the saddle in (xi_ini, xi_max) (NaN if none);
+        * ``xi_saddle``, ``gamma_saddle``: the saddle of the F_SM branch (gamma 0 or pi;
+          -delta(xi) or pi - delta(xi) for an asymmetric well);
+        * ``xi_saddle_smm``: the saddle above xi_max on the F_SMM branch.
+
+        F_cr equals the largest existing branch, provided no upper-bound constraint excludes it.
+        Attributes: xi_max, xi_ini, gamma_ini, fourier, well.
     """
     well = resolve_well(well, fourier)
     w, fourier, E_b = well, well.fourier, well.barrier_energy
