@@ -205,7 +205,7 @@ def test_bad_input_names_the_reason():
     with pytest.raises(ValueError, match="exact first harmonic"):
         integrity_map.integrity_map_analytic([0.9], [0.01], 0.0, 0.1, q, p, fourier="paper", well=cub)
     with pytest.raises(ValueError, match="well must be"):
-        erosion.erosion_profile_analytic([0.01], 0.9, 0.0, 0.1, q, p, well="cubic")
+        erosion.erosion_profile_analytic([0.01], 0.9, 0.0, 0.1, q, p, well=3.5)
     with pytest.raises(ValueError, match="quartic's"):
         fourier_compare.fcr_fourier_comparison([0.9], 0.1, well=cub)
     ch = escape_chart(q[::4], p[::4], 0.01, 0.9, 0.0, xi_max=(0.1,), cycles=5, well=cub)

@@ -176,9 +176,9 @@ def test_basin_writes_the_manifold_layout(tmp_path):
 
 
 HELP = {"": ["chart", "fcr", "basin", "info"],
-        "chart": ["--xi-max", "--grid", "--tiles", "--t-eval", "--out PREFIX", "[default: 3000]"],
+        "chart": ["--xi-max", "--grid", "--tiles", "--t-eval", "--out PREFIX", "[default: 3000]", "--well"],
         "fcr": ["--Omega-range", "--numeric / --no-numeric", "--n-scan", "[default: 301]"],
-        "basin": ["--xi-top", "[default: 0.2499]"], "info": ["FILE"]}
+        "basin": ["--xi-top", "0.2499", "--well"], "info": ["FILE"]}
 
 
 def run_all(cases, tmp_path_factory):

@@ -10,8 +10,9 @@ stop_any, the forcing table in global memory and more trajectories than threads 
 threads take several each; compaction runs); and knife-edge thresholds set to an energy the CPU
 trajectory reaches exactly, where a one-ulp difference in the state would move the recorded
 step (this is what catches a multiply-add rounded twice).  Other wells: the cubic (kernel flag
-POLY4, Horner from run-time coefficients, one barrier) with asymmetric displacement bounds, and
-the quartic with asymmetric bounds (QUARTIC_SIGNED), several parameter sets.  Subprocess: ~10-15 s.
+code: Horner from run-time coefficients, one barrier) with asymmetric displacement bounds, the
+quartic with asymmetric bounds (signed tracking), several parameter sets, and a rational well
+written as an expression (generated V, dV).  Subprocess: ~10-15 s.
 """
 from __future__ import annotations
 
@@ -23,18 +24,14 @@ import sys
 import time
 from pathlib import Path
 
-from types import SimpleNamespace
-
 import numpy as np
 
 SRC = Path(__file__).resolve().parents[2] / "src"
-# the cubic V = q^2/2 - q^3/3 as a duck-typed polynomial well (criteria.resolve_well)
-CUBIC = dict(name="cubic", coefficients=[0.0, 0.0, 0.5, -1.0 / 3.0], barriers=[-math.inf, 1.0],
-             barrier_energy=1.0 / 6.0)
-
-
-def _well(spec):
-    return None if spec is None else SimpleNamespace(**spec)
+# wells travel to the subprocess as specs (safebasins.wells.resolve_well): the cubic
+# V = q^2/2 - q^3/3 (a polynomial code, Horner from run-time coefficients) and a well written as
+# an expression (the generic V, dV code; sqrt and division: correctly rounded on every target)
+CUBIC = "cubic"
+RATIONAL = {"expression": "q**2/2 - q**4/(4 + q**2)"}
 
 
 def _grid_ics():
@@ -63,7 +60,7 @@ def _knife_edges(integrator, ics, Omega, F, Psi, S, n_steps, per_ic=2):
             else:
                 q, p = kernels.bm6_step(q, p, *c, *row)
             e = kernels.energy2(q, p)
-            if e > emax and abs(q) <= kernels.Q_BARRIER:
+            if e > emax and abs(q) <= 1.0:
                 emax = e
                 records.append((n + 1, e))
         for step, e in records[-per_ic:]:
@@ -103,6 +100,10 @@ def _cases():
             kw=dict(xi_max=[0.12, 1.0 / 6.0], q_bounds=[[-0.43, 0.65], [-math.inf, 0.9]], cycles=20,
                     steps_per_cycle=16, integrator=integrator),
             well=CUBIC)
+        yield f"{integrator}/expression", dict(
+            args=[(0.9 * Q).tolist(), (0.9 * P).tolist(), zero, [0.8], [0.05], 1.0],
+            kw=dict(xi_max=[0.2, 0.3], q_bounds=[[-0.9, 1.0]], cycles=20, steps_per_cycle=16, integrator=integrator),
+            well=RATIONAL)
     yield "srkn6b/quartic_signed", dict(
         args=[Q.tolist(), P.tolist(), zero, [0.95], [0.0876], np.pi],
         kw=dict(xi_max=[0.2], q_max=[0.7], q_bounds=[[-0.75, 0.8]], cycles=15, steps_per_cycle=8, stop_any=False),
@@ -125,7 +126,7 @@ def child():
     for name, c in json.load(sys.stdin).items():
         cuda_kernels.SHARED_TABLE_BYTES = 0 if c.get("global_table") else 16 * 1024
         t = time.perf_counter()
-        E, Q = cuda_engine.run_ensemble_cuda(*c["args"], **c["kw"], **c.get("cuda", {}), well=_well(c.get("well")))
+        E, Q = cuda_engine.run_ensemble_cuda(*c["args"], **c["kw"], **c.get("cuda", {}), well=c.get("well"))
         out[name] = dict(E=E.tolist(), Q=Q.tolist(), dtype=[str(E.dtype), str(Q.dtype)],
                          seconds=round(time.perf_counter() - t, 2))
     print(json.dumps(out))
@@ -151,7 +152,7 @@ def test_cuda_simulator_matches_cpu_engine_bitwise():
     assert np.array_equal(np.array(api["Q"]), ch["escape_cycle_displacement"].values)
     assert sorted(gpu) == sorted(cases)
     for name, c in cases.items():
-        cpu_E, cpu_Q, _ = engine.run_ensemble(*c["args"], threads=1, **c["kw"], well=_well(c.get("well")))
+        cpu_E, cpu_Q, _ = engine.run_ensemble(*c["args"], threads=1, **c["kw"], well=c.get("well"))
         for j, (ic, step) in enumerate(c.get("expect", ())):   # the knife edges really are ones
             assert cpu_E[ic, 2 * j + 1] == step and cpu_E[ic, 2 * j] != step, (name, cpu_E, c["expect"])
         g = gpu[name]

@@ -2,9 +2,10 @@
 (Horner from run-time coefficients) against the quartic and against scipy's DOP853, asymmetric
 displacement bounds, the signed lane machinery, bad input.
 
-Compiled kernels used here: QUARTIC (shared with the other numerics tests), POLY4 (the cubic and
-the quartic as coefficients) and QUARTIC_SIGNED (asymmetric bounds in the quartic); POLY8 only
-through its Horner arithmetic and final_states (small compiles).
+Compiled kernels used here: the quartic's closed form (shared with the other numerics tests), the
+degree-4 polynomial code (the cubic and the quartic as coefficients) and the quartic's signed
+tracking (asymmetric bounds); the degree-8 code only through its Horner arithmetic and
+final_states (small compiles).
 """
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ from numba import njit
 from scipy.integrate import solve_ivp
 
 from safebasins.numerics import (critical_forcing_numeric, displacement_bounds, engine, escape_chart,
-                                 escape_chart_batch, kernels, steps, stroboscopic_map)
+                                 escape_chart_batch, kernels, steps, stroboscopic_map, wellcode)
 from safebasins.wells.polynomial import PolynomialWell, cubic
 
 # ---------------------------------------------------------------------------------------------
@@ -95,9 +96,9 @@ def _within_one_step(a, b, S):
 
 @pytest.mark.parametrize("integrator", ["srkn6b", "rk4"])
 def test_quartic_as_polynomial_agrees_within_one_step(wells, integrator):
-    """V = [0, 0, 0.5, 0, -0.25] by Horner (POLY4) against the closed-form quartic path: the same
-    physics, other rounding; every pixel of every threshold within one step.  Also the
-    per-lane path (two control points) and asymmetric bounds (QUARTIC_SIGNED vs POLY4)."""
+    """V = [0, 0, 0.5, 0, -0.25] by Horner (degree-4 code) against the closed-form quartic path:
+    the same physics, other rounding; every pixel of every threshold within one step.  Also the
+    per-lane path (two control points) and asymmetric bounds (signed quartic vs polynomial)."""
     q, p = np.linspace(-0.95, 0.95, 12), np.linspace(-0.6, 0.6, 10)
     kw = dict(xi_max=(0.2, 0.12, 0.25), q_max=(0.8, 1.0), cycles=40, steps_per_cycle=16, integrator=integrator)
     a = escape_chart(q, p, 0.0876, 0.95, np.pi, **kw)
@@ -117,14 +118,15 @@ def test_quartic_as_polynomial_agrees_within_one_step(wells, integrator):
 
 @pytest.mark.parametrize("npar", [1, 2])
 def test_signed_tracking_equals_abs_tracking_bitwise(npar):
-    """The signed lane machinery (max q and max -q, split maxima loop; kernel flag
-    QUARTIC_SIGNED) with symmetric bounds makes exactly the QUARTIC path's decisions: every
-    escape step equal (shared and per-lane paths)."""
+    """The signed lane machinery (max q and max -q, split maxima loop: the quartic code's signed
+    variant) with symmetric bounds makes exactly the |q| path's decisions: every escape step equal
+    (shared and per-lane paths)."""
     q = np.linspace(-1, 1, 30)
     Q, P = (a.ravel() for a in np.meshgrid(q, q, indexing="ij"))
     N, S = Q.size, 16
     out = []
-    for flag in (kernels.QUARTIC, kernels.QUARTIC_SIGNED):
+    code = wellcode.quartic_code()
+    for flag in (code, code.signed()):
         oE = np.full((N, 2), -1, np.int64)
         oQ = np.full((N, 2), -1, np.int64)
         hi = np.array([0.8, 1.0])
@@ -171,7 +173,7 @@ def dop853_cubic(q0, p0, F, Omega, Psi, xi_max, bounds, cycles):
 
 
 def test_cubic_chart_matches_dop853_pixel_by_pixel(wells):
-    """The cubic well (POLY4: Horner, one barrier at q = 1, none on the left), 7x6 ICs, 40 cycles,
+    """The cubic well (degree-4 code: Horner, one barrier at q = 1, none on the left), 7x6 ICs, 40 cycles,
     two energy thresholds (one at the barrier energy) and two asymmetric bound pairs (the turning
     points of xi = 0.12, and a one-sided pair (-inf, 0.9)): the same escape / no-escape label on
     every pixel and every escape time within one step of DOP853's event time."""
@@ -202,7 +204,7 @@ def test_cubic_chart_matches_dop853_pixel_by_pixel(wells):
 
 
 def test_cubic_map_and_bisection(wells):
-    """stroboscopic_map in the cubic: iterates bitwise the plain POLY4 integrator's; the
+    """stroboscopic_map in the cubic: iterates bitwise the plain integrator's of its code; the
     displacement criterion of critical_forcing_numeric uses the turning points of xi_max."""
     w = wells.cubic
     q0, p0 = np.array([0.1, -0.2, 0.3, 0.0]), np.array([0.1, 0.2, -0.1, 0.05])
@@ -211,9 +213,8 @@ def test_cubic_map_and_bisection(wells):
     safe = np.flatnonzero(~m["escaped"].values)
     assert safe.size
     S = m.attrs["steps_per_cycle"]
-    _, wpar = steps.well_parameters(w.barriers, w.coefficients)
     q, p = kernels.final_states(q0[safe], p0[safe], np.zeros(safe.size, np.int64), kernels.lane_coefficients(0.85, S),
-                                np.array([0.02]), kernels.sine_table(S, 0.3), 30, well=kernels.POLY4, wpar=wpar)
+                                np.array([0.02]), kernels.sine_table(S, 0.3), 30, well=w.compiled)
     np.testing.assert_array_equal(q, m["q"].values[safe, 30])
     np.testing.assert_array_equal(p, m["p"].values[safe, 30])
     f = critical_forcing_numeric([0.8, 0.9], 0.12, cycles=60, n_scan=0, F_bracket=(0.0, 0.1), tol=2e-3,
@@ -226,14 +227,14 @@ def test_cubic_map_and_bisection(wells):
 
 
 @njit
-def _horner(flag, wpar, q, p):
+def _horner(key, wpar, q, p):
     w = steps.wtuple(wpar)
-    return steps.well_force(flag, w, q, 0.25), steps.well_energy2(flag, w, q, p)
+    return wellcode.well_force(key, w, q, 0.25), wellcode.well_energy2(key, w, q, p)
 
 
-POLY4, POLY8 = steps.POLY4, steps.POLY8     # globals: numba literals (a kernel flag is a compile-time constant)
-_horner4 = njit(lambda wpar, q, p: _horner(POLY4, wpar, q, p))
-_horner8 = njit(lambda wpar, q, p: _horner(POLY8, wpar, q, p))
+def _horner_of(code):
+    key = code.key         # a global constant of the jitted lambda: a numba literal
+    return njit(lambda wpar, q, p: _horner(key, wpar, q, p))
 
 
 def test_horner_classes():
@@ -241,25 +242,28 @@ def test_horner_classes():
     runs bitwise the same in the degree-4 and degree-8 classes (leading zeros are exact)."""
     P = np.polynomial.polynomial
     c6 = [0.0, 0.0, 0.5, 0.1, -0.3, 0.02, 0.05]
-    cls, wpar = steps.well_parameters((-1.0, 1.0), c6)
-    assert cls == steps.POLY8
+    code6 = wellcode.polynomial_code(c6, (-1.0, 1.0))
+    assert "class 8" in code6.name
+    h8 = _horner_of(code6)
     for q, p in ((0.3, -0.2), (-0.7, 0.4), (1.3, 0.0)):
-        f, e = _horner8(wpar, q, p)
+        f, e = h8(code6.wpar, q, p)
         assert f == pytest.approx(0.25 - P.polyval(q, P.polyder(c6)), rel=1e-14, abs=1e-15)
         assert e == pytest.approx(2 * P.polyval(q, c6) + p * p, rel=1e-14, abs=1e-15)
     c3 = [0.0, 0.0, 0.5, -1.0 / 3.0]
-    cls, w3 = steps.well_parameters((-np.inf, 1.0), c3)
-    assert cls == steps.POLY4
+    code3 = wellcode.polynomial_code(c3, (-np.inf, 1.0))
+    assert "class 4" in code3.name
+    as8 = wellcode.WellCode("cubic in class 8", code6.make, code3.wpar, False, code6.source)   # same coefficients
+    h4 = _horner_of(code3)
     for q, p in ((0.3, -0.2), (-0.7, 0.4)):
-        assert _horner4(w3, q, p) == _horner8(w3, q, p)
+        assert h4(code3.wpar, q, p) == h8(code3.wpar, q, p)
     S = 16
     args = (np.array([0.2, -0.3]), np.array([0.1, 0.2]), np.zeros(2, np.int64), kernels.lane_coefficients(0.9, S),
             np.array([0.02]), kernels.sine_table(S, 0.0), 5)
-    a = kernels.final_states(*args, well=kernels.POLY4, wpar=w3)
-    b = kernels.final_states(*args, well=kernels.POLY8, wpar=w3)
+    a = kernels.final_states(*args, well=code3)
+    b = kernels.final_states(*args, well=as8)
     np.testing.assert_array_equal(a, b)
     with pytest.raises(ValueError, match="degree 9"):
-        steps.well_parameters((-1.0, 1.0), [0, 0, 1, 0, 0, 0, 0, 0, 0, -1])
+        wellcode.polynomial_code([0, 0, 1, 0, 0, 0, 0, 0, 0, -1], (-1.0, 1.0))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -287,16 +291,13 @@ def test_bad_thresholds_for_the_cubic(wells, kw, name):
 
 def test_bad_wells_and_quartic_limits(wells):
     from safebasins.wells.numeric import NumericWell
-    nw = NumericWell(lambda q: 0.5 * q * q - 0.25 * q ** 4, lambda q: q - q ** 3)
-    with pytest.raises(ValueError, match="well"):
+    from scipy.special import erf
+    nw = NumericWell(lambda q: 0.5 * q * q - 0.25 * q ** 4 + 0 * erf(q), lambda q: q - q ** 3)
+    with pytest.raises(ValueError, match="V: the compiled engines need V"):     # scipy's erf: not numba code
         _chart(well=nw)
-    deg9 = SimpleNamespace(name="deg9", coefficients=[0, 0, 1, 0, 0, 0, 0, 0, 0, -1], barriers=(-np.inf, np.inf),
-                           barrier_energy=1.0)
-    with pytest.raises(ValueError, match="well.*degree 9"):
-        _chart(well=deg9)
-    wrong = SimpleNamespace(name="wrong", coefficients=[0, 0, 0.5, -1 / 3], barriers=(-np.inf, 0.9), barrier_energy=0.1)
-    with pytest.raises(ValueError, match="well.*root of V'"):
-        _chart(well=wrong)
+    for bad in (object(), "nonsense", {"polynomial": "x"}, {"expression": 3}, {"a": 1, "b": 2}):
+        with pytest.raises(ValueError, match="well"):
+            _chart(well=bad)
     with pytest.raises(ValueError, match="q_bounds"):
         _chart(q_bounds=(-1.1, 0.5))                       # the quartic's barrier at -1
     with pytest.raises(ValueError, match="xi_max"):

@@ -119,8 +119,11 @@ def test_bad_input_names_the_reason():
         critical_forcing([0.9], 0.1, well=cub, fourier="paper")
     with pytest.raises(ValueError):
         phase_point(0.3, 0.2, well=cub)           # energy above the barrier
-    with pytest.raises(ValueError, match="well"):
-        slow_flow_escapes(0.1, 0.1, 0.01, 0.9, 0.0, 0.1, well="cubic")
+    with pytest.raises(ValueError, match="unknown well 'no-such-well'"):
+        slow_flow_escapes(0.1, 0.1, 0.01, 0.9, 0.0, 0.1, well="no-such-well")
+    # a name or a spec is a well everywhere (the config's forms)
+    assert slow_flow_escapes(0.1, 0.1, 0.01, 0.9, 0.0, 0.1, well="cubic") == \
+        slow_flow_escapes(0.1, 0.1, 0.01, 0.9, 0.0, 0.1, well=cub)
     with pytest.raises(ValueError, match="V'\\(0\\) = 0"):
         wells.polynomial([0, 0.1, 0.5, 0, -0.25])   # minimum not at q = 0
     with pytest.raises(ValueError, match="no barrier"):

@@ -8,19 +8,25 @@ from pathlib import Path
 import click
 
 from safebasins.cli.options import (DISPLACEMENT, ENERGY, FINITE, OPTION_OF, POSITIVE, Deferred, Fields, Number,
-                                    NumberList, analytic_threshold, checked, common_options, forcing_options,
-                                    from_library, from_schema, grid_options, grid_params, joined, lib_check,
-                                    library_errors, numerics_options, out_option)
+                                    NumberList, analytic_threshold, checked, common_options, current_well,
+                                    forcing_options, fourier_of, from_library, from_schema, grid_options, grid_params,
+                                    joined, lib_check, library_errors, numerics_options, out_option)
 from safebasins.cli.output import chatter, describe, draw, finish, fmt, job, progress, write_outputs
 
-#: the command line works on the paper's quartic well (the pipeline config names any well)
-QUARTIC_SPEC = {"name": "quartic"}
+
+
+def well_label(spec):
+    """How titles name the well of a run."""
+    return spec.get("expression", spec["name"]) if spec["name"] == "expression" else spec["name"]
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
 @click.version_option(package_name="safebasins")
 def main():
-    """Safe basins of q'' + q - q^3 = F sin(Omega t + Psi): analytic (slow flow) and numeric.
+    """Safe basins of q'' + V'(q) = F sin(Omega t + Psi): analytic (slow flow) and numeric.
+
+    The well is the paper's quartic V = q^2/2 - q^4/4 unless --well names another one (a name,
+    polynomial:..., expression:'...': the forms of the pipeline config's `well:`).
 
     Each command writes PREFIX.nc (CF + provenance attributes, the pipeline's dataset layout)
     and PREFIX.png (the pipeline's figure).  Long runs show a progress bar on stderr when it is
@@ -32,9 +38,11 @@ def main():
 @forcing_options
 @click.option("--xi-max", "xi_max", type=NumberList("xi_max", analytic_threshold), multiple=True, required=True,
               callback=joined(unique=True),
-              help="Energy thresholds in (0, 1/4): comma list or repeated (one basin each).")
+              help="Energy thresholds in (0, E_b) (E_b: the well's barrier energy, 1/4 for the quartic): comma "
+                   "list or repeated (one basin each).")
 @click.option("--q-max", "q_max", type=NumberList("q_max", DISPLACEMENT), multiple=True,
-              callback=joined(unique=True), help="Displacement thresholds |q| > q_max in (0, 1], stored beside the energy ones.")
+              callback=joined(unique=True), help="Displacement thresholds |q| > q_max up to the nearest barrier, "
+                                                 "stored beside the energy ones.")
 @grid_options
 @numerics_options("safebasins.numerics:escape_chart", "integrated; the stored IoU is evaluated at it")
 @click.option("--t-eval", "t_eval", type=Number("t_eval", POSITIVE), default=None,
@@ -48,7 +56,7 @@ def main():
 @common_options
 @out_option("chart")
 def chart(F, Omega, Psi, xi_max, q_max, grid, n, cycles, steps_per_cycle, threads, backend, t_eval, n_points, tiles,
-          fourier, no_plot, quiet, verbose, out):
+          fourier, well, no_plot, quiet, verbose, out):
     """Numeric escape chart on an IC grid with the analytic safe basins and their IoU.
 
     One integration serves every threshold.  PREFIX.nc is the chart in the layout of the
@@ -66,12 +74,13 @@ def chart(F, Omega, Psi, xi_max, q_max, grid, n, cycles, steps_per_cycle, thread
     if tiles > n[0]:
         raise click.BadParameter(f"{tiles} tiles but only {n[0]} q0 rows", param_hint="'--tiles'")
     name = Path(out).name
-    params = dict(command="chart", kind="basin_chart", experiment=name, fourier=fourier, well=QUARTIC_SPEC, scan="xi_max", F=F,
+    fourier = fourier_of(click.get_current_context(), fourier)
+    params = dict(command="chart", kind="basin_chart", experiment=name, fourier=fourier, well=well, scan="xi_max", F=F,
                   xi_max=xi_max, q_max=q_max, Omega=Omega, Psi=Psi, grid=grid_params(grid, n), cycles=cycles,
                   t_eval=[t_eval], n_points=n_points, steps_per_cycle=steps_per_cycle,
                   tasks=[{"F": F, "xi_max": xi_max, "q_max": q_max}])
-    params["title"] = (f"Escape chart and slow-flow safe basins, F = {fmt(F)}, Omega = {fmt(Omega)}, "
-                       f"Psi = {fmt(Psi, angle=True)} (safebasins chart {name})")
+    params["title"] = (f"Escape chart and slow-flow safe basins, {well_label(well)} well, F = {fmt(F)}, "
+                       f"Omega = {fmt(Omega)}, Psi = {fmt(Psi, angle=True)} (safebasins chart {name})")
     with library_errors(), chatter(verbose):
         ds, basins = chart_dataset(params, tiles, job(threads, backend), quiet)
         finish(ds, title=params["title"], params=params)
@@ -121,11 +130,12 @@ def n_scan_check(n):
 
 
 @main.command()
-@click.option("--Omega-range", "Omega_range", type=Fields("range"), default="0.5,1.2,351", show_default=True,
-              help="Analytic Omega values start,stop,num (endpoints included).")
+@click.option("--Omega-range", "Omega_range", type=Fields("range"), default=None,
+              help="Analytic Omega values start,stop,num (endpoints included) [default: 0.5 w0,1.2 w0,351 with w0 "
+                   "the well's small-amplitude frequency: 0.5,1.2,351 for the quartic].")
 @click.option("--xi-max", "xi_max", type=NumberList("xi_max", analytic_threshold), multiple=True, required=True,
               callback=joined(unique=False),
-              help="Truncation levels in (0, 1/4): one curve each (comma list or repeated).")
+              help="Truncation levels in (0, E_b): one curve each (comma list or repeated).")
 @click.option("--xi-ini", "xi_ini", type=NumberList("xi_ini", ENERGY), multiple=True,
               callback=joined(unique=False), help="Initial energies (< xi_max) [default: 0, the zero IC].")
 @click.option("--gamma-ini", "gamma_ini", type=NumberList("gamma_ini", FINITE, angle=True), multiple=True,
@@ -150,7 +160,7 @@ def n_scan_check(n):
 @common_options
 @out_option("fcr")
 def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cycles, steps_per_cycle,
-        threads, backend, tol, n_scan, F_bracket, criterion, fourier, no_plot, quiet, verbose, out):
+        threads, backend, tol, n_scan, F_bracket, criterion, fourier, well, no_plot, quiet, verbose, out):
     """Critical forcing F_cr(Omega): analytic curves, optionally with the numeric bisection.
 
     Curves come from --xi-max / --xi-ini / --gamma-ini (equal lengths or length 1).  Writes
@@ -175,13 +185,18 @@ def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cyc
             raise click.BadParameter(f"initial energy {c['xi_ini']} must be below the truncation level xi_max = "
                                      f"{c['xi_max']}", param_hint="'--xi-ini'")
     name = Path(out).name
-    params = dict(command="fcr", kind="fcr_compare" if numeric else "fcr_theory", experiment=name, fourier=fourier, well=QUARTIC_SPEC,
-                  Omega=values.range_values(Omega_range), curves=curves)
+    ctx = click.get_current_context()
+    fourier = fourier_of(ctx, fourier)
+    if Omega_range is None:
+        w0 = float(current_well(ctx).omega(0.0))
+        Omega_range = {"start": round(0.5 * w0, 12), "stop": round(1.2 * w0, 12), "num": 351}
+    params = dict(command="fcr", kind="fcr_compare" if numeric else "fcr_theory", experiment=name, fourier=fourier,
+                  well=well, Omega=values.range_values(Omega_range), curves=curves)
     if numeric:
         params["numeric"] = {"Omega": values.range_values(numeric_Omega or Omega_range), "cycles": cycles,
                              "tol": tol, "F_bracket": F_bracket, "n_scan": n_scan, "criterion": criterion,
                              "steps_per_cycle": steps_per_cycle}
-    params["title"] = f"Critical forcing F_cr(Omega) (safebasins fcr {name})"
+    params["title"] = f"Critical forcing F_cr(Omega), {well_label(well)} well (safebasins fcr {name})"
     from safebasins.pipeline.kinds.fcr import build_fcr_analytic
 
     with library_errors(), chatter(verbose):
@@ -244,7 +259,7 @@ def fcr_numeric(params, job, quiet):
 @main.command()
 @forcing_options
 @click.option("--xi-max", "xi_max", type=Number("xi_max", analytic_threshold), required=True,
-              help="Energy truncation level in (0, 1/4).")
+              help="Energy truncation level in (0, E_b).")
 @grid_options
 @click.option("--n-points", "n_points", cls=Deferred, type=int, default=from_schema("basin_rm", "n_points"),
               callback=checked("n_points", lib_check("safebasins.checks:check_positive_int")),
@@ -255,12 +270,13 @@ def fcr_numeric(params, job, quiet):
 @click.option("--n-xi", "n_xi", type=click.IntRange(min=2),
               cls=Deferred, default=from_schema("basin_rm", "manifold", "n_xi"),
               help="xi points of the resonance-manifold panel.")
-@click.option("--xi-top", "xi_top", type=Number("xi_top", ENERGY),
-              cls=Deferred, default=from_schema("basin_rm", "manifold", "xi_top"),
-              help="Top of the resonance-manifold panel (< 1/4).")
+@click.option("--xi-top", "xi_top", type=Number("xi_top", ENERGY), default=None,
+              help="Top of the resonance-manifold panel (< E_b) [default: the basin_rm schema's 0.2499 for the "
+                   "quartic, 0.9996 E_b for any other well].")
 @common_options
 @out_option("basin")
-def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, fourier, no_plot, quiet, verbose, out):
+def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, fourier, well, no_plot, quiet, verbose,
+          out):
     """Analytic safe basin of the slow flow, on the resonance manifold and on the IC plane.
 
     PREFIX.nc has the layout of the pipeline's Figs 5-9: boundary curves (`gamma`, `xi`,
@@ -269,14 +285,20 @@ def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, fouri
 
     Example: safebasins basin --F 0.0876 --Omega 0.92 --xi-max 0.24
     """
+    ctx = click.get_current_context()
+    if xi_top is None:
+        w = current_well(ctx)
+        xi_top = (from_schema("basin_rm", "manifold", "xi_top")() if w.name == "quartic"
+                  else 0.9996 * float(w.barrier_energy))
     if not xi_top > 0:
         raise click.BadParameter(f"must be > 0, got {xi_top}", param_hint="'--xi-top'")
     name = Path(out).name
-    params = dict(command="basin", kind="basin_rm", experiment=name, fourier=fourier, well=QUARTIC_SPEC, F=F, Omega=Omega, Psi=Psi,
+    fourier = fourier_of(ctx, fourier)
+    params = dict(command="basin", kind="basin_rm", experiment=name, fourier=fourier, well=well, F=F, Omega=Omega, Psi=Psi,
                   xi_max=xi_max, grid=grid_params(grid, n), n_points=n_points,
                   manifold={"n_gamma": n_gamma, "n_xi": n_xi, "xi_top": xi_top})
-    params["title"] = (f"Analytic safe basin, F = {fmt(F)}, Omega = {fmt(Omega)}, Psi = {fmt(Psi, angle=True)}, "
-                       f"xi_max = {fmt(xi_max)} (safebasins basin {name})")
+    params["title"] = (f"Analytic safe basin, {well_label(well)} well, F = {fmt(F)}, Omega = {fmt(Omega)}, "
+                       f"Psi = {fmt(Psi, angle=True)}, xi_max = {fmt(xi_max)} (safebasins basin {name})")
     from safebasins.pipeline.kinds.basins import build_basin_single
 
     with library_errors(), chatter(verbose):

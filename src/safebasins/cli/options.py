@@ -62,15 +62,88 @@ def lib_check(path):
 NONNEG = lib_check("safebasins.checks:check_nonnegative")
 POSITIVE = lib_check("safebasins.checks:check_positive")
 FINITE = lib_check("safebasins.checks:check_finite")
-ENERGY = lib_check("safebasins.wells.quartic:QUARTIC.check_energy")          # [0, 1/4)
-THRESHOLD = lib_check("safebasins.wells.quartic:QUARTIC.check_threshold")    # (0, 1/4]
-DISPLACEMENT = lib_check("safebasins.wells.quartic:QUARTIC.check_displacement")
+#: where the eager --well option leaves the resolved well for the checks of the other options
+WELL_META = "safebasins.well"
 
 
-def analytic_threshold(name, value):
-    """(0, 1/4): the action-angle map of the slow flow is singular on the separatrix."""
-    THRESHOLD(name, value)
-    return ENERGY(name, value)
+def current_well(ctx):
+    """The well of the command being parsed (--well, resolved before every other option)."""
+    well = ctx.meta.get(WELL_META) if ctx is not None else None
+    if well is None:
+        from safebasins.wells import QUARTIC
+
+        well = QUARTIC
+    return well
+
+
+def well_check(method):
+    """A check of the command's well (``Well.<method>(name, value)``): energies below its barrier
+    energy, thresholds, displacements."""
+    def check(name, value, ctx):
+        return getattr(current_well(ctx), method)(name, value)
+    check.needs_ctx = True
+    return check
+
+
+ENERGY = well_check("check_energy")          # [0, E_b)
+THRESHOLD = well_check("check_threshold")    # (0, E_b] (below an asymptote: (0, E_b))
+DISPLACEMENT = well_check("check_displacement")
+
+
+def analytic_threshold(name, value, ctx):
+    """(0, E_b): the action-angle map of the slow flow is singular on the separatrix."""
+    THRESHOLD(name, value, ctx)
+    return ENERGY(name, value, ctx)
+
+
+analytic_threshold.needs_ctx = True
+
+
+def parse_well(text):
+    """A --well value: a name (quartic, cubic, pendulum, ...), ``polynomial:c0,c1,...``,
+    ``expression:<formula in q>``, or the config's own mapping ``{expression: '1 - cos(q)'}``
+    (YAML); returns the resolved spec (safebasins.wells.spec_of)."""
+    from safebasins import wells
+
+    t = str(text).strip()
+    if t.startswith("{"):
+        import yaml
+
+        try:
+            value = yaml.safe_load(t)
+        except yaml.YAMLError as exc:
+            raise ValueError(f"well: cannot read {t!r} as a mapping ({exc.__class__.__name__})") from None
+    elif t.startswith("polynomial:"):
+        value = {"polynomial": [parse_number(c) for c in t.removeprefix("polynomial:").split(",") if c.strip()]}
+    elif t.startswith("expression:"):
+        value = {"expression": t.removeprefix("expression:").strip()}
+    else:
+        value = t
+    return wells.spec_of(value)
+
+
+def well_callback(ctx, param, value):
+    """--well (eager): the resolved spec; the well itself goes to ctx.meta for the other checks."""
+    from safebasins import wells
+
+    try:
+        spec = parse_well(value)
+        ctx.meta[WELL_META] = wells.from_spec(spec)
+    except ValueError as exc:
+        raise click.BadParameter(str(exc), ctx, param) from None
+    return spec
+
+
+def fourier_of(ctx, fourier):
+    """The first harmonic of the run: --fourier for the quartic (default 'paper', eq 20 as printed);
+    every other well uses its exact one ('paper' is a usage error there)."""
+    well = current_well(ctx)
+    if well.name == "quartic":
+        return fourier or "paper"
+    if fourier == "paper":
+        raise click.BadParameter(f"'paper' is the quartic's truncated first harmonic (eq 20); the {well.name} well "
+                                 "uses its exact first harmonic", ctx, param_hint="'--fourier'")
+    return "exact"
 
 
 class Number(click.ParamType):
@@ -81,9 +154,14 @@ class Number(click.ParamType):
     def __init__(self, arg, check, angle=False):
         self.arg, self.check, self.angle = arg, check, angle
 
+    def checked(self, value, ctx):
+        if getattr(self.check, "needs_ctx", False):
+            return self.check(self.arg, value, ctx)
+        return self.check(self.arg, value)
+
     def convert(self, value, param, ctx):
         try:
-            return float(self.check(self.arg, parse_number(value, self.angle)))
+            return float(self.checked(parse_number(value, self.angle), ctx))
         except ValueError as exc:
             self.fail(str(exc), param, ctx)
 
@@ -100,7 +178,7 @@ class NumberList(Number):
             vals = [parse_number(v, self.angle) for v in str(value).split(",") if v.strip()]
             if not vals:
                 raise ValueError(f"{self.arg} needs at least one value")
-            return [float(self.check(self.arg, v)) for v in vals]
+            return [float(self.checked(v, ctx)) for v in vals]
         except ValueError as exc:
             self.fail(str(exc), param, ctx)
 
@@ -262,17 +340,28 @@ def forcing_options(f):
 def grid_options(f):
     f = click.option("--n", "n", type=Fields("size"), default="200", show_default=True,
                      help="Points per axis: N, or NQxNP (q0 x p0); at least 3.")(f)
-    return click.option("--grid", "grid", type=Fields("grid"), default="-1,1,-0.75,0.75", show_default=True,
-                        help="IC window q0min,q0max,p0min,p0max (endpoints included; default: the whole well).")(f)
+    return click.option("--grid", "grid", type=Fields("grid"), default=None,
+                        help="IC window q0min,q0max,p0min,p0max (endpoints included) [default: the whole well, "
+                             "Well.ic_window(): -1,1,-0.75,0.75 for the quartic].")(f)
+
+
+def well_option(f):
+    return click.option(
+        "--well", "well", default="quartic", show_default=True, is_eager=True, callback=well_callback,
+        metavar="WELL",
+        help="The potential well, as in the config's `well:`: a name (quartic, cubic, pendulum, sech2, morse), "
+             "polynomial:c0,c1,c2,... (V = sum c_k q^k), expression:'<formula in q>' (e.g. expression:'1 - cos(q)'), "
+             "or a mapping {expression: '...'}.")(f)
 
 
 def common_options(f):
     f = click.option("--verbose", "-v", is_flag=True, help="Log lines of the pipeline build functions on stderr.")(f)
     f = click.option("--quiet", "-q", is_flag=True, help="No progress bar on stderr.")(f)
     f = click.option("--no-plot", "no_plot", is_flag=True, help="Write only the netCDF file.")(f)
-    f = click.option("--fourier", type=click.Choice(FOURIER), default="paper", show_default=True,
-                     help="First harmonic G(xi): eq (20) as printed, or the exact sn coefficient.")(f)
-    return f
+    f = click.option("--fourier", type=click.Choice(FOURIER), default=None,
+                     help="First harmonic G(xi) of the quartic: eq (20) as printed [default] or the exact sn "
+                          "coefficient; every other well uses its exact first harmonic.")(f)
+    return well_option(f)
 
 
 def numerics_options(func, what):
@@ -318,7 +407,11 @@ def out_option(default):
                         callback=out_prefix, help="Output prefix: writes PREFIX.nc and PREFIX.png (folders are created).")
 
 
-def grid_params(grid, n):
+def grid_params(grid, n, ctx=None):
+    """The resolved grid of --grid (default: the window of the command's well) and --n."""
     from safebasins.pipeline import values
 
+    if grid is None:
+        (q_lo, q_hi), (p_lo, p_hi) = current_well(ctx or click.get_current_context()).ic_window()
+        grid = {"q0": [q_lo, q_hi], "p0": [p_lo, p_hi]}
     return values.grid({**grid, "n": n})

@@ -135,6 +135,9 @@ def describe(path, show_params=True, width=100):
     lines = [f"{path}", f"  title: {a.get('title', '(none)')}"]
     if "experiment" in a:
         lines.append(f"  experiment: {a['experiment']}")
+    if "well" in a:
+        detail = a.get("well_expression", a.get("well_potential", a.get("well_coefficients", "")))
+        lines.append(f"  well: {a['well']}" + (f" (V = {detail})" if len(str(detail)) else ""))
     lines.append("dimensions: " + (", ".join(f"{k}={v}" for k, v in ds.sizes.items()) or "none"))
     lines.append("coordinates:")
     for k, v in ds.coords.items():

@@ -6,18 +6,19 @@ import xarray as xr
 
 from safebasins import checks
 from safebasins.numerics import criteria
+from safebasins.wells import QuarticWell, resolve_well
 from safebasins.numerics import engine
 from safebasins.numerics import kernels
 
 DEFAULT_N_SCAN = 301
 
 
-def _escapes(q0, p0, Omega, F, Psi, thr_kw, cycles, spc, threads, integrator, backend, well):
+def _escapes(q0, p0, Omega, F, Psi, thr_kw, cycles, spc, threads, integrator, backend, w):
     """One compiled ensemble: trajectory k with (Omega[k], F[k]); True where it escapes."""
     n = Omega.size
     sE, sQ = engine.integrate(np.full(n, q0), np.full(n, p0), np.arange(n), Omega, F, Psi, cycles=cycles,
                               steps_per_cycle=spc, threads=threads, stop_any=True, integrator=integrator,
-                              backend=backend, well=well, **thr_kw)
+                              backend=backend, well=w, **thr_kw)
     return ((sE >= 0).any(axis=1)) | ((sQ >= 0).any(axis=1))
 
 
@@ -50,8 +51,8 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
         raise ValueError(f"Omega must be a scalar or 1-D, got shape {Om.shape}")
     if not np.isfinite(Om).all():
         raise ValueError("Omega must be finite")
-    ew = criteria.resolve_well(well)
-    xi = checks.check_scalar("xi_max", xi_max, ew.check_xi_max)
+    w = resolve_well(well)
+    xi = checks.check_scalar("xi_max", xi_max, w.check_threshold)
     q0 = checks.check_scalar("q0", q0, checks.check_finite)
     p0 = checks.check_scalar("p0", p0, checks.check_finite)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
@@ -70,19 +71,19 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     bounds = {}
     if criterion == "energy":
         thr_kw = {"xi_max": (xi,), "q_max": ()}
-    elif ew.closed_form:
+    elif isinstance(w, QuarticWell):
         qm = float(np.sqrt(1.0 - np.sqrt(1.0 - 4.0 * xi)))
         thr_kw = {"xi_max": (), "q_max": (qm,)}
         bounds = {"q_lower": -qm, "q_upper": qm}
     else:
-        qlo, qhi = criteria.displacement_bounds(xi, well)[0]
+        qlo, qhi = criteria.displacement_bounds(xi, w)[0]
         thr_kw = {"xi_max": (), "q_bounds": ((qlo, qhi),)}
         bounds = {"q_lower": float(qlo), "q_upper": float(qhi)}
 
     nO = Om.size
     # ---- bracket ends (one ensemble)
     ends = _escapes(q0, p0, np.concatenate([Om, Om]), np.concatenate([np.full(nO, br[0]), np.full(nO, br[1])]),
-                    Psi, thr_kw, cycles, spc, threads, integrator, backend, well)
+                    Psi, thr_kw, cycles, spc, threads, integrator, backend, w)
     valid = ~ends[:nO] & ends[nO:]
     lo = np.full(nO, br[0])
     hi = np.full(nO, br[1])
@@ -91,7 +92,7 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     while active.any():
         idx = np.flatnonzero(active)
         mid = 0.5 * (lo[idx] + hi[idx])
-        esc = _escapes(q0, p0, Om[idx], mid, Psi, thr_kw, cycles, spc, threads, integrator, backend, well)
+        esc = _escapes(q0, p0, Om[idx], mid, Psi, thr_kw, cycles, spc, threads, integrator, backend, w)
         hi[idx[esc]] = mid[esc]
         lo[idx[~esc]] = mid[~esc]
         levels += 1
@@ -108,7 +109,7 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
         Fs = np.linspace(br[0], br[1], int(n_scan))
         OO, FF = np.meshgrid(Om, Fs, indexing="ij")
         esc = _escapes(q0, p0, OO.ravel(), FF.ravel(), Psi, thr_kw, cycles, spc, threads, integrator, backend,
-                       well).reshape(nO, Fs.size)
+                       w).reshape(nO, Fs.size)
         for k in range(nO):
             e = esc[k]
             if e.any():
@@ -134,7 +135,7 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
                     F_bracket=br, n_scan=int(n_scan), steps_per_cycle=spc, integrator=kernels.INTEGRATORS[integrator],
                     bisection_levels=levels,
                     F_scan_step=float((br[1] - br[0]) / (n_scan - 1)) if n_scan else np.nan,
-                    escape_criteria=(f"energy ({ew.energy_criterion()})" if criterion == "energy" else
+                    escape_criteria=(f"energy ({w.energy_criterion()})" if criterion == "energy" else
                                      "displacement: q < q_lower or q > q_upper, the turning points of xi_max"),
-                    **bounds, **ew.attrs())
+                    **bounds, **w.numerics_attrs())
     return ds

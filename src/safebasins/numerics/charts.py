@@ -7,6 +7,7 @@ import xarray as xr
 from safebasins import checks
 from safebasins.io import cf
 from safebasins.numerics import criteria
+from safebasins.wells import resolve_well
 from safebasins.numerics import engine
 from safebasins.numerics import kernels
 
@@ -33,20 +34,15 @@ def _ic_arrays(q0, p0, grid):
     return False, qa, pa, qa.ravel(), pa.ravel()
 
 
-def _thresholds(ew, xi_max, q_max, q_bounds):
-    """Checked thresholds of a chart: (xi, q_max, q_bounds (n, 2))."""
-    xi = engine.thresholds("xi_max", xi_max, ew.check_xi_max)
-    qm = engine.thresholds("q_max", q_max, ew.check_q_max)
-    qb = ew.check_q_bounds("q_bounds", q_bounds)
+def _thresholds(w, xi_max, q_max, q_bounds):
+    """Checked thresholds of a chart in the well w: (xi, q_max, q_bounds (n, 2))."""
+    xi = engine.thresholds("xi_max", xi_max, w.check_threshold)
+    qm = engine.thresholds("q_max", q_max, w.check_displacement)
+    qb = w.check_bounds("q_bounds", q_bounds)
     if xi.size == 0 and qm.size == 0 and qb.shape[0] == 0:
         raise ValueError("xi_max, q_max and q_bounds: at least one threshold is required")
     engine.displacement_pairs(qm, qb)          # nested (ValueError naming q_max / q_bounds)
     return xi, qm, qb
-
-
-def _criteria_text(ew):
-    return (f"energy ({ew.energy_criterion()}); displacement: |q| > q_max, or q < q_lower or q > q_upper "
-            "(q_bounds); checked after every step; escape_cycle = step / steps_per_cycle")
 
 
 def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=(), well=None, cycles=3000,
@@ -100,8 +96,8 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=()
     F = checks.check_scalar("F", F, checks.check_nonnegative)
     Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
-    ew = criteria.resolve_well(well)
-    xi, qm, qb = _thresholds(ew, xi_max, q_max, q_bounds)
+    w = resolve_well(well)
+    xi, qm, qb = _thresholds(w, xi_max, q_max, q_bounds)
     cycles = engine.check_cycles("cycles", cycles)
     spc = engine.check_steps_per_cycle(steps_per_cycle)
     threads = engine.check_threads(threads)
@@ -109,7 +105,7 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=()
 
     sE, sQ = engine.integrate(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
                               q_bounds=qb, cycles=cycles, steps_per_cycle=spc, threads=threads, integrator=integrator,
-                              backend=backend, well=well)
+                              backend=backend, well=w)
     tE = engine.steps_to_cycles(sE, spc).T   # (nE, N)
     tQ = engine.steps_to_cycles(sQ, spc).T   # (nQ + nB, N)
     if is_grid:
@@ -133,8 +129,8 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=()
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(
         F=F, Omega=Omega, Psi=Psi, cycles=cycles, steps_per_cycle=spc, integrator=kernels.INTEGRATORS[integrator],
-        grid=int(is_grid), escape_criteria=_criteria_text(ew),
-        safe_basin="escape_cycle > t_eval (t_eval <= cycles)", **ew.attrs(),
+        grid=int(is_grid), escape_criteria=criteria.criteria_text(w),
+        safe_basin="escape_cycle > t_eval (t_eval <= cycles)", **w.numerics_attrs(),
     )
     return ds
 
@@ -164,8 +160,8 @@ def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bou
     if F.size != Omega.size or F.size == 0:
         raise ValueError(f"F and Omega must be 1-D of the same non-zero length, got {F.size} and {Omega.size}")
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
-    ew = criteria.resolve_well(well)
-    xi, qm, qb = _thresholds(ew, xi_max, q_max, q_bounds)
+    w = resolve_well(well)
+    xi, qm, qb = _thresholds(w, xi_max, q_max, q_bounds)
     cycles = engine.check_cycles("cycles", cycles)
     spc = engine.check_steps_per_cycle(steps_per_cycle)
     threads = engine.check_threads(threads)
@@ -173,7 +169,7 @@ def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bou
     K, n = F.size, Q.size
     sE, sQ = engine.integrate(np.tile(Q, K), np.tile(P, K), np.repeat(np.arange(K), n), Omega, F, Psi,
                               xi_max=xi, q_max=qm, q_bounds=qb, cycles=cycles, steps_per_cycle=spc, threads=threads,
-                              integrator=integrator, backend=backend, well=well)
+                              integrator=integrator, backend=backend, well=w)
     shape = (K, qa.size, pa.size)
     nQ, nB = qm.size, qb.shape[0]
     tE = np.moveaxis(engine.steps_to_cycles(sE, spc).reshape(shape + (xi.size,)), -1, 1)
@@ -190,6 +186,6 @@ def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bou
         data["escape_cycle_bounds"] = (("control", "q_bounds", "q0", "p0"), tQ[:, nQ:], cf.attrs("escape_cycle_bounds"))
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(Psi=Psi, cycles=cycles, steps_per_cycle=spc, integrator=kernels.INTEGRATORS[integrator],
-                    escape_criteria=_criteria_text(ew), safe_basin="escape_cycle > t_eval (t_eval <= cycles)",
-                    **ew.attrs())
+                    escape_criteria=criteria.criteria_text(w), safe_basin="escape_cycle > t_eval (t_eval <= cycles)",
+                    **w.numerics_attrs())
     return ds

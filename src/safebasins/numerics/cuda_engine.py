@@ -17,7 +17,6 @@ import time
 import numpy as np
 from numba import cuda
 
-from safebasins.numerics import criteria
 from safebasins.numerics import cuda_kernels
 from safebasins.numerics import engine
 from safebasins.numerics import kernels
@@ -82,8 +81,8 @@ def run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bou
     bitwise equal to engine.run_ensemble's; the displacement columns are the q_max thresholds
     then the q_bounds pairs (nested: engine.displacement_pairs).  A trajectory stops once every
     threshold is crossed (stop_any: once any is).  integrator: "srkn6b" (default) or "rk4";
-    well: None (the quartic) or a polynomial well (criteria.resolve_well), the kernel flag as on
-    the CPU.
+    well: any form safebasins.wells.resolve_well reads (None: the quartic), its compiled form as
+    on the CPU.
 
     block, grid: threads per block (default 128, simulator 32) and blocks (default: as many as
     stay resident; the simulator: 2); results do not depend on them.  timing: a dict to receive
@@ -92,7 +91,7 @@ def run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bou
     """
     require_cuda()
     kernels.check_integrator(integrator)
-    ew = criteria.resolve_well(well)
+    code = engine.engine_code(well, q_max, q_bounds)
     t_wall = time.perf_counter()
     q0 = np.ascontiguousarray(q0, dtype=float).ravel()
     p0 = np.ascontiguousarray(p0, dtype=float).ravel()
@@ -100,8 +99,7 @@ def run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bou
     Omega = np.atleast_1d(np.asarray(Omega, dtype=float)).ravel()
     F = np.atleast_1d(np.asarray(F, dtype=float)).ravel()
     xi = np.asarray(xi_max, dtype=float).ravel()
-    lo, hi, oQ, signed = engine.displacement_pairs(q_max, q_bounds)
-    flag = ew.flag(signed)
+    lo, hi, oQ, _ = engine.displacement_pairs(q_max, q_bounds)
     N = q0.size
     if p0.size != N or pidx.size != N:
         raise ValueError(f"q0, p0 and pidx must have the same size, got {q0.size}, {p0.size}, {pidx.size}")
@@ -130,7 +128,7 @@ def run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bou
         shared = FS.nbytes <= cuda_kernels.SHARED_TABLE_BYTES
         smem = FS.nbytes if shared else 0
         warp = SIMULATOR_WARP if cuda_kernels.SIMULATOR else cuda_kernels.WARP
-        kernel = cuda_kernels.ensemble_kernel(integrator, shared, blk, math.gcd(blk, warp), flag)
+        kernel = cuda_kernels.ensemble_kernel(integrator, shared, blk, math.gcd(blk, warp), code)
         nblk = int(grid) if grid is not None else launch_grid(kernel, N, blk, smem)
 
         d_outE = cuda.to_device(np.full(max(N * nE, 1), -1, dtype=np.int64))
@@ -138,7 +136,7 @@ def run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bou
         args = (cuda.to_device(q0), cuda.to_device(p0), cuda.to_device(pidx), cuda.to_device(coef),
                 cuda.to_device(FS), cuda.to_device(thrE2), nE, cuda.to_device(thrLo), cuda.to_device(thrHi), nQ, N, S,
                 cycles, bool(stop_any), scramble_multiplier(N), cuda.to_device(np.zeros(1, np.int64)), d_outE, d_outQ,
-                cuda.to_device(np.ascontiguousarray(ew.wpar)))
+                cuda.to_device(code.wpar))
         if cuda_kernels.SIMULATOR:
             t0 = time.perf_counter()
             kernel[nblk, blk, 0, smem](*args)

@@ -1,8 +1,8 @@
 """CUDA kernels (numba-cuda) for the escape ensembles of q'' + V'(q) = F sin(Omega t + Psi).
 
 The GPU twin of kernels.py: same schemes (Blanes-Moan SRKN6b by default, classic RK4), same
-wells (the kernel flag of steps.py: the quartic in closed form, QUARTIC_SIGNED, the polynomial
-classes POLY4 / POLY8 by Horner from run-time coefficients), same forcing tables, same escape
+wells (the one compiled form of a well, wellcode.WellCode: the SAME Python source of its force
+and energy, compiled here as device functions), same forcing tables, same escape
 criteria, and the SAME SEQUENCE OF IEEE OPERATIONS per trajectory, so the recorded
 first-crossing steps are bitwise equal to the CPU engine's.
 
@@ -28,7 +28,12 @@ operand is the result of a multiply; this module leaves no such pair:
 * RK4's sums (p2 + p3 etc.) contain no product.  LLVM may rewrite s + s as s * 2.0 and NVVM
   then fuse that into fma(s, 2, x): doubling is exact, so round(x + 2 s) is the same number
   either way (short of overflow, long after escape).
-No fast-math anywhere, no division, no transcendental in the kernel (sin is in the host table).
+* a well written as an expression writes every product with wellcode.mul (mul.rn.f64 here:
+  never contracted).
+No fast-math anywhere; no division and no transcendental in the kernel (sin is in the host
+table), except what a well's own formula contains: IEEE division and sqrt are correctly rounded
+on both targets, but transcendental functions come from libdevice here and glibc on the CPU, so
+a well with sin, exp, ... may differ from the CPU in the last bit (wellcode docstring).
 FP64 has no flush-to-zero on the GPU.  benchmarks/bench_gpu.py counts the f64 instructions of
 the compiled kernel and the multiplies that feed an add (must be none), and compares the escape
 steps with the CPU engine.  On an H100 (numba-cuda 0.30.4) the SASS has exactly the PTX's DFMA
@@ -36,8 +41,8 @@ and DMUL counts (nothing fused) and the Fig 21 chart (90,000 ICs, 11,000 cycles)
 1e5-trajectory job gave 0 differing escape steps for both schemes.
 
 The simulator (NUMBA_ENABLE_CUDASIM=1) implements cuda.fma as a*b + c (two roundings); under
-the simulator `fma` is therefore the CPU's correctly rounded kernels.fma (llvm.fma), called
-from Python, so the simulator runs the same arithmetic as the GPU.
+the simulator the wells' `fma` (wellcode.fma) runs its Python body, the CPU's correctly rounded
+llvm.fma, so the simulator runs the same arithmetic as the GPU.
 
 Kernel organisation (one thread = one trajectory at a time)
 -----------------------------------------------------------
@@ -61,11 +66,11 @@ Kernel organisation (one thread = one trajectory at a time)
   another lane does not change its arithmetic.
 * Forcing table in shared memory when it fits (one parameter set: S * 7 doubles); many
   parameter sets (bisection) read it from global memory (cached).
-* The well is the kernel factory's `well` flag (steps.py): its force -V'(q) + f and energy
-  2 H0 (make_well, the coefficients w loaded from `wpar` once per thread) and its escape tests
-  (make_criteria): QUARTIC compares |q| with the q_max thresholds and the barrier 1, the signed
-  flags compare q with the bound pairs (lo, hi) and the barriers (q_left, q_right), as
-  kernels._check_state.
+* The well is the kernel factory's compiled well (wellcode.WellCode): its force -V'(q) + f and
+  energy 2 H0 compiled from the one source (make_well, the coefficients w loaded from `wpar`
+  once per thread) and its escape tests (make_criteria): |q| tracking compares |q| with the
+  q_max thresholds and the barrier, signed tracking compares q with the bound pairs (lo, hi)
+  and the barriers (q_left, q_right), as kernels._check_state.
 """
 from __future__ import annotations
 
@@ -73,14 +78,13 @@ import functools
 import math
 
 import numpy as np
-from numba import cuda, float64, int32, int64, njit, uint64
+from numba import cuda, float64, int32, int64, uint64
 from numba.cuda.core import config as cuda_config
 
 from safebasins.numerics import kernels
-from safebasins.numerics.steps import POLY4, POLY8, QUARTIC, WELL_FLAGS
+from safebasins.numerics import wellcode
 
 SIMULATOR = bool(cuda_config.ENABLE_CUDASIM)
-Q_BARRIER = kernels.Q_BARRIER
 WIDTHS = {"srkn6b": 7, "rk4": 3}     # forcing values per step (the scheme of a table)
 BLOCK = 128                          # threads per block on a GPU
 WARP = 32
@@ -98,78 +102,38 @@ def _device(fn):
     return cuda.jit(device=True)(fn)
 
 
-if SIMULATOR:
-    @njit(cache=True)
-    def _fma_cpu(a, b, c):
-        return kernels.fma(a, b, c)
+# the GPU's primitives of the wells' one source (wellcode.fma / wellcode.mul): fma.rn.f64 and
+# mul.rn.f64 (a rounded product the compiler may not contract).  Under the simulator the device
+# functions run as Python and the primitives' Python bodies are the CPU's correctly rounded ones.
+if not SIMULATOR:
+    from numba.cuda import libdevice
+    from numba.cuda.extending import overload as cuda_overload
 
-    def fma(a, b, c):
-        """Correctly rounded a*b + c: the CPU's llvm.fma (the simulator's cuda.fma rounds twice)."""
-        return _fma_cpu(a, b, c)
-else:
-    @_device
-    def fma(a, b, c):
-        """Correctly rounded a*b + c (llvm.fma -> fma.rn.f64)."""
-        return cuda.fma(a, b, c)
+    @cuda_overload(wellcode.fma, inline="always")
+    def _ol_fma(a, b, c):
+        return lambda a, b, c: cuda.fma(a, b, c)
+
+    @cuda_overload(wellcode.mul, inline="always")
+    def _ol_mul(a, b):
+        return lambda a, b: libdevice.dmul_rn(a, b)
+
+fma = wellcode.fma
 
 
 # ------------------------------------------------------------------------------- the well
-def make_force_quartic():
-    """force(q, f) = q^3 - q + f for V = q^2/2 - q^4/4, as kernels.force: fma(q*q, q, f - q)."""
+def make_well(code):
+    """(force(q, f, w), energy2(q, p, w)) device functions of a compiled well (wellcode.WellCode):
+    its one source compiled for the GPU, w = the 14 coefficients of wpar (steps.wtuple)."""
+    force_w, energy_w = code.make(_device)
+
     @_device
-    def force(q, f):
-        return fma(q * q, q, f - q)
-    return force
+    def force(q, f, w):
+        return force_w(w, q, f)
 
+    @_device
+    def energy2w(q, p, w):
+        return energy_w(w, q, p)
 
-@_device
-def energy2(q, p):
-    """2 H0 = p^2 + q^2 - q^4/2, as kernels.energy2."""
-    q2 = q * q
-    return fma(q2, fma(-0.5, q2, 1.0), p * p)
-
-
-def make_well(well):
-    """(force(q, f, w), energy2(q, p, w)) for a kernel flag (steps.py), w = the 14 coefficients
-    of wpar (steps.wtuple): the operations of steps.well_force / steps.well_energy2."""
-    if well == POLY4:
-        @_device
-        def force(q, f, w):
-            return fma(fma(fma(w[2], q, w[1]), q, w[0]), q, f)
-
-        @_device
-        def energy2w(q, p, w):
-            h = fma(fma(w[9], q, w[8]), q, w[7])
-            return fma(h, q * q, p * p)
-    elif well == POLY8:
-        @_device
-        def force(q, f, w):
-            a = fma(w[6], q, w[5])
-            a = fma(a, q, w[4])
-            a = fma(a, q, w[3])
-            a = fma(a, q, w[2])
-            a = fma(a, q, w[1])
-            a = fma(a, q, w[0])
-            return fma(a, q, f)
-
-        @_device
-        def energy2w(q, p, w):
-            h = fma(w[13], q, w[12])
-            h = fma(h, q, w[11])
-            h = fma(h, q, w[10])
-            h = fma(h, q, w[9])
-            h = fma(h, q, w[8])
-            h = fma(h, q, w[7])
-            return fma(h, q * q, p * p)
-    else:
-        @_device
-        def force(q, f, w):
-            return fma(q * q, q, f - q)
-
-        @_device
-        def energy2w(q, p, w):
-            q2 = q * q
-            return fma(q2, fma(-0.5, q2, 1.0), p * p)
     return force, energy2w
 
 
@@ -219,8 +183,8 @@ def make_steps(force):
 
 
 # ------------------------------------------------------------------------------- escape bookkeeping
-def make_criteria(well):
-    """(crossed, check_state, next_filters) for a kernel flag:
+def make_criteria(abs_q):
+    """(crossed, check_state, next_filters) for |q| tracking (abs_q, the quartic) or signed tracking:
 
     crossed(e, q, tE, tQ, tN): the branch-free filter (2 H0 above the next uncrossed 2 xi_max, q
     beyond the next uncrossed bound or, while an energy threshold is uncrossed, a barrier);
@@ -228,20 +192,21 @@ def make_criteria(well):
     kernels._check_state with e = energy2(q, p): record `step` for every next uncrossed threshold
     the state is beyond (outE, outQ flat, row i);
     next_filters(iE, iQ, thrE2, nE, thrLo, thrHi, nQ, qL, qR) -> (tE, tQ, tN) as kernels._filters.
-    QUARTIC compares |q| with thrHi (the q_max) and the barrier 1; the signed flags compare q
-    with (thrLo, thrHi) and the barriers (qL, qR)."""
-    if well == QUARTIC:
+    |q| tracking compares |q| with thrHi (the q_max) and the barrier qR; signed tracking compares
+    q with (thrLo, thrHi) and the barriers (qL, qR).  Every comparison is `not x <= t`, as on the
+    CPU: a NaN state is beyond every threshold."""
+    if abs_q:
         @_device
         def crossed(e, q, tE, tQ, tN):
-            return e > tE or abs(q) > tQ
+            return not e <= tE or not abs(q) <= tQ
 
         @_device
         def check_state(i, e, q, step, thrE2, nE, thrLo, thrHi, nQ, iE, iQ, outE, outQ, qL, qR):
             aq = abs(q)
-            while iE < nE and (e > thrE2[iE] or aq > Q_BARRIER):
+            while iE < nE and (not e <= thrE2[iE] or not aq <= qR):
                 outE[i * nE + iE] = step
                 iE += 1
-            while iQ < nQ and aq > thrHi[iQ]:
+            while iQ < nQ and not aq <= thrHi[iQ]:
                 outQ[i * nQ + iQ] = step
                 iQ += 1
             return iE, iQ
@@ -254,21 +219,21 @@ def make_criteria(well):
                 tQ = thrHi[iQ]
             if iE < nE:
                 tE = thrE2[iE]
-                if Q_BARRIER < tQ:
-                    tQ = Q_BARRIER
+                if qR < tQ:
+                    tQ = qR
             return tE, tQ, math.inf
     else:
         @_device
         def crossed(e, q, tE, tQ, tN):
-            return e > tE or q > tQ or -q > tN
+            return not e <= tE or not q <= tQ or not -q <= tN
 
         @_device
         def check_state(i, e, q, step, thrE2, nE, thrLo, thrHi, nQ, iE, iQ, outE, outQ, qL, qR):
-            out = q > qR or q < qL
-            while iE < nE and (e > thrE2[iE] or out):
+            out = not q <= qR or not q >= qL
+            while iE < nE and (not e <= thrE2[iE] or out):
                 outE[i * nE + iE] = step
                 iE += 1
-            while iQ < nQ and (q > thrHi[iQ] or q < thrLo[iQ]):
+            while iQ < nQ and (not q <= thrHi[iQ] or not q >= thrLo[iQ]):
                 outQ[i * nQ + iQ] = step
                 iQ += 1
             return iE, iQ
@@ -298,30 +263,31 @@ def finished(iE, iQ, nE, nQ, stop_any):
 
 # ------------------------------------------------------------------------------- the kernel
 @functools.lru_cache(maxsize=None)
-def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WARP, well=QUARTIC):
+def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WARP, well=None):
     """The compiled ensemble kernel for one scheme and well (cached per argument set).
 
     integrator: "srkn6b" | "rk4"; shared_table: copy the forcing table into dynamic shared
     memory (launch with its size in bytes); block: threads per block (static shared buffers);
     warp: compaction granularity (32 on a GPU; smaller values exercise compaction in the
-    simulator); well: the kernel flag (steps.WELL_FLAGS; default the quartic).
+    simulator); well: the compiled well (wellcode.WellCode; None: the quartic).
 
     Launch: kernel[grid, block, 0, table_bytes if shared_table else 0](
         q0, p0, pidx, coef, FS, thrE2, nE, thrLo, thrHi, nQ, N, S, cycles, stop_any, A, counter,
         outE, outQ, wpar)
     q0, p0 (N,) float64; pidx (N,) int64; coef (P*7,) lane_coefficients; FS (P*S*W,) the
     forcing products F[k] * sine_table (W = 7 or 3); thrE2 (>= max(nE, 1),) sorted 2*xi_max;
-    thrLo, thrHi (>= max(nQ, 1),) the nested displacement bounds, inside out (QUARTIC: thrHi
+    thrLo, thrHi (>= max(nQ, 1),) the nested displacement bounds, inside out (|q| tracking: thrHi
     = sorted q_max, thrLo unused); A: scrambling multiplier (coprime to N); counter (1,) int64
     = 0; outE (N*nE,), outQ (N*nQ,) int64 pre-filled with -1; wpar (steps.N_WPAR,) the well's
     barriers and coefficients (steps.well_parameters).
     """
     W = WIDTHS[kernels.check_integrator(integrator)]
     UW = np.uint64(W)
-    if well not in WELL_FLAGS:
-        raise ValueError(f"well must be one of the kernel flags {WELL_FLAGS}, got {well!r}")
-    force, energy2w = make_well(well)
-    crossed, check_state, next_filters = make_criteria(well)
+    code = wellcode.quartic_code() if well is None else well
+    if not isinstance(code, wellcode.WellCode):
+        raise ValueError(f"well must be a compiled well (wellcode.WellCode), got {well!r}")
+    force, energy2w = make_well(code)
+    crossed, check_state, next_filters = make_criteria(code.abs_tracking)
     bm6_step, rk4_step = make_steps(force)
     step = rk4_step if integrator == "rk4" else bm6_step
     SHARED = bool(shared_table)

@@ -8,8 +8,8 @@ import numba
 import numpy as np
 
 from safebasins import checks
-from safebasins.numerics import criteria
 from safebasins.numerics import kernels
+from safebasins.wells import resolve_well
 
 DEFAULT_STEPS_PER_CYCLE = 32
 DEFAULT_INTEGRATOR = "srkn6b"
@@ -81,6 +81,13 @@ def displacement_pairs(q_max=(), q_bounds=()):
     return lo, hi, order, bool((lo != -hi).any())
 
 
+def engine_code(well, q_max=(), q_bounds=()):
+    """The compiled form the engines integrate ``well`` in: its |q|-tracking form only when every
+    displacement bound is symmetric (displacement_pairs)."""
+    code = resolve_well(well).compiled
+    return code.signed() if displacement_pairs(q_max, q_bounds)[3] else code
+
+
 def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bounds=(), cycles, steps_per_cycle,
                  threads=None, stop_any=False, store=False, integrator=DEFAULT_INTEGRATOR, well=None):
     """Integrate trajectories i from (q0[i], p0[i]) with Omega[pidx[i]], F[pidx[i]] in `well`.
@@ -89,19 +96,19 @@ def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bounds=(
     order of the given thresholds (-1: not within `cycles`), and period-map iterates.  The
     displacement columns are the q_max thresholds (|q| > q_max) followed by the q_bounds pairs
     (q < lo or q > hi); all of them must be nested (displacement_pairs).
-    integrator: "srkn6b" (default) or "rk4" (kernels.INTEGRATORS); well: None (the quartic) or a
-    supported well (criteria.resolve_well).  Thresholds are not checked against the well here
-    (the public functions do that).
+    integrator: "srkn6b" (default) or "rk4" (kernels.INTEGRATORS); well: any form
+    safebasins.wells.resolve_well reads (None: the quartic), integrated in its compiled form.
+    Thresholds are not checked against the well here (the public functions do that).
     """
     kernels.check_integrator(integrator)
-    ew = criteria.resolve_well(well)
+    code = engine_code(well, q_max, q_bounds)
     q0 = np.ascontiguousarray(q0, dtype=float).ravel()
     p0 = np.ascontiguousarray(p0, dtype=float).ravel()
     pidx = np.ascontiguousarray(pidx, dtype=np.int64).ravel()
     Omega = np.atleast_1d(np.asarray(Omega, dtype=float))
     F = np.atleast_1d(np.asarray(F, dtype=float))
     xi = np.asarray(xi_max, dtype=float).ravel()
-    lo, hi, oQ_sorted, signed = displacement_pairs(q_max, q_bounds)
+    lo, hi, oQ_sorted, _ = displacement_pairs(q_max, q_bounds)
     N = q0.size
     oE_sorted = np.argsort(xi, kind="stable")
     outE = np.full((N, xi.size), -1, dtype=np.int64)
@@ -117,7 +124,7 @@ def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bounds=(
             kernels.ensemble(q0, p0, pidx, coef, kernels.step_sizes(Omega, steps_per_cycle), np.ascontiguousarray(F), sintab,
                        np.ascontiguousarray(2.0 * xi[oE_sorted]), np.ascontiguousarray(hi[oQ_sorted]),
                        int(cycles), bool(stop_any), int(n_tasks), LANES, outE, outQ, st, bool(store),
-                       well=ew.flag(signed), wpar=ew.wpar, thrQlo=np.ascontiguousarray(lo[oQ_sorted]))
+                       well=code, thrQlo=np.ascontiguousarray(lo[oQ_sorted]))
     # back to the caller's threshold order
     steps_E = np.empty_like(outE)
     steps_E[:, oE_sorted] = outE

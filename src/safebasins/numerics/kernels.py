@@ -1,20 +1,16 @@
 """Compiled ensemble integrator for eq (1) in any supported well: q'' + V'(q) = F sin(Omega t + Psi).
 
-The step (schemes, forcing tables, the well's force and energy, the well flags) lives in
-steps.py, the vectorised period loops over the lanes in periods.py; this module holds the lane
-machinery: escape detection, replay, refill, compaction, and the entry points.
+The step (schemes, forcing tables) lives in steps.py, the vectorised period loops over the
+lanes in periods.py, the well's force and energy in its compiled form (wellcode.py); this module
+holds the lane machinery: escape detection, replay, refill, compaction, and the entry points.
 
 Schemes and wells are compile-time constants of the inline period bodies: `rk4` (the width of
-the forcing table: 3 RK4, 7 SRKN6b) and `well` (steps.QUARTIC, QUARTIC_SIGNED, POLY4, POLY8).
-Each well flag has its own entry point (_ENSEMBLE) passing the flag down as a global
-constant, which numba types as a literal: every flag value is its own compiled, cached
-kernel, compiled on first use, so the quartic kernel is today's code and a polynomial well
-costs no compile time until one is integrated.  The force, the energy and the period bodies
-of a flag are chosen at typing time (numba @overload on the literal): a kernel holds only its
-own well's code.
-
-Numba's on-disk cache checks only the file that defines a function: after editing steps.py or
-periods.py, touch this file (or delete __pycache__/*.nbi) so that the cached kernels are rebuilt.
+the forcing table: 3 RK4, 7 SRKN6b) and `well`, the kernel key of a compiled well
+(wellcode.WellCode.key), which _run_task forces to a numba literal (`literally`): every key is
+its own compiled kernel, cached on disk and compiled on first use, and holds only its own
+well's code (numba @overload on the literal, resolved at typing time).  Keys hash the
+arithmetic and the engine's source, so a cached kernel is never reused after an edit.
+Parallelism: one task per thread (Python threads; the task function releases the GIL).
 
 Every lane's arithmetic is written with explicit fused multiply-adds (llvm.fma), no
 fast-math flags: the vector loop and the scalar replay produce bitwise identical numbers
@@ -22,17 +18,17 @@ and a trajectory's result does not depend on which lane, block or thread ran it.
 
 Escape criteria
 ---------------
-energy: 2 H0 = p^2 + 2 V(q) > 2 xi_max, or q beyond a barrier (QUARTIC: |q| > 1; the other
-flags: q > q_right or q < q_left, a side without barrier has q_left = -inf / q_right = +inf
+energy: 2 H0 = p^2 + 2 V(q) > 2 xi_max, or q beyond a barrier (|q| tracking, the quartic: |q| > 1; signed
+tracking: q > q_right or q < q_left, a side without barrier has q_left = -inf / q_right = +inf
 and never escapes that way); displacement: q outside the bound pair (lo, hi), q < lo or
-q > hi (QUARTIC: |q| > q_max, lo = -hi).  The thresholds are sorted: 2 xi_max ascending, the
+q > hi (|q| tracking: |q| > q_max, lo = -hi).  A NaN or inf state is beyond every threshold.  The thresholds are sorted: 2 xi_max ascending, the
 bound pairs nested from the inside out (lo non-increasing, hi non-decreasing), so crossing a
 threshold crosses every inner one and each lane only watches its next uncrossed one.
 
 Escape detection
 ----------------
-Per step the kernel tracks, per lane, max 2*H0 and max |q| (QUARTIC) or max q and max -q
-(the signed flags) over the current quarter period (vectorised, branch free; the period runs
+Per step the kernel tracks, per lane, max 2*H0 and max |q| (|q| tracking) or max q and max -q
+(signed tracking) over the current quarter period (vectorised, branch free; the period runs
 in SEGMENTS = 4 segments with a (q, p) snapshot before each).  At the period boundary a lane
 whose segment maxima crossed its next uncrossed threshold replays that segment from its
 snapshot (scalar, same arithmetic) and records the exact step of first crossing of every
@@ -46,16 +42,18 @@ the vector loop only runs over live trajectories.
 """
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
-from numba import njit, prange
+from numba import literally, njit, typeof, types
 
 from safebasins.numerics.steps import (  # noqa: F401  (re-exported: the step API of the engine)
     BM6_DRIFT, BM6_KICK, BM6_KICK_TIMES, DRIFT1, DRIFT2, DRIFT3, INTEGRATOR, INTEGRATORS, KICK1, KICK2, KICK3,
-    KICK4, N_KICKS, N_WPAR, POLY4, POLY8, POLY_DEGREES, Q_BARRIER, QUARTIC, QUARTIC_SIGNED, RK4_C1, RK4_C2, RK4_C3,
-    RK4_COEF, RK4_TIMES, WELL_FLAGS, bm6_step, check_integrator, energy, energy2, fma, force, lane_coefficients,
-    lane_coefs, rk4_step, row, sine_table, step, step_sizes, well_bm6_step, well_energy2, well_force,
-    well_parameters, well_rk4_step, wtuple)
+    KICK4, N_KICKS, RK4_C1, RK4_C2, RK4_C3, RK4_COEF, RK4_TIMES, bm6_step, check_integrator, energy, energy2,
+    force, lane_coefficients, lane_coefs, rk4_step, row, sine_table, step, step_sizes, well_bm6_step,
+    well_rk4_step, wtuple)
 from safebasins.numerics.periods import _period_lanes, _period_shared
+from safebasins.numerics.wellcode import WellCode, abs_tracking, quartic_code, well_energy2
 
 # smallest lane segment of the 4-chain vector loop (lanes run: 4 * segment)
 MIN_SEGMENT = 16
@@ -69,20 +67,22 @@ def _check_state(well, wpar, i, q, p, step, thrE2, thrLo, thrHi, iE, iQ, outE, o
     e = well_energy2(well, wtuple(wpar), q, p)
     nE = thrE2.shape[0]
     nQ = thrHi.shape[0]
-    if well == QUARTIC:
+    # comparisons are written `not x <= t`: a NaN state is beyond every threshold (escaped,
+    # never safe)
+    if abs_tracking(well):
         aq = abs(q)
-        while iE < nE and (e > thrE2[iE] or aq > Q_BARRIER):
+        while iE < nE and (not e <= thrE2[iE] or not aq <= wpar[1]):
             outE[i, iE] = step
             iE += 1
-        while iQ < nQ and aq > thrHi[iQ]:
+        while iQ < nQ and not aq <= thrHi[iQ]:
             outQ[i, iQ] = step
             iQ += 1
     else:
-        out = q > wpar[1] or q < wpar[0]
-        while iE < nE and (e > thrE2[iE] or out):
+        out = not q <= wpar[1] or not q >= wpar[0]
+        while iE < nE and (not e <= thrE2[iE] or out):
             outE[i, iE] = step
             iE += 1
-        while iQ < nQ and (q > thrHi[iQ] or q < thrLo[iQ]):
+        while iQ < nQ and (not q <= thrHi[iQ] or not q >= thrLo[iQ]):
             outQ[i, iQ] = step
             iQ += 1
     return iE, iQ
@@ -95,7 +95,7 @@ def _finished(iE, iQ, nE, nQ, stop_any):
 
 @njit(cache=True, inline="always")
 def _filters(well, wpar, iE, iQ, thrE2, thrLo, thrHi):
-    """(tE, tQ, tN): the lane's next uncrossed 2 xi_max, and the levels its max q (QUARTIC:
+    """(tE, tQ, tN): the lane's next uncrossed 2 xi_max, and the levels its max q (|q| tracking:
     max |q|) and max -q must exceed to cross its next uncrossed bound or, while an energy
     threshold is uncrossed, a barrier (inf: none)."""
     inf = np.inf
@@ -104,9 +104,9 @@ def _filters(well, wpar, iE, iQ, thrE2, thrLo, thrHi):
     tE = thrE2[iE] if iE < nE else inf
     tQ = thrHi[iQ] if iQ < nQ else inf
     tN = inf
-    if well == QUARTIC:
+    if abs_tracking(well):
         if iE < nE:
-            tQ = min(tQ, Q_BARRIER)
+            tQ = min(tQ, wpar[1])
     else:
         tN = -thrLo[iQ] if iQ < nQ else inf
         if iE < nE:
@@ -141,9 +141,13 @@ def _replay(well, wpar, i, q, p, period, s0, s1, sintab, c, F, thrE2, thrLo, thr
     return iE, iQ
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _run_task(well, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrLo, thrHi,
               cycles, stop_any, outE, outQ, store, do_store):
+    """Trajectories task, task + n_tasks, ... (one thread): the lane machinery of the module
+    docstring.  `well` is the kernel key of a compiled well (a numba literal: one specialised,
+    cached kernel per key)."""
+    literally(well)
     N = q0.shape[0]
     S = sintab.shape[0]
     nE = thrE2.shape[0]
@@ -167,7 +171,7 @@ def _run_task(well, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, 
     SP = np.zeros((Gmax, Lmem))
     SME = np.empty((Gmax, Lmem))
     SMQ = np.empty((Gmax, Lmem))
-    SMN = np.empty((Gmax, Lmem if well != QUARTIC else 1))    # max -q (signed flags only)
+    SMN = np.empty((Gmax, 1 if abs_tracking(well) else Lmem))    # max -q (signed tracking only)
     nhit = np.int64(1)         # crossings at the last period boundary (first period: segmented)
     traj = np.empty(L, np.int64)
     per = np.empty(L, np.int64)
@@ -176,8 +180,8 @@ def _run_task(well, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, 
     done = np.zeros(L, np.bool_)
     hit = np.zeros(L, np.bool_)
     tE = np.empty(L)      # next uncrossed 2*xi threshold of the lane (inf: none)
-    tQ = np.empty(L)      # next uncrossed |q| (QUARTIC) or upper bound, or the barrier
-    tN = np.empty(L)      # signed flags: next uncrossed -lower bound, or -q_left
+    tQ = np.empty(L)      # next uncrossed |q| (|q| tracking) or upper bound, or the barrier
+    tN = np.empty(L)      # signed tracking: next uncrossed -lower bound, or -q_left
     FS = Fpar[0] * sintab        # (S, 7) or (S, 3), shared path
     HL = np.zeros(Lmem)          # per-lane path
     FL = np.zeros(Lmem)
@@ -253,14 +257,14 @@ def _run_task(well, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, 
         # map, every lane) need the scalar bookkeeping below
         for l in range(nact):
             hit[l] = False
-        if well == QUARTIC:
+        if abs_tracking(well):
             for g in range(G):
                 for l in range(nact):
-                    hit[l] = hit[l] | (SME[g, l] > tE[l]) | (SMQ[g, l] > tQ[l])
+                    hit[l] = hit[l] | (not SME[g, l] <= tE[l]) | (not SMQ[g, l] <= tQ[l])
         else:
             for g in range(G):
                 for l in range(nact):
-                    hit[l] = hit[l] | (SME[g, l] > tE[l]) | (SMQ[g, l] > tQ[l]) | (SMN[g, l] > tN[l])
+                    hit[l] = hit[l] | (not SME[g, l] <= tE[l]) | (not SMQ[g, l] <= tQ[l]) | (not SMN[g, l] <= tN[l])
         nhit = np.int64(0)
         for l in range(nact):
             nhit += hit[l]
@@ -280,7 +284,7 @@ def _run_task(well, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, 
             iQ = lQ[l]
             if hit[l]:
                 for g in range(G):
-                    if SME[g, l] > tE[l] or SMQ[g, l] > tQ[l] or (well != QUARTIC and SMN[g, l] > tN[l]):
+                    if not SME[g, l] <= tE[l] or not SMQ[g, l] <= tQ[l] or (not abs_tracking(well) and not SMN[g, l] <= tN[l]):
                         k = pidx[i]
                         iE, iQ = _replay(well, wpar, i, SQ[g, l], SP[g, l], per[l] - 1, seg[g], seg[g + 1], sintab,
                                          coef[k], Fpar[k], thrE2, thrLo, thrHi, iE, iQ, outE, outQ, stop_any)
@@ -298,85 +302,76 @@ def _run_task(well, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, 
             done[l] = d
 
 
-# one compiled entry point per well flag: the flag reaches every callee as a numba literal (a
-# global constant), so each flag is its own specialised kernel, compiled (and cached) on first
-# use; `task` is cast to int64 so that _run_task is compiled once (prange indices are uint64
-# inside the parallel region)
-@njit(cache=True, parallel=True)
-def _ensemble_quartic(wpar, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrLo, thrHi, cycles, stop_any, n_tasks,
-                      lanes, outE, outQ, store, do_store):
-    for task in prange(n_tasks):
-        _run_task(QUARTIC, wpar, np.int64(task), n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2,
-                  thrLo, thrHi, cycles, stop_any, outE, outQ, store, do_store)
+def specialised(dispatcher, args):
+    """The compiled entry point of ``dispatcher`` for ``args``, whose first argument is a kernel key
+    taken as a numba literal (compiled, or loaded from the on-disk cache, on first use).  Calling
+    it skips numba's dispatch, which would first try the non-literal signature at every call."""
+    sig = (types.literal(args[0]),) + tuple(typeof(a) for a in args[1:])
+    entry = _ENTRIES.get((dispatcher, sig))
+    if entry is None:
+        dispatcher.compile(sig)
+        entry = _ENTRIES[(dispatcher, sig)] = dispatcher.overloads[sig].entry_point
+    return entry
 
 
-@njit(cache=True, parallel=True)
-def _ensemble_quartic_signed(wpar, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrLo, thrHi, cycles, stop_any,
-                             n_tasks, lanes, outE, outQ, store, do_store):
-    for task in prange(n_tasks):
-        _run_task(QUARTIC_SIGNED, wpar, np.int64(task), n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab,
-                  thrE2, thrLo, thrHi, cycles, stop_any, outE, outQ, store, do_store)
+_ENTRIES = {}
 
 
-@njit(cache=True, parallel=True)
-def _ensemble_poly4(wpar, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrLo, thrHi, cycles, stop_any, n_tasks,
-                    lanes, outE, outQ, store, do_store):
-    for task in prange(n_tasks):
-        _run_task(POLY4, wpar, np.int64(task), n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2,
-                  thrLo, thrHi, cycles, stop_any, outE, outQ, store, do_store)
+def run_tasks(fn, n_tasks):
+    """fn(task) for task in range(n_tasks), on n_tasks threads (the compiled task functions release
+    the GIL); exceptions propagate."""
+    if n_tasks == 1:
+        fn(0)
+        return
+    with ThreadPoolExecutor(max_workers=n_tasks) as pool:
+        for f in [pool.submit(fn, t) for t in range(n_tasks)]:
+            f.result()
 
 
-@njit(cache=True, parallel=True)
-def _ensemble_poly8(wpar, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrLo, thrHi, cycles, stop_any, n_tasks,
-                    lanes, outE, outQ, store, do_store):
-    for task in prange(n_tasks):
-        _run_task(POLY8, wpar, np.int64(task), n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2,
-                  thrLo, thrHi, cycles, stop_any, outE, outQ, store, do_store)
-
-
-_ENSEMBLE = {QUARTIC: _ensemble_quartic, QUARTIC_SIGNED: _ensemble_quartic_signed, POLY4: _ensemble_poly4,
-             POLY8: _ensemble_poly8}
+def _check_code(well):
+    if not isinstance(well, WellCode):
+        raise ValueError(f"well must be a compiled well (safebasins.numerics.wellcode.WellCode: Well.compiled), "
+                         f"got {well!r}")
+    return well
 
 
 def ensemble(q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQ, cycles, stop_any, n_tasks, lanes,
-             outE, outQ, store, do_store, well=QUARTIC, wpar=None, thrQlo=None):
+             outE, outQ, store, do_store, well=None, thrQlo=None):
     """Integrate every trajectory i from (q0[i], p0[i]) with parameter set pidx[i]
     (coef[pidx[i]] = step coefficients from lane_coefficients, hpar[pidx[i]] = the step h
     from step_sizes, Fpar[pidx[i]] = F) for at most
     `cycles` forcing periods of S = sintab.shape[0] steps.
 
     thrE2: sorted ascending 2*xi_max thresholds; thrQ: the upper displacement bounds, sorted
-    ascending (QUARTIC: the q_max of |q| > q_max), thrQlo: the lower bounds (signed flags; None:
-    -thrQ), nested with thrQ (non-increasing); either threshold list may be empty.
+    ascending (|q| tracking: the q_max of |q| > q_max), thrQlo: the lower bounds (signed
+    tracking; None: -thrQ), nested with thrQ (non-increasing); either threshold list may be empty.
     outE (N, nE), outQ (N, nQ): int64 step after which the threshold is first
     exceeded (0 = the initial condition), pre-filled with -1 (= not within the horizon).
-    A trajectory stops when every threshold is crossed (stop_any: when any is crossed).
+    A trajectory stops when every threshold is crossed (stop_any: when any is crossed); a NaN
+    or inf state is beyond every threshold.
     store (N, cycles+1, 2): period-map iterates when do_store (pre-filled with NaN).
     The scheme is the width of sintab (sine_table / lane_coefficients of the same integrator);
-    the well is the flag `well` (steps.WELL_FLAGS) with its parameters wpar (steps.well_parameters;
-    None: the quartic's barriers).
-    Trajectory i is run by task i % n_tasks; the results do not depend on n_tasks, lanes or
-    the thread count (each trajectory is the same sequence of IEEE operations).
+    the well is its compiled form `well` (wellcode.WellCode; None: the quartic).
+    Trajectory i is run by task i % n_tasks (one thread each); the results do not depend on
+    n_tasks, lanes or the thread count (each trajectory is the same sequence of IEEE operations).
     """
-    if well not in WELL_FLAGS:
-        raise ValueError(f"well must be one of the kernel flags {WELL_FLAGS}, got {well!r}")
-    if wpar is None:
-        wpar = well_parameters()[1]
+    code = quartic_code() if well is None else _check_code(well)
     thrQ = np.ascontiguousarray(thrQ, dtype=float)
     thrQlo = -thrQ if thrQlo is None else np.ascontiguousarray(thrQlo, dtype=float)
-    _ENSEMBLE[well](np.ascontiguousarray(wpar, dtype=float), q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2,
-              thrQlo, thrQ, cycles, stop_any, n_tasks, lanes, outE, outQ, store, do_store)
+    args = [code.key, code.wpar, 0, int(n_tasks), int(lanes), q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQlo,
+            thrQ, int(cycles), bool(stop_any), outE, outQ, store, bool(do_store)]
+    entry = specialised(_run_task, args)
+    run_tasks(lambda task: entry(*args[:2], task, *args[3:]), n_tasks)
 
 
-@njit(cache=True, inline="always")
-def _final_states_body(well, wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods):
+@njit(cache=True, nogil=True)
+def _final_states(well, wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods, task, n_tasks, qo, po):
+    literally(well)
     N = q0.shape[0]
     S = sintab.shape[0]
     rk4 = sintab.shape[1] == 3
     w = wtuple(wpar)
-    qo = np.empty(N)
-    po = np.empty(N)
-    for i in prange(N):
+    for i in range(task, N, n_tasks):
         k = pidx[i]
         F = Fpar[k]
         c = coef[k]
@@ -394,37 +389,18 @@ def _final_states_body(well, wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods):
                                          F * sintab[s, 6])
         qo[i] = q
         po[i] = p
-    return qo, po
 
 
-
-
-@njit(cache=True, parallel=True)
-def _final_states_quartic(wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods):
-    return _final_states_body(QUARTIC, wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods)
-
-
-@njit(cache=True, parallel=True)
-def _final_states_poly4(wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods):
-    return _final_states_body(POLY4, wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods)
-
-
-@njit(cache=True, parallel=True)
-def _final_states_poly8(wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods):
-    return _final_states_body(POLY8, wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods)
-
-
-_FINAL_STATES = {QUARTIC: _final_states_quartic, QUARTIC_SIGNED: _final_states_quartic, POLY4: _final_states_poly4,
-                 POLY8: _final_states_poly8}
-
-
-def final_states(q0, p0, pidx, coef, Fpar, sintab, n_periods, well=QUARTIC, wpar=None):
+def final_states(q0, p0, pidx, coef, Fpar, sintab, n_periods, well=None, n_tasks=2):
     """Plain integration (no escape checks) for n_periods periods; returns (q, p).
-    Scalar per trajectory; used by tests (convergence order, energy drift).  well, wpar: as
-    ensemble (the quartic by default)."""
-    if well not in WELL_FLAGS:
-        raise ValueError(f"well must be one of the kernel flags {WELL_FLAGS}, got {well!r}")
-    if wpar is None:
-        wpar = well_parameters()[1]
-    return _FINAL_STATES[well](np.ascontiguousarray(wpar, dtype=float), q0, p0, pidx, coef, Fpar, sintab,
-                         int(n_periods))
+    Scalar per trajectory; used by tests (convergence order, energy drift).  well: a compiled
+    well (None: the quartic)."""
+    code = quartic_code() if well is None else _check_code(well)
+    q0 = np.ascontiguousarray(q0, dtype=float)
+    qo, po = np.empty(q0.shape), np.empty(q0.shape)
+    n_tasks = max(1, min(int(n_tasks), q0.size))
+    args = [code.key, code.wpar, q0, np.ascontiguousarray(p0, dtype=float), pidx, coef, Fpar, sintab, int(n_periods), 0,
+            n_tasks, qo, po]
+    entry = specialised(_final_states, args)
+    run_tasks(lambda t: entry(*args[:9], t, *args[10:]), n_tasks)
+    return qo, po

@@ -7,6 +7,7 @@ import xarray as xr
 from safebasins import checks
 from safebasins.io import cf
 from safebasins.numerics import criteria
+from safebasins.wells import resolve_well
 from safebasins.numerics import engine
 from safebasins.numerics import kernels
 
@@ -40,10 +41,10 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
     Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
     n_iter = engine.check_cycles("n_iter", n_iter)
-    ew = criteria.resolve_well(well)
-    xi = () if xi_max is None else (checks.check_scalar("xi_max", xi_max, ew.check_xi_max),)
-    qm = () if q_max is None else (checks.check_scalar("q_max", q_max, ew.check_q_max),)
-    qb = np.zeros((0, 2)) if q_bounds is None else ew.check_q_bounds("q_bounds", q_bounds)
+    w = resolve_well(well)
+    xi = () if xi_max is None else (checks.check_scalar("xi_max", xi_max, w.check_threshold),)
+    qm = () if q_max is None else (checks.check_scalar("q_max", q_max, w.check_displacement),)
+    qb = np.zeros((0, 2)) if q_bounds is None else w.check_bounds("q_bounds", q_bounds)
     if qb.shape[0] > 1:
         raise ValueError(f"q_bounds must be one pair (lo, hi) for the map, got {qb.tolist()}")
     if not xi and not qm and not qb.shape[0]:
@@ -55,7 +56,7 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
 
     sE, sQ, st = engine.run_ensemble(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
                                      q_bounds=qb, cycles=n_iter, steps_per_cycle=spc, threads=threads, stop_any=True,
-                                     store=True, integrator=integrator, well=well)
+                                     store=True, integrator=integrator, well=w)
     steps = np.concatenate([sE, sQ], axis=1).astype(float)
     steps[steps < 0] = np.inf
     first = steps.min(axis=1)
@@ -78,8 +79,8 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
     ds.attrs.update(F=F, Omega=Omega, Psi=Psi, xi_max=xi[0] if xi else np.nan, q_max=qm[0] if qm else np.nan,
                     n_iter=n_iter, steps_per_cycle=spc, integrator=kernels.INTEGRATORS[integrator],
                     map="eq (29): (q(t), p(t)) -> (q(t + T), p(t + T)), T = 2 pi / Omega; NaN after escape",
-                    escape_criteria=f"energy ({ew.energy_criterion()}); displacement: |q| > q_max, q < q_lower or "
-                                    "q > q_upper", **ew.attrs())
+                    escape_criteria=f"energy ({w.energy_criterion()}); displacement: |q| > q_max, q < q_lower or "
+                                    "q > q_upper", **w.numerics_attrs())
     if qb.shape[0]:
         ds.attrs.update(q_lower=float(qb[0, 0]), q_upper=float(qb[0, 1]))
     return ds

@@ -1,15 +1,15 @@
 """The vectorised period loops of the compiled engine: steps [s0, s1) of the forcing period
 for every lane of a task, with the per-lane maxima the escape detection of kernels.py reads.
 
-Two loops, each specialised at compile time on the scheme (`rk4`) and the well flag
+Two loops, each specialised at compile time on the scheme (`rk4`) and the kernel key
 (steps.py): _period_shared (every lane with the same Omega and F: 4 dependency chains per
-iteration) and _period_lanes (per-lane Omega and F: one chain).  The body of a flag is picked at
-typing time (@overload on the literal flag): QUARTIC tracks max 2 H0 and max |q| exactly as
-before the well flag (_shared_fused, _lanes_abs); the signed flags (QUARTIC_SIGNED, POLY4,
-POLY8) track max 2 H0, max q and max -q (_shared_split, _lanes_signed).
+iteration) and _period_lanes (per-lane Omega and F: one chain).  The body of a key is picked at
+typing time (@overload on the literal kernel key): a code with |q| tracking (the quartic's
+closed form, wellcode.WellCode.abs_tracking) tracks max 2 H0 and max |q| (_shared_fused,
+_lanes_abs); every other code tracks max 2 H0, max q and max -q (_shared_split, _lanes_signed).
 
-Numba's on-disk cache of the kernels (kernels.py) does not see edits of this file: touch
-kernels.py after changing it.
+The kernel keys hash this file's source (wellcode.engine_fingerprint): an edit here never
+reuses a kernel cached before it.
 """
 from __future__ import annotations
 
@@ -18,20 +18,22 @@ from numba import njit, types
 from numba.core import errors
 from numba.extending import overload
 
-from safebasins.numerics.steps import QUARTIC, _literal_flag, lane_coefs, row, step, well_energy2, wtuple
+from safebasins.numerics.steps import lane_coefs, row, step, wtuple
+from safebasins.numerics.wellcode import _literal_code, abs_tracking, well_energy2
 
 
 @njit(cache=True, inline="always")
 def _keep_abs(well, w, l, q, p, Q, P, ME, MQ, MN):
-    """Store lane l's new state and update its maxima of 2*H0 and |q| (branch free)."""
+    """Store lane l's new state and update its maxima of 2*H0 and |q| (branch free; NaN wins, so that
+    a NaN or inf state is detected as beyond every threshold at the period boundary)."""
     Q[l] = q
     P[l] = p
     e = well_energy2(well, w, q, p)
     x = abs(q)
     m = ME[l]
-    ME[l] = e if e > m else m
+    ME[l] = e if not e <= m else m       # a NaN state propagates: it counts as a crossing
     m = MQ[l]
-    MQ[l] = x if x > m else m
+    MQ[l] = x if not x <= m else m
 
 
 @njit(cache=True, inline="always")
@@ -46,12 +48,12 @@ def _keep_signed(well, w, l, q, p, Q, P, ME, MQ, MN):
 def _maxima_signed(well, w, l, q, p, ME, MQ, MN):
     e = well_energy2(well, w, q, p)
     m = ME[l]
-    ME[l] = e if e > m else m
+    ME[l] = e if not e <= m else m       # a NaN state propagates: it counts as a crossing
     m = MQ[l]
-    MQ[l] = q if q > m else m
+    MQ[l] = q if not q <= m else m
     y = -q
     m = MN[l]
-    MN[l] = y if y > m else m
+    MN[l] = y if not y <= m else m
 
 
 def _literal_scheme(rk4):
@@ -66,14 +68,14 @@ def _reset(well, n, ME, MQ, MN):
     for l in range(n):
         ME[l] = -np.inf
         MQ[l] = -np.inf
-    if well != QUARTIC:
+    if not abs_tracking(well):
         for l in range(n):
             MN[l] = -np.inf
 
 
 @njit(cache=True, inline="always")
 def _shared_fused(rk4, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
-    """QUARTIC: steps [s0, s1) of the forcing period for lanes [0, 4M), all sharing one
+    """|q| tracking (the quartic): steps [s0, s1) of the forcing period for lanes [0, 4M), all sharing one
     parameter set; ME, MQ = max 2*H0 and max |q| over these steps.
 
     The lane loop (j) vectorises; its body advances 4 independent lanes j, M+j, 2M+j, 3M+j
@@ -100,7 +102,7 @@ def _shared_fused(rk4, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
 
 @njit(cache=True, inline="always")
 def _shared_split(rk4, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
-    """The signed flags: as _shared_fused, with the maxima of 2*H0, q and -q updated in a
+    """Signed tracking: as _shared_fused, with the maxima of 2*H0, q and -q updated in a
     second lane loop per step.  (Fused, the 4 chains x 5 arrays need 190 runtime alias checks,
     over LLVM's limit of 128 -vectorize-memory-check-threshold, and the loop stays scalar: 7x
     slower.  Split, the step loop has 2 arrays x 4 chains and the maxima loop 5 arrays x 1
@@ -141,8 +143,9 @@ def _period_shared_body(rk4, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
 
 @overload(_period_shared_body)
 def _ol_period_shared_body(rk4, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
-    RK4, WELL = _literal_scheme(rk4), _literal_flag(well)
-    if WELL == QUARTIC:
+    RK4, code = _literal_scheme(rk4), _literal_code(well)
+    WELL = code.key
+    if code.abs_tracking:
         def impl(rk4, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
             _shared_fused(RK4, WELL, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1)
     else:
@@ -201,8 +204,9 @@ def _period_lanes_body(rk4, well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0,
 
 @overload(_period_lanes_body)
 def _ol_period_lanes_body(rk4, well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1):
-    RK4, WELL = _literal_scheme(rk4), _literal_flag(well)
-    if WELL == QUARTIC:
+    RK4, code = _literal_scheme(rk4), _literal_code(well)
+    WELL = code.key
+    if code.abs_tracking:
         def impl(rk4, well, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1):
             _lanes_abs(RK4, WELL, wpar, M, Q, P, ME, MQ, MN, HL, FL, sintab, s0, s1)
     else:

@@ -21,40 +21,23 @@ table (7: SRKN6b, 3: RK4).
 Every operation is written with explicit fused multiply-adds (llvm.fma), no fast-math flags:
 vector loop and scalar replay produce bitwise identical numbers.
 
-Wells (the compile-time flag ``well``)
---------------------------------------
-The well enters the step through the force -V'(q) + f and the escape test through
-2 H0 = p^2 + 2 V(q).  Both are inline functions specialised on a compile-time constant flag,
-like the scheme (kernels.py threads it through as a numba literal: each flag value is its own
-compiled, cached kernel, compiled on first use; well_force / well_energy2 pick the flag's
-arithmetic at typing time):
+Wells (the compile-time kernel key ``well``)
+--------------------------------------------
+The well enters the step through its force -V'(q) + f and the escape test through
+2 H0 = p^2 + 2 V(q): wellcode.well_force / well_energy2 of the well's compiled form
+(wellcode.WellCode), chosen at typing time from the kernel key, a numba literal threaded
+through every call like the scheme flag.  Each key is its own compiled, cached kernel; keys
+hash the arithmetic and the engine's source, so editing this file invalidates the cache.
 
-* ``QUARTIC`` (0): the paper's V = q^2/2 - q^4/4 in closed form, force fma(q*q, q, f - q),
-  2 H0 = fma(q2, fma(-0.5, q2, 1.0), p*p) (q2 = q*q); the lanes track max |q| (symmetric
-  displacement thresholds, barrier |q| > 1);
-* ``QUARTIC_SIGNED`` (1): the same arithmetic; the lanes track max q and max -q (asymmetric
-  displacement bounds lo < q < hi);
-* ``POLY4`` (4), ``POLY8`` (8): a polynomial well V = sum_{k=2}^{n} c_k q^k of degree
-  n <= 4 (resp. 8).  The coefficients are run-time numbers (``well_parameters``), so one
-  compiled kernel serves every polynomial well of its degree class; the force
-  -V'(q) + f = f + q (g_1 + q (g_2 + ...)), g_k = -(k+1) c_{k+1}, and
-  2 V(q) + p^2 = q^2 (e_2 + q (e_3 + ...)) + p^2, e_k = 2 c_k, are Horner evaluations with
-  explicit fma over the class's full length (the missing top coefficients are zeros, and a
-  leading zero leaves the Horner value bitwise unchanged: fma(0, q, g) = g for finite q).
-  Signed maxima (max q, max -q) as QUARTIC_SIGNED.
-
-Numba's on-disk cache of the kernels (kernels.py) does not see edits of this file: touch
-kernels.py after changing it.
-
-``wpar`` (float64, ``N_WPAR``): [q_left, q_right, g_1 .. g_7, e_2 .. e_8]; the barriers
-(+-inf where there is none) are used by the signed flags, the coefficients by the POLY flags.
+``wpar`` (float64, ``wellcode.N_WPAR``): [q_left, q_right, w_0 .. w_13]; the barriers (+-inf
+where there is none) and the well's run-time coefficients (``wtuple``).
 """
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, types
-from numba.core import errors
-from numba.extending import intrinsic, overload
+from numba import njit
+
+from safebasins.numerics.wellcode import fma, quartic_code, well_energy2, well_force
 
 # --- Blanes & Moan 2002, SRKN_6^b (Table 3), order 4 -------------------------------------
 _A1 = 0.245298957184271
@@ -83,55 +66,9 @@ INTEGRATORS = {
     "rk4": "classic RK4 (order 4, not symplectic, 4 force evaluations/step)",
 }
 
-# --- wells ----------------------------------------------------------------------------------
-QUARTIC = 0
-QUARTIC_SIGNED = 1
-POLY4 = 4
-POLY8 = 8
-#: degree classes of the polynomial path (a well of degree n runs in the smallest class >= n)
-POLY_DEGREES = (POLY4, POLY8)
-WELL_FLAGS = (QUARTIC, QUARTIC_SIGNED) + POLY_DEGREES
-#: wpar = [q_left, q_right, g_1 .. g_7, e_2 .. e_8]
-N_WPAR = 16
-_G0 = 2      # g_k at wpar[_G0 + k - 1]
-_E0 = 9      # e_k at wpar[_E0 + k - 2]
-# the paper's barrier |q| = 1 (the QUARTIC flag compares |q| with this constant)
-Q_BARRIER = 1.0
-
-
-@intrinsic
-def fma(typingctx, a, b, c):
-    """Correctly rounded a*b + c (llvm.fma.f64): same bits in vector and scalar code."""
-    sig = types.float64(types.float64, types.float64, types.float64)
-
-    def codegen(context, builder, signature, args):
-        return builder.fma(*args)
-
-    return sig, codegen
-
-
-def well_parameters(barriers=(-Q_BARRIER, Q_BARRIER), coefficients=None):
-    """``wpar`` for the kernels: barriers (q_left, q_right) and, for a polynomial well, the
-    Horner coefficients of -V' and 2 V from ``coefficients`` c_0 .. c_n (c_0 = c_1 = 0,
-    n <= max(POLY_DEGREES)).  Returns (flag class or None, wpar): the POLY flag of the
-    coefficients' degree (None without coefficients)."""
-    w = np.zeros(N_WPAR)
-    w[0], w[1] = float(barriers[0]), float(barriers[1])
-    if coefficients is None:
-        return None, w
-    c = np.trim_zeros(np.asarray(coefficients, dtype=float), "b")
-    n = c.size - 1
-    if c.ndim != 1 or n < 2 or c[0] != 0.0 or c[1] != 0.0:
-        raise ValueError(f"coefficients must be c_0 = 0, c_1 = 0, c_2, ... (degree >= 2), got {coefficients!r}")
-    cls = next((d for d in POLY_DEGREES if n <= d), None)
-    if cls is None:
-        raise ValueError(f"coefficients: degree {n} exceeds the largest compiled polynomial class "
-                         f"{max(POLY_DEGREES)}")
-    for k in range(1, n):                   # -V' = sum_k g_k q^k, g_k = -(k+1) c_{k+1}
-        w[_G0 + k - 1] = -(k + 1) * c[k + 1]
-    for k in range(2, n + 1):               # 2 V = sum_k e_k q^k, e_k = 2 c_k
-        w[_E0 + k - 2] = 2.0 * c[k]
-    return cls, w
+# --- wells: the compiled form of a well (force and energy written once) is wellcode.py ---------
+#: kernel key of the paper's quartic (a global constant: numba types it as a literal)
+QUARTIC_KEY = quartic_code().key
 
 
 @njit(cache=True, inline="always")
@@ -144,88 +81,16 @@ def wtuple(wpar):
 _W0 = (0.0,) * 14
 
 
-def _quartic_force(well, w, q, f):
-    return fma(q * q, q, f - q)
-
-
-def _poly4_force(well, w, q, f):
-    return fma(fma(fma(w[2], q, w[1]), q, w[0]), q, f)
-
-
-def _poly8_force(well, w, q, f):
-    a = fma(w[6], q, w[5])
-    a = fma(a, q, w[4])
-    a = fma(a, q, w[3])
-    a = fma(a, q, w[2])
-    a = fma(a, q, w[1])
-    a = fma(a, q, w[0])
-    return fma(a, q, f)
-
-
-def _quartic_energy2(well, w, q, p):
-    q2 = q * q
-    return fma(q2, fma(-0.5, q2, 1.0), p * p)
-
-
-def _poly4_energy2(well, w, q, p):
-    h = fma(fma(w[9], q, w[8]), q, w[7])
-    return fma(h, q * q, p * p)
-
-
-def _poly8_energy2(well, w, q, p):
-    h = fma(w[13], q, w[12])
-    h = fma(h, q, w[11])
-    h = fma(h, q, w[10])
-    h = fma(h, q, w[9])
-    h = fma(h, q, w[8])
-    h = fma(h, q, w[7])
-    return fma(h, q * q, p * p)
-
-
-_FORCES = {QUARTIC: _quartic_force, QUARTIC_SIGNED: _quartic_force, POLY4: _poly4_force, POLY8: _poly8_force}
-_ENERGIES = {QUARTIC: _quartic_energy2, QUARTIC_SIGNED: _quartic_energy2, POLY4: _poly4_energy2,
-             POLY8: _poly8_energy2}
-
-
-def _literal_flag(well):
-    if not isinstance(well, types.IntegerLiteral) or well.literal_value not in WELL_FLAGS:
-        raise errors.TypingError(f"well must be a compile-time constant among {WELL_FLAGS}, got {well}")
-    return well.literal_value
-
-
-def well_force(well, w, q, f):
-    """-V'(q) + f, with f = F sin(Omega t_k + Psi) (a product F * table value), w = wtuple(wpar),
-    for the well flag `well` (a compile-time constant)."""
-    raise NotImplementedError("well_force is compiled code (numba)")
-
-
-def well_energy2(well, w, q, p):
-    """2 H0 = p^2 + 2 V(q) (eq 7, untruncated), compared with 2 xi_max (exact doubling)."""
-    raise NotImplementedError("well_energy2 is compiled code (numba)")
-
-
-# the implementation of the flag is chosen at typing time: a kernel contains only its own
-# well's arithmetic (branches on the flag would compile every well into every kernel)
-@overload(well_force, inline="always")
-def _ol_well_force(well, w, q, f):
-    return _FORCES[_literal_flag(well)]
-
-
-@overload(well_energy2, inline="always")
-def _ol_well_energy2(well, w, q, p):
-    return _ENERGIES[_literal_flag(well)]
-
-
 @njit(cache=True, inline="always")
 def force(q, f):
     """q^3 - q + f (the quartic), with f = F sin(Omega t_k + Psi)."""
-    return well_force(QUARTIC, _W0, q, f)
+    return well_force(QUARTIC_KEY, _W0, q, f)
 
 
 @njit(cache=True, inline="always")
 def energy2(q, p):
     """2 H0 = p^2 + q^2 - q^4/2 of the quartic (eq 7, untruncated)."""
-    return well_energy2(QUARTIC, _W0, q, p)
+    return well_energy2(QUARTIC_KEY, _W0, q, p)
 
 
 @njit(cache=True)
@@ -275,13 +140,13 @@ def well_rk4_step(well, w, q, p, hh, h, h6, f1, f2, f3):
 @njit(cache=True, inline="always")
 def bm6_step(q, p, a1, a2, a3, b1, b2, b3, b4, f1, f2, f3, f4, f5, f6, f7):
     """One SRKN6b step of the quartic."""
-    return well_bm6_step(QUARTIC, _W0, q, p, a1, a2, a3, b1, b2, b3, b4, f1, f2, f3, f4, f5, f6, f7)
+    return well_bm6_step(QUARTIC_KEY, _W0, q, p, a1, a2, a3, b1, b2, b3, b4, f1, f2, f3, f4, f5, f6, f7)
 
 
 @njit(cache=True, inline="always")
 def rk4_step(q, p, hh, h, h6, f1, f2, f3):
     """One RK4 step of the quartic."""
-    return well_rk4_step(QUARTIC, _W0, q, p, hh, h, h6, f1, f2, f3)
+    return well_rk4_step(QUARTIC_KEY, _W0, q, p, hh, h, h6, f1, f2, f3)
 
 
 @njit(cache=True, inline="always")

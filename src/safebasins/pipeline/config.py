@@ -56,10 +56,29 @@ def load_kinds(extensions=()):
         importlib.import_module(mod)
 
 
+def well_schema() -> dict:
+    """``$defs/well``: the forms of safebasins.wells (the named wells are read from its table)."""
+    from safebasins.wells import NAMED_WELLS
+
+    names = "; ".join(f"{k}: {d}" for k, (_, d) in NAMED_WELLS.items())
+    return {
+        "description": ("the potential well V(q) of q'' + V'(q) = F sin(Omega t + Psi) (safebasins.wells): a name "
+                        f"({names}), {{polynomial: [c0, c1, c2, ...]}} for V = sum c_k q^k (c0 = c1 = 0, c2 > 0), or "
+                        "{expression: '<formula in q>'} (sympy; e.g. '1 - cos(q)'); V(0) = V'(0) = 0, V''(0) > 0, "
+                        "escape over a barrier or to an asymptote on at least one side"),
+        "oneOf": [{"enum": list(NAMED_WELLS)},
+                  {"type": "object", "additionalProperties": False, "required": ["polynomial"],
+                   "properties": {"polynomial": {"type": "array", "minItems": 3, "items": {"type": "number"}}}},
+                  {"type": "object", "additionalProperties": False, "required": ["expression"],
+                   "properties": {"expression": {"type": "string", "minLength": 1}}}],
+    }
+
+
 def build_schema(base=None) -> dict:
     """The full JSON schema: the base file plus one ``$defs`` entry per registered kind."""
     schema = copy.deepcopy(load_yaml(SCHEMA_PATH) if base is None else base)
     defs = schema.setdefault("$defs", {})
+    defs["well"] = well_schema()
     for name, kind in KINDS.items():
         defs[name] = copy.deepcopy(kind.schema)
         # every experiment may name its well (issue 12); the quartic keeps the paper's results

@@ -54,7 +54,7 @@ class CheckContext:
         key = repr(spec)
         if key not in self._wells:
             try:
-                self._wells[key] = wells.from_spec(spec, self.config["fourier"])
+                self._wells[key] = wells.from_spec(spec, self.config["fourier"] if spec["name"] == "quartic" else None)
             except ValueError as exc:
                 fail(f"{self.keys[experiment]}.well", f"not a potential well: {exc}")
         return self._wells[key]

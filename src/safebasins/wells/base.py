@@ -148,3 +148,88 @@ class Well(abc.ABC):
     def unforced_safe(self, q, p, xi_max):
         """The unforced safe set of a threshold: ``H0 < xi_max`` inside the well."""
         return (self.H0(q, p) < xi_max) & self.in_well(q)
+
+    # ------------------------------------------------------------------ what the numerics need
+    def check_displacement(self, name, q_max):
+        """Symmetric displacement thresholds ``|q| > q_max``: q_max in (0, nearest barrier]."""
+        from safebasins.checks import as_array, value_repr
+
+        a = as_array(name, q_max)
+        lim = min(-self.barriers[0], self.barriers[1])
+        if ((a <= 0) | (a > lim)).any():
+            raise ValueError(f"{name} must lie in (0, {lim!r}] (|q| > q_max beyond a barrier of the {self.name} "
+                             f"well at {self.barriers}), got {value_repr(a)}")
+        return a
+
+    def check_bounds(self, name, q_bounds):
+        """Displacement bound pairs ``(lo, hi)`` as an (n, 2) float array: lo < 0 < hi, inside the
+        barriers (a single pair may be given as (lo, hi))."""
+        from safebasins.checks import as_array
+
+        a = as_array(name, q_bounds)
+        if a.size == 0:
+            return np.zeros((0, 2))
+        if a.ndim == 1:
+            a = a[None, :]
+        if a.ndim != 2 or a.shape[1] != 2:
+            raise ValueError(f"{name} must be pairs (lo, hi): shape (n, 2) or (2,), got shape {a.shape}")
+        lo, hi = a[:, 0], a[:, 1]
+        if not ((lo < 0) & (hi > 0)).all():
+            raise ValueError(f"{name} must satisfy lo < 0 < hi (the well bottom q = 0 inside), got {a.tolist()}")
+        ql, qr = self.barriers
+        if (lo < ql).any() or (hi > qr).any():
+            raise ValueError(f"{name} must lie inside the barriers of the {self.name} well, {ql!r} <= lo and "
+                             f"hi <= {qr!r}; got {a.tolist()}")
+        return a
+
+    def spec(self) -> dict:
+        """The resolved spec that rebuilds this well (:func:`safebasins.wells.from_spec`): its name,
+        plus the coefficients or the expression of an unnamed polynomial or expression well."""
+        return {"name": self.name}
+
+    def potential_text(self) -> str:
+        """``V(q)`` in words for datasets and figures."""
+        return f"V(q) of the {self.name} well"
+
+    def barrier_text(self) -> str:
+        """Where the escape over a barrier happens, e.g. ``q < -1 or q > 1`` ("" without a finite barrier)."""
+        return " or ".join(f"q {op} {b!r}" for op, b in zip(("<", ">"), self.barriers) if np.isfinite(b))
+
+    def energy_criterion(self) -> str:
+        """The energy escape criterion in words, naming the well."""
+        beyond = self.barrier_text()
+        return (f"well {self.name!r}, V(q) = {self.potential_text()}: H0 = p^2/2 + V(q) > xi_max"
+                + (f" or {beyond} (beyond a barrier)" if beyond else ""))
+
+    def numerics_attrs(self) -> dict:
+        """Attributes a numeric dataset records about its well."""
+        return {"well": self.name, "well_potential": self.potential_text(),
+                "well_barriers": np.array(self.barriers, dtype=float),
+                "well_barrier_energy": float(self.barrier_energy)}
+
+    def ic_window(self):
+        """``((q_lo, q_hi), (p_lo, p_hi))``: an initial-condition window holding the whole well, the
+        turning points of the escape energy E_b (of 0.99 E_b when they are not finite: a side open
+        at infinity) and ``|p| <= 1.5 sqrt(E_b)`` (the quartic: [-1, 1] x [-0.75, 0.75])."""
+        E = float(self.barrier_energy)
+        try:
+            lo, hi = (float(x) for x in self.turning_points(E))
+        except ValueError:
+            lo = hi = np.inf
+        if not (np.isfinite(lo) and np.isfinite(hi)):
+            lo, hi = (float(x) for x in self.turning_points(0.99 * E))
+        pm = 1.5 * float(np.sqrt(E))
+        return (lo, hi), (-pm, pm)
+
+    @property
+    def compiled(self):
+        """The well's one compiled form (:class:`safebasins.numerics.wellcode.WellCode`: force and
+        energy for the CPU and CUDA engines), built on first use and kept."""
+        code = self.__dict__.get("_compiled")
+        if code is None:
+            code = self._compiled_form()
+            self.__dict__["_compiled"] = code
+        return code
+
+    def _compiled_form(self):
+        raise ValueError(f"the {self.name} well ({type(self).__name__}) has no compiled form for the numerics")

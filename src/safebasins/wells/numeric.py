@@ -467,3 +467,12 @@ class NumericWell(Well):
             q[k] = qq
             p[k] = np.where(upper, 1.0, -1.0) * R * np.sin(psi)
         return q.reshape(shape), p.reshape(shape)
+
+    # ------------------------------------------------------------------ the numerics
+    def _compiled_form(self):
+        from safebasins.numerics.wellcode import user_code
+
+        return user_code(self._V, self._dV, self.barriers, self.name)
+
+    def potential_text(self):
+        return f"user function {getattr(self._V, '__qualname__', type(self._V).__name__)}"

@@ -135,6 +135,26 @@ class PolynomialWell(NumericWell):
         return P.polyval(as_array("q", q), self.dV_coefficients)
 
 
+    # ------------------------------------------------------------------ the numerics
+    def _compiled_form(self):
+        from safebasins.numerics.wellcode import polynomial_code
+
+        return polynomial_code(self.coefficients, self.barriers, self.name)
+
+    def potential_text(self):
+        terms = [f"{'-' if c < 0 else '+'} {abs(c)!r} q^{k}" for k, c in enumerate(self.coefficients.tolist())
+                 if c != 0.0]
+        return " ".join(terms).removeprefix("+ ")
+
+    def numerics_attrs(self):
+        return {**super().numerics_attrs(), "well_coefficients": np.array(self.coefficients, dtype=float)}
+
+    def spec(self):
+        if self.name != "polynomial":          # a named polynomial well (cubic)
+            return super().spec()
+        return {"name": "polynomial", "coefficients": [float(c) for c in self.coefficients]}
+
+
 def polynomial(coefficients, **kwargs):
     """The well ``V = sum_k c_k q^k`` (see :class:`PolynomialWell`)."""
     return PolynomialWell(coefficients, **kwargs)

@@ -224,6 +224,18 @@ class QuarticWell(Well):
             raise ValueError(f"{name} must lie in (0, 1], got {value_repr(a)}")
         return a
 
+    # -- the numerics
+    def _compiled_form(self):
+        from safebasins.numerics.wellcode import quartic_code
+
+        return quartic_code()
+
+    def potential_text(self):
+        return "q^2/2 - q^4/4"
+
+    def barrier_text(self):
+        return "|q| > 1"
+
     # -- potential (plain arithmetic: numpy arrays, DataArrays and scalars alike, no checks)
     def V(self, q):
         return _V(q)

@@ -1,0 +1,354 @@
+"""The one compiled form of a well: its force and energy, written once, compiled for every target.
+
+A well reaches the engines as a :class:`WellCode` (``Well.compiled``, built once per well object):
+
+* ``force(w, q, f) = -V'(q) + f`` and ``energy2(w, q, p) = p^2 + 2 V(q)`` (eq 7, untruncated,
+  compared with 2 xi_max: exact doubling) as plain, device-compatible Python functions.  ``w``
+  is the tuple of the well's 14 run-time coefficients (``wpar[2:]``; the polynomial wells' Horner
+  coefficients), ``wpar = [q_left, q_right, w_0 .. w_13]`` with the barriers (+-inf on a side
+  without one).
+* ``make(jit) -> (force, energy2)`` compiles them with a target's decorator: the CPU lanes use
+  ``numba.njit(inline="always")`` (kernels.py, through :func:`well_force` / :func:`well_energy2`),
+  the CUDA kernels ``numba.cuda.jit(device=True)`` (cuda_kernels.py).  The SAME Python source
+  serves both; only the two primitives below differ by target.
+* ``key``: a 61-bit hash of the source text of the arithmetic (and of the engine's own source),
+  the compile-time constant (numba literal) on which the CPU kernels are specialised and cached
+  on disk.  Equal keys mean equal arithmetic, so a cached kernel is never reused for other code.
+* ``abs_tracking``: a well symmetric about q = 0 may track max |q| (one maximum per lane: the
+  quartic's closed-form path, eq (4)); every other code tracks max q and max -q.
+
+Primitives (one name each, an implementation per target):
+
+* :func:`fma` -- correctly rounded a*b + c: llvm.fma on the CPU, fma.rn.f64 on the GPU
+  (registered by cuda_kernels), the CPU's llvm.fma when called from Python (numba's CUDA
+  simulator runs device functions as Python);
+* :func:`mul` -- a rounded product that the GPU compiler may not contract with a following add
+  (``__dmul_rn`` on the GPU, a plain product on the CPU, which never contracts).  Generated code
+  (expression wells) writes every product with it, so CPU and GPU round the same operations.
+
+Bitwise CPU = GPU holds for arithmetic wells (quartic, polynomials, rational expressions: IEEE
++, -, *, /, sqrt and fma are correctly rounded on both).  Transcendental functions (sin, exp,
+...) come from each target's math library (glibc on the CPU, libdevice on the GPU), which may
+differ in the last bit.
+
+Adding a compiled well family with run-time parameters is one :class:`WellCode` builder here
+(see docs/adding-a-well.md); a well written as an expression needs none (wells.expression).
+"""
+from __future__ import annotations
+
+import functools
+import hashlib
+import inspect
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+from numba import njit, types
+from numba.core import errors
+from numba.extending import intrinsic, overload
+
+__all__ = ["WellCode", "fma", "mul", "N_WPAR", "quartic_code", "polynomial_code", "callable_code",
+           "well_force", "well_energy2", "abs_tracking", "code_of", "POLY_DEGREES"]
+
+#: wpar = [q_left, q_right, w_0 .. w_13]
+N_WPAR = 16
+#: degree classes of the polynomial codes (a well of degree n runs in the smallest class >= n)
+POLY_DEGREES = (4, 8)
+
+
+# ------------------------------------------------------------------------------- primitives
+@intrinsic
+def fma_cpu(typingctx, a, b, c):
+    """Correctly rounded a*b + c (llvm.fma.f64): same bits in vector and scalar code."""
+    sig = types.float64(types.float64, types.float64, types.float64)
+
+    def codegen(context, builder, signature, args):
+        return builder.fma(*args)
+
+    return sig, codegen
+
+
+@njit(cache=True)
+def _fma_python(a, b, c):
+    return fma_cpu(a, b, c)
+
+
+def fma(a, b, c):
+    """Correctly rounded ``a*b + c`` on every target (see the module docstring)."""
+    return _fma_python(a, b, c)
+
+
+def mul(a, b):
+    """``a * b``, never contracted with a following add (see the module docstring)."""
+    return a * b
+
+
+@overload(fma, inline="always")
+def _ol_fma(a, b, c):
+    return lambda a, b, c: fma_cpu(a, b, c)
+
+
+@overload(mul, inline="always")
+def _ol_mul(a, b):
+    return lambda a, b: a * b
+
+
+# ------------------------------------------------------------------------------- the compiled form
+@functools.cache
+def engine_fingerprint() -> str:
+    """Hash of the engine's source (steps, periods, kernels and this module): part of every key,
+    so an edit of the engine never reuses a kernel cached before it."""
+    h = hashlib.blake2b(digest_size=16)
+    here = Path(__file__).parent
+    for name in ("wellcode.py", "steps.py", "periods.py", "kernels.py"):
+        h.update((here / name).read_bytes())
+    return h.hexdigest()
+
+
+_CODES: dict[int, "WellCode"] = {}
+
+
+@dataclass(frozen=True, eq=False)
+class WellCode:
+    """A well as the compiled engines see it (module docstring)."""
+
+    name: str
+    make: Callable = field(repr=False)
+    wpar: np.ndarray = field(repr=False)
+    abs_tracking: bool
+    source: str = field(repr=False)
+    key: int = field(init=False)
+
+    def __post_init__(self):
+        w = np.ascontiguousarray(self.wpar, dtype=float)
+        if w.shape != (N_WPAR,):
+            raise ValueError(f"wpar must have {N_WPAR} entries [q_left, q_right, w_0 .. w_13], got shape {w.shape}")
+        object.__setattr__(self, "wpar", w)
+        text = f"{engine_fingerprint()}\0{self.source}\0abs={bool(self.abs_tracking)}"
+        key = int.from_bytes(hashlib.blake2b(text.encode(), digest_size=8).digest(), "little") >> 3
+        object.__setattr__(self, "key", key)
+        _CODES.setdefault(key, self)
+
+    @property
+    def barriers(self):
+        return float(self.wpar[0]), float(self.wpar[1])
+
+    def signed(self) -> "WellCode":
+        """The same arithmetic with max q / max -q tracking (asymmetric displacement bounds)."""
+        if not self.abs_tracking:
+            return self
+        return _signed_variant(self)
+
+
+@functools.cache
+def _signed_variant(code):
+    return WellCode(code.name, code.make, code.wpar, False, code.source)
+
+
+def code_of(key: int) -> WellCode:
+    """The registered code of a kernel key."""
+    try:
+        return _CODES[key]
+    except KeyError:
+        raise ValueError(f"no compiled well with key {key!r} (build it from a well: Well.compiled)") from None
+
+
+def _wpar(barriers, coefficients=()):
+    w = np.zeros(N_WPAR)
+    w[0], w[1] = float(barriers[0]), float(barriers[1])
+    c = np.asarray(coefficients, dtype=float)
+    w[2:2 + c.size] = c
+    return w
+
+
+def _plain(force, energy2):
+    """``make`` of a code whose two functions need nothing but the primitives."""
+    def make(jit):
+        return jit(force), jit(energy2)
+    make.source = inspect.getsource(force) + inspect.getsource(energy2)
+    return make
+
+
+# ------------------------------------------------------------------------------- the quartic, eq (2)
+def quartic_force(w, q, f):
+    """q^3 - q + f for V = q^2/2 - q^4/4 (eq 1)."""
+    return fma(q * q, q, f - q)
+
+
+def quartic_energy2(w, q, p):
+    """2 H0 = p^2 + q^2 - q^4/2 (eq 7, untruncated)."""
+    q2 = q * q
+    return fma(q2, fma(-0.5, q2, 1.0), p * p)
+
+
+_QUARTIC_MAKE = _plain(quartic_force, quartic_energy2)
+
+
+@functools.cache
+def quartic_code() -> WellCode:
+    """The paper's quartic in closed form, barriers +-1, |q| tracking."""
+    return WellCode("quartic", _QUARTIC_MAKE, _wpar((-1.0, 1.0)), True, _QUARTIC_MAKE.source)
+
+
+# ------------------------------------------------------------------------------- polynomial wells
+# -V'(q) + f = f + q (g_1 + q (g_2 + ...)), g_k = -(k+1) c_{k+1}:  w[0 .. 6] = g_1 .. g_7
+# 2 V(q) + p^2 = q^2 (e_2 + q (e_3 + ...)) + p^2, e_k = 2 c_k:   w[7 .. 13] = e_2 .. e_8
+# Horner with explicit fma over the class's full length: a missing top coefficient is a zero,
+# and fma(0, q, g) = g for finite q leaves the value bitwise unchanged.
+def poly4_force(w, q, f):
+    return fma(fma(fma(w[2], q, w[1]), q, w[0]), q, f)
+
+
+def poly4_energy2(w, q, p):
+    h = fma(fma(w[9], q, w[8]), q, w[7])
+    return fma(h, q * q, p * p)
+
+
+def poly8_force(w, q, f):
+    a = fma(w[6], q, w[5])
+    a = fma(a, q, w[4])
+    a = fma(a, q, w[3])
+    a = fma(a, q, w[2])
+    a = fma(a, q, w[1])
+    a = fma(a, q, w[0])
+    return fma(a, q, f)
+
+
+def poly8_energy2(w, q, p):
+    h = fma(w[13], q, w[12])
+    h = fma(h, q, w[11])
+    h = fma(h, q, w[10])
+    h = fma(h, q, w[9])
+    h = fma(h, q, w[8])
+    h = fma(h, q, w[7])
+    return fma(h, q * q, p * p)
+
+
+_POLY_MAKE = {4: _plain(poly4_force, poly4_energy2), 8: _plain(poly8_force, poly8_energy2)}
+
+
+def polynomial_code(coefficients, barriers, name="polynomial") -> WellCode:
+    """Code of ``V = sum_k c_k q^k`` (c_0 = c_1 = 0, degree <= 8) with its barriers: one compiled
+    kernel per degree class (the coefficients are run-time numbers)."""
+    c = np.trim_zeros(np.asarray(coefficients, dtype=float), "b")
+    n = c.size - 1
+    if c.ndim != 1 or n < 2 or c[0] != 0.0 or c[1] != 0.0:
+        raise ValueError(f"coefficients must be c_0 = 0, c_1 = 0, c_2, ... (degree >= 2), got {coefficients!r}")
+    cls = next((d for d in POLY_DEGREES if n <= d), None)
+    if cls is None:
+        raise ValueError(f"coefficients: degree {n} exceeds the largest compiled polynomial class {max(POLY_DEGREES)} "
+                         "(write the well as an expression: {'expression': ...})")
+    w = np.zeros(14)
+    for k in range(1, n):
+        w[k - 1] = -(k + 1) * c[k + 1]
+    for k in range(2, n + 1):
+        w[7 + k - 2] = 2.0 * c[k]
+    make = _POLY_MAKE[cls]
+    return WellCode(f"{name} (degree class {cls})", make, _wpar(barriers, w), False, make.source)
+
+
+# ------------------------------------------------------------------------------- any V, dV
+def _template(V, dV):
+    """force and energy of a well given by scalar functions V, dV (already compiled for the
+    target): the same two lines for every such well."""
+    def force(w, q, f):
+        return f - dV(q)
+
+    def energy2(w, q, p):
+        return fma(p, p, 2.0 * V(q))
+
+    return force, energy2
+
+
+_TEMPLATE_SOURCE = inspect.getsource(_template)
+
+
+def callable_code(V, dV, barriers, name, source) -> WellCode:
+    """Code of a well from scalar, numba-compilable Python functions ``V(q)``, ``dV(q)`` (plain
+    functions: each target compiles them).  ``source`` must identify their arithmetic exactly
+    (the expression well's generated text; for user functions the LLVM IR of their CPU
+    compilation): it is the cache key of the compiled kernels."""
+    def make(jit):
+        force, energy2 = _template(jit(V), jit(dV))
+        return jit(force), jit(energy2)
+
+    return WellCode(name, make, _wpar(barriers), False, f"{_TEMPLATE_SOURCE}\0{source}")
+
+
+# ------------------------------------------------------------------------------- CPU dispatch
+def _literal_code(well):
+    if not isinstance(well, types.IntegerLiteral):
+        raise errors.TypingError(f"well must be a compile-time constant kernel key (a numba literal), got {well}")
+    return code_of(well.literal_value)
+
+
+@functools.cache
+def cpu_functions(key):
+    """(force, energy2) of a code compiled for the CPU lanes (inlined into the kernels)."""
+    return code_of(key).make(njit(inline="always"))
+
+
+def well_force(well, w, q, f):
+    """-V'(q) + f of the code with kernel key ``well`` (a compile-time constant), f = F sin(...)."""
+    raise NotImplementedError("well_force is compiled code (numba)")
+
+
+def well_energy2(well, w, q, p):
+    """2 H0 = p^2 + 2 V(q) of the code with kernel key ``well`` (a compile-time constant)."""
+    raise NotImplementedError("well_energy2 is compiled code (numba)")
+
+
+def abs_tracking(well):
+    """True when the code of kernel key ``well`` tracks max |q| (a compile-time constant)."""
+    raise NotImplementedError("abs_tracking is compiled code (numba)")
+
+
+# the code of a key is chosen at typing time: a kernel holds only its own well's arithmetic
+@overload(well_force, inline="always")
+def _ol_well_force(well, w, q, f):
+    FORCE = cpu_functions(_literal_code(well).key)[0]
+    return lambda well, w, q, f: FORCE(w, q, f)
+
+
+@overload(well_energy2, inline="always")
+def _ol_well_energy2(well, w, q, p):
+    ENERGY2 = cpu_functions(_literal_code(well).key)[1]
+    return lambda well, w, q, p: ENERGY2(w, q, p)
+
+
+@overload(abs_tracking, inline="always")
+def _ol_abs_tracking(well):
+    if _literal_code(well).abs_tracking:
+        return lambda well: True
+    return lambda well: False
+
+
+def _ir_identity(arg, fn):
+    """(plain Python function, text identifying its float64 -> float64 compilation): the LLVM IR of
+    its CPU compilation with the mangled symbol names removed (they carry process-local counters)."""
+    import re
+
+    py = getattr(fn, "py_func", fn)
+    if not callable(py):
+        raise ValueError(f"{arg} must be a callable, got {fn!r}")
+    try:
+        d = njit(py)
+        cres = d.compile((types.float64,))
+        ir = d.inspect_llvm((types.float64,))
+    except errors.NumbaError as exc:
+        head = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise ValueError(f"{arg}: the compiled engines need {arg}(q) as a scalar function numba can compile "
+                         f"(numpy/math calls on a float; numba said: {head}); or write the well as an expression "
+                         "{'expression': ...}") from None
+    if cres.signature.return_type not in (types.float64, types.int64):
+        raise ValueError(f"{arg}(q) must return a float for a float q, numba infers {cres.signature.return_type}")
+    return py, re.sub(r"_ZN\w+", "_Z", ir)
+
+
+def user_code(V, dV, barriers, name) -> WellCode:
+    """Code of a well from the user's callables (a NumericWell): V, dV compiled by numba for a
+    scalar q (plain Python functions or numba dispatchers); ValueError naming V / dV otherwise."""
+    pv, iv = _ir_identity("V", V)
+    pd, id_ = _ir_identity("dV", dV)
+    return callable_code(pv, pd, barriers, name, f"V:\n{iv}\ndV:\n{id_}")

@@ -1,0 +1,241 @@
+"""Wells written as an expression in ``q``: ``{expression: "1 - cos(q)"}``.
+
+The text is parsed by sympy; ``V'`` is its symbolic derivative.  One generated Python source of
+``V(q)`` and ``dV(q)`` serves every consumer:
+
+* the theory (action-angle variables by quadrature, :class:`~safebasins.wells.numeric.NumericWell`)
+  runs it vectorised on numpy arrays;
+* the compiled engines run it through the well's compiled form (numerics.wellcode.callable_code),
+  compiled by numba for the CPU and by numba-cuda for the GPU; every product is written with
+  ``mul`` (never contracted into an fma by the GPU compiler).
+
+The generated source is what a user would write by hand (``1.0 - math.cos(q)``, ``math.sin(q)``):
+the same well given as a :class:`NumericWell` with the same arithmetic integrates bitwise alike.
+A side where ``V`` tends to a finite limit (sympy's ``limit``) is declared open at infinity with
+that limit as its escape energy (sech^2, Morse).
+
+Allowed: the variable ``q``, numbers, ``+ - * / **``, ``pi``, ``E`` and the functions of
+:data:`FUNCTIONS`.
+"""
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+
+from safebasins.wells.numeric import NumericWell
+
+__all__ = ["ExpressionWell", "expression", "FUNCTIONS"]
+
+#: functions an expression may use -> (math-module name, numpy function)
+FUNCTIONS = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "log": np.log, "sqrt": np.sqrt,
+             "sinh": np.sinh, "cosh": np.cosh, "tanh": np.tanh, "atan": np.arctan, "asinh": np.arcsinh}
+#: the ``math`` of the generated source when it runs on numpy arrays (the theory)
+_NUMPY_MATH = SimpleNamespace(pow=np.power, **FUNCTIONS)
+_NAMESPACE_NUMPY = {"math": _NUMPY_MATH, "mul": np.multiply}
+
+
+def _sympy():
+    import sympy
+
+    return sympy
+
+
+def parse(text):
+    """``(V, q)`` as sympy objects from the text of an expression in q; ValueError naming
+    ``expression`` for anything else."""
+    sp = _sympy()
+    if not isinstance(text, str) or not text.strip():
+        raise ValueError(f"expression must be a non-empty string in q, e.g. '1 - cos(q)', got {text!r}")
+    if "__" in text or any(c in text for c in ";\n"):
+        raise ValueError(f"expression: {text!r} is not a formula in q")
+    q = sp.Symbol("q", real=True)
+    names = {"q": q, "pi": sp.pi, "E": sp.E, "sech": sp.sech}
+    names.update({k: getattr(sp, k) for k in FUNCTIONS})
+    from sympy.parsing.sympy_parser import parse_expr, standard_transformations
+
+    try:
+        V = parse_expr(text, local_dict=names, global_dict={"Integer": sp.Integer, "Float": sp.Float,
+                                                            "Rational": sp.Rational, "Symbol": sp.Symbol},
+                       transformations=standard_transformations)
+    except Exception as exc:   # sympy raises SyntaxError, TokenError, TypeError, NameError ...
+        raise ValueError(f"expression: cannot read {text!r} as a formula in q ({type(exc).__name__}: {exc})") from None
+    if not isinstance(V, sp.Expr):
+        raise ValueError(f"expression: {text!r} is not a formula in q")
+    extra = sorted(str(s) for s in V.free_symbols if s != q)
+    if extra:
+        raise ValueError(f"expression: unknown name(s) {', '.join(extra)} in {text!r} (the only variable is q; "
+                         f"functions: {', '.join(sorted(FUNCTIONS))}, sech; constants pi, E)")
+    if q not in V.free_symbols:
+        raise ValueError(f"expression: {text!r} does not depend on q")
+    return V, q
+
+
+class _Printer:
+    """Python source of a sympy expression: ``math.<f>`` calls, products with ``mul`` (left to right),
+    quotients as ``/``, integer powers as repeated products."""
+
+    def __init__(self, q):
+        self.q = q
+        self.sp = _sympy()
+
+    def __call__(self, e):
+        sp = self.sp
+        if e == self.q:
+            return "q"
+        if e is sp.pi:
+            return repr(math.pi)
+        if e is sp.E:
+            return repr(math.e)
+        if e.is_Number:
+            if not e.is_real:
+                raise ValueError(f"expression: complex constant {e}")
+            return repr(float(e))
+        if e.is_Add:
+            return self._add(e)
+        if e.is_Mul:
+            return self._mul(e)
+        if e.is_Pow:
+            return self._pow(e.base, e.exp)
+        if isinstance(e, sp.sech):
+            return f"1.0 / math.cosh({self(e.args[0])})"
+        name = type(e).__name__
+        if isinstance(e, sp.Function) and name in FUNCTIONS and len(e.args) == 1:
+            return f"math.{name}({self(e.args[0])})"
+        raise ValueError(f"expression: {e} is not supported (functions: {', '.join(sorted(FUNCTIONS))}, sech)")
+
+    def _wrap(self, e):
+        s = self(e)
+        return f"({s})" if e.is_Add or (e.is_Number and float(e) < 0) else s
+
+    def _add(self, e):
+        terms = list(e.args)
+        out = self._wrap(terms[0]) if terms[0].is_Add else self(terms[0])
+        for t in terms[1:]:
+            if t.could_extract_minus_sign():
+                out = f"{out} - {self._term(-t)}"
+            else:
+                out = f"{out} + {self._term(t)}"
+        return out
+
+    def _term(self, t):
+        s = self(t)
+        return f"({s})" if t.is_Add or s.startswith("-") else s
+
+    def _product(self, factors):
+        out = None
+        for f in factors:
+            s = self._factor(f)
+            out = s if out is None else f"mul({out}, {s})"
+        return out
+
+    def _factor(self, f):
+        s = self(f)
+        return f"({s})" if f.is_Add or s.startswith("-") or " / " in s else s
+
+    def _mul(self, e):
+        sp = self.sp
+        if e.could_extract_minus_sign():
+            return f"-{self._factor(-e)}"
+        num, den = [], []
+        for f in e.args:
+            if f.is_Pow and f.exp.is_number and f.exp.is_negative:
+                den.append(sp.Pow(f.base, -f.exp, evaluate=False) if f.exp != -1 else f.base)
+            elif f.is_Rational and not f.is_Integer:
+                if f.p != 1:
+                    num.append(sp.Integer(f.p))
+                den.append(sp.Integer(f.q))
+            else:
+                num.append(f)
+        top = self._product(num) if num else "1.0"
+        if not den:
+            return top
+        return f"{top} / {self._factor(den[0]) if len(den) == 1 else '(' + self._product(den) + ')'}"
+
+    def _pow(self, b, x):
+        sp = self.sp
+        if x.is_Integer or (x.is_Float and float(x).is_integer()):
+            n = int(x)
+            if n == 0:
+                return "1.0"
+            if n < 0:
+                return f"1.0 / {self._factor(sp.Pow(b, -n, evaluate=False)) if n != -1 else self._factor(b)}"
+            return self._product([b] * n)
+        if x == sp.Rational(1, 2):
+            return f"math.sqrt({self(b)})"
+        if x == sp.Rational(-1, 2):
+            return f"1.0 / math.sqrt({self(b)})"
+        return f"math.pow({self(b)}, {self(x)})"
+
+
+def generate_source(V, q):
+    """(source text of ``V(q)`` and ``dV(q)``, the sympy derivative)."""
+    sp = _sympy()
+    dV = sp.diff(V, q)
+    pr = _Printer(q)
+    return f"def V(q):\n    return {pr(V)}\n\n\ndef dV(q):\n    return {pr(dV)}\n", dV
+
+
+def _functions(source, namespace):
+    ns = dict(namespace)
+    exec(compile(source, "<safebasins expression well>", "exec"), ns)   # our own generated text
+    return ns["V"], ns["dV"]
+
+
+def _limit(V, q, side):
+    """Finite limit of V as q -> side * inf, or None (unbounded or oscillating)."""
+    sp = _sympy()
+    try:
+        lim = sp.limit(V, q, side * sp.oo)
+    except (NotImplementedError, ValueError):
+        return None
+    if isinstance(lim, sp.AccumBounds) or not (lim.is_number and lim.is_finite and lim.is_real):
+        return None                        # unbounded, or oscillating (AccumBounds: 1 - cos q)
+    return float(lim)
+
+
+class ExpressionWell(NumericWell):
+    """A well ``V(q)`` given as text, e.g. ``ExpressionWell("1 - cos(q)")`` (the pendulum).
+
+    ``expression`` is kept as given; ``formula`` is sympy's reading of it, ``derivative`` its
+    V'(q), ``source`` the generated Python source of V and dV (what the engines compile).
+    Remaining keywords go to :class:`NumericWell` (``tol``, ``search_bound``, ...).
+    """
+
+    name = "expression"
+
+    def __init__(self, expression, *, name=None, **kwargs):
+        V, q = parse(expression)
+        self.expression = expression
+        self.formula = str(V)
+        self.source, dV = generate_source(V, q)
+        self.derivative = str(dV)
+        self._V_scalar, self._dV_scalar = _functions(self.source, {"math": math, "mul": _mul_stub()})
+        Vn, dVn = _functions(self.source, _NAMESPACE_NUMPY)
+        lims = (_limit(V, q, -1), _limit(V, q, 1))
+        if any(x is not None for x in lims):                     # TEMP until NumericWell takes asymptotes
+            kwargs.setdefault("asymptotes", lims)
+        super().__init__(Vn, dVn, name=name, **kwargs)
+
+    def _compiled_form(self):
+        from safebasins.numerics.wellcode import callable_code
+
+        return callable_code(self._V_scalar, self._dV_scalar, self.barriers, self.name, self.source)
+
+    def potential_text(self):
+        return self.formula
+
+    def spec(self):
+        return {"name": "expression", "expression": self.expression}
+
+
+def _mul_stub():
+    from safebasins.numerics.wellcode import mul
+
+    return mul
+
+
+def expression(text, **kwargs):
+    """The well ``V(q) = text`` (see :class:`ExpressionWell`)."""
+    return ExpressionWell(text, **kwargs)
