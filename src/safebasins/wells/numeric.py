@@ -30,7 +30,7 @@ with ``p > 0``; ``q(theta) = sum_k q_k e^{ik theta}``.  For the quartic ``q_1 = 
 ``arg q_1 = -pi/2`` and ``C = xi - Omega J + F |q_1| sin(gamma + arg q_1)`` is eq (18).
 
 Accuracy (measured for the quartic against the closed forms, asserted with margin in
-``tests/wells``): J, omega, |q_1| within 5e-15 relative for ``E <= 0.249``, 1e-15 at 0.2499,
+``tests/wells``): J, omega, ``|q_1|`` within 5e-15 relative for ``E <= 0.249``, 1e-15 at 0.2499,
 <= 3e-11 at ``E_b - E = 1e-12`` and ~1e-9 at the last float below ``E_b``; ``d|q_1|/dE``
 within 4e-12 for ``E <= 0.249``; angles within 2e-13 (``E <= 0.249``) and 1e-13 at 0.2499.
 Closer to the separatrix the angle of a given point is ill-conditioned (an error ``eps E_b``

@@ -218,7 +218,7 @@ class QuarticWell(Well):
         return a
 
     def check_displacement(self, name, q_max):
-        """Displacement threshold in (0, 1] (the barrier at |q| = 1)."""
+        """Displacement threshold in (0, 1] (the barrier at ``|q| = 1``)."""
         a = as_array(name, q_max)
         if ((a <= 0) | (a > 1)).any():
             raise ValueError(f"{name} must lie in (0, 1], got {value_repr(a)}")
