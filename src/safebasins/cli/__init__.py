@@ -9,7 +9,11 @@ kinds (same layout and variables as ``results/data``), adds the CF/provenance at
 options   option types and checks (library checks, library/schema defaults)
 output    provenance, progress bars, figures, atomic files, the `info` summary
 commands  the click group ``main`` (console script ``safebasins``) and its commands
+explore   the ``explore`` command: the interactive explorer (safebasins.explore) in a browser
 """
 from safebasins.cli.commands import main
+from safebasins.cli.explore import explore
+
+main.add_command(explore)
 
 __all__ = ["main"]

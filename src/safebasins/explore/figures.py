@@ -1,0 +1,121 @@
+"""The explorer's two Bokeh figures and their data sources.
+
+* ``ic_plane``: the plane of initial conditions (q0, p0): the slow-flow safe basin (light blue
+  image ``analytic_basin``), the numeric safe basin once integrated (grey image
+  ``numeric_basin``), the analytic boundaries (red lines, source ``boundary_source``) and the
+  unforced orbit H0 = xi_max (dashed);
+* ``manifold``: the resonance manifold (gamma, xi): the safe region (light blue), level curves of
+  C (grey), the limiting phase trajectory C = 0 through the well bottom (black) and the
+  threshold xi = xi_max (red dashed).
+
+Models carry names (``Bokeh.documents[0].get_model_by_name(...)`` in the browser, and the tests).
+"""
+from __future__ import annotations
+
+import numpy as np
+from bokeh.models import ColumnDataSource, LinearColorMapper, Range1d, Span
+from bokeh.plotting import figure
+from bokeh.plotting.contour import contour_data
+
+from safebasins.explore.ranges import WellRanges
+
+__all__ = ["Figures", "key"]
+
+SAFE_COLOR = "#9ecae1"
+NUMERIC_COLOR = "#404040"
+BOUNDARY_COLOR = "#d62728"
+LEVEL_COLOR = "#8c8c8c"
+TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
+
+
+def _swatch(color, alpha=1.0, dashed=False):
+    if dashed:
+        return '<span style="display:inline-block;width:18px;border-top:2px dashed black;vertical-align:middle"></span>'
+    return (f'<span style="display:inline-block;width:14px;height:10px;background:{color};opacity:{alpha};'
+            'vertical-align:middle"></span>')
+
+
+def key() -> str:
+    """HTML key of the colours of both figures."""
+    items = [(_swatch(SAFE_COLOR), "slow-flow safe"), (_swatch(NUMERIC_COLOR, 0.55), "numeric safe (after a run)"),
+             (_swatch(BOUNDARY_COLOR), "analytic boundary (eqs 27-28), xi = xi_max"),
+             (_swatch(None, dashed=True), "unforced orbit H0 = xi_max"),
+             (_swatch(LEVEL_COLOR), "level curves of C"), (_swatch("black"), "C = 0 through the well bottom")]
+    return " &nbsp; ".join(f"{sw}&nbsp;{label}" for sw, label in items)
+
+
+def _mask_image(mask, x_window, y_window):
+    """Image data of a boolean mask (rows = y): 1 where True, NaN (transparent) elsewhere."""
+    img = np.where(np.asarray(mask, dtype=bool), 1.0, np.nan)
+    return {"image": [img], "x": [x_window[0]], "y": [y_window[0]],
+            "dw": [x_window[1] - x_window[0]], "dh": [y_window[1] - y_window[0]]}
+
+
+def _mapper(color):
+    return LinearColorMapper(palette=[color], low=0.0, high=2.0, nan_color=(0, 0, 0, 0))
+
+
+class Figures:
+    """Both figures, built for one well's windows and a first pair of pictures."""
+
+    def __init__(self, r: WellRanges, ic: dict, rm: dict):
+        self.ic = figure(name="ic_plane", title="Initial conditions: slow-flow safe basin",
+                         x_axis_label="q0", y_axis_label="p0", width=500, height=440, tools=TOOLS,
+                         x_range=Range1d(*r.q_window), y_range=Range1d(*r.p_window))
+        self.analytic_source = ColumnDataSource(name="analytic_source",
+                                                data=_mask_image(ic["safe"].T, r.q_window, r.p_window))
+        self.ic.image(source=self.analytic_source, color_mapper=_mapper(SAFE_COLOR), name="analytic_basin")
+        self.numeric_source = ColumnDataSource(name="numeric_source",
+                                               data=_mask_image(np.zeros((2, 2), bool), r.q_window, r.p_window))
+        self.numeric = self.ic.image(source=self.numeric_source, color_mapper=_mapper(NUMERIC_COLOR),
+                                     global_alpha=0.55, name="numeric_basin", visible=False)
+        xs, ys, _ = ic["boundaries"]
+        self.boundary_source = ColumnDataSource(name="boundary_source", data={"xs": xs, "ys": ys})
+        self.ic.multi_line(xs="xs", ys="ys", source=self.boundary_source, line_color=BOUNDARY_COLOR, line_width=2,
+                           name="boundaries")
+        q, p = ic["orbit"]
+        self.orbit_source = ColumnDataSource(name="orbit_source", data={"q": q, "p": p})
+        self.ic.line(x="q", y="p", source=self.orbit_source, line_color="black", line_dash="dashed", name="orbit")
+
+        self.rm = figure(name="manifold", title="Resonance manifold: level curves of C (eq 18)",
+                         x_axis_label="gamma", y_axis_label="xi", width=500, height=440, tools=TOOLS,
+                         x_range=Range1d(-np.pi, np.pi), y_range=Range1d(0.0, r.xi_top))
+        self.rm_source = ColumnDataSource(name="manifold_source", data=self._rm_image(rm))
+        self.rm.image(source=self.rm_source, color_mapper=_mapper(SAFE_COLOR), name="manifold_safe")
+        self.levels = self.rm.contour(rm["gamma"], rm["xi"], rm["C"], rm["levels"], line_color=LEVEL_COLOR,
+                                      line_width=1, fill_color=None)
+        self.lpt = self.rm.contour(rm["gamma"], rm["xi"], rm["C"], [0.0], line_color="black", line_width=2,
+                                   fill_color=None)
+        self.levels.name, self.lpt.name = "levels", "lpt"
+        self.threshold = Span(location=0.0, dimension="width", line_color=BOUNDARY_COLOR, line_dash="dashed",
+                              line_width=2, name="threshold")
+        self.rm.add_layout(self.threshold)
+
+    @staticmethod
+    def _rm_image(rm):
+        g, x = rm["gamma"], rm["xi"]
+        return _mask_image(~rm["escapes"], (g[0], g[-1]), (x[0], x[-1]))
+
+    def set_windows(self, r: WellRanges):
+        """Axes of a new well."""
+        self.ic.x_range.update(start=r.q_window[0], end=r.q_window[1])
+        self.ic.y_range.update(start=r.p_window[0], end=r.p_window[1])
+        self.rm.y_range.update(start=0.0, end=r.xi_top)
+
+    def show(self, r: WellRanges, xi_max: float, ic: dict, rm: dict):
+        """Redraw both pictures (the numeric basin is hidden: it belongs to other parameters)."""
+        self.numeric.visible = False
+        self.analytic_source.data = _mask_image(ic["safe"].T, r.q_window, r.p_window)
+        xs, ys, _ = ic["boundaries"]
+        self.boundary_source.data = {"xs": xs, "ys": ys}
+        q, p = ic["orbit"]
+        self.orbit_source.data = {"q": q, "p": p}
+        self.rm_source.data = self._rm_image(rm)
+        self.levels.set_data(contour_data(rm["gamma"], rm["xi"], rm["C"], rm["levels"], want_fill=False))
+        self.lpt.set_data(contour_data(rm["gamma"], rm["xi"], rm["C"], [0.0], want_fill=False))
+        self.threshold.location = xi_max
+
+    def show_numeric(self, r: WellRanges, safe):
+        """Show a numeric safe mask (q0, p0) over the analytic basin."""
+        self.numeric_source.data = _mask_image(safe.T, r.q_window, r.p_window)
+        self.numeric.visible = True
