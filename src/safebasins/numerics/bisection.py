@@ -31,8 +31,8 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     Bisection: all Omega points advance together, one compiled ensemble per bisection level,
     until the bracket [F_lo (no escape within `cycles`), F_hi (escape)] is narrower than tol;
     F_cr = (F_lo + F_hi) / 2 (NaN where F_bracket[1] does not escape or F_bracket[0] does).
-    criterion "energy": escape when H0 > xi_max (or q beyond a barrier: |q| > 1 for the quartic);
-    "displacement": q outside the turning points of the energy level xi_max, |q| > q_max(xi_max)
+    criterion "energy": escape when H0 > xi_max (or q beyond a barrier: ``|q| > 1`` for the quartic);
+    "displacement": q outside the turning points of the energy level xi_max, ``|q| > q_max(xi_max)``
     (eq 4) for the quartic, q < q_minus(xi_max) or q > q_plus(xi_max) (well.turning_points) for
     any other well.  well: None (the quartic) or a polynomial well (see escape_chart); xi_max in
     (0, its barrier energy].  Escape is not monotone in F near the resonance minimum, so a scan on n_scan

@@ -64,9 +64,9 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=()
         same compiled engine (numerics.criteria).  Dataset attrs `well`, `well_potential`,
         `well_barriers`, `escape_criteria` name it.
     xi_max : energy thresholds in (0, barrier energy]: H0 = p^2/2 + V(q) > xi_max means escape
-        (eq 7).  q beyond a barrier (quartic: |q| > 1; in general q > q_right or q < q_left; a
+        (eq 7).  q beyond a barrier (quartic: ``|q| > 1``; in general q > q_right or q < q_left; a
         side without barrier never escapes that way) also counts as energy escape.
-    q_max : symmetric displacement thresholds, |q| > q_max means escape (q_max(xi_max): eq 4),
+    q_max : symmetric displacement thresholds, ``|q| > q_max`` means escape (q_max(xi_max): eq 4),
         q_max up to the nearest barrier.
     q_bounds : asymmetric displacement bounds, pairs (lo, hi) (shape (n, 2); one pair may be
         given as (lo, hi)): q < lo or q > hi means escape; lo < 0 < hi, inside the barriers.

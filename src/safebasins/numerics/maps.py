@@ -16,21 +16,29 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
                      steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None, integrator=engine.DEFAULT_INTEGRATOR):
     """Period-map iterates (q(nT), p(nT)), T = 2 pi / Omega, n = 0..n_iter, of paired ICs.
 
-    q0, p0 : paired initial conditions of equal shape (flattened in C order to dim 'sample').
-    xi_max : energy threshold (None: no energy criterion); q_max: displacement threshold
-        (None: none); q_bounds: one asymmetric displacement bound pair (lo, hi) (None: none).
-        A trajectory has escaped once it crosses ANY given threshold (energy: H0 > xi_max or
-        q beyond a barrier; displacement: |q| > q_max, q < lo or q > hi); its iterates from
-        that period on are NaN and it is no longer integrated.  q_max and q_bounds must be
-        nested.
-    well : None (the quartic) or a polynomial well (see escape_chart).
-    integrator : "srkn6b" (default) or "rk4" (see escape_chart).
+    Parameters
+    ----------
+    q0, p0
+        Paired initial conditions of equal shape (flattened in C order to dim 'sample').
+    xi_max, q_max, q_bounds
+        Energy threshold (None: no energy criterion); displacement threshold (None: none); one
+        asymmetric displacement bound pair (lo, hi) (None: none).  A trajectory has escaped
+        once it crosses ANY given threshold (energy: H0 > xi_max or q beyond a barrier;
+        displacement: ``|q| > q_max``, q < lo or q > hi); its iterates from that period on are
+        NaN and it is no longer integrated.  q_max and q_bounds must be nested.
+    well
+        None (the quartic) or a polynomial well (see escape_chart).
+    integrator
+        "srkn6b" (default) or "rk4" (see escape_chart).
 
-    Returns xr.Dataset with q, p (sample, iteration) (iteration 0 = the IC), escaped (sample,
-    bool), escape_cycle (sample; step / steps_per_cycle, +inf = not within n_iter cycles),
-    q0, p0 (sample); attrs F, Omega, Psi, xi_max, q_max, n_iter, steps_per_cycle, integrator,
-    well (name), well_potential, well_barriers, escape_criteria, and q_lower, q_upper when
-    q_bounds is given.
+    Returns
+    -------
+    xr.Dataset
+        q, p (sample, iteration) (iteration 0 = the IC), escaped (sample, bool), escape_cycle
+        (sample; step / steps_per_cycle, +inf = not within n_iter cycles), q0, p0 (sample);
+        attrs F, Omega, Psi, xi_max, q_max, n_iter, steps_per_cycle, integrator, well (name),
+        well_potential, well_barriers, escape_criteria, and q_lower, q_upper when q_bounds is
+        given.
     """
     qa = checks.check_finite("q0", q0)
     pa = checks.check_finite("p0", p0)
