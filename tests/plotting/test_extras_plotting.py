@@ -29,7 +29,8 @@ def test_three_figures(toy, tmp_path):  # noqa: F811
     ta = phase_invariant.true_safe_basin_analytic(0.01, 0.9, 0.18, Q, P, n_psi=6)
     tn = phase_invariant.true_safe_basin_numeric(0.01, 0.9, 0.18, Q, P, n_psi=4, t_eval=[50, 100], cycles=100)
     fig = plotting_extras.figure_true_basin(ta, tn)
-    assert len(fig.axes) == 2 and "GIM" in fig.axes[0].get_title() and "GIM" in fig.axes[1].get_title()
+    assert len(fig.axes) == 3 and "GIM" in fig.axes[0].get_title() and "GIM" in fig.axes[1].get_title()
+    assert "Psi" in fig.axes[2].get_ylabel()  # the colour bar of the per-phase outlines
     render(fig, tmp_path, "extra_true_basin")
 
     fc = fourier_compare.fcr_fourier_comparison([0.8, 0.9, 1.0], 0.2).assign_attrs(source_experiment="fig10")

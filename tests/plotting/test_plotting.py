@@ -13,7 +13,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 import xarray as xr  # noqa: E402
 
-from safebasins.plotting import basins, charts, fcr, maps  # noqa: E402
+from safebasins.plotting import basins, charts, curves, fcr, maps  # noqa: E402
 from safebasins.plotting.captions import notes  # noqa: E402
 from safebasins.plotting.style import SB_EDGE, fmt_value, save_figure  # noqa: E402
 
@@ -238,7 +238,7 @@ def test_period_map_criteria_dsb_area(tmp_path):
     text = " ".join(notes(fig))
     assert "1 island chain" in text and "period 3" in text and "Stochastic layer: 1 orbit" in text
     assert "only 4 of these 6 orbits survive" in text  # energy-criterion escapes read from the data
-    assert any(t.get_text() == "1:3" for t in fig.axes[0].texts)  # the chain is labelled
+    assert any(t.get_text() == "1:3 (A)" for t in fig.axes[0].texts)  # the chain is labelled m:k by its rotation
     render(fig, tmp_path, "strobe")
     fig = charts.figure_criteria(criteria())
     colors = [ln.get_color() for ln in fig.axes[0].lines if ln.get_marker() == "o"]
@@ -249,9 +249,13 @@ def test_period_map_criteria_dsb_area(tmp_path):
     render(fig, tmp_path, "dsb")
     chart = dsb_esb()
     fig = charts.figure_area_vs_time(chart, None, t_evals=list(range(50, 1001, 50)))
-    ls = sorted(ln.get_linestyle() for ln in fig.axes[0].lines if ln.get_linestyle() in ("-", "--"))
-    assert ls == ["-", "--"]
-    assert fig.axes[0].get_xscale() == "log" and fig.axes[0].get_xlim()[0] == 1.0  # the early transient shows
+    for ax in fig.axes[:2]:
+        ls = sorted(ln.get_linestyle() for ln in ax.lines if ln.get_linestyle() in ("-", "--"))
+        assert ls == ["-", "--"]
+    lin, log = fig.axes[:2]
+    assert lin.get_xscale() == "linear" and lin.lines[0].get_marker() == "o"  # as in the paper: points per t_eval
+    assert len(lin.lines[0].get_xdata()) == 20
+    assert log.get_xscale() == "log" and log.get_xlim()[0] == 1.0  # the early transient shows
     ec = chart["escape_cycle_energy"].values
     last = ec[np.isfinite(ec)].max()
     assert f"loses its last pixel at {charts.ec(last)} and keeps {int(np.isinf(ec).sum()):,} pixels" in \
@@ -267,8 +271,9 @@ def test_settle_time_and_coincident_curves():
     circle = (0, np.cos(s), np.sin(s))
     same = (1, np.cos(s[::-1]), np.sin(s[::-1]))        # the same curve, other direction and slice
     other = (2, 1.1 * np.cos(s), 1.1 * np.sin(s))
-    assert charts.coincident_groups([circle, same, other], tol=0.01) == [[0, 1]]
-    assert charts.coincident_groups([circle, other], tol=0.2) == [[0, 1]]
+    assert [g for g, _ in charts.coincident_groups([circle, same, other], tol=0.01)] == [[0, 1]]
+    (g, d), = charts.coincident_groups([circle, other], tol=0.2)
+    assert g == [0, 1] and 0.09 < d < 0.11  # the largest distance between the two is reported
 
 
 def test_nested_basins_draw_shared_boundaries_in_alternating_colours(tmp_path):
@@ -287,7 +292,7 @@ def test_exact_names_fail_loudly():
     ds = rm_basin().drop_vars("q0_vertex")
     ds.encoding["source"] = "results/data/analytic/basin_figXX.nc"
     with pytest.raises(KeyError, match="basin_figXX.nc.*'q0_vertex'"):
-        basins.boundary_polylines(ds, "q0_vertex", "p0_vertex")
+        curves.boundary_polylines(ds, "q0_vertex", "p0_vertex")
     with pytest.raises(KeyError, match="'saddle_gamma'"):
         basins.figure_rm_basin(rm_basin().drop_attrs(deep=False).assign_attrs(F=0.1, Omega=0.9, Psi=0.0, xi_max=0.2))
     plt.close("all")
@@ -297,12 +302,12 @@ def test_fmt_and_boundary_polylines():
     assert fmt_value(np.pi, "Psi") == r"$\pi$"
     assert fmt_value(1.0, "Psi") == "1"
     assert fmt_value(5e-5) == "5e-05"
-    polys = basins.boundary_polylines(rm_basin(), "q0_vertex", "p0_vertex")
+    polys = curves.boundary_polylines(rm_basin(), "q0_vertex", "p0_vertex")
     assert len(polys) == 2 and polys[1][2] == "saddle"
 
 
 def test_break_wraps():
-    x, y = basins.break_wraps([3.0, 3.1, -3.1, -3.0], [0, 1, 2, 3])
+    x, y = curves.break_wraps([3.0, 3.1, -3.1, -3.0], [0, 1, 2, 3])
     assert np.isnan(x[2]) and x.size == 5
 
 
@@ -312,14 +317,15 @@ def test_interior_curves_are_not_drawn_as_boundaries():
     Q, P = np.meshgrid(q0, p0, indexing="ij")
     safe = xr.DataArray(np.hypot(Q, P) < 0.6, dims=("q0", "p0"), coords=dict(q0=q0, p0=p0))
     t = np.linspace(0, 2 * np.pi, 80)
-    assert basins.separates_mask(0.6 * np.cos(t), 0.6 * np.sin(t), safe)       # the edge
-    assert not basins.separates_mask(0.3 * np.cos(t), 0.3 * np.sin(t), safe)   # inside the basin
-    assert not basins.separates_mask(0.9 * np.cos(t), 0.9 * np.sin(t), safe)   # in the escape region
+    assert curves.separates_mask(0.6 * np.cos(t), 0.6 * np.sin(t), safe)       # the edge
+    assert not curves.separates_mask(0.3 * np.cos(t), 0.3 * np.sin(t), safe)   # inside the basin
+    assert not curves.separates_mask(0.9 * np.cos(t), 0.9 * np.sin(t), safe)   # in the escape region
 
 
 def test_rm_basin_marks_parts_the_numerics_do_not_keep(tmp_path):
-    """A slow-flow island where no IC stays in the stored numeric check is drawn dotted/hatched
-    and left out of the title's (paper's) classification; the caption gives the fractions."""
+    """A slow-flow part that fewer than half of its ICs survive in the stored numeric check is
+    drawn dotted/hatched and named apart in the title's (paper's) classification; the caption
+    gives the rule and the fractions."""
     ds = rm_basin()
     Q, P = np.meshgrid(ds.q0.values, ds.p0.values, indexing="ij")
     blob = np.hypot(Q - 0.7, P - 0.5) < 0.15
@@ -335,18 +341,19 @@ def test_rm_basin_marks_parts_the_numerics_do_not_keep(tmp_path):
     region = np.where(Q**2 + P**2 <= 0.2, 1, np.where(blob, 2, 0))
     ds["region"] = (("q0", "p0"), region)
     ds["region_size"] = ("region_index", [(region == 1).sum(), (region == 2).sum()])
-    ds["region_numeric_safe"] = ("region_index", [0.9, 0.0])
+    ds["region_numeric_safe"] = ("region_index", [0.9, 0.3])
     ds.attrs["check_cycles"] = 100
     assert basins.unconfirmed_parts(ds)[0] == {1}
     fig = basins.figure_rm_basin(ds)
-    assert fig._suptitle.get_text().endswith("[saddle type (SBST)]")
+    assert fig._suptitle.get_text().endswith("[saddle type (SBST); not confirmed: maximum type (SBMT), island]")
     text = " ".join(notes(fig))
-    assert "90.0% stay" in text and "1 further part" in text and "none stays" in text
+    assert "Part 1: " in text and "90.0% stay (confirmed)" in text and "30.0% stay (not confirmed)" in text
+    assert f"at least {100 * basins.CONFIRMED_FROM:.0f}% of its ICs stay" in text
     dotted = [a for a in fig.axes[1].lines + fig.axes[1].patches if a.get_linestyle() in (":", "dotted")]
     assert dotted, "the unconfirmed island is drawn dotted"
     render(fig, tmp_path, "rm_unconfirmed")
 
 
 def test_join_seams_removes_zero_length_gaps():
-    x, y = basins.join_seams([0.0, 1.0, np.nan, 1.0, 2.0, np.nan, 5.0], [0, 1, np.nan, 1, 0, np.nan, 3])
+    x, y = curves.join_seams([0.0, 1.0, np.nan, 1.0, 2.0, np.nan, 5.0], [0, 1, np.nan, 1, 0, np.nan, 3])
     assert np.isnan(x).sum() == 1 and x.size == 6

@@ -27,10 +27,14 @@ class Declaration:
 
 
 _SB_LEFT_RIGHT = ('Left: level curves of the first integral C(γ, ξ) of eq. (18) on the resonance-manifold '
-     'cylinder (γ from -π to π in every figure), the truncation level ξ = ξ_max (thick blue dashed line) '
-     'and the safe basin (grey region with red boundary). Right: the same safe basin mapped to the plane of initial '
-     'conditions (q0, p0) with eqs. (15), (17); the thin dashed oval is the edge of the unforced '
-     'well H0 = ξ_max.')
+     'cylinder (γ from -π to π, widened just enough that a part of the basin crossing the cut γ = ±π is drawn '
+     'whole, the cut then marked by dotted verticals), the truncation level ξ = ξ_max (thick blue dashed line), '
+     'energies above the barrier (light grey band) and the safe basin (grey region with red boundary). Right: the '
+     'same safe basin mapped to the plane of initial conditions (q0, p0) with eqs. (15), (17); the thin dashed oval '
+     'is the edge of the unforced well H0 = ξ_max. Numeric check (one rule for Figs 5-9, stated with its numbers '
+     'below): orange hatching marks the analytic-safe ICs that escape in the numerics; a connected part of the '
+     'basin that the numerics do not confirm has a dotted dark-orange boundary on both panels and is left out of '
+     'the classification in the title.')
 
 _NESTED = ('Grey regions: numeric safe basins (escape chart of eq. (1), energy criterion, t_eval = the '
      'integration horizon) shaded by the scanned parameter; the shading is painted from the '
@@ -38,7 +42,8 @@ _NESTED = ('Grey regions: numeric safe basins (escape chart of eq. (1), energy c
      'ones and white is escape common to all values. Coloured curves: analytic boundaries '
      '(isolated-resonance approximation) for the same parameter values, matched by colour and line '
      'style in the legend, which also gives the stored analytic/numeric intersection over union '
-     '(IoU).')
+     '(IoU). Boundaries of several values that run within a few chart pixels of each other are drawn as '
+     'one line of alternating colours and named in the legend.')
 
 DECLARATIONS = (
     Declaration(
@@ -68,11 +73,13 @@ DECLARATIONS = (
         caption=('Escape threshold versus excitation frequency for the zero IC and the truncation '
                  'energy level ξ_max = 0.15. Dotted, solid and dashed lines correspond to SMM, SM '
                  'and MM, respectively.'),
-        look=('The overall threshold (thick) is coloured and styled by the mechanism that sets it: '
-              'MM through the tangent point at γ* = π (green dashed), SM (blue solid), SMM (red dotted); '
-              'thin faint lines in the same colour and style continue each branch where it is not the '
-              'smallest, and a branch that never sets F_cr (MM through γ* = 0, purple dash-dot) appears '
-              'thin only; the legend lists every branch drawn.')),
+        look=('The overall threshold F_cr (thick) is coloured and styled by the mechanism that sets it: '
+              'MM through the tangent point at γ* = 0 (purple dash-dot) or γ* = π (green dashed), SM (blue '
+              'solid), SMM (red dotted). F_cr is the largest of the branches at each Ω, not the smallest: the '
+              'IC escapes only once F exceeds every obstacle its level curve meets, so the operative branch is '
+              'the top one and a lower branch cannot cause escape (below). Thin lines in the same colour and '
+              'style continue each branch where it lies below F_cr; a branch that never sets F_cr appears thin '
+              'only. The legend lists every branch drawn.')),
     Declaration(
         name="fig04", kind="fcr_theory", key=("figures", "fig04"), stem="fig04_fcr_xi_max",
         label="Fig. 4", category="Figures", options={'color_by': 'curve', 'show_branches': False, 'F_max': None},
@@ -115,16 +122,16 @@ DECLARATIONS = (
         caption=('SBST for the parameters F = 0.0876, Ω = 0.57. Thick dashed line corresponds to '
                  'truncation level ξ_max = 0.2499.'),
         look=_SB_LEFT_RIGHT + " " + ('Saddle type: the boundary passes through the saddle (open circle) of C; the safe '
-              'region lies between it and ξ = 0. Parts of the slow-flow basin where no IC stays in the numeric '
-              'check are dotted / hatched orange and left out of the classification in the title.')),
+              'region lies between it and ξ = 0. The thin slow-flow islands just below ξ_max are marked by the '
+              'numeric check.')),
     Declaration(
         name="fig09", kind="basin_rm", key=("figures", "fig09"), stem="fig09_sb_coexisting",
         label="Fig. 9", category="Figures", options={},
         title='Coexisting safe basins of both types (F = 0.0478, Omega = 0.76, xi_max = 0.235)',
         caption=('Co-existence of two types of SB with parameters F = 0.0478, Ω = 0.76. Thick '
                  'dashed line corresponds to truncation level ξ_max = 0.235.'),
-        look=_SB_LEFT_RIGHT + " " + ('Both a maximum-type and a saddle-type region exist, so the safe basin on (q0, p0) '
-              'is made of two disjoint parts.')),
+        look=_SB_LEFT_RIGHT + " " + ('Both a maximum-type and a saddle-type region exist, so the slow-flow safe basin on '
+              '(q0, p0) is made of two disjoint parts; the numeric check judges each part on its own.')),
     Declaration(
         name="fig10", kind="fcr_compare", key=("figures", "fig10"), stem="fig10_fcr_numeric_zero_ic",
         label="Fig. 10", category="Figures", options={'layout': 'panels', 'bracket': True, 'F_max': None},
@@ -144,7 +151,9 @@ DECLARATIONS = (
         caption=('Escape threshold versus excitation frequency for various values of ξ_ini and '
                  'ξ_max = 0.242, γ_ini = 0.25, Ψ = π. The notation is the same as in Figure 10.'),
         look=('Theory lines and numeric markers share a colour (qualitative palette) and each curve has '
-              'its own marker shape; black bars with a ring mark the non-monotone escape brackets.')),
+              'its own marker shape; black bars with a ring mark the non-monotone escape brackets. The error is '
+              'split below by the mechanism of the theory: the SM side (below the resonance, where F_cr is '
+              'large) and the MM side.')),
     Declaration(
         name="fig12", kind="fcr_compare", key=("figures", "fig12"), stem="fig12_fcr_numeric_gamma_ini",
         label="Fig. 12", category="Figures", options={'layout': 'overlay', 'bracket': True, 'F_max': None},
@@ -153,7 +162,9 @@ DECLARATIONS = (
         caption=('Escape threshold versus excitation frequency for various values of γ_ini and '
                  'ξ_max = 0.242, ξ_ini = 0.15, Ψ = π. The notation is the same as in Figure 10.'),
         look=('Theory lines and numeric markers share a colour (qualitative palette) and each curve has '
-              'its own marker shape; black bars with a ring mark the non-monotone escape brackets.')),
+              'its own marker shape; black bars with a ring mark the non-monotone escape brackets. The error is '
+              'split below by the mechanism of the theory: the SM side (below the resonance, where F_cr is '
+              'large) and the MM side.')),
     Declaration(
         name="fig13", kind="basin_chart", key=("figures", "fig13"), stem="fig13_sb_xi_max_a",
         label="Fig. 13", category="Figures", options={},
@@ -203,7 +214,8 @@ DECLARATIONS = (
         look=('Stroboscopic points of each orbit, coloured by its class (safebasins.analysis.period_map): '
               'tori of the main island in blue (darker = larger rotation number about the central elliptic '
               'fixed point, x), each island chain in its own colour with its elliptic periodic orbit (+, '
-              'found by Newton) and the label 1:k of its k-periodic solution (the paper\'s naming), chaotic '
+              'found by Newton), labelled m:k by its rotation number m/k about the centre (the paper\'s 1:6) or, '
+              'when it does not turn about the centre (rotation 0), by its period k, and a letter; chaotic '
               'orbits of the stochastic layer in black. Green circles: the line of initial conditions drawn '
               'first, the rest are seeded random. Dashed: the theoretical SB boundary; dotted: the well edge '
               'H0 = ξ_max. The escape criterion of the map is in the title.')),
@@ -226,7 +238,8 @@ DECLARATIONS = (
                  'the resolution is 300×300. Left: t_eval = 500 EC. Right: t_eval = 11,000 EC, DSB '
                  '(grey) and ESB (black).'),
         look=('DSB (grey) under ESB (black); left the first, right the last evaluation time of the '
-              'experiment (panel titles). A pixel is safe when its trajectory has not escaped by t_eval.')),
+              'experiment (panel titles). A pixel is safe when its trajectory has not escaped by t_eval. Whether '
+              'the paper\'s transient irregularity at the short t_eval is reproduced is said below.')),
     Declaration(
         name="fig21", kind="chart", key=("figures", "fig21"), stem="fig21_dsb_esb_full",
         label="Fig. 21", category="Figures", options={'t_evals': None},
@@ -235,17 +248,18 @@ DECLARATIONS = (
                  'the resolution is 300×300. Left: t_eval = 500 EC. Right: t_eval = 11,000 EC, DSB '
                  '(grey) and ESB (black).'),
         look=('Full view of the basins of Figure 20: DSB (grey) under ESB (black), left the first, right the '
-              'last evaluation time.')),
+              'last evaluation time. Whether the paper\'s transient irregularity is reproduced is said below.')),
     Declaration(
         name="fig22", kind="area_time", key=("figures", "fig22"), stem="fig22_sb_area_vs_time",
         label="Fig. 22", category="Figures", options={'t_evals': None},
         title='Safe-basin area versus evaluation time (read from the Fig 21 chart)',
         caption=('Log of SB area in pixels fading with t_eval for DSB (dashed) and ESB (solid), F '
                  '= 0.0876, Ω = 0.95, Ψ = π, ξ_max = 0.25, the resolution is 300×300.'),
-        look=('Natural log of the number of safe pixels of the Figure 21 chart versus the evaluation time on '
-              'a logarithmic axis starting at one cycle (so that the early transient shows), DSB dashed, ESB '
-              'solid; dotted verticals mark the last energy escape and the time from which the DSB area stays '
-              'close to its final value.')),
+        look=('Natural log of the number of safe pixels of the Figure 21 chart versus the evaluation time, DSB '
+              'dashed, ESB solid. Left, as in the paper: a linear time axis with one point per configured '
+              't_eval. Right: a logarithmic axis starting at one cycle, so that the early transient shows. Dotted '
+              'verticals mark the last energy escape and the time from which the DSB area stays close to its '
+              'final value. Whether the paper\'s shrinking over about 2000 EC is reproduced is said below.')),
     Declaration(
         name="extra_erosion", kind="erosion", key=("extras", "erosion"), stem="extra_erosion",
         label='Erosion profiles: integrity measures versus forcing amplitude', category="Beyond the paper", options={'measures': ['GIM', 'LIM', 'IF'], 'xi_max': None, 't_eval': None},
@@ -268,7 +282,7 @@ DECLARATIONS = (
                  'the safe basins over equispaced phases, slow flow (left) and numerics (right), F '
                  '= 0.01, Ω = 0.9, ξ_max = 0.18.'),
         look=('Light grey: safe for at least one phase; thin outlines: the per-phase basins coloured by '
-              'Ψ (analytic panel: the slow flow\'s boundary curves; numeric panel: outlines of the chart '
+              'Ψ (colour bar; analytic panel: the slow flow\'s boundary curves; numeric panel: outlines of the chart '
               'pixels); green: safe for every sampled phase, with its IF disk (thick purple, + at the '
               'centre) and LIM disk (red dashed, drawn on top: where the two coincide the outline is purple '
               'and red). The dotted black oval, on both panels, is the analytic all-phase basin H0 = ξ_true '
@@ -353,8 +367,8 @@ DECLARATIONS += (
         title="Escape equation: phase-invariant (true) safe basin, intersection over Psi",
         caption=_CUBIC_NOTE + " Initial conditions safe whatever the forcing phase Ψ, slow flow (left) "
                 "and numerics (right).",
-        look=("Green: safe for every sampled phase; thin outlines: the per-phase basins coloured by Ψ; "
-              "dotted oval: the analytic all-phase basin H0 = ξ_true.")),
+        look=("Green: safe for every sampled phase; thin outlines: the per-phase basins coloured by Ψ (colour "
+              "bar); dotted oval: the analytic all-phase basin H0 = ξ_true.")),
 )
 
 BY_NAME = {d.name: d for d in DECLARATIONS}

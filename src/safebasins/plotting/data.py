@@ -1,8 +1,10 @@
 """Reading datasets for figures: exact names only (docs/contracts.md).
 
-A figure reads what the pipeline wrote and never recomputes physics.  Every read names the
-variable or parameter exactly; a missing one is a ``KeyError`` naming the dataset (its file)
-and the name, never a silent fallback to another spelling.
+A figure reads what the pipeline (or the API) wrote and never recomputes physics.  Every read
+names the variable or parameter exactly; a missing one is a :class:`MissingData` naming the
+dataset (its file) and the name, never a silent fallback to another spelling.  ``MissingData``
+is both a ``KeyError`` (a lookup that failed) and a ``ValueError`` (a dataset unfit for the
+figure: what the public plotting functions document).
 """
 from __future__ import annotations
 
@@ -24,26 +26,33 @@ def open_dataset(src):
     return out
 
 
+class MissingData(KeyError, ValueError):
+    """A dataset lacks a variable, coordinate or attribute a figure needs (the message names it)."""
+
+    def __str__(self):  # KeyError would print the message quoted
+        return str(self.args[0]) if self.args else ""
+
+
 def source(ds) -> str:
     return ds.encoding.get("source", "<dataset>")
 
 
 def var(ds, name):
-    """Data variable or coordinate ``name``; KeyError naming the dataset if absent."""
+    """Data variable or coordinate ``name``; MissingData naming the dataset if absent."""
     if name not in ds.variables:
-        raise KeyError(f"{source(ds)}: no variable {name!r} (it has {sorted(map(str, ds.variables))})")
+        raise MissingData(f"{source(ds)}: no variable {name!r} (it has {sorted(map(str, ds.variables))})")
     return ds[name]
 
 
 def param(ds, name):
     """A parameter of a dataset: its global attribute, or its coordinate when the dataset is
-    stacked over it with a single value (docs/contracts.md).  KeyError naming both if absent."""
+    stacked over it with a single value (docs/contracts.md).  MissingData naming both if absent."""
     if name in ds.attrs:
         v = ds.attrs[name]
         return v.item() if isinstance(v, np.ndarray) and v.size == 1 else v
     if name in ds.coords and ds[name].size == 1:
         return ds[name].item()
-    raise KeyError(f"{source(ds)}: no attribute or single-valued coordinate {name!r}")
+    raise MissingData(f"{source(ds)}: no attribute or single-valued coordinate {name!r}")
 
 
 def well(ds):
@@ -51,8 +60,58 @@ def well(ds):
     from safebasins.wells import from_attrs
 
     if "well" not in ds.attrs:
-        raise KeyError(f"{source(ds)}: no attribute 'well' (datasets name their potential well)")
+        raise MissingData(f"{source(ds)}: no attribute 'well' (datasets name their potential well)")
     return from_attrs(ds.attrs)
+
+
+#: dataset attributes written into saved figures (io.datasets.finalize: provenance; wells.spec_attrs)
+PROVENANCE = ("title", "safebasins_version", "git_commit", "config_hash", "well", "well_coefficients", "parameters")
+_PROVENANCE_ATTR = "_safebasins_datasets"
+
+
+def attach(fig, *datasets):
+    """Remember the datasets a Figure was drawn from (their provenance goes into the saved file,
+    :func:`safebasins.plotting.style.save_figure`)."""
+    have = getattr(fig, _PROVENANCE_ATTR, None)
+    if have is None:
+        have = []
+        setattr(fig, _PROVENANCE_ATTR, have)
+    have += [d for d in datasets if d is not None and not any(d is h for h in have)]
+    return fig
+
+
+def _flat(datasets):
+    for d in datasets:
+        if isinstance(d, (list, tuple)):
+            yield from _flat(d)
+        elif d is not None and not str(d).endswith((".yaml", ".yml")):  # parameter files: the datasets hold them
+            yield d
+
+
+def provenance(*datasets, fig=None) -> dict:
+    """Text metadata of a saved figure: ``Source`` (the dataset files) and every attribute of
+    :data:`PROVENANCE` the datasets carry (paths, Datasets or lists of them; those attached to
+    ``fig`` with :func:`attach` too).  A value the datasets disagree on lists each one, one a line."""
+    items = list(_flat([*datasets, *(getattr(fig, _PROVENANCE_ATTR, None) or [])]))
+    out, sources = {}, []
+    for d in items:
+        if isinstance(d, (xr.Dataset, xr.DataArray)):
+            attrs, src = d.attrs, source(d) if isinstance(d, xr.Dataset) else "<data array>"
+        else:
+            with xr.open_dataset(d) as ds:
+                attrs, src = dict(ds.attrs), os.fspath(d)
+        if src not in sources:
+            sources.append(src)
+        for k in PROVENANCE:
+            if k in attrs:
+                v = attrs[k]
+                v = " ".join(map(str, np.ravel(v))) if isinstance(v, np.ndarray) else str(v)
+                out.setdefault(k, [])
+                if v not in out[k]:
+                    out[k].append(v)
+    meta = {"Source": "\n".join(sources)} if sources else {}
+    meta.update({("Title" if k == "title" else k): "\n".join(v) for k, v in out.items()})
+    return meta
 
 
 def load_params(src):

@@ -23,7 +23,7 @@ from matplotlib.legend_handler import HandlerTuple
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Patch
 
-from safebasins.plotting.basins import draw_well, plot_curve, separates_mask
+from safebasins.plotting.curves import draw_well, plot_curve, separates_mask
 from safebasins.plotting.captions import add_note, fmt_range
 from safebasins.plotting import data
 from safebasins.plotting.data import open_dataset, param, var
@@ -197,6 +197,19 @@ def _draw_basin_panel(ax, ds, sel, label):
     ax.set_aspect("equal", adjustable="box")
 
 
+def _phase_colorbar(fig, cax):
+    """Colour scale of the per-phase outlines: the forcing phase Psi over one period."""
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
+
+    from safebasins.plotting.style import pi_ticks
+
+    cb = fig.colorbar(ScalarMappable(norm=Normalize(0, 2 * np.pi), cmap="twilight"), cax=cax)
+    cb.set_label(r"forcing phase $\Psi$ of the per-phase outlines")
+    pi_ticks(cb.ax, 0, 2 * np.pi, axis="y")
+    return cb
+
+
 def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, fourier="paper", title=None,
                       ):
     """Per-phase safe basins (faint outlines coloured by Psi, light grey union) and the
@@ -206,7 +219,8 @@ def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, 
     panels = [(d, lab) for d, lab in ((analytic, "analytic"), (numeric, "numeric")) if d is not None]
     if not panels:
         raise ValueError("give at least one of analytic, numeric")
-    fig, axes = plt.subplots(1, len(panels), figsize=(4.3 * len(panels), 4.5), squeeze=False)
+    fig, axes = plt.subplots(1, len(panels), figsize=(4.3 * len(panels) + 0.8, 4.5), squeeze=False)
+    data.attach(fig, analytic, numeric)
     for ax, (ds, lab) in zip(axes[0], panels):
         x = xi_max if xi_max is not None else (float(ds["xi_max"][0]) if "xi_max" in ds.dims else None)
         sel = {"xi_max": x, "fourier": fourier}
@@ -238,7 +252,8 @@ def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, 
         par["xi_max"] = float(xi_max if xi_max is not None else ref["xi_max"][0])
     head = "Phase-invariant safe basin" + (": " + param_text(par) if any(v is not None for v in par.values()) else "")
     fig.suptitle(title or head, fontsize=10)
-    fig.subplots_adjust(left=0.08, right=0.98, top=0.84, bottom=0.2, wspace=0.22)
+    fig.subplots_adjust(left=0.08, right=0.88, top=0.84, bottom=0.2, wspace=0.22)
+    _phase_colorbar(fig, fig.add_axes([0.905, 0.3, 0.014, 0.5]))
     for ds, lab in panels:
         x = xi_max if xi_max is not None else (float(ds["xi_max"][0]) if "xi_max" in ds.dims else None)
         sel = {"xi_max": x, "fourier": fourier}

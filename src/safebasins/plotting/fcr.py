@@ -14,7 +14,7 @@ from matplotlib.lines import Line2D
 from safebasins.plotting.captions import add_note, count, fmt_range
 
 from safebasins.plotting.data import open_dataset, param, var
-from safebasins.plotting.style import LABELS, SYMBOLS, fmt_value, param_text
+from safebasins.plotting.style import LABELS, SYMBOLS, fmt_value, param_text, plain_text
 
 # mechanism flags of theory.critical_forcing: "none MM_0 MM_pi SM SMM"
 MECHANISMS = {
@@ -115,14 +115,25 @@ def mechanism_legend_handles(mechanisms, *, by_mechanism_color=False):
             for m in sorted(mechanisms)]
 
 
+#: thin lines of the branches where they do not set F_cr
+THIN = dict(lw=1.0, alpha=0.7)
+
+
+def _mechanism_of(d):
+    """The ``mechanism`` variable of one curve, or None where a dataset has none (drawn as one run)."""
+    return var(d, "mechanism") if "mechanism" in d.variables else None
+
+
 def draw_fcr(ax, ds, *, color_by="curve", show_branches=False, colors=None, lw=1.8,
              legend=True, legend_loc="best"):
     """All curves of a critical_forcing dataset stacked over ``curve`` (or a single curve).
 
     ``color_by="curve"``: one colour per curve, line style = mechanism (Figs 1, 2, 4);
     ``color_by="mechanism"``: colours *and* styles by mechanism (Fig 3).
-    ``show_branches``: also draw every branch F_MM_0/F_MM_pi/F_SM/F_SMM thin and faint where it
-    exists, so the branch the overall minimum switches from stays visible."""
+    ``show_branches``: also draw every branch F_MM_0/F_MM_pi/F_SM/F_SMM thin where it exists.
+    F_cr is the *largest* branch at each Omega (theory.critical_forcing: every branch is a lower
+    bound F must exceed for the level curve through the IC to pass one obstacle), so a thin
+    branch lies below the thick curve."""
     if "curve" not in ds.dims:
         ds = ds.expand_dims("curve")
     labels, _ = curve_labels(ds)
@@ -130,7 +141,7 @@ def draw_fcr(ax, ds, *, color_by="curve", show_branches=False, colors=None, lw=1
     if colors is None:
         cmap = plt.get_cmap("viridis")
         colors = ["k"] if n == 1 else [cmap(v) for v in np.linspace(0.0, 0.9, n)]
-    Omega = np.asarray(ds["Omega"], float)
+    Omega = np.asarray(var(ds, "Omega"), float)
     mechs_seen = set()
     curve_handles = []
     for i in range(n):
@@ -139,9 +150,9 @@ def draw_fcr(ax, ds, *, color_by="curve", show_branches=False, colors=None, lw=1
         if show_branches:
             for m, v in BRANCHES.items():
                 st = MECHANISMS[m]
-                ax.plot(Omega, np.asarray(var(d, v), float), ls=st["ls"], lw=0.9, alpha=0.45,
-                        color=st["color"] if color_by == "mechanism" else col, zorder=2)
-        mechs_seen |= draw_fcr_curve(ax, Omega, var(d, "F_cr"), var(d, "mechanism"), color=col,
+                ax.plot(Omega, np.asarray(var(d, v), float), ls=st["ls"], zorder=2,
+                        color=st["color"] if color_by == "mechanism" else col, **THIN)
+        mechs_seen |= draw_fcr_curve(ax, Omega, var(d, "F_cr"), _mechanism_of(d), color=col,
                                      by_mechanism_color=(color_by == "mechanism"), lw=lw)
         curve_handles.append(Line2D([], [], color=col, lw=lw, label=labels[i]))
     ax.set_xlabel(LABELS["Omega"])
@@ -152,30 +163,38 @@ def draw_fcr(ax, ds, *, color_by="curve", show_branches=False, colors=None, lw=1
     if legend:
         by_color = color_by == "mechanism"
         if show_branches:
-            # one entry per branch that exists: thick where it sets F_cr, thin (faint) elsewhere
+            # one entry per branch that exists: thick where it sets F_cr, thin where it lies below F_cr
             handles, labels = [], []
             for m in sorted(mechs_seen | branches):
                 st = MECHANISMS[m]
                 c = st["color"] if by_color else "k"
-                thin = Line2D([], [], ls=st["ls"], lw=0.9, alpha=0.45 if by_color else 0.6, color=c)
+                thin = Line2D([], [], ls=st["ls"], color=c, **THIN)
                 thick = Line2D([], [], ls=st["ls"], lw=lw, color=c)
                 if m in mechs_seen:
                     handles.append((thick, thin) if m in branches else thick)
                     labels.append(st["label"])
                 else:
                     handles.append(thin)
-                    labels.append(st["label"] + ": never the minimum")
+                    labels.append(st["label"] + r": below $F_{cr}$ everywhere")
             if color_by == "curve" and n > 1:
                 handles = curve_handles + handles
                 labels = [h.get_label() for h in curve_handles] + labels
             ax.legend(handles, labels, handler_map={tuple: HandlerTuple(ndivide=None, pad=0.3)}, loc=legend_loc,
-                      title="thick: sets $F_{cr}$; thin: branch elsewhere", title_fontsize=8)
+                      title="thick: sets $F_{cr}$ (the largest branch)\nthin: branch below $F_{cr}$",
+                      title_fontsize=8)
         else:
             handles = mechanism_legend_handles(mechs_seen, by_mechanism_color=by_color)
             if color_by == "curve" and n > 1:
                 handles = curve_handles + [Line2D([], [], ls="none", label="")] + handles
             ax.legend(handles=handles, loc=legend_loc)
     return mechs_seen, branches
+
+
+def omega_margins(ax, Omega, frac=0.025):
+    """x limits of an F_cr axes with a margin, so that the markers at the ends are not clipped."""
+    lo, hi = float(np.nanmin(Omega)), float(np.nanmax(Omega))
+    pad = frac * (hi - lo) if hi > lo else 0.05
+    ax.set_xlim(lo - pad, hi + pad)
 
 
 def _fcr_ylim(ax, arrays, top=None, pad=1.08):
@@ -220,11 +239,8 @@ def _fcr_notes(fig, ds, seen, branches, color_by):
     labels, _ = curve_labels(ds)
     add_note(fig, "Line styles drawn (mechanism setting F_cr): " + ", ".join(_mechanism_text(m, color_by) for m in
                                                                             sorted(seen)) + ".")
-    never = sorted(branches - seen)
-    if never:
-        add_note(fig, "Drawn thin only (a branch that exists but never sets F_cr): "
-                      + ", ".join(_mechanism_text(m, color_by) + " for Ω = " + _extent(ds, BRANCHES[m]) for m in never)
-                      + ".")
+    if branches:
+        _branch_notes(fig, ds, seen, branches, color_by)
     Om = np.asarray(ds["Omega"], float)
     parts = []
     for i in range(ds.sizes["curve"]):
@@ -235,17 +251,47 @@ def _fcr_notes(fig, ds, seen, branches, color_by):
             continue
         k = int(np.nanargmin(F))
         mech = sorted({int(m) for m in _mechanism_array(var(d, "mechanism")) if m})
-        parts.append(f"{_plain(labels[i])}: minimum F_cr = {F[k]:.4g} at Ω = {Om[k]:.3g}, mechanisms "
+        parts.append(f"{plain_text(labels[i])}: minimum F_cr = {F[k]:.4g} at Ω = {Om[k]:.3g}, mechanisms "
                      + ", ".join(_mechanism_text(m, None).rsplit(" ", 1)[0] for m in mech))
     add_note(fig, "; ".join(parts) + ".")
 
 
-def _plain(txt):
-    """Legend label (mathtext) as plain text for captions."""
-    for a, b in (("$\\xi_{max}$", "ξ_max"), ("$\\xi_{ini}$", "ξ_ini"), ("$\\gamma_{ini}$", "γ_ini"),
-                 ("$\\Psi$", "Ψ"), ("$\\pi$", "π"), ("$", "")):
-        txt = txt.replace(a, b)
-    return txt
+def _name(m):
+    return _mechanism_text(m, None).rsplit(" ", 1)[0]
+
+
+def _branch_notes(fig, ds, seen, branches, color_by):
+    """Which branch is operative (sets F_cr) and where the others lie below it, from the data."""
+    add_note(fig, "F_cr is the largest branch at each Ω, not the smallest: each branch is a lower bound that F must "
+                  "exceed for the level curve of C through the IC to pass one obstacle (the tangency with ξ = ξ_max at "
+                  "γ* = 0 or π, or a saddle of C below ξ_max), so the IC escapes only above all of them "
+                  "(safebasins.theory.critical_forcing). The operative branch is the largest; a lower one does not "
+                  "cause escape, because at its F the level curve through the IC is still held by the operative "
+                  "obstacle (it closes below that saddle, or crosses the ray γ = 0 or π of that tangency below ξ_max).")
+    never = sorted(branches - seen)
+    if never:
+        add_note(fig, "Drawn thin only (a branch that exists but lies below F_cr wherever it exists): "
+                      + ", ".join(_mechanism_text(m, color_by) + " for Ω = " + _extent(ds, BRANCHES[m]) for m in never)
+                      + ".")
+    Om = np.asarray(ds["Omega"], float)
+    for i in range(ds.sizes["curve"]):
+        d = ds.isel(curve=i)
+        F = np.asarray(var(d, "F_cr"), float)
+        mech = _mechanism_array(var(d, "mechanism"))
+        parts = []
+        for m in sorted(branches):
+            b = np.asarray(var(d, BRANCHES[m]), float)
+            below = np.isfinite(b) & np.isfinite(F) & (mech != m)
+            for op, s_, e in _runs(np.where(below, mech, 0)):
+                if op:
+                    gap = np.nanmax((F - b)[s_:e])
+                    xs = f" (saddle at ξ = {fmt_range(np.asarray(var(d, 'xi_saddle'), float)[s_:e], '{:.3g}')})" \
+                        if op == 3 and "xi_saddle" in d.variables else ""
+                    parts.append(f"{_name(m)} below F_cr for Ω = {Om[s_]:.3g}-{Om[e - 1]:.3g} (up to "
+                                 f"{gap:.3g} below), where {_name(int(op))} sets F_cr{xs}")
+        if parts:
+            add_note(fig, "Branches below F_cr" + (f" ({plain_text(curve_labels(ds)[0][i])})" if ds.sizes["curve"] > 1
+                                                   else "") + ": " + "; ".join(parts) + ".")
 
 
 def _extent(ds, name):
@@ -351,7 +397,7 @@ def figure_fcr_comparison(analytic, numeric, *, layout="overlay", F_max=None, ti
         if layout == "panels" or i == n - 1:
             ax.set_xlabel(LABELS["Omega"])
             ax.set_ylabel(LABELS["F_cr"])
-            ax.set_xlim(Om.min(), Om.max())
+            omega_margins(ax, Om)
         if layout == "panels":
             _fcr_ylim(ax, arrays, F_max)
             ax.set_title(labels[i])
@@ -387,15 +433,56 @@ def figure_fcr_comparison(analytic, numeric, *, layout="overlay", F_max=None, ti
     return fig
 
 
+#: the two sides of an F_cr curve by the mechanism of the theory there (MECHANISMS codes)
+SIDES = {"SM": (3, 4), "MM": (1, 2)}
+
+
+def side_errors(a, Om, rel, Fn):
+    """Relative errors |theory - numeric| / numeric at the numeric Omega split by the mechanism of
+    the theoretical curve there: {"SM": (median, max, Omega at max, F at max), "MM": ...}."""
+    if "mechanism" not in a.variables:
+        return {}
+    mech = _mechanism_array(var(a, "mechanism"))
+    Oa = np.asarray(a["Omega"], float)
+    at = mech[np.clip(np.searchsorted(Oa, Om), 0, Oa.size - 1)]
+    out = {}
+    for side, codes in SIDES.items():
+        sel = np.isin(at, codes) & np.isfinite(rel)
+        if sel.any():
+            k = np.flatnonzero(sel)[np.argmax(rel[sel])]
+            out[side] = (float(np.median(rel[sel])), float(rel[k]), float(Om[k]), float(Fn[k]))
+    return out
+
+
+def _side_notes(fig, sides):
+    """The error on the SM side (left of each minimum, large F) versus the MM side, read from the data."""
+    txt = []
+    for lab, e in sides:
+        txt.append(f"{lab}: " + ", ".join(f"{side} side median {100 * e[side][0]:.0f}%, max {100 * e[side][1]:.0f}% "
+                                          f"(Ω = {e[side][2]:.3g}, numeric F_cr = {e[side][3]:.3g})" for side in SIDES if side in e))
+    if not txt:
+        return
+    add_note(fig, "Error by the mechanism of the theory (SM side: SM or SMM sets the theoretical F_cr, below the "
+                  "resonance; MM side: MM): " + "; ".join(txt) + ".")
+    worse = [(lab, e) for lab, e in sides if "SM" in e and "MM" in e and e["SM"][1] > e["MM"][1]]
+    if worse:
+        big = max(worse, key=lambda x: x[1]["SM"][1])
+        add_note(fig, f"The paper names the MM side as the weaker one; here the SM side is worse for "
+                      f"{count(len(worse), 'curve')} of {len(sides)} ({', '.join(lab for lab, _ in worse)}), up to "
+                      f"{100 * big[1]['SM'][1]:.0f}% ({big[0]}, Ω = {big[1]['SM'][2]:.3g}, numeric F_cr = "
+                      f"{big[1]['SM'][3]:.3g}). This gap is the isolated-resonance approximation's (the slow flow of "
+                      "the 1:1 resonance alone), not a coding error: it was confirmed independently.")
+
+
 def _comparison_notes(fig, pairs, cycles, tol):
     """Caption notes of Figs 10-12: settings, per-curve relative error, brackets, isolated dips."""
     add_note(fig, f"Numeric F_cr: bisection to {fmt_value(tol)} in F, a trajectory is safe if it does not escape "
                   f"within {fmt_value(cycles)} EC; a scan of the whole F bracket flags non-monotone escape.")
-    errs, dips, brackets = [], [], []
+    errs, dips, brackets, sides = [], [], [], []
     for lab, a, b in pairs:
         if b is None:
             continue
-        lab = _plain(lab)
+        lab = plain_text(lab)
         Om = np.asarray(b["Omega"], float)
         Fn = np.asarray(b["F_cr"], float)
         Ft = np.interp(Om, np.asarray(a["Omega"], float), np.asarray(a["F_cr"], float), left=np.nan, right=np.nan)
@@ -403,6 +490,7 @@ def _comparison_notes(fig, pairs, cycles, tol):
         if np.isfinite(rel).any():
             errs.append(f"{lab}: {100 * np.nanmedian(rel):.1f}% (max {100 * np.nanmax(rel):.0f}% at Ω = "
                         f"{Om[np.nanargmax(rel)]:.3g})")
+            sides.append((lab, side_errors(a, Om, rel, Fn)))
         nm = np.asarray(var(b, "non_monotone")).astype(bool)
         if nm.any():
             lo, hi = np.asarray(var(b, "F_escape_low"), float), np.asarray(var(b, "F_escape_all"), float)
@@ -418,6 +506,7 @@ def _comparison_notes(fig, pairs, cycles, tol):
                                                   f"escaping F {lo_k:.4g})" if not nm[k] else ", non-monotone there"))
     if errs:
         add_note(fig, "Median relative error |theory - numeric| / numeric per curve: " + "; ".join(errs) + ".")
+    _side_notes(fig, sides)
     add_note(fig, ("Non-monotone escape in F (brackets): " + "; ".join(brackets) + ".") if brackets
              else "Escape is monotone in F at every numeric Ω (no brackets).")
     if dips:

@@ -15,7 +15,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.lines import Line2D
 
-from safebasins.plotting.basins import analytic_safe, draw_boundaries, draw_well
+from safebasins.plotting.curves import analytic_safe, draw_boundaries, draw_well
 from safebasins.plotting.captions import add_note, count, fmt_range
 from safebasins.plotting import data
 from safebasins.plotting.data import open_dataset, param, var
@@ -32,10 +32,18 @@ def _fraction(rho, k):
     return "0" if m == 0 else f"{m}/{k}"
 
 
+def chain_tag(rho, k):
+    """Label of an island chain: ``m:k`` (the paper's 1:6) from its rotation number m/k about the
+    centre; a chain that does not turn about the centre (m = 0) is named by its period."""
+    m = int(round(rho * k)) if np.isfinite(rho) else 0
+    return f"{m}:{k}" if m else f"period {k}, ρ=0"
+
+
 def figure_period_map(analytic, numeric, *, title=None, figsize=(8.2, 7.4), s=0.6, max_points=None):
     strobe = open_dataset(numeric)
     basin = open_dataset(analytic)
     fig, ax = plt.subplots(figsize=figsize, layout="constrained")
+    data.attach(fig, basin, strobe)
     q = np.asarray(var(strobe, "q").transpose("sample", "iteration"), float)
     p = np.asarray(var(strobe, "p").transpose("sample", "iteration"), float)
     cls = np.asarray(var(strobe, "orbit_class"), int)
@@ -84,11 +92,11 @@ def figure_period_map(analytic, numeric, *, title=None, figsize=(8.2, 7.4), s=0.
         pts = np.c_[cq[c, :k], cp[c, :k]]
         ax.plot(pts[:, 0], pts[:, 1], "+", color=col, ms=7, mew=1.4, zorder=7)
         rho_c = float(np.nanmedian(rho[members])) if members.size else np.nan
-        tag = f"1:{k}"
-        labels.append((c, tag, col, pts))
+        tag = chain_tag(rho_c, k)
+        labels.append((c, f"{tag} ({chr(65 + c)})", col, pts))
         turn = _fraction(rho_c, k)
         handles.append(Line2D([], [], marker="+", ls="none", color=col, ms=7, mew=1.4,
-                              label=f"{tag} chain {chr(65 + c)}: period-{k} elliptic orbit (+), "
+                              label=f"chain {chr(65 + c)}, {tag}: period-{k} elliptic orbit (+), "
                                     f"{count(n_chain_orbits[c], 'orbit')}, " + rf"$\rho$ = {turn}"
                                     + (" (does not encircle the centre)" if turn == "0" else "")))
     if (cls == 3).any():
@@ -121,13 +129,13 @@ def figure_period_map(analytic, numeric, *, title=None, figsize=(8.2, 7.4), s=0.
     if xs.size and ys.size:
         pad = 0.05 * max(np.ptp(xs), np.ptp(ys), 0.1)
         ax.set_xlim(xs.min() - pad, xs.max() + pad)
-        ax.set_ylim(ys.min() - (2.0 if labels else 1.0) * pad, ys.max() + pad)
-        # chain labels below the portrait, each joined to the lowest-but-one island of its chain
+        ax.set_ylim(ys.min() - (1.4 + 0.9 * len(labels) if labels else 1.0) * pad, ys.max() + pad)
+        # chain labels below the portrait (one row each), joined to the lowest-but-one island of the chain
         for c, tag, col, pts in labels:
             order = np.argsort(pts[:, 1] + 1e-3 * pts[:, 0])
             j = int(order[min(1 + c, len(order) - 1)])
-            ax.annotate(tag, pts[j], xytext=(pts[j, 0], ys.min() - 1.2 * pad), textcoords="data", ha="center",
-                        va="center", fontsize=10, color=col, fontweight="bold", zorder=8,
+            ax.annotate(tag, pts[j], xytext=(pts[j, 0], ys.min() - (1.2 + 0.9 * c) * pad), textcoords="data", ha="center",
+                        va="center", fontsize=9, color=col, fontweight="bold", zorder=8,
                         arrowprops=dict(arrowstyle="-", color=col, lw=0.9, shrinkA=2, shrinkB=4))
     ax.set_aspect("equal")
     ax.set_xlabel(LABELS["q"] + r" at $t = nT$")
@@ -153,7 +161,8 @@ def figure_period_map(analytic, numeric, *, title=None, figsize=(8.2, 7.4), s=0.
                       f"numbers {fmt_range(r_main)} (rotation numbers converge to "
                       f"{fmt_range(digits[main], '{:.0f}')} digits).")
     if k_chain.size:
-        per = ", ".join(f"chain {chr(65 + c)}: period {int(k_chain[c])}, {count(n_chain_orbits[c], 'orbit')}, "
+        per = ", ".join(f"chain {chr(65 + c)} (labelled {chain_tag(float(np.nanmedian(rho[chain == c])), int(k_chain[c]))}"
+                        f"): period {int(k_chain[c])}, {count(n_chain_orbits[c], 'orbit')}, "
                         f"rotation {_fraction(float(np.nanmedian(rho[chain == c])), int(k_chain[c]))} about the centre, "
                         f"monodromy trace {float(var(strobe, 'chain_trace')[c]):.3f}"
                         for c in range(k_chain.size))

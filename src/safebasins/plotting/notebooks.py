@@ -4,7 +4,8 @@ Every notebook is: a title cell, a ``parameters`` cell (dataset paths relative t
 repository root, output paths, style options; Snakemake overrides the paths with papermill), a
 summary cell (:func:`safebasins.plotting.data.describe`) and one call of the figure's builder,
 which also writes the report caption with the numbers read from the datasets
-(:func:`safebasins.plotting.captions.write_caption`, ``results/captions/<name>.rst``).
+(:func:`safebasins.plotting.captions.write_caption`, ``results/captions/<name>.rst``); the saved
+PNG carries the datasets' provenance in its text chunks (:func:`safebasins.plotting.style.save_figure`).
 """
 from __future__ import annotations
 
@@ -51,7 +52,8 @@ def build_notebook(fig) -> nbformat.NotebookNode:
                           "from safebasins.plotting.style import apply_style, save_figure\n"
                           f"from {module} import {function}\n\n"
                           f"apply_style()\ndescribe({inputs});")
-    draw = new_code_cell(f"fig = {function}({inputs}{opts}, title=title)\nsave_figure(fig, png, pdf, dpi=dpi)\n"
+    draw = new_code_cell(f"fig = {function}({inputs}{opts}, title=title)\n"
+                         f"save_figure(fig, png, pdf, dpi=dpi, datasets=[{', '.join(fig.inputs)}])\n"
                          f"write_caption(caption, fig, label={fig.label!r}, "
                          f"{'paper' if fig.category == 'Figures' else 'shows'}={fig.caption!r},\n"
                          f"              look={fig.look!r},\n"

@@ -69,9 +69,28 @@ def style(**overrides):
         yield
 
 
-def save_figure(fig, png=None, pdf=None, *, dpi=DEFAULT_DPI):
-    """Write ``fig`` to PNG (``dpi``) and/or PDF, creating parent folders."""
-    for path, kw in ((png, dict(dpi=dpi)), (pdf, {})):
+def new_axes(ax, figsize):
+    """(Figure, Axes): a new constrained-layout figure, or the figure of the given axes (``ax=``
+    of the public plotting functions)."""
+    if ax is None:
+        fig, ax = plt.subplots(figsize=figsize, layout="constrained")
+        return fig, ax
+    return ax.figure, ax
+
+
+def save_figure(fig, png=None, pdf=None, *, dpi=DEFAULT_DPI, datasets=()):
+    """Write ``fig`` to PNG (``dpi``) and/or PDF, creating parent folders.
+
+    The provenance of the datasets drawn (``datasets``: paths or Datasets, and those the
+    builder attached, :func:`safebasins.plotting.data.attach`) goes into the files: PNG text
+    chunks ``Source``, ``safebasins_version``, ``git_commit``, ``config_hash``, ``well``,
+    ``parameters``, ... (:func:`safebasins.plotting.data.provenance`); the PDF ``Subject``."""
+    from safebasins.plotting.data import provenance
+
+    meta = provenance(*datasets, fig=fig)
+    summary = ", ".join(f"{k} {meta[k]}" for k in ("safebasins_version", "git_commit", "config_hash", "well")
+                        if k in meta).replace("\n", " / ")
+    for path, kw in ((png, dict(dpi=dpi, metadata=meta)), (pdf, dict(metadata={"Subject": summary} if summary else {}))):
         if path:
             d = os.path.dirname(os.fspath(path))
             if d:
@@ -107,6 +126,16 @@ def param_text(params, *, sep=", "):
             continue
         parts.append(f"{SYMBOLS.get(k, k)} = {fmt_value(v, k)}")
     return sep.join(parts)
+
+
+def plain_text(txt):
+    """Mathtext of titles and legends (``$\\xi_{max}$ = 0.18, $\\Psi$ = $\\pi$``) as plain text for
+    captions (``ξ_max = 0.18, Ψ = π``)."""
+    for a, b in (("$\\xi_{max}$", "ξ_max"), ("$\\xi_{ini}$", "ξ_ini"), ("$\\gamma_{ini}$", "γ_ini"),
+                 ("$\\Psi$", "Ψ"), ("$\\Omega$", "Ω"), ("$q_{max}$", "q_max"), ("$t_{eval}$", "t_eval"),
+                 ("\\pi", "π"), ("$", "")):
+        txt = txt.replace(a, b)
+    return txt
 
 
 def pi_ticks(ax, lo, hi, axis="x"):

@@ -1,0 +1,157 @@
+"""Drawing pieces every basin figure shares: boundary curves of a basin dataset, safe-mask fills
+and hatches, the unforced well outline (Figs 5-9, 13-18, the extras and the public plotting
+functions).
+
+Boundary vertices ``q0_vertex``, ``p0_vertex`` (or ``gamma``, ``xi``), ``curve_index`` on dim
+``vertex`` and ``kind`` on dim ``curve`` (:func:`safebasins.theory.safe_basin_boundaries`,
+docs/contracts.md).
+"""
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.colors import ListedColormap
+
+from safebasins.plotting.data import var
+from safebasins.plotting.style import SB_EDGE, SB_FACE
+
+
+def draw_well(ax, xi_max, well, *, n=400, **kw):
+    """Dashed outline of the unforced well ``H0(q, p) = xi_max`` on a (q, p) axes, between the
+    turning points of the level (``-+q_max`` of eq (4) for the quartic)."""
+    lo, hi = (float(np.ravel(t)[0]) for t in well.turning_points(xi_max))
+    qq = np.linspace(lo, hi, n)
+    pp = np.sqrt(np.clip(2 * (xi_max - well.V(qq)), 0, None))
+    x = np.r_[qq, qq[::-1], qq[:1]]
+    y = np.r_[pp, -pp[::-1], pp[:1]]
+    style = dict(color="0.35", lw=0.9, ls=(0, (4, 2)), zorder=4)
+    style.update(kw)
+    (line,) = ax.plot(x, y, **style)
+    return line
+
+
+def boundary_polylines(ds, xname, yname):
+    """Polylines (x, y, kind) of a safe_basin_boundaries dataset (one slice of a stack);
+    ``xname``/``yname``: ``"gamma"``/``"xi"`` on the manifold, ``"q0_vertex"``/``"p0_vertex"``
+    on the IC plane."""
+    x = np.asarray(var(ds, xname), float)
+    y = np.asarray(var(ds, yname), float)
+    idx = np.asarray(var(ds, "curve_index"), float)
+    idx = np.where(np.isfinite(idx), idx, -1).astype(int)
+    kinds = [str(k) for k in np.asarray(var(ds, "kind"))]
+    out = []
+    for ci in np.unique(idx[idx >= 0]):
+        sel = idx == ci
+        # keep NaN separators that sit between vertices of this curve
+        xs, ys = x[sel], y[sel]
+        if not np.isfinite(xs).any():
+            continue
+        out.append((xs, ys, kinds[ci]))
+    return out
+
+
+def join_seams(xs, ys, tol=1e-9):
+    """Drop NaN separators between coincident vertices (a curve split at the gamma = +-pi cut of
+    the cylinder maps to one continuous curve on the IC plane), so that no cap is drawn there."""
+    xs, ys = np.asarray(xs, float), np.asarray(ys, float)
+    gap = np.flatnonzero(~np.isfinite(xs) | ~np.isfinite(ys))
+    drop = [i for i in gap if 0 < i < xs.size - 1 and np.isfinite(xs[i - 1]) and np.isfinite(xs[i + 1])
+            and np.hypot(xs[i + 1] - xs[i - 1], ys[i + 1] - ys[i - 1]) < tol]
+    return np.delete(xs, drop), np.delete(ys, drop)
+
+
+#: boundary lines on the IC plane: round caps and joins, so closed curves have no visible seam
+IC_LINE = dict(solid_capstyle="round", solid_joinstyle="round")
+
+
+def plot_curve(ax, xs, ys, **style):
+    """A boundary polyline on the IC plane: seams at the gamma cut removed (:func:`join_seams`);
+    a curve that closes on itself is drawn as one closed path (no start / end cap)."""
+    from matplotlib.patches import Polygon
+
+    xs, ys = join_seams(xs, ys)
+    ok = np.isfinite(xs) & np.isfinite(ys)
+    if ok.all() and xs.size > 3 and np.hypot(xs[-1] - xs[0], ys[-1] - ys[0]) < 1e-9:
+        kw = {k: v for k, v in style.items() if k not in ("solid_capstyle", "solid_joinstyle", "dash_capstyle")}
+        kw["edgecolor"] = kw.pop("color", SB_EDGE)
+        kw["linewidth"] = kw.pop("lw", 1.8)
+        kw["linestyle"] = kw.pop("ls", "-")
+        patch = Polygon(np.c_[xs[:-1], ys[:-1]], closed=True, fill=False, joinstyle="round", **kw)
+        ax.add_patch(patch)
+        return [patch]
+    return ax.plot(xs, ys, **style)
+
+
+def analytic_safe(ds):
+    """Analytic safe mask ``~escapes`` over (q0, p0) of one basin slice."""
+    return ~var(ds, "escapes").astype(bool)
+
+
+def separates_mask(xs, ys, safe, *, halo=2, min_fraction=0.5):
+    """True if the polyline (xs, ys) runs along the edge of the boolean DataArray ``safe``
+    (dims q0, p0): at least ``min_fraction`` of its vertices have both safe and escaping
+    pixels within ``halo`` pixels.  Level curves of C through a saddle can lie entirely
+    inside the predicted basin (e.g. a saddle-type region contained in a peninsula): they are
+    not boundaries of the safe basin and are not drawn on the IC plane."""
+    q = np.asarray(safe["q0"], float)
+    p = np.asarray(safe["p0"], float)
+    S = np.asarray(safe.transpose("q0", "p0")).astype(bool)
+    ok = np.isfinite(xs) & np.isfinite(ys)
+    if not ok.any():
+        return False
+    i = np.clip(np.searchsorted(q, xs[ok]), 0, q.size - 1)
+    j = np.clip(np.searchsorted(p, ys[ok]), 0, p.size - 1)
+    edge = np.zeros(i.size, bool)
+    for k, (a, b) in enumerate(zip(i, j)):
+        win = S[max(a - halo, 0):a + halo + 1, max(b - halo, 0):b + halo + 1]
+        edge[k] = win.any() and not win.all()
+    return edge.mean() >= min_fraction
+
+
+def draw_boundaries(ax, ds, *, safe=None, **kw):
+    """Boundary polylines of a basin dataset on the IC plane.  With ``safe`` (the analytic safe
+    mask on (q0, p0)), curves that do not border it are skipped (:func:`separates_mask`)."""
+    style = dict(color=SB_EDGE, lw=1.8, zorder=6, **IC_LINE)
+    style.update(kw)
+    lines = []
+    for xs, ys, _kind in boundary_polylines(ds, "q0_vertex", "p0_vertex"):
+        if safe is not None and not separates_mask(xs, ys, safe):
+            continue
+        lines += plot_curve(ax, xs, ys, **style)
+    return lines
+
+
+def break_wraps(x, y, period=2 * np.pi):
+    """Insert NaN where a periodic coordinate jumps by more than half a period."""
+    x = np.asarray(x, float)
+    y = np.asarray(y, float)
+    if x.size < 2:
+        return x, y
+    jumps = np.flatnonzero(np.abs(np.diff(x)) > period / 2) + 1
+    if jumps.size:
+        x = np.insert(x, jumps, np.nan)
+        y = np.insert(y, jumps, np.nan)
+    return x, y
+
+
+def xy_grid(da):
+    """DataArray over (q0, p0) in any order -> (q0, p0, Z) with Z indexed [p0, q0] for pcolor."""
+    da = da.transpose("p0", "q0")
+    return np.asarray(da["q0"]), np.asarray(da["p0"]), np.asarray(da)
+
+
+def safe_fill(ax, x, y, safe, *, color=SB_FACE, zorder=1, alpha=1.0):
+    """Fill where ``safe`` (2-D, indexed [y, x]) is True with a flat colour."""
+    z = np.ma.masked_where(~safe, np.ones(safe.shape))
+    return ax.pcolormesh(x, y, z, cmap=ListedColormap([color]), vmin=0, vmax=1, shading="nearest",
+                         zorder=zorder, alpha=alpha, rasterized=True, linewidth=0)
+
+
+def hatch(ax, x, y, mask, *, color, hatches="xxxx", zorder=2):
+    """Hatch where ``mask`` (2-D, indexed [y, x]) is True, the hatch lines in ``color`` (not the
+    default black: on a few pixels a black hatch reads as a stray line)."""
+    if not np.asarray(mask).any():
+        return None
+    with plt.rc_context({"hatch.color": color, "hatch.linewidth": 0.8}):
+        return ax.contourf(x, y, np.asarray(mask, float), levels=[0.5, 1.5], colors="none", hatches=[hatches],
+                           zorder=zorder)
