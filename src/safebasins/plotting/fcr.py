@@ -438,7 +438,7 @@ SIDES = {"SM": (3, 4), "MM": (1, 2)}
 
 
 def side_errors(a, Om, rel, Fn):
-    """Relative errors |theory - numeric| / numeric at the numeric Omega split by the mechanism of
+    """Relative errors ``|theory - numeric| / numeric`` at the numeric Omega split by the mechanism of
     the theoretical curve there: {"SM": (median, max, Omega at max, F at max), "MM": ...}."""
     if "mechanism" not in a.variables:
         return {}
