@@ -74,6 +74,27 @@ def test_plot_basin(basin, tmp_path):
     _png_ok(fig, tmp_path, "basin")
 
 
+def test_plot_basin_and_chart_with_a_basin_stack(chart, basin, tmp_path):
+    """A stack over xi_max (the pipeline's layout, Figs 13-15) draws one colour per value."""
+    from safebasins.io.datasets import stack
+
+    parts = []
+    for x in (0.14, 0.18):
+        b = th.safe_basin_boundaries(0.01, 0.9, np.pi, x, n_points=200)
+        esc = th.slow_flow_escapes(Q0[:, None], P0[None, :], 0.01, 0.9, np.pi, x)
+        parts.append(b.assign(escapes=xr.DataArray(esc, dims=("q0", "p0"), coords={"q0": Q0, "p0": P0})))
+    stacked = stack(parts, "xi_max", [0.14, 0.18])
+    fig = plot_basin(stacked)
+    texts = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert sum(t.startswith(r"$\xi_{max}$ = ") for t in texts) == 2
+    _png_ok(fig, tmp_path, "basin_stack")
+    fig = plot_escape_chart(chart, basin=stacked)
+    ax = fig.axes[0]  # a theory colour per threshold (closed curves are patches)
+    colors = {ln.get_color() for ln in ax.lines} | {matplotlib.colors.to_hex(p.get_edgecolor()) for p in ax.patches}
+    assert {"#d62728", "#1f77b4"} <= {matplotlib.colors.to_hex(c) for c in colors}
+    plt.close(fig)
+
+
 def test_plot_fcr(tmp_path):
     ana = th.critical_forcing(np.linspace(0.6, 1.2, 120), xi_max=0.15)
     num = nu.critical_forcing_numeric([0.7, 1.1], 0.15, cycles=50, n_scan=6)

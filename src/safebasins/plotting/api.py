@@ -17,11 +17,11 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from safebasins.plotting import data
-from safebasins.plotting.charts import CRITERIA, agreement_time, chart_scan, draw_nested_chart
-from safebasins.plotting.curves import IC_LINE, boundary_polylines, draw_well, plot_curve, safe_fill, xy_grid
+from safebasins.plotting.charts import CRITERIA, agreement_time, chart_scan, draw_nested_chart, draw_nested_safe
+from safebasins.plotting.curves import IC_LINE, boundary_polylines, draw_well, plot_curve
 from safebasins.plotting.data import MissingData, open_dataset, param, source, var
 from safebasins.plotting.integrity_maps import plot_integrity_map
-from safebasins.plotting.style import LABELS, SB_EDGE, SB_FACE, SYMBOLS, fmt_value, grey_levels, new_axes, param_text
+from safebasins.plotting.style import LABELS, SB_EDGE, SB_FACE, SYMBOLS, fmt_value, new_axes, param_text
 
 __all__ = ["plot_escape_chart", "plot_basin", "plot_fcr", "plot_integrity_map"]
 
@@ -179,16 +179,13 @@ def plot_basin(basin, *, ax=None):
         handles = [Line2D([], [], color=SB_EDGE, lw=1.8, label="safe-basin boundary (slow flow)")]
     else:
         vals = np.asarray(var(basin, dim), float)
-        greys = grey_levels(len(vals))
-        order = np.argsort(vals)[::-1] if dim == "xi_max" else np.argsort(vals)  # largest basin painted first
+        slices = [basin.isel({dim: i}) for i in range(vals.size)]
         colors = plt.get_cmap("tab10")
+        if "escapes" in basin.variables:  # lighter contains darker, as in Figs 13-17
+            draw_nested_safe(ax, [~var(b, "escapes").astype(bool) for b in slices])
+        for i, b in enumerate(slices):
+            _draw_basin_slice(ax, b, color=colors(i % 10))
         handles = []
-        for r, i in enumerate(order):
-            b = basin.isel({dim: int(i)})
-            if "escapes" in b.variables:
-                q, p, Z = xy_grid(var(b, "escapes"))
-                safe_fill(ax, q, p, ~Z.astype(bool), color=greys[r], zorder=1 + 0.01 * r)
-            _draw_basin_slice(ax, b, color=colors(int(i) % 10))
         for i in np.argsort(vals):
             handles.append(Line2D([], [], color=colors(int(i) % 10), lw=1.8,
                                   label=f"{SYMBOLS.get(dim, dim)} = {fmt_value(vals[i])}"))

@@ -19,7 +19,7 @@ FRONT_TEXT = {"analytic": "slow flow solid", "numeric": "numerics dotted", "all_
 
 
 def symmetric_limit(*arrays):
-    """Colour limit of a difference map: the largest ``|value|`` of the data, rounded up to two
+    """Colour limit of a difference map: the largest |value| of the data, rounded up to two
     significant digits (never the full +-1 range, on which small differences look blank)."""
     v = np.concatenate([np.abs(np.asarray(a, float)).ravel() for a in arrays])
     v = v[np.isfinite(v)]
@@ -183,10 +183,10 @@ def plot_integrity_map(ds, *, measure="GIM", ax=None):
                      diverging=measure.endswith("_diff"))
     front = f"F_{measure}"
     if front in ds.variables:
-        f = ds[front].isel(t_eval=-1) if "t_eval" in ds[front].dims else ds[front]
-        ax.plot(np.asarray(var(ds, "Omega"), float), np.asarray(f, float), color="w", **FRONT_STYLE["analytic"],
-                label=f"erosion front ({measure} = {fmt_value(ds.attrs['level'])})" if "level" in ds.attrs
-                else "erosion front")
+        at = ds.isel(t_eval=-1) if "t_eval" in ds[front].dims else ds
+        (line,) = draw_front(ax, at, front, color="w", style="analytic")
+        line.set_label(f"erosion front ({measure} = {fmt_value(ds.attrs['level'])})" if "level" in ds.attrs
+                       else "erosion front")
         ax.legend(loc="upper center", fontsize=8)
     shown = {k: ds.attrs[k] for k in ("xi_max", "Psi") if k in ds.attrs}
     ax.set_title(f"{measure}" + (f", {param_text(shown)}" if shown else "")
