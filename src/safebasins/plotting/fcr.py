@@ -39,12 +39,12 @@ def curve_labels(ds, dim="curve"):
                 constant[c] = vals[0]
             else:
                 varying.append(c)
-        elif c in ds.attrs:
+        elif c in ds.attrs or (c in ds.coords and ds[c].size == 1):  # one curve: a scalar coordinate
             constant[c] = param(ds, c)
     if varying:
         labels = [param_text({c: ds[c].values[i] for c in varying}) for i in range(n)]
     elif "label" in ds.coords:
-        labels = [_symbols(str(v)) for v in np.asarray(ds["label"])]
+        labels = [_symbols(str(v)) for v in np.atleast_1d(np.asarray(ds["label"]))]
     else:
         labels = [f"curve {i}" for i in range(n)]
     return labels, constant
