@@ -19,7 +19,7 @@ FRONT_TEXT = {"analytic": "slow flow solid", "numeric": "numerics dotted", "all_
 
 
 def symmetric_limit(*arrays):
-    """Colour limit of a difference map: the largest |value| of the data, rounded up to two
+    """Colour limit of a difference map: the largest ``|value|`` of the data, rounded up to two
     significant digits (never the full +-1 range, on which small differences look blank)."""
     v = np.concatenate([np.abs(np.asarray(a, float)).ravel() for a in arrays])
     v = v[np.isfinite(v)]
