@@ -44,3 +44,9 @@ lock:
 .PHONY: test-cluster
 test-cluster: $(STAMP)
 	tests/cluster/run_cluster_check.sh
+
+## The documentation site (docs/_build/html): Sphinx + MyST-NB, tutorials executed on every
+## build, every warning an error. Open docs/_build/html/index.html (docs/index.md says more).
+.PHONY: docs
+docs: $(STAMP)
+	$(BIN)/sphinx-build -E -W --keep-going -b html -d docs/_build/doctrees docs docs/_build/html
