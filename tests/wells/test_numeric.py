@@ -225,8 +225,8 @@ def test_theta_must_be_finite(quartic):
     (lambda q: quartic_V(q) + 0.05 * q, lambda q: quartic_dV(q) + 0.05, r"V'\(0\)"),
     (lambda q: -quartic_V(q), lambda q: -quartic_dV(q), r"V''\(0\)"),
     (lambda q: q ** 4 / 4 - q ** 6 / 6, lambda q: q ** 3 - q ** 5, r"V''\(0\)"),
-    (lambda q: 0.5 * q * q, lambda q: q, "no barrier"),
-    (lambda q: 0.5 * (1 - np.exp(-q)) ** 2, lambda q: (1 - np.exp(-q)) * np.exp(-q), "no barrier"),  # Morse
+    (lambda q: 0.5 * q * q, lambda q: q, "closed: no barrier"),
+    (lambda q: q * q * (0.5 + 0.25 * q * q), lambda q: q * (1 + q * q), "closed: no barrier"),
     (quartic_V, lambda q: q - 0.9 * q ** 3, "dV does not match"),
     (1.0, quartic_dV, "V must be a callable"),
 ])
@@ -235,12 +235,23 @@ def test_bad_potentials(V, dV, match):
         NumericWell(V, dV)
 
 
-def test_open_side_rejected():
-    # right: the cubic's barrier (E_b = 1/6); left: a plateau at 0.1 < E_b (no closing wall)
+def test_plateau_side_is_open():
+    # right: the cubic's barrier (E_b = 1/6); left: a plateau at 0.1 < 1/6, open at infinity
     a = np.sqrt(5.0)                  # V''(0) = 1 on both sides
     V = lambda q: np.where(q < 0, 0.1 * np.tanh(a * q) ** 2, q * q * (0.5 - q / 3))
     dV = lambda q: np.where(q < 0, 0.2 * a * np.tanh(a * q) / np.cosh(a * q) ** 2, q * (1 - q))
-    with pytest.raises(ValueError, match="search_bound.*not closed"):
+    w = NumericWell(V, dV)
+    assert w.asymptotes == (0.1, None) and w.barrier_energy == 0.1 and w.open_at_infinity
+    assert w.barriers == (-np.inf, 1.0) and w.limits == (-np.inf, 1.0)
+    assert np.all(np.diff(w.omega(0.1 - np.geomspace(0.05, 1e-14, 20))) < 0)   # omega -> 0 at the limit
+
+
+def test_side_neither_closing_nor_converging():
+    # left: V -> 0.1 (below E_b = 1/6) like 1/log|q|: not converged within float range
+    L = lambda q: np.logaddexp(0.0, np.log(5.0) + 2 * np.log(np.abs(q)))
+    V = lambda q: np.where(q < 0, 0.1 * (1 - 1 / (1 + L(q))), q * q * (0.5 - q / 3))
+    dV = lambda q: np.where(q < 0, q / (1 + 5 * q * q) / (1 + L(q)) ** 2, q * (1 - q))
+    with np.errstate(divide="ignore"), pytest.raises(ValueError, match="neither closes nor is open at infinity"):
         NumericWell(V, dV)
 
 

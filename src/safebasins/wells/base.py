@@ -2,10 +2,17 @@
 motion's action-angle variables (paper Sec. 2.1, generalised to any well).
 
 A well is a potential ``V(q)`` with its minimum at ``q = 0``: ``V(0) = V'(0) = 0``,
-``V''(0) > 0``.  On each side the well ends at a barrier (a local maximum of V, i.e. a saddle
-of H0) or nowhere (``V -> inf``).  The escape energy is the lowest barrier, ``barrier_energy``;
+``V''(0) > 0``.  On each side the well ends in one of three ways:
+
+* at a barrier (a local maximum of V, i.e. a saddle of H0) at ``q_b``: escape energy ``V(q_b)``;
+* open at infinity: ``V'`` keeps its sign and V tends to a finite limit ``A`` (Morse, sech^2):
+  escape energy ``A`` (``asymptotes``), barrier position ``+-inf``;
+* closed: ``V -> inf`` (no escape that way), barrier position ``+-inf``.
+
+The escape energy ``barrier_energy`` is the lowest of the barriers' ``V(q_b)`` and the limits;
 below it every energy level ``0 <= E < barrier_energy`` carries one periodic orbit around the
-well bottom with turning points ``q_minus(E) < 0 < q_plus(E)``.
+well bottom with turning points ``q_minus(E) < 0 < q_plus(E)``.  When it is a limit
+(``open_at_infinity``) the orbit at ``barrier_energy`` itself is unbounded, not a separatrix.
 
 Conventions shared by every well (they reproduce eqs (13)-(17), (20) for the quartic):
 
@@ -20,7 +27,7 @@ Conventions shared by every well (they reproduce eqs (13)-(17), (20) for the qua
 Escape criteria (one definition, used by theory, numerics, integrity and plotting):
 
 * energy: ``H0(q, p) > xi_max``, or ``q`` beyond a barrier (there H0 no longer measures the
-  well energy);
+  well energy; a side open at infinity has its barrier at ``+-inf``: there only ``H0 > xi_max``);
 * displacement: ``q < q_minus(xi_max)`` or ``q > q_plus(xi_max)`` (eq (4) for the quartic,
   where ``q_plus = -q_minus = q_max(xi_max)``);
 * the unforced safe set of a threshold: ``S0(xi_max) = {H0 < xi_max, q_minus < q < q_plus}``.
@@ -64,13 +71,28 @@ class Well(abc.ABC):
         bottom; ``-inf`` / ``+inf`` on a side where ``V -> inf`` (no escape that way)."""
 
     @property
+    def asymptotes(self) -> tuple:
+        """``(left, right)``: on a side without a barrier where V tends to a finite limit as
+        ``q -> -inf`` / ``+inf`` (open at infinity), that limit; None on a side with a barrier or
+        where ``V -> inf``."""
+        return (None, None)
+
+    @property
     def barrier_energy(self) -> float:
-        """Escape energy: the lowest barrier ``min V(q_left), V(q_right)``."""
+        """Escape energy: the lowest of the barriers' ``V(q_b)`` and the finite limits of V at infinity."""
         lo, hi = self.barriers
-        vals = [float(self.V(q)) for q in (lo, hi) if np.isfinite(q)]
+        vals = [float(self.V(q)) for q in (lo, hi) if np.isfinite(q)] + [a for a in self.asymptotes if a is not None]
         if not vals:
-            raise ValueError(f"well {self.name!r} has no barrier: nothing can escape")
+            raise ValueError(f"well {self.name!r} is closed: no barrier and no finite limit of V at infinity "
+                             "(V -> inf on both sides): no orbit escapes, there is no escape energy")
         return min(vals)
+
+    @property
+    def open_at_infinity(self) -> bool:
+        """Whether the escape energy is a limit of V at infinity (then the orbit at
+        ``barrier_energy`` is unbounded and thresholds must lie strictly below it)."""
+        lims = [a for a in self.asymptotes if a is not None]
+        return bool(lims) and min(lims) <= self.barrier_energy
 
     def H0(self, q, p):
         """Unforced energy ``p^2 / 2 + V(q)`` (eq 7, untruncated)."""
@@ -136,10 +158,17 @@ class Well(abc.ABC):
         return (q > lo) & (q < hi)
 
     def check_threshold(self, name, xi_max):
-        """Energy truncation level in ``(0, barrier_energy]``."""
+        """Energy truncation level in ``(0, barrier_energy]``; in ``(0, barrier_energy)`` when the
+        escape energy is a limit of V at infinity (the orbit at it is unbounded)."""
         from safebasins.checks import as_array, value_repr
 
         a = as_array(name, xi_max)
+        if self.open_at_infinity:
+            if ((a <= 0) | (a >= self.barrier_energy)).any():
+                raise ValueError(f"{name} must lie in (0, {self.barrier_energy!r}), below the escape energy of the "
+                                 f"{self.name} well: it is the limit of V at infinity, where the orbit is unbounded; "
+                                 f"got {value_repr(a)}")
+            return a
         if ((a <= 0) | (a > self.barrier_energy)).any():
             raise ValueError(f"{name} must lie in (0, {self.barrier_energy!r}] (the barrier energy of the "
                              f"{self.name} well), got {value_repr(a)}")

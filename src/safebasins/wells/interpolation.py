@@ -80,8 +80,10 @@ class EnergyInterpolant:
                     nxt += [(kind, a, c), (kind, c, b)]
             todo = nxt
         if todo:
-            raise RuntimeError(f"energy interpolation did not converge: {len(todo)} panels still above "
-                               f"tolerance after {max_rounds} rounds (kinds/bounds {todo[:3]}...)")
+            where = ", ".join(f"E in [{min(e):.6g}, {max(e):.6g}]" for e in (self._energies(p) for p in todo[:3]))
+            raise ValueError(f"tol: the energy interpolation did not reach tol = {self.tol!r} after {max_rounds} rounds "
+                             f"({len(todo)} panels, {where}, ...): the orbit data are not smooth in E there, or V, dV "
+                             "are not accurate to tol; give a larger tol or a smoother, more accurate V")
         self.n_quantities = done[0][1].shape[0]
         self.error_estimate = max(e for _, _, e in done)
         self._build(done)

@@ -48,7 +48,9 @@ from scipy import optimize
 
 from safebasins.checks import as_array, value_repr
 from safebasins.wells.base import Well
+from safebasins.wells.bottom import cancellation_fix
 from safebasins.wells.interpolation import BOTTOM, EnergyInterpolant
+from safebasins.wells.open_sides import CONVERGED, TAIL_START, Tail, converged_limit, geometric_values
 from safebasins.wells.orbit_quadrature import EPS, OrbitQuadrature, solve_increasing
 
 __all__ = ["NumericWell"]
@@ -57,6 +59,36 @@ __all__ = ["NumericWell"]
 _T, _JE, _H, _THM, _TL, _QM, _QP = range(7)
 #: tolerance for V(0) = 0 and V'(0) = 0 (absolute)
 BOTTOM_ATOL = 1e-12
+
+
+def check_options(*, tol=1e-13, n_scan=20001, asymptotes=None):
+    """Validated ``(tol, n_scan, asymptotes)`` of :class:`NumericWell` (ValueError naming the argument),
+    checked before anything is computed.  ``asymptotes``: None or a pair of float-or-None."""
+    t = as_array("tol", tol)
+    if t.ndim != 0 or not (1e-15 <= float(t) <= 1e-2):
+        raise ValueError(f"tol must be a number in [1e-15, 1e-2] (relative accuracy of the energy interpolants), "
+                         f"got {tol!r}")
+    if isinstance(n_scan, bool) or not isinstance(n_scan, (int, np.integer)) or n_scan < 100:
+        raise ValueError(f"n_scan must be an integer >= 100 (points of the barrier scan on each side), got {n_scan!r}")
+    if asymptotes is None:
+        return float(t), int(n_scan), None
+    try:
+        pair = list(asymptotes)
+    except TypeError:
+        pair = None
+    if pair is None or len(pair) != 2:
+        raise ValueError(f"asymptotes must be a pair (left, right) of limits of V at -inf / +inf, each a float or None, "
+                         f"got {asymptotes!r}")
+    out = []
+    for side, a in zip(("left", "right"), pair):
+        if a is not None:
+            a = as_array("asymptotes", a)
+            if a.ndim != 0 or not (np.isfinite(a) and a > 0):
+                raise ValueError(f"asymptotes: the {side} limit must be a finite number > 0 (V rises from V(0) = 0 "
+                                 f"towards it) or None, got {pair[0 if side == 'left' else 1]!r}")
+            a = float(a)
+        out.append(a)
+    return float(t), int(n_scan), tuple(out)
 
 
 def _call(f, q):
@@ -108,11 +140,13 @@ class NumericWell(Well):
 
     name = "numeric"
 
-    def __init__(self, V, dV, *, barriers=None, search_bound=10.0, name=None, n_scan=20001, tol=1e-13):
+    def __init__(self, V, dV, *, barriers=None, search_bound=10.0, name=None, n_scan=20001, tol=1e-13,
+                 asymptotes=None):
         if not callable(V):
             raise ValueError(f"V must be a callable V(q), got {V!r}")
         if not callable(dV):
             raise ValueError(f"dV must be a callable V'(q), got {dV!r}")
+        tol, n_scan, declared = check_options(tol=tol, n_scan=n_scan, asymptotes=asymptotes)
         if name is not None:
             self.name = str(name)
         self._V, self._dV = V, dV
@@ -121,16 +155,21 @@ class NumericWell(Well):
             raise ValueError(f"search_bound must be finite and > 0, got {search_bound!r}")
         self.search_bound = B
         self._check_bottom()
-        found = self._locate_barriers(B, int(n_scan))
+        found = self._locate_barriers(B, n_scan)
         if barriers is not None:
             self._check_given_barriers(barriers, found)
         self._barriers = found
         vals = [float(_call(V, np.array([b]))[0]) for b in found if np.isfinite(b)]
-        if not vals:
-            raise ValueError(f"V: the well has no barrier within search_bound={B} (V' keeps its sign "
-                             "on both sides): nothing can escape")
-        self._E_b = min(vals)
-        self.limits = tuple(self._limit(side, b, B, int(n_scan)) for side, b in zip((-1.0, 1.0), found))
+        limits_at_inf = self._find_asymptotes(found, declared, B)
+        self._asymptotes = tuple(None if np.isfinite(b) else a for b, a in zip(found, limits_at_inf))
+        levels = vals + [a for a in self._asymptotes if a is not None]
+        if not levels:
+            raise ValueError(f"V: the well is closed: no barrier within search_bound={B} and no finite limit of V at "
+                             "either side (V' keeps its sign and V -> inf both ways, e.g. the harmonic well or an even "
+                             "quartic with positive q^4): no orbit escapes, there is no escape energy")
+        self._E_b = min(levels)
+        self._tails = tuple(self._open_tail(side, a) for side, a in zip((-1.0, 1.0), self._asymptotes))
+        self.limits = tuple(self._limit(side, b, B, n_scan) for side, b in zip((-1.0, 1.0), found))
         for side, lim in zip((-1.0, 1.0), self.limits):
             self._check_monotone(side, lim)
         self._check_derivative()
@@ -139,7 +178,10 @@ class NumericWell(Well):
             if np.isfinite(b) and not k > 1e-8 * self.omega0 ** 2:
                 raise ValueError(f"V: the barrier at q = {b!r} is degenerate (V''(q_b) = {-k!r}): the logarithmic "
                                  "separatrix behaviour assumed by the interpolation in E does not hold")
-        self._quad = OrbitQuadrature(partial(_call, V), partial(_call, dV), self.limits, found, kappa)
+        self._V_bottom = cancellation_fix(partial(_call, V), partial(_call, dV), self._bottom_scales())
+        V_acc = partial(_call, V) if self._V_bottom is None else self._V_bottom
+        opened = {"tails": self._tails, "n_mean": 8} if self.open_at_infinity else {}
+        self._quad = OrbitQuadrature(V_acc, partial(_call, dV), self.limits, found, kappa, **opened)
         self._interp = EnergyInterpolant(self._orbit_table, self._E_b, tol=tol, noise=self._noise)
         self.interpolation_error = self._interp.error_estimate
 
@@ -157,8 +199,9 @@ class NumericWell(Well):
         g = _call(self._dV, h) / h
         k0 = float(np.mean(g))
         if not (np.isfinite(g).all() and (g > 0).all() and g.min() > 0.5 * g.max()):
-            raise ValueError(f"V: V''(0) = {float(g.min())!r} (V'(q)/q near 0), must be > 0: q = 0 must be a "
-                             "non-degenerate minimum")
+            raise ValueError(f"V: V''(0) = {float(g.min())!r} (V'(q)/q at |q| = 1e-8 and 1e-7 search_bound = "
+                             f"{self.search_bound!r}), must be > 0: q = 0 must be a non-degenerate minimum (a well much "
+                             "smaller than search_bound needs a smaller search_bound)")
         self.omega0 = float(np.sqrt(k0))
 
     def _locate_barriers(self, B, n):
@@ -222,21 +265,85 @@ class NumericWell(Well):
                 raise ValueError(f"barriers: the {side} barrier is given as {g!r} but the nearest local maximum "
                                  f"of V on that side (within search_bound) is at {f!r}")
 
+    def _find_asymptotes(self, found, declared, B):
+        """Per side, the finite limit of V at infinity or None (V -> inf; a barrier side without a
+        declared limit).  Declared limits (``asymptotes``) are checked against V at large |q|."""
+        out = []
+        self._sequences = {}
+        for k, side in enumerate((-1.0, 1.0)):
+            where, sign = ("left", "-") if side < 0 else ("right", "+")
+            given = None if declared is None else declared[k]
+            if np.isfinite(found[k]) and given is None:
+                out.append(None)
+                continue
+            x, v = geometric_values(partial(_call, self._V), side, B)
+            self._sequences[side] = (x, v)
+            A, i = converged_limit(v)
+            if given is not None and (A is None or abs(A - given) > 1e-12 * abs(given)):
+                seen = (f"tends to {A!r}" if A is not None else
+                        f"does not converge (V = {float(v[np.isfinite(v)][-1])!r} at q = {float(side * x[np.isfinite(v)][-1])!r})")
+                raise ValueError(f"asymptotes: the {where} limit is declared as {given!r}, but V {seen} along "
+                                 f"q -> {sign}inf (|q| = search_bound 2^k)")
+            if declared is not None and given is None and A is not None:
+                raise ValueError(f"asymptotes: the {where} entry is None (no finite limit), but V tends to {A!r} as "
+                                 f"q -> {sign}inf")
+            if A is not None and np.isfinite(found[k]):
+                out.append(given)
+                continue
+            if A is not None:
+                rise = np.diff(v[:i + 1])
+                if not (A > 0 and (rise >= -CONVERGED * A).all()):
+                    raise ValueError(f"search_bound: V is not increasing towards its limit {A!r} on the {where} side "
+                                     f"beyond search_bound = {B} (V' changes sign there: a barrier?); give a larger "
+                                     "search_bound")
+            out.append(given if given is not None else A)
+        return tuple(out)
+
+    def _open_tail(self, side, A):
+        """The :class:`~safebasins.wells.open_sides.Tail` of a side open at infinity (its limit is
+        the escape energy), else None."""
+        if A is None or A > self._E_b:
+            return None
+        where = "left" if side < 0 else "right"
+        x, v = self._sequences[side]
+        hint = float(x[np.nonzero(v >= (1.0 - TAIL_START) * A)[0][0]])
+        f = lambda s: side * _call(self._dV, side * s)
+        tail = Tail(f, partial(_call, self._V), side, A, hint, where)
+        # V(x0) + int_x0^inf V' must be the limit: a wrong declared limit, or V' not the derivative of V
+        rest = A - float(_call(self._V, np.array([side * tail.x0]))[0])
+        if abs(rest - tail.G0) > 1e-11 * A:
+            raise ValueError(f"asymptotes: the {where} limit {A!r} is not V(q) + int_q^inf V' = "
+                             f"{A - rest + tail.G0!r} (q = {side * tail.x0!r}): a wrong limit, or dV is not V'")
+        return tail
+
     def _limit(self, side, barrier, B, n):
         if np.isfinite(barrier):
             return float(barrier)
+        if self._tails[0 if side < 0 else 1] is not None:
+            return side * np.inf
         s = np.geomspace(1e-9 * B, B, n)
         v = _call(self._V, side * s)
         above = np.nonzero(v > self._E_b)[0]
+        if above.size:
+            return float(side * s[above[0]])
+        # V rises above E_b only beyond search_bound (slowly growing V, or a limit above E_b)
+        x, v = self._sequences[side]
+        above = np.nonzero(v > self._E_b)[0]
         if above.size == 0:
-            raise ValueError(f"search_bound: on the {'left' if side < 0 else 'right'} V has no barrier and stays "
-                             f"below the escape energy {self._E_b!r} up to |q| = {B}: the well is not closed")
-        return float(side * s[above[0]])
+            raise ValueError(f"V: on the {'left' if side < 0 else 'right'} side V' keeps its sign up to search_bound = "
+                             f"{B}, but V neither rises above the escape energy {self._E_b!r} nor converges to a finite "
+                             f"limit (|q| up to {float(x[-1])!r}): the side neither closes nor is open at infinity")
+        return float(side * x[above[0]])
+
+    def _bottom_scales(self):
+        """Per side the extent of the well proper: the limit, or where the tail of an open side begins."""
+        return tuple(abs(lim) if t is None else t.x0 for lim, t in zip(self.limits, self._tails))
 
     def _check_derivative(self):
-        q = np.linspace(self.limits[0], self.limits[1], 13)[1:-1]
+        lo, hi = (side * s for side, s in zip((-1.0, 1.0), self._bottom_scales()))
+        q = np.linspace(lo, hi, 13)[1:-1]
         q = q[q != 0]
-        h = 1e-5 * max(abs(self.limits[0]), abs(self.limits[1]))
+        h = 1e-5 * max(abs(lo), abs(hi))
         fd = (_call(self._V, q + h) - _call(self._V, q - h)) / (2 * h)
         d = _call(self._dV, q)
         scale = np.max(np.abs(d))
@@ -293,8 +400,10 @@ class NumericWell(Well):
 
     # ------------------------------------------------------------------ the potential
     def V(self, q):
+        """``V(q)``; near the bottom ``int_0^q V'`` where the given V loses relative accuracy
+        (:mod:`safebasins.wells.bottom`, e.g. ``1 - cos q``)."""
         q = as_array("q", q)
-        return _call(self._V, q)
+        return _call(self._V, q) if self._V_bottom is None else self._V_bottom(q)
 
     def dV(self, q):
         q = as_array("q", q)
@@ -307,6 +416,10 @@ class NumericWell(Well):
     @property
     def barrier_energy(self):
         return self._E_b
+
+    @property
+    def asymptotes(self):
+        return self._asymptotes
 
     def turning_points(self, E):
         E = self.check_energy("E", E, allow_separatrix=True)

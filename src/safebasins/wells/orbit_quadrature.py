@@ -121,11 +121,24 @@ class OrbitQuadrature:
     ``(q_end - q)/d > gap_switch``, else as ``(q_end - q) <V'>`` with ``n_mean`` Gauss nodes;
     turning points within ``barrier_zone |q_b|`` of a barrier use the barrier form.  The
     defaults give ~1e-15 relative accuracy (tested against closed forms).
+
+    Sides open at infinity (``tails``: per side a :class:`~safebasins.wells.open_sides.Tail` or
+    None; ``limits`` are ``+-inf`` there).  Beyond the tail's ``x0``, ``E - V(q) = G(|q|) - (A - E)``
+    and ``V(q) - E = (A - E) - G(|q|)`` with ``G = A - V`` from the quadrature of ``V'`` (no
+    cancellation near ``A``); turning points are bracketed by the tail's knots.  Near ``A`` the
+    orbit lingers at its far turning point ``q_t`` as it does at a barrier: the peak of
+    ``dt/dpsi`` has the width ``alpha = 2 sqrt(l / d)`` with ``l = (A - E) / |V'(q_t)|`` the decay
+    length of ``A - V`` (the barrier formula with ``l = V'(q_t) / |V''(q_b)|``).  Between ``q_t``
+    and the well ``A - V`` changes by ``log(G / (A - E))`` e-folds (up to ~37): panels are added so
+    that ``sqrt(G)`` varies by at most ``efolds`` e-folds on a panel (bound below).
     """
 
-    def __init__(self, V, dV, limits, barriers, kappa, *, n_nodes=20, n_point=12, panel_length=1.5,
-                 alpha_max=3.0, gap_switch=0.02, n_mean=4, barrier_zone=0.1):
+    def __init__(self, V, dV, limits, barriers, kappa, *, tails=(None, None), n_nodes=20, n_point=12,
+                 panel_length=1.5, alpha_max=3.0, gap_switch=0.02, n_mean=4, barrier_zone=0.1, efolds=2.0):
         self.V, self.dV = V, dV
+        self.tails = tuple(tails)
+        self.open = any(t is not None for t in self.tails)
+        self.efolds = float(efolds)
         self.limits = (float(limits[0]), float(limits[1]))
         self.barriers = tuple(float(b) for b in barriers)
         self.barrier_V = tuple(float(V(np.array([b]))[0]) if np.isfinite(b) else np.inf
@@ -150,6 +163,12 @@ class OrbitQuadrature:
         out = []
         for k, side in enumerate((-1.0, 1.0)):
             lim, qb, Vb = self.limits[k], self.barriers[k], self.barrier_V[k]
+            if self.tails[k] is not None:
+                q = np.zeros(E_all.shape)
+                q[pos] = side * self._tail_turning_point(self.tails[k], E, None if guess is None else
+                                                         side * np.asarray(guess[k])[pos])
+                out.append(q)
+                continue
             x0 = np.full(E.shape, 0.5 * lim) if guess is None else np.asarray(guess[k])[pos]
 
             # F(s) = V(side s) - E is increasing in s = side q on [0, |lim|]; near a barrier
@@ -171,6 +190,65 @@ class OrbitQuadrature:
             out.append(q)
         return out[0], out[1]
 
+    def _tail_turning_point(self, tail, E, guess):
+        """Distance ``x`` of the turning point on an open side: ``V(side x) = E`` (``inf`` at
+        ``E >= A``); in the tail as ``(A - E) - G(x) = 0`` (both terms exact or accurate)."""
+        side = tail.side
+        s_E = tail.A - E                      # exact for E >= A/2 (Sterbenz), i.e. wherever the tail is used
+        x = np.full(E.shape, np.inf)
+        i = np.nonzero(s_E > 0)[0]
+        Ei, si = E[i], s_E[i]
+        lo, hi = tail.bracket(si)
+        x0 = 0.5 * (lo + hi) if guess is None else np.clip(guess[i], lo, hi)
+
+        def fdf(s, idx):
+            F = self.V(side * s) - Ei[idx]
+            far = s >= tail.x0
+            if far.any():
+                F[far] = si[idx][far] - tail.G(s[far])
+            return F, side * self.dV(side * s)
+        x[i] = solve_increasing(fdf, lo, hi, x0)
+        return x
+
+    def _tail_gap(self, E, q, gap):
+        """``E - V(q)`` (``gap``, computed directly) replaced beyond each open side's ``x0`` by
+        ``G(|q|) - (A - E)``."""
+        for tail in self.tails:
+            if tail is not None:
+                far = tail.side * q >= tail.x0
+                if far.any():
+                    gap[far] = tail.G(tail.side * q[far]) - (tail.A - E[far])
+        return gap
+
+    def _tail_length(self, q):
+        """Least decay length ``l = G / |V'|`` of ``A - V`` over the tail points among ``q`` (per item,
+        a tuple of 1-D arrays of equal length) and the start ``x0`` of their tails; ``inf`` where none."""
+        ell = np.full(q[0].shape, np.inf)
+        for tail in self.tails:
+            if tail is None:
+                continue
+            for qq in q:
+                x = tail.side * qq
+                far = np.isfinite(x) & (x >= tail.x0)
+                if far.any():
+                    l_far = tail.length(x[far], tail.G(x[far]))
+                    ell[far] = np.minimum(ell[far], np.minimum(l_far, tail.ell0))
+        return ell
+
+    def panels(self, v_end, d, alpha, q_end, sigma):
+        """Panels per item on ``[0, v_end]``: ``ceil(v_end / panel_length)``, and on an orbit through
+        an open side's tail enough that ``sqrt(A - V)`` varies by <= ``efolds`` e-folds per panel:
+        its rate ``|d log sqrt(G) / dv| <= d alpha cosh(v) / (2 l)``, at most
+        ``d sqrt(alpha^2 + (pi/2)^2) / (2 l)`` on ``psi <= pi/2``."""
+        m = np.maximum(np.ceil(v_end / self.panel_length), 1)
+        if not self.open:
+            return m
+        q_end = np.broadcast_to(np.asarray(q_end, dtype=float), np.shape(v_end))
+        centre = q_end - sigma * np.broadcast_to(d, np.shape(v_end))
+        ell = self._tail_length((q_end, centre))
+        rate = d * np.sqrt(alpha * alpha + 0.25 * np.pi ** 2) / (2.0 * ell)
+        return np.maximum(m, np.ceil(v_end * rate / self.efolds))
+
     def mean_dV(self, q, q_end):
         """Mean of ``V'`` over the segment ``[q, q_end]`` (Gauss-Legendre, ``n_mean`` nodes)."""
         mean = np.zeros(np.broadcast_shapes(np.shape(q), np.shape(q_end)))
@@ -183,8 +261,16 @@ class OrbitQuadrature:
         m = 0.5 * (q_plus + q_minus)
         d = 0.5 * (q_plus - q_minus)
         alphas = []
-        for sigma, q_end, kappa in ((-1.0, q_minus, self.kappa[0]), (1.0, q_plus, self.kappa[1])):
-            if np.isfinite(kappa) and kappa > 0:
+        for sigma, q_end, kappa, tail in ((-1.0, q_minus, self.kappa[0], self.tails[0]),
+                                          (1.0, q_plus, self.kappa[1], self.tails[1])):
+            if tail is not None:
+                # the barrier formula with the decay length l = (A - E) / |V'(q_t)| of the tail
+                a = np.full(np.shape(E), self.alpha_max)
+                far = sigma * q_end >= tail.x0
+                if far.any():
+                    ell = tail.length(sigma * q_end[far], tail.A - E[far])
+                    a[far] = np.clip(2.0 * np.sqrt(ell / d[far]), 1e-12, self.alpha_max)
+            elif np.isfinite(kappa) and kappa > 0:
                 slope = np.maximum(sigma * self.dV(q_end), 0.0)
                 with np.errstate(divide="ignore", invalid="ignore"):
                     a = 2.0 * np.sqrt(slope / (kappa * d))
@@ -214,6 +300,8 @@ class OrbitQuadrature:
         far = ~near
         if far.any():
             gap = Eb[far] - self.V(q[far])
+            if self.open:
+                gap = self._tail_gap(Eb[far], q[far], gap)
             R[far] = np.sqrt(2.0 * gap) / np.sin(psi_b[far])
         if near.any():
             qn = q[near]
@@ -241,8 +329,10 @@ class OrbitQuadrature:
         ``tau`` from the turning point (N, K) and the CC weights in v (N, K).
         """
         v_end = np.arcsinh(0.5 * np.pi / alpha)
-        if m is None:
+        if m is None and not self.open:
             m = max(int(np.ceil(np.max(v_end) / self.panel_length)), 1)
+        elif m is None:
+            m = int(np.max(self.panels(v_end, d, alpha, q_end, sigma)))
         v, half = self._nodes(v_end, m, self.x)
         N = v.shape[0]
         col = lambda a: np.asarray(a, dtype=float).reshape(N, 1, 1)
@@ -264,7 +354,7 @@ class OrbitQuadrature:
         E, q_end, d, alpha, psi = (np.asarray(a, dtype=float) for a in (E, q_end, d, alpha, psi))
         sigma = np.broadcast_to(np.asarray(sigma, dtype=float), E.shape)
         v_end = np.arcsinh(psi / alpha)
-        m = np.maximum(np.ceil(v_end / self.panel_length), 1).astype(int)
+        m = self.panels(v_end, d, alpha, q_end, sigma).astype(int)
         out = np.zeros(E.shape)
         for mm in np.unique(m):
             idx = np.nonzero(m == mm)[0]

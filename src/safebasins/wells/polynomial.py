@@ -24,7 +24,7 @@ import numpy as np
 from numpy.polynomial import polynomial as P
 
 from safebasins.checks import as_array
-from safebasins.wells.numeric import NumericWell
+from safebasins.wells.numeric import NumericWell, check_options
 
 __all__ = ["PolynomialWell", "polynomial", "cubic", "quartic_polynomial"]
 
@@ -52,22 +52,43 @@ class PolynomialWell(NumericWell):
 
     ``coefficients`` (float ndarray, trailing zeros removed) is kept for compiled integrators;
     ``dV_coefficients`` are those of ``V'``.  Remaining keywords go to :class:`NumericWell`
-    (``tol``); ``search_bound`` defaults to a bound on every real root of ``V'`` and of
-    ``V - E_b`` (Cauchy), so that the no-barrier side closes within it.
+    (``tol``, checked first); ``search_bound`` defaults to a bound on every real root of ``V'``
+    and of ``V - E_b`` (Cauchy), so that the no-barrier side closes within it; where Cauchy's
+    bound exceeds 1e3 times 4 x the largest of those roots (high degree, small leading
+    coefficient: 1.7e30 for the degree-8 Taylor pendulum), the latter.
     """
 
     name = "polynomial"
 
     def __init__(self, coefficients, *, name=None, **kwargs):
+        check_options(**{k: kwargs[k] for k in ("tol", "n_scan", "asymptotes") if k in kwargs})
         c = _check_coefficients(coefficients)
         self.coefficients = c
         self.dV_coefficients = P.polyder(c)
         self._d2 = P.polyder(self.dV_coefficients)
         if "barriers" in kwargs:
             raise ValueError("barriers: a PolynomialWell finds its barriers from the roots of V'")
-        kwargs.setdefault("search_bound", self._cauchy_bound())
+        if "search_bound" not in kwargs:
+            kwargs["search_bound"] = self._default_search_bound()
         dc = self.dV_coefficients
         super().__init__(lambda q: P.polyval(q, c), lambda q: P.polyval(q, dc), name=name, **kwargs)
+
+    def _default_search_bound(self):
+        cauchy = self._cauchy_bound()
+        roots = self._root_bound()
+        return cauchy if not (roots > 0 and cauchy > 1e3 * roots) else roots
+
+    def _root_bound(self):
+        """4 x the largest real root of ``V'`` and of ``V - E_b`` (0 without a barrier)."""
+        barriers = self._locate_barriers(None, None)
+        Vb = [float(P.polyval(b, self.coefficients)) for b in barriers if np.isfinite(b)]
+        if not Vb:
+            return 0.0
+        shifted = self.coefficients.copy()
+        shifted[0] -= min(Vb)
+        r = P.polyroots(shifted)
+        real = r[np.abs(r.imag) <= 1e-7 * max(1.0, float(np.max(np.abs(r))))].real
+        return 4.0 * float(np.max(np.abs(np.concatenate([real, self._real_roots]))))
 
     def _cauchy_bound(self):
         """Search bound (x4 margin) from Cauchy's root bound ``1 + max |a_k / a_n|``: it contains
