@@ -235,15 +235,17 @@ def test_bad_potentials(V, dV, match):
         NumericWell(V, dV)
 
 
-def test_plateau_side_is_open():
-    # right: the cubic's barrier (E_b = 1/6); left: a plateau at 0.1 < 1/6, open at infinity
-    a = np.sqrt(5.0)                  # V''(0) = 1 on both sides
-    V = lambda q: np.where(q < 0, 0.1 * np.tanh(a * q) ** 2, q * q * (0.5 - q / 3))
-    dV = lambda q: np.where(q < 0, 0.2 * a * np.tanh(a * q) / np.cosh(a * q) ** 2, q * (1 - q))
+def test_two_open_sides_with_different_limits():
+    # V = tanh^2 q (1 + 0.6 tanh q) / 2: limits 0.2 (left, the escape energy) and 0.8 (right, above
+    # it: that side closes where V = 0.2)
+    V = lambda q: 0.5 * np.tanh(q) ** 2 * (1 + 0.6 * np.tanh(q))
+    dV = lambda q: 0.5 * np.tanh(q) * (2 + 1.8 * np.tanh(q)) / np.cosh(q) ** 2
     w = NumericWell(V, dV)
-    assert w.asymptotes == (0.1, None) and w.barrier_energy == 0.1 and w.open_at_infinity
-    assert w.barriers == (-np.inf, 1.0) and w.limits == (-np.inf, 1.0)
-    assert np.all(np.diff(w.omega(0.1 - np.geomspace(0.05, 1e-14, 20))) < 0)   # omega -> 0 at the limit
+    assert w.asymptotes == pytest.approx((0.2, 0.8), rel=1e-15) and w.barrier_energy == w.asymptotes[0]
+    assert w.open_at_infinity and w.barriers == (-np.inf, np.inf)
+    assert w.limits[0] == -np.inf and 0.6 < w.limits[1] < 0.62 and V(w.limits[1]) > 0.2
+    E = 0.2 - 0.2 * np.geomspace(0.5, 1e-15, 30)
+    assert np.all(np.diff(w.omega(E)) < 0) and w.omega(E[-1]) < 1e-6    # omega -> 0 at the limit
 
 
 def test_side_neither_closing_nor_converging():

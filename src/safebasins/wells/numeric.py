@@ -8,10 +8,12 @@ frequency ``omega(E) = dE/dJ`` (eq 16), the angle ``theta(q, p)`` and its invers
 ``q(theta)`` that enters the slow flow (eqs 12, 18, 20).
 
 How (details in :mod:`safebasins.wells.orbit_quadrature` and
-:mod:`safebasins.wells.interpolation`):
+:mod:`safebasins.wells.interpolation`; the shape of the well in
+:mod:`safebasins.wells.well_shape`, sides open at infinity in :mod:`safebasins.wells.open_sides`):
 
 * turning points ``V(q_pm) = E`` by vectorised safeguarded Newton (near a barrier written as
-  ``(V_b - E) - (q_b - q) <V'>`` so that they stay accurate at the separatrix);
+  ``(V_b - E) - (q_b - q) <V'>`` so that they stay accurate at the separatrix; far out on a side
+  open at infinity as ``(A - E) - int_q^inf V'``);
 * orbit integrals with ``q = m + d sin(phi)`` (square-root end singularities removed), the
   near-separatrix peak resolved by ``psi = alpha sinh(v)``; composite Clenshaw-Curtis in ``v``
   for the cumulative time along a half orbit, composite Gauss-Legendre to a single point;
@@ -19,7 +21,8 @@ How (details in :mod:`safebasins.wells.orbit_quadrature` and
   point ``theta_plus``), ``|q_1| = (1/pi) int sin(omega tau_plus(q)) dq``;
 * period, ``J/E``, ``|q_1|/sqrt(E)``, ``theta_minus``, the turning points etc. as adaptive
   piecewise Chebyshev interpolants in ``sqrt(E)`` (well bottom) and ``log(E_b - E)``
-  (separatrix), built once at construction (~0.1 s, 420 orbits for the quartic);
+  (separatrix, or the approach to the limit of an open side), built once at construction
+  (~0.02 s CPU, 420 orbits for the quartic; 0.05-0.3 s, 460 orbits, for Morse and sech^2);
 * ``angle_energy`` evaluates the time integral from the nearer turning point for every point
   (no interpolation in ``q``; near a turning point the position on the orbit is taken from
   ``p``, which is well conditioned there); ``phase_point`` inverts it by safeguarded Newton.
@@ -34,71 +37,38 @@ Accuracy (measured for the quartic against the closed forms, asserted with margi
 <= 3e-11 at ``E_b - E = 1e-12`` and ~1e-9 at the last float below ``E_b``; ``d|q_1|/dE``
 within 4e-12 for ``E <= 0.249``; angles within 2e-13 (``E <= 0.249``) and 1e-13 at 0.2499.
 Closer to the separatrix the angle of a given point is ill-conditioned (an error ``eps E_b``
-in ``H0(q, p)`` moves theta by ~``eps E_b / (E_b - E)``).  Wells from callables need ``V``
-accurate to relative precision near ``q = 0`` (write ``2 sin(q/2)^2``, not ``1 - cos q``) and
-``V'`` near the barriers; the asymmetric quartic and the cubic agree with DOP853 orbits and
-scipy quad to 1e-14 .. 1e-12 (limited by the references).
+in ``H0(q, p)`` moves theta by ~``eps E_b / (E_b - E)``).  The asymmetric quartic and the cubic
+agree with DOP853 orbits and scipy quad to 1e-14 .. 1e-12 (limited by the references).
+
+Wells open at infinity (docs/wells.md; closed forms of Morse ``D (1 - e^{-a q})^2`` and of
+``tanh^2 q``): omega, J, ``|q_1|``, ``arg q_1`` within 1e-13 relative for every float
+``E < E_b`` (the last one included; J within 2e-13 where the interpolation tolerance 1e-13
+dominates), ``phase_point`` within 4e-13 (as an angle) up to ``E_b - E = 1e-12 E_b``; DOP853
+orbits agree to their own accuracy (~1e-12).  Such wells need ``V'`` accurate to relative
+precision in the tail (``2 tanh(q) / cosh(q)^2``, not ``2 tanh(q) (1 - tanh(q)^2)``: ValueError
+naming dV).  ``V`` may lose relative accuracy at the bottom (``1 - cos q``, ``(1 - exp(-q))^2``):
+this is detected and V is evaluated there as ``int_0^q V'`` (:mod:`safebasins.wells.bottom`).
 """
 from __future__ import annotations
 
 from functools import partial
 
 import numpy as np
-from scipy import optimize
 
 from safebasins.checks import as_array, value_repr
 from safebasins.wells.base import Well
 from safebasins.wells.bottom import cancellation_fix
 from safebasins.wells.interpolation import BOTTOM, EnergyInterpolant
-from safebasins.wells.open_sides import CONVERGED, TAIL_START, Tail, converged_limit, geometric_values
 from safebasins.wells.orbit_quadrature import EPS, OrbitQuadrature, solve_increasing
+from safebasins.wells.well_shape import WellShape, _call, check_options
 
-__all__ = ["NumericWell"]
+__all__ = ["NumericWell", "check_options"]
 
 # interpolated quantities (rows of the interpolant)
 _T, _JE, _H, _THM, _TL, _QM, _QP = range(7)
-#: tolerance for V(0) = 0 and V'(0) = 0 (absolute)
-BOTTOM_ATOL = 1e-12
 
 
-def check_options(*, tol=1e-13, n_scan=20001, asymptotes=None):
-    """Validated ``(tol, n_scan, asymptotes)`` of :class:`NumericWell` (ValueError naming the argument),
-    checked before anything is computed.  ``asymptotes``: None or a pair of float-or-None."""
-    t = as_array("tol", tol)
-    if t.ndim != 0 or not (1e-15 <= float(t) <= 1e-2):
-        raise ValueError(f"tol must be a number in [1e-15, 1e-2] (relative accuracy of the energy interpolants), "
-                         f"got {tol!r}")
-    if isinstance(n_scan, bool) or not isinstance(n_scan, (int, np.integer)) or n_scan < 100:
-        raise ValueError(f"n_scan must be an integer >= 100 (points of the barrier scan on each side), got {n_scan!r}")
-    if asymptotes is None:
-        return float(t), int(n_scan), None
-    try:
-        pair = list(asymptotes)
-    except TypeError:
-        pair = None
-    if pair is None or len(pair) != 2:
-        raise ValueError(f"asymptotes must be a pair (left, right) of limits of V at -inf / +inf, each a float or None, "
-                         f"got {asymptotes!r}")
-    out = []
-    for side, a in zip(("left", "right"), pair):
-        if a is not None:
-            a = as_array("asymptotes", a)
-            if a.ndim != 0 or not (np.isfinite(a) and a > 0):
-                raise ValueError(f"asymptotes: the {side} limit must be a finite number > 0 (V rises from V(0) = 0 "
-                                 f"towards it) or None, got {pair[0 if side == 'left' else 1]!r}")
-            a = float(a)
-        out.append(a)
-    return float(t), int(n_scan), tuple(out)
-
-
-def _call(f, q):
-    """``f(q)`` as a float array of q's shape (a callable returning a constant is broadcast)."""
-    with np.errstate(over="ignore", invalid="ignore"):
-        out = np.asarray(f(q), dtype=float)
-    return out if out.shape == np.shape(q) else np.broadcast_to(out, np.shape(q)).copy()
-
-
-class NumericWell(Well):
+class NumericWell(WellShape, Well):
     """A potential well ``V(q)`` given by callables, action-angle data by quadrature.
 
     Parameters
@@ -114,28 +84,42 @@ class NumericWell(Well):
         search and ValueError is raised on a mismatch.
     search_bound : float
         How far (in ``|q|``) the barriers are searched.  A side whose ``V'`` keeps its sign up
-        to ``search_bound`` has no barrier (``+-inf``); there ``V`` must rise above the escape
-        energy within ``search_bound`` (else ValueError: the well would be open).
+        to ``search_bound`` has no barrier (``+-inf``); it is either closed (``V`` rises above the
+        escape energy, within ``search_bound`` or beyond it) or open at infinity (``V`` converges
+        to a finite limit along ``|q| = search_bound 2^k``, float precision), else ValueError.
     name : str
         Name used in datasets and configs.
     n_scan : int
-        Points of the barrier scan on each side.
+        Points of the barrier scan on each side (>= 100).
     tol : float
-        Target relative accuracy of the energy interpolants (trailing Chebyshev coefficients).
+        Target relative accuracy of the energy interpolants (trailing Chebyshev coefficients),
+        in ``[1e-15, 1e-2]``.
+    asymptotes : (left, right) or None
+        Limits of ``V`` as ``q -> -inf`` / ``+inf`` when the caller knows them exactly (e.g.
+        sympy's ``limit``): each a float, or None for "no finite limit" (``V -> inf``).  On a side
+        without a barrier it is checked against ``V`` at large ``|q|`` (``1e-12`` relative) and,
+        if open, against ``V(x0) + int_x0^inf V'`` (ValueError naming ``asymptotes`` on a
+        mismatch) and replaces the float limit found along the geometric sequence; on a side
+        with a barrier (escape over the barrier) it is not used.  ``None`` (default): detected.
 
     Attributes
     ----------
-    barriers, barrier_energy, limits (bracket of all orbits of energy <= barrier_energy:
-    barrier or the point where V exceeds it), omega0 (= sqrt(V''(0)), finite differences),
-    interpolation_error (largest trailing-coefficient estimate of the energy interpolants,
-    dominated by the panels within ~1e-12 E_b of the separatrix).
+    barriers, barrier_energy (the lowest of the barriers' ``V(q_b)`` and of the limits of V at
+    infinity), asymptotes (per side the finite limit of V on a side without a barrier, None
+    where there is a barrier or ``V -> inf``), open_at_infinity (the escape energy is such a
+    limit: thresholds ``xi_max`` must lie in ``(0, E_b)``), limits (bracket of all orbits of
+    energy <= barrier_energy: barrier, the point where V exceeds it, or ``+-inf`` on a side open
+    at infinity), omega0 (= sqrt(V''(0)), finite differences), interpolation_error (largest
+    trailing-coefficient estimate of the energy interpolants, dominated by the panels within
+    ~1e-12 E_b of the separatrix).
 
     Beyond :class:`~safebasins.wells.base.Well` (what a slow flow needs): ``period``,
     ``dJ_dE`` (= 1/omega), ``harmonic_amplitude`` (|q_1|, eq 20's G),
     ``harmonic_amplitude_derivative``, ``harmonic_phase`` (arg q_1, continuous in
     ``(-pi, 0)``), ``harmonic_phase_derivative``, ``check_energy``, ``check_point``.  Energies
-    are in ``[0, E_b)`` (``turning_points``: ``[0, E_b]``; derivatives: ``(0, E_b)``); arrays
-    broadcast; bad input raises ValueError naming the argument.
+    are in ``[0, E_b)``, every float below ``E_b`` (``turning_points``: ``[0, E_b]``, ``+-inf``
+    on an open side at ``E_b``; derivatives: ``(0, E_b)``); arrays broadcast; bad input raises
+    ValueError naming the argument.
     """
 
     name = "numeric"
@@ -160,8 +144,7 @@ class NumericWell(Well):
             self._check_given_barriers(barriers, found)
         self._barriers = found
         vals = [float(_call(V, np.array([b]))[0]) for b in found if np.isfinite(b)]
-        limits_at_inf = self._find_asymptotes(found, declared, B)
-        self._asymptotes = tuple(None if np.isfinite(b) else a for b, a in zip(found, limits_at_inf))
+        self._asymptotes = self._find_asymptotes(found, declared, B)
         levels = vals + [a for a in self._asymptotes if a is not None]
         if not levels:
             raise ValueError(f"V: the well is closed: no barrier within search_bound={B} and no finite limit of V at "
@@ -180,181 +163,13 @@ class NumericWell(Well):
                                  "separatrix behaviour assumed by the interpolation in E does not hold")
         self._V_bottom = cancellation_fix(partial(_call, V), partial(_call, dV), self._bottom_scales())
         V_acc = partial(_call, V) if self._V_bottom is None else self._V_bottom
-        opened = {"tails": self._tails, "n_mean": 8} if self.open_at_infinity else {}
+        opened = ({"tails": self._tails, "core": min(self._bottom_scales()), "n_mean": 8}
+                  if self.open_at_infinity else {})
         self._quad = OrbitQuadrature(V_acc, partial(_call, dV), self.limits, found, kappa, **opened)
         self._interp = EnergyInterpolant(self._orbit_table, self._E_b, tol=tol, noise=self._noise)
         self.interpolation_error = self._interp.error_estimate
 
     # ------------------------------------------------------------------ construction
-    def _check_bottom(self):
-        z = np.zeros(1)
-        v0, d0 = float(_call(self._V, z)[0]), float(_call(self._dV, z)[0])
-        if not (np.isfinite(v0) and abs(v0) <= BOTTOM_ATOL):
-            raise ValueError(f"V: V(0) = {v0!r}, must be 0 (energies are measured from the well bottom q = 0)")
-        if not (np.isfinite(d0) and abs(d0) <= BOTTOM_ATOL):
-            raise ValueError(f"dV: V'(0) = {d0!r}, must be 0 (the minimum of the well must be at q = 0)")
-        # V''(0) from V'(h)/h on both sides at h = 1e-7 and 1e-8 search_bound: they must agree
-        # (a degenerate minimum, V''(0) = 0, has V'(h)/h ~ h^2 and fails the comparison)
-        h = self.search_bound * np.array([-1e-7, -1e-8, 1e-8, 1e-7])
-        g = _call(self._dV, h) / h
-        k0 = float(np.mean(g))
-        if not (np.isfinite(g).all() and (g > 0).all() and g.min() > 0.5 * g.max()):
-            raise ValueError(f"V: V''(0) = {float(g.min())!r} (V'(q)/q at |q| = 1e-8 and 1e-7 search_bound = "
-                             f"{self.search_bound!r}), must be > 0: q = 0 must be a non-degenerate minimum (a well much "
-                             "smaller than search_bound needs a smaller search_bound)")
-        self.omega0 = float(np.sqrt(k0))
-
-    def _locate_barriers(self, B, n):
-        """``(q_left, q_right)``: nearest local maxima of V on each side (``+-inf`` if none)."""
-        return tuple(self._find_barrier(side, B, n) for side in (-1.0, 1.0))
-
-    def _scan(self, side, B, n):
-        s = np.geomspace(1e-9 * B, B, n)
-        return s, side * _call(self._dV, side * s)
-
-    def _find_barrier(self, side, B, n):
-        s, f = self._scan(side, B, n)
-        where = "left" if side < 0 else "right"
-        stop = np.nonzero((f < 0) | ~np.isfinite(f))[0]
-        self._scans = getattr(self, "_scans", {})
-        self._scans[side] = (s, f)
-        if stop.size == 0:
-            return side * np.inf
-        i = int(stop[0])
-        if not np.isfinite(f[i]):
-            raise ValueError(f"dV: V'({float(side * s[i])!r}) is not finite, {where} of 0 before any barrier")
-        if i == 0:
-            raise ValueError("dV: V' has the wrong sign next to q = 0 (q = 0 is not a minimum)")
-        a, b = s[i - 1], s[i]
-        if f[i - 1] == 0:
-            return side * a
-        g = lambda x: side * float(_call(self._dV, np.array([side * x]))[0])
-        r = optimize.brentq(g, a, b, xtol=1e-300, rtol=4 * EPS, maxiter=500)
-        return side * r
-
-    def _check_monotone(self, side, lim):
-        """V' must not vanish between 0 and the limit (an interior equilibrium, e.g. an
-        inflection point with V' = 0, carries a non-periodic orbit): interior local minima of
-        ``V'(q)/q`` on the scan are polished and rejected if they reach ~0."""
-        s, f = self._scans[side]
-        keep = s < abs(lim)
-        s, g = s[keep], f[keep] / s[keep]
-        if g.size < 3:
-            return
-        j = np.nonzero((g[1:-1] <= g[:-2]) & (g[1:-1] <= g[2:]) & (g[1:-1] < 1e-3 * g[0]))[0] + 1
-        h = lambda x: side * float(_call(self._dV, np.array([side * x]))[0]) / x
-        for k in j:
-            res = optimize.minimize_scalar(h, bounds=(s[k - 1], s[k + 1]), method="bounded",
-                                           options={"xatol": 1e-12 * s[k]})
-            if res.fun <= 1e-9 * g[0]:
-                raise ValueError(f"V: V' vanishes at q ~ {float(side * res.x)!r} inside the well (an equilibrium that is "
-                                 "not a barrier): the orbit through it is not periodic")
-
-    def _check_given_barriers(self, barriers, found):
-        try:
-            given = tuple(float(b) for b in barriers)
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"barriers must be a pair (q_left, q_right), got {barriers!r}") from exc
-        if len(given) != 2 or np.isnan(given).any():
-            raise ValueError(f"barriers must be a pair (q_left, q_right) without NaN, got {barriers!r}")
-        if not (given[0] < 0 < given[1]):
-            raise ValueError(f"barriers must satisfy q_left < 0 < q_right, got {given!r}")
-        for g, f, side in zip(given, found, ("left", "right")):
-            same = (g == f) if not (np.isfinite(g) and np.isfinite(f)) else abs(g - f) <= 1e-9 * max(1.0, abs(f))
-            if not same:
-                raise ValueError(f"barriers: the {side} barrier is given as {g!r} but the nearest local maximum "
-                                 f"of V on that side (within search_bound) is at {f!r}")
-
-    def _find_asymptotes(self, found, declared, B):
-        """Per side, the finite limit of V at infinity or None (V -> inf; a barrier side without a
-        declared limit).  Declared limits (``asymptotes``) are checked against V at large |q|."""
-        out = []
-        self._sequences = {}
-        for k, side in enumerate((-1.0, 1.0)):
-            where, sign = ("left", "-") if side < 0 else ("right", "+")
-            given = None if declared is None else declared[k]
-            if np.isfinite(found[k]) and given is None:
-                out.append(None)
-                continue
-            x, v = geometric_values(partial(_call, self._V), side, B)
-            self._sequences[side] = (x, v)
-            A, i = converged_limit(v)
-            if given is not None and (A is None or abs(A - given) > 1e-12 * abs(given)):
-                seen = (f"tends to {A!r}" if A is not None else
-                        f"does not converge (V = {float(v[np.isfinite(v)][-1])!r} at q = {float(side * x[np.isfinite(v)][-1])!r})")
-                raise ValueError(f"asymptotes: the {where} limit is declared as {given!r}, but V {seen} along "
-                                 f"q -> {sign}inf (|q| = search_bound 2^k)")
-            if declared is not None and given is None and A is not None:
-                raise ValueError(f"asymptotes: the {where} entry is None (no finite limit), but V tends to {A!r} as "
-                                 f"q -> {sign}inf")
-            if A is not None and np.isfinite(found[k]):
-                out.append(given)
-                continue
-            if A is not None:
-                rise = np.diff(v[:i + 1])
-                if not (A > 0 and (rise >= -CONVERGED * A).all()):
-                    raise ValueError(f"search_bound: V is not increasing towards its limit {A!r} on the {where} side "
-                                     f"beyond search_bound = {B} (V' changes sign there: a barrier?); give a larger "
-                                     "search_bound")
-            out.append(given if given is not None else A)
-        return tuple(out)
-
-    def _open_tail(self, side, A):
-        """The :class:`~safebasins.wells.open_sides.Tail` of a side open at infinity (its limit is
-        the escape energy), else None."""
-        if A is None or A > self._E_b:
-            return None
-        where = "left" if side < 0 else "right"
-        x, v = self._sequences[side]
-        hint = float(x[np.nonzero(v >= (1.0 - TAIL_START) * A)[0][0]])
-        f = lambda s: side * _call(self._dV, side * s)
-        tail = Tail(f, partial(_call, self._V), side, A, hint, where)
-        # V(x0) + int_x0^inf V' must be the limit: a wrong declared limit, or V' not the derivative of V
-        rest = A - float(_call(self._V, np.array([side * tail.x0]))[0])
-        if abs(rest - tail.G0) > 1e-11 * A:
-            raise ValueError(f"asymptotes: the {where} limit {A!r} is not V(q) + int_q^inf V' = "
-                             f"{A - rest + tail.G0!r} (q = {side * tail.x0!r}): a wrong limit, or dV is not V'")
-        return tail
-
-    def _limit(self, side, barrier, B, n):
-        if np.isfinite(barrier):
-            return float(barrier)
-        if self._tails[0 if side < 0 else 1] is not None:
-            return side * np.inf
-        s = np.geomspace(1e-9 * B, B, n)
-        v = _call(self._V, side * s)
-        above = np.nonzero(v > self._E_b)[0]
-        if above.size:
-            return float(side * s[above[0]])
-        # V rises above E_b only beyond search_bound (slowly growing V, or a limit above E_b)
-        x, v = self._sequences[side]
-        above = np.nonzero(v > self._E_b)[0]
-        if above.size == 0:
-            raise ValueError(f"V: on the {'left' if side < 0 else 'right'} side V' keeps its sign up to search_bound = "
-                             f"{B}, but V neither rises above the escape energy {self._E_b!r} nor converges to a finite "
-                             f"limit (|q| up to {float(x[-1])!r}): the side neither closes nor is open at infinity")
-        return float(side * x[above[0]])
-
-    def _bottom_scales(self):
-        """Per side the extent of the well proper: the limit, or where the tail of an open side begins."""
-        return tuple(abs(lim) if t is None else t.x0 for lim, t in zip(self.limits, self._tails))
-
-    def _check_derivative(self):
-        lo, hi = (side * s for side, s in zip((-1.0, 1.0), self._bottom_scales()))
-        q = np.linspace(lo, hi, 13)[1:-1]
-        q = q[q != 0]
-        h = 1e-5 * max(abs(lo), abs(hi))
-        fd = (_call(self._V, q + h) - _call(self._V, q - h)) / (2 * h)
-        d = _call(self._dV, q)
-        scale = np.max(np.abs(d))
-        if not np.allclose(fd, d, rtol=0, atol=1e-6 * scale):
-            raise ValueError(f"dV does not match the derivative of V (max |dV - dV_fd| = {np.max(np.abs(fd - d))!r} "
-                             f"relative to max |dV| = {scale!r})")
-
-    def _curvature(self, qb):
-        h = 1e-5 * max(1.0, abs(qb))
-        return float(-(_call(self._dV, np.array([qb + h]))[0] - _call(self._dV, np.array([qb - h]))[0]) / (2 * h))
-
     def _noise(self, kind, a, b):
         """Relative accuracy floor of the tabulated data on a panel (conditioning near E_b)."""
         if kind == BOTTOM:
@@ -520,7 +335,10 @@ class NumericWell(Well):
             # sin(psi/2) from q (h = 2 d sin^2(psi/2)); near the turning point, where that is
             # ill-conditioned in E (q_end moves with E), from p = 2 sqrt(sigma d <V'>) sin(psi/2)
             half = np.sqrt(np.clip(np.abs(qk - q_end) / (2.0 * o["d"]), 0.0, 1.0))
-            near = np.nonzero(half < 0.5)[0]
+            close = half < 0.5
+            if self.open_at_infinity:     # <V'> by a few nodes: only on the scale of the end
+                close &= np.abs(qk - q_end) <= self._quad.end_length(q_end)
+            near = np.nonzero(close)[0]
             if near.size:
                 mean = self._quad.mean_dV(qk[near], q_end[near])
                 with np.errstate(divide="ignore", invalid="ignore"):

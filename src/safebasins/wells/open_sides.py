@@ -10,8 +10,8 @@ separatrix of a saddle) and the period diverges as a power of ``A - E``, not log
 (Morse: ``omega = a sqrt(2 (D - E))``).  Details: docs/wells.md.
 
 Detection (:func:`geometric_values`, :func:`converged_limit`): ``V`` along ``|q| = x_start 2^k``
-(``k = 0, 1, ...`` while finite); the side converges when, from some ``k`` on, every finite value
-agrees with ``V(x_k)`` within ``CONVERGED`` (relative) and at least three do.
+(``k = 0, 1, ...`` while finite); the side converges when ``RUN`` consecutive values agree within
+``CONVERGED`` (relative), i.e. V is constant to float precision over a factor 256 in ``|q|``.
 
 Accuracy near the limit (:class:`Tail`): far out ``V`` is within a few ulps of ``A`` and
 ``A - V(q)`` has lost its digits, but ``V'`` has not.  Beyond ``x0`` (where ``A - V = A/8``) the
@@ -29,8 +29,10 @@ from scipy import optimize
 __all__ = ["geometric_values", "converged_limit", "Tail", "TAIL_START", "CONVERGED"]
 
 EPS = np.finfo(float).eps
-#: relative agreement of the values of V along the geometric sequence that counts as converged
+#: relative agreement of RUN consecutive values of V along the geometric sequence (|q| growing by
+#: 2^RUN) that counts as converged
 CONVERGED = 4 * EPS
+RUN = 8
 #: ``G(x0) = TAIL_START * A``: beyond x0, ``A - V`` would lose more than 3 bits
 TAIL_START = 0.125
 #: a panel integral below ``NEGLIGIBLE * A`` ends the table: the rest is negligible against the
@@ -53,25 +55,21 @@ def geometric_values(V, side, start):
 
 
 def converged_limit(v):
-    """``(A, k)``: the value ``V`` settles to along the sequence ``v`` (from index ``k`` on every
-    finite value within ``CONVERGED`` of ``v[k]``, at least three of them), or ``(None, None)``."""
-    fin = np.flatnonzero(np.isfinite(v))
-    if fin.size < 3:
+    """``(A, k)``: the value ``V`` settles to along the sequence ``v``: the first run of ``RUN``
+    consecutive finite values within ``CONVERGED`` of each other starts at ``k``, ``A`` its last
+    value; ``(None, None)`` if there is none.  (Values beyond the run are not looked at: near
+    ``|q| ~ 1e150`` a formula such as ``q^2 / (1 + q^2)`` overflows.)"""
+    v = np.asarray(v, dtype=float)
+    if v.size < RUN:
         return None, None
-    last = v[fin[-1]]
-    close = np.abs(v[fin] - last) <= CONVERGED * abs(last)
-    if not close[-1] or last == 0.0:
+    w = np.lib.stride_tricks.sliding_window_view(v, RUN)
+    with np.errstate(invalid="ignore"):
+        flat = np.isfinite(w).all(axis=1) & (w[:, 0] != 0) & \
+            (np.abs(w - w[:, :1]) <= CONVERGED * np.abs(w[:, :1])).all(axis=1)
+    k = np.flatnonzero(flat)
+    if k.size == 0:
         return None, None
-    # the run of close finite values reaching the last finite one
-    start = fin.size - 1
-    while start > 0 and close[start - 1]:
-        start -= 1
-    if fin.size - start < 3:
-        return None, None
-    k = int(fin[start])
-    if np.any(np.abs(v[fin[start:]] - v[k]) > CONVERGED * abs(v[k])):
-        return None, None
-    return float(v[k]), k
+    return float(w[k[0], -1]), int(k[0])
 
 
 class Tail:
@@ -80,7 +78,8 @@ class Tail:
     ``f(x) = side V'(side x)`` (vectorised, > 0 on the side), ``A`` the limit, ``V`` the potential
     (for ``x0``: the first ``x`` with ``A - V <= TAIL_START A``), ``x_hint`` a point with ``V``
     above that level.  ``where`` names the side in error messages.  Attributes: ``A``, ``x0``,
-    ``G0 = G(x0)``, ``ell0`` (decay length ``G/f`` at x0), ``knots``, ``G_knots``.
+    ``G0 = G(x0)``, ``ell0`` (decay length ``G/f`` at x0), ``knots``, ``G_knots``, ``ell_knots``
+    (``G/f`` there).
     """
 
     def __init__(self, f, V, side, A, x_hint, where):
@@ -137,6 +136,10 @@ class Tail:
                                  f"float arithmetic (A - V still ~{float(np.sum(parts[-8:]))!r} at |q| ~ {x!r})")
         self.knots = np.array(knots)
         self.G_knots = np.append(np.cumsum(np.array(parts)[::-1])[::-1], 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ell = self.G_knots / self.f(self.knots)
+        # the last knot has G = 0 (the negligible rest): carry the previous length
+        self.ell_knots = np.where(np.isfinite(ell) & (ell > 0), ell, np.append(ell[:-1], ell[-2]))
 
     def G(self, x):
         """``A - V(side x)`` for ``x >= x0`` (0 beyond the table, where it is below ``NEGLIGIBLE A``)."""
@@ -160,6 +163,10 @@ class Tail:
         lo = np.where(core, 0.0, self.knots[j - 1])
         hi = np.where(core, self.x0, self.knots[j])
         return lo, hi
+
+    def length_at(self, x):
+        """Decay length ``G / f`` at ``x0 <= x`` interpolated between the knots (a panel-count estimate)."""
+        return np.interp(x, self.knots, self.ell_knots)
 
     def length(self, x, G):
         """Decay length ``G / f`` of the tail at ``x`` (``G = G(x)``): e-folding length of ``A - V``."""

@@ -118,7 +118,8 @@ class OrbitQuadrature:
     time), ``n_point`` Gauss-Legendre nodes per panel for the time to one point, panels of
     length <= ``panel_length`` in ``v``; ``alpha`` is capped at ``alpha_max`` (far from the
     separatrix the map is nearly linear).  ``E - V(q)`` is evaluated directly where
-    ``(q_end - q)/d > gap_switch``, else as ``(q_end - q) <V'>`` with ``n_mean`` Gauss nodes;
+    ``(q_end - q)/d > gap_switch``, else as ``(q_end - q) <V'>`` with ``n_mean`` Gauss nodes
+    (for a well open at infinity also only within ``gap_switch`` times :meth:`end_length`);
     turning points within ``barrier_zone |q_b|`` of a barrier use the barrier form.  The
     defaults give ~1e-15 relative accuracy (tested against closed forms).
 
@@ -129,16 +130,17 @@ class OrbitQuadrature:
     orbit lingers at its far turning point ``q_t`` as it does at a barrier: the peak of
     ``dt/dpsi`` has the width ``alpha = 2 sqrt(l / d)`` with ``l = (A - E) / |V'(q_t)|`` the decay
     length of ``A - V`` (the barrier formula with ``l = V'(q_t) / |V''(q_b)|``).  Between ``q_t``
-    and the well ``A - V`` changes by ``log(G / (A - E))`` e-folds (up to ~37): panels are added so
-    that ``sqrt(G)`` varies by at most ``efolds`` e-folds on a panel (bound below).
+    and the well ``A - V`` changes by ``log(G / (A - E))`` e-folds (up to ~37), and along an
+    algebraic tail the well proper (extent ``core``) is a sliver of the half orbit: the panels are
+    graded (:meth:`breaks`).
     """
 
-    def __init__(self, V, dV, limits, barriers, kappa, *, tails=(None, None), n_nodes=20, n_point=12,
-                 panel_length=1.5, alpha_max=3.0, gap_switch=0.02, n_mean=4, barrier_zone=0.1, efolds=2.0):
+    def __init__(self, V, dV, limits, barriers, kappa, *, tails=(None, None), core=None, n_nodes=20, n_point=12,
+                 panel_length=1.5, alpha_max=3.0, gap_switch=0.02, n_mean=4, barrier_zone=0.1, span=4.0):
         self.V, self.dV = V, dV
         self.tails = tuple(tails)
         self.open = any(t is not None for t in self.tails)
-        self.efolds = float(efolds)
+        self.core, self.span = core, float(span)
         self.limits = (float(limits[0]), float(limits[1]))
         self.barriers = tuple(float(b) for b in barriers)
         self.barrier_V = tuple(float(V(np.array([b]))[0]) if np.isfinite(b) else np.inf
@@ -221,33 +223,53 @@ class OrbitQuadrature:
         return gap
 
     def _tail_length(self, q):
-        """Least decay length ``l = G / |V'|`` of ``A - V`` over the tail points among ``q`` (per item,
-        a tuple of 1-D arrays of equal length) and the start ``x0`` of their tails; ``inf`` where none."""
-        ell = np.full(q[0].shape, np.inf)
+        """Decay length ``l = (A - V) / |V'|`` at the points ``q`` (``inf`` outside the tails)."""
+        ell = np.full(np.shape(q), np.inf)
         for tail in self.tails:
-            if tail is None:
-                continue
-            for qq in q:
-                x = tail.side * qq
-                far = np.isfinite(x) & (x >= tail.x0)
-                if far.any():
-                    l_far = tail.length(x[far], tail.G(x[far]))
-                    ell[far] = np.minimum(ell[far], np.minimum(l_far, tail.ell0))
+            if tail is not None:
+                x = tail.side * q
+                far = x >= tail.x0
+                ell[far] = tail.length_at(x[far])
         return ell
 
-    def panels(self, v_end, d, alpha, q_end, sigma):
-        """Panels per item on ``[0, v_end]``: ``ceil(v_end / panel_length)``, and on an orbit through
-        an open side's tail enough that ``sqrt(A - V)`` varies by <= ``efolds`` e-folds per panel:
-        its rate ``|d log sqrt(G) / dv| <= d alpha cosh(v) / (2 l)``, at most
-        ``d sqrt(alpha^2 + (pi/2)^2) / (2 l)`` on ``psi <= pi/2``."""
-        m = np.maximum(np.ceil(v_end / self.panel_length), 1)
-        if not self.open:
-            return m
-        q_end = np.broadcast_to(np.asarray(q_end, dtype=float), np.shape(v_end))
-        centre = q_end - sigma * np.broadcast_to(d, np.shape(v_end))
-        ell = self._tail_length((q_end, centre))
-        rate = d * np.sqrt(alpha * alpha + 0.25 * np.pi ** 2) / (2.0 * ell)
-        return np.maximum(m, np.ceil(v_end * rate / self.efolds))
+    def end_length(self, q_end):
+        """Length scale of V' at a turning point of a well open at infinity: the decay length
+        ``l`` of the tail beyond ``x0``, else the extent ``core`` of the well proper (with a far
+        turning point on an open side the half width ``d`` is far larger than either)."""
+        ell = self._tail_length(np.asarray(q_end, dtype=float))
+        return np.where(np.isfinite(ell), ell, self.core)
+
+    def breaks(self, v_end, d, alpha, q_end, sigma, max_panels=4000):
+        """Panel breaks ``(N, M + 1)`` on ``[0, v_end]`` for a well open at infinity, marching from
+        the turning point: a panel spans at most ``panel_length`` in ``v`` and, in ``q``, at most
+        ``span`` decay lengths ``l = (A - V) / |V'|`` of a tail (``sqrt(A - V)`` changes by
+        ``span / 2`` e-folds) and half the distance to the well bottom, at least half ``core``:
+        uniform in ``q`` along an exponential tail, geometric along an algebraic one (where the
+        well proper shrinks to a sliver at ``psi = pi/2``), a few panels across the well proper.
+        Items that end earlier are padded with ``v_end`` (empty panels)."""
+        v_end = np.asarray(v_end, dtype=float)
+        q_end, d, alpha, sigma = (np.broadcast_to(np.asarray(a, dtype=float), v_end.shape)
+                                  for a in (q_end, d, alpha, sigma))
+        v = np.zeros(v_end.shape)
+        rows = [v]
+        for _ in range(max_panels):
+            going = v < v_end
+            if not going.any():
+                return np.stack(rows, axis=-1)
+            q = q_end - sigma * 2.0 * d * np.sin(0.5 * alpha * np.sinh(v)) ** 2
+            step = np.minimum(self.span * self._tail_length(q), 0.5 * np.maximum(np.abs(q), self.core))
+            gap = np.minimum(np.abs(q_end - q) + step, d)          # distance from the turning point
+            v_next = np.arcsinh(2.0 * np.arcsin(np.sqrt(0.5 * gap / d)) / alpha)
+            v = np.where(going, np.minimum(np.minimum(v_next, v + self.panel_length), v_end), v)
+            rows.append(v)
+        raise RuntimeError(f"panel breaks of the open well did not reach the end in {max_panels} panels")
+
+    @staticmethod
+    def _nodes_between(b, x):
+        """Nodes ``(N, M, n)`` (reference nodes ``x`` on [-1, 1]) on the panels between the breaks
+        ``b`` ``(N, M + 1)``, and the panel half-lengths ``(N, M, 1)``."""
+        half = 0.5 * (b[:, 1:, None] - b[:, :-1, None])
+        return b[:, :-1, None] + half * (x[None, None, :] + 1.0), half
 
     def mean_dV(self, q, q_end):
         """Mean of ``V'`` over the segment ``[q, q_end]`` (Gauss-Legendre, ``n_mean`` nodes)."""
@@ -293,7 +315,10 @@ class OrbitQuadrature:
         shape = np.broadcast_shapes(psi.shape, np.shape(E), np.shape(d))
         q = np.broadcast_to(q, shape)
         psi_b = np.broadcast_to(psi, shape)
-        near = np.broadcast_to(2.0 * s2 <= self.gap_switch, shape)
+        near = 2.0 * s2 <= self.gap_switch
+        if self.open:      # <V'> by n_mean nodes only over a short stretch on the scale of the end
+            near = near & (2.0 * d * s2 <= self.gap_switch * self.end_length(q_end))
+        near = np.broadcast_to(near, shape)
         R = np.empty(shape)
         Eb = np.broadcast_to(E, shape)
         # away from the end: E - V(q) directly (no cancellation there)
@@ -329,11 +354,12 @@ class OrbitQuadrature:
         ``tau`` from the turning point (N, K) and the CC weights in v (N, K).
         """
         v_end = np.arcsinh(0.5 * np.pi / alpha)
-        if m is None and not self.open:
-            m = max(int(np.ceil(np.max(v_end) / self.panel_length)), 1)
-        elif m is None:
-            m = int(np.max(self.panels(v_end, d, alpha, q_end, sigma)))
-        v, half = self._nodes(v_end, m, self.x)
+        if self.open:
+            v, half = self._nodes_between(self.breaks(v_end, d, alpha, q_end, sigma), self.x)
+        else:
+            if m is None:
+                m = max(int(np.ceil(np.max(v_end) / self.panel_length)), 1)
+            v, half = self._nodes(v_end, m, self.x)
         N = v.shape[0]
         col = lambda a: np.asarray(a, dtype=float).reshape(N, 1, 1)
         psi, q, R, dpsi = self.integrand(col(E), col(q_end), col(d), col(alpha), sigma, v)
@@ -354,7 +380,12 @@ class OrbitQuadrature:
         E, q_end, d, alpha, psi = (np.asarray(a, dtype=float) for a in (E, q_end, d, alpha, psi))
         sigma = np.broadcast_to(np.asarray(sigma, dtype=float), E.shape)
         v_end = np.arcsinh(psi / alpha)
-        m = self.panels(v_end, d, alpha, q_end, sigma).astype(int)
+        if self.open:
+            v, half = self._nodes_between(self.breaks(v_end, d, alpha, q_end, sigma), self.gx)
+            col = lambda a: a.reshape(-1, 1, 1)
+            _, _, R, dpsi = self.integrand(col(E), col(q_end), col(d), col(alpha), col(sigma), v)
+            return np.sum(half[:, :, 0] * ((col(d) / R * dpsi) @ self.gw), axis=1)
+        m = np.maximum(np.ceil(v_end / self.panel_length), 1).astype(int)
         out = np.zeros(E.shape)
         for mm in np.unique(m):
             idx = np.nonzero(m == mm)[0]
