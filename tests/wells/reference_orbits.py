@@ -7,9 +7,18 @@ from scipy import integrate, optimize
 
 
 def turning_points_brentq(well, E):
-    """``V(q) = E`` on each side of 0 by Brent's method inside the well's limits."""
+    """``V(q) = E`` on each side of 0 by Brent's method inside the well's limits (an infinite
+    limit, a side open at infinity, is replaced by the first ``+-2^k`` with ``V > E``)."""
     f = lambda q: float(well.V(q)) - E
-    lo, hi = well.limits
+
+    def bracket(lim, side):
+        if np.isfinite(lim):
+            return lim
+        x = side
+        while f(x) <= 0:
+            x *= 2.0
+        return x
+    lo, hi = (bracket(lim, side) for lim, side in zip(well.limits, (-1.0, 1.0)))
     return (optimize.brentq(f, lo, 0.0, xtol=1e-16, rtol=1e-15),
             optimize.brentq(f, 0.0, hi, xtol=1e-16, rtol=1e-15))
 
@@ -49,3 +58,29 @@ class Orbit:
     def state(self, t):
         y = self.sol.sol(t)
         return y[0], y[1]
+
+
+def rel(a, b):
+    """Largest relative difference."""
+    return np.max(np.abs(np.asarray(a) / np.asarray(b) - 1.0))
+
+
+def angle_diff(a, b):
+    """Largest difference of angles (mod 2 pi)."""
+    return np.max(np.abs(np.angle(np.exp(1j * (np.asarray(a) - np.asarray(b))))))
+
+
+def assert_matches_orbit(well, E, n_points, tol=1e-9):
+    """The well's J against scipy quad (1e-11), its period and q_1 against a DOP853 orbit (1e-10),
+    and angle_energy / phase_point along that orbit (``tol``, ``n_points`` points)."""
+    assert rel(well.J(E), action_quad(well, E)) <= 1e-11
+    orbit = Orbit(well, E)
+    assert rel(well.period(E), orbit.T) <= 1e-10
+    assert abs(well.first_harmonic(E) - orbit.q1) <= 1e-10 * abs(orbit.q1)
+    t = np.linspace(0, orbit.T, n_points + 1)[:-1]
+    q, p = orbit.state(t)
+    theta = 2 * np.pi * t / orbit.T
+    assert angle_diff(well.angle_energy(q, p)[0], theta) <= tol
+    qq, pp = well.phase_point(theta, E)
+    assert np.max(np.abs(qq - q)) <= tol and np.max(np.abs(pp - p)) <= tol
+    return orbit

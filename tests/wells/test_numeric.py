@@ -13,7 +13,7 @@ from scipy import special
 
 from safebasins.theory import action_angle as aa
 from safebasins.wells.numeric import NumericWell
-from tests.wells.reference_orbits import Orbit, action_quad
+from tests.wells.reference_orbits import angle_diff, assert_matches_orbit, rel
 
 
 def quartic_V(q):
@@ -48,14 +48,6 @@ def asym():
 @pytest.fixture(scope="module")
 def pendulum():
     return NumericWell(lambda q: 2.0 * np.sin(0.5 * q) ** 2, np.sin, name="pendulum")
-
-
-def rel(a, b):
-    return np.max(np.abs(np.asarray(a) / np.asarray(b) - 1.0))
-
-
-def angle_diff(a, b):
-    return np.max(np.abs(np.angle(np.exp(1j * (np.asarray(a) - np.asarray(b))))))
 
 
 # ----------------------------------------------------------------------------- quartic
@@ -151,21 +143,8 @@ def test_asymmetric_well_data(asym):
 
 @pytest.mark.parametrize("frac", [0.01, 0.3, 0.7, 0.95, 0.999])
 def test_asymmetric_against_quad_and_dop853(asym, frac):
-    E = frac * asym.barrier_energy
-    assert rel(asym.J(E), action_quad(asym, E)) <= 1e-11
-    orbit = Orbit(asym, E)
-    assert rel(asym.period(E), orbit.T) <= 1e-10
-    q1 = asym.first_harmonic(E)
-    assert abs(q1 - orbit.q1) <= 1e-10 * abs(orbit.q1)
-    assert abs(asym.harmonic_phase(E) - np.angle(orbit.q1)) <= 1e-10
-    # angles along the orbit: theta = omega t (theta = 0 at q = 0, p > 0)
-    t = np.linspace(0, orbit.T, 97)[:-1]
-    q, p = orbit.state(t)
-    theta = 2 * np.pi * t / orbit.T
-    th, xi = asym.angle_energy(q, p)
-    assert angle_diff(th, theta) <= 1e-9
-    qq, pp = asym.phase_point(theta, E)
-    assert np.max(np.abs(qq - q)) <= 1e-9 and np.max(np.abs(pp - p)) <= 1e-9
+    orbit = assert_matches_orbit(asym, frac * asym.barrier_energy, 96)
+    assert abs(asym.harmonic_phase(frac * asym.barrier_energy) - np.angle(orbit.q1)) <= 1e-10
 
 
 def test_asymmetric_first_harmonic_is_complex(asym):

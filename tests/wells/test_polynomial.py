@@ -8,7 +8,7 @@ from numpy.polynomial import polynomial as P
 from safebasins.theory import action_angle as aa
 from safebasins.wells.numeric import NumericWell
 from safebasins.wells.polynomial import PolynomialWell, cubic, polynomial, quartic_polynomial
-from tests.wells.reference_orbits import Orbit, action_quad
+from tests.wells.reference_orbits import assert_matches_orbit, rel
 
 ASYM = [0.0, 0.0, 0.5, 0.1, -0.25]
 
@@ -16,10 +16,6 @@ ASYM = [0.0, 0.0, 0.5, 0.1, -0.25]
 @pytest.fixture(scope="module")
 def cub():
     return cubic()
-
-
-def rel(a, b):
-    return np.max(np.abs(np.asarray(a) / np.asarray(b) - 1.0))
 
 
 # ----------------------------------------------------------------------------- coefficients
@@ -75,18 +71,7 @@ def test_cubic_well_data(cub):
 
 @pytest.mark.parametrize("frac", [0.001, 0.2, 0.6, 0.9, 0.99, 0.9999])
 def test_cubic_against_quad_and_dop853(cub, frac):
-    E = frac / 6.0
-    assert rel(cub.J(E), action_quad(cub, E)) <= 1e-11
-    orbit = Orbit(cub, E)
-    assert rel(cub.period(E), orbit.T) <= 1e-10
-    assert abs(cub.first_harmonic(E) - orbit.q1) <= 1e-10 * abs(orbit.q1)
-    t = np.linspace(0, orbit.T, 61)[:-1]
-    q, p = orbit.state(t)
-    theta = 2 * np.pi * t / orbit.T
-    th, _ = cub.angle_energy(q, p)
-    assert np.max(np.abs(np.angle(np.exp(1j * (th - theta))))) <= 1e-9
-    qq, pp = cub.phase_point(theta, E)
-    assert np.max(np.abs(qq - q)) <= 1e-9 and np.max(np.abs(pp - p)) <= 1e-9
+    assert_matches_orbit(cub, frac / 6.0, 60)
 
 
 def test_cubic_small_energy_limit(cub):
@@ -119,3 +104,35 @@ def test_asymmetric_quartic_barriers_and_generic_agreement():
     for f in ("J", "omega", "harmonic_amplitude", "harmonic_phase"):
         a, b = getattr(w, f)(E), getattr(generic, f)(E)
         assert np.max(np.abs(a - b)) <= 1e-12 * np.max(np.abs(b)), f
+
+
+# ----------------------------------------------------------------------------- high degree, options
+TAYLOR8 = [0.0, 0.0, 1 / 2, 0.0, -1 / 24, 0.0, 1 / 720, 0.0, -1 / 40320]     # 1 - cos q to degree 8
+
+
+def test_degree8_taylor_pendulum():
+    """Cauchy's bound is 1.7e30 here (leading coefficient 1/40320): the search bound comes from the
+    real roots of V' and V - E_b instead, and the bottom check probes at 1e-7 of it."""
+    w = polynomial(TAYLOR8)
+    assert w._cauchy_bound() > 1e29 and w.search_bound < 20
+    qb = w.barriers[1]
+    assert w.barriers[0] == -qb and 3.07 < qb < 3.08 and abs(P.polyval(qb, w.dV_coefficients)) <= 1e-15
+    assert w.barrier_energy == P.polyval(qb, TAYLOR8) and 1.97 < w.barrier_energy < 1.98
+    assert w.omega0 == pytest.approx(1.0, abs=1e-12)
+    # the pendulum 2 sin^2(q/2) differs by -q^10/10! + ...: relative ~ 1e-5 E^4 (measured 1.2e-5)
+    pend = NumericWell(lambda q: 2 * np.sin(0.5 * q) ** 2, np.sin)
+    E = np.array([1e-8, 1e-4, 1e-3, 1e-2, 0.05, 0.1])
+    for f in ("omega", "J", "harmonic_amplitude"):
+        assert np.all(np.abs(getattr(w, f)(E) / getattr(pend, f)(E) - 1) <= 3e-5 * E ** 4 + 2e-15), f
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"tol": -1}, "tol must be"), ({"tol": 0.0}, "tol must be"), ({"tol": "x"}, "tol must be numeric"),
+    ({"tol": [1e-13, 1e-12]}, "tol must be"), ({"n_scan": 3}, "n_scan must be"),
+    ({"asymptotes": (1.0,)}, "asymptotes must be a pair"),
+])
+def test_bad_options_named_first(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        cubic(**kwargs)
+    with pytest.raises(ValueError, match=match):       # before the coefficients are looked at
+        polynomial([1.0, 0.0, 0.5], **kwargs)

@@ -109,9 +109,10 @@ class NumericWell(WellShape, Well):
     where there is a barrier or ``V -> inf``), open_at_infinity (the escape energy is such a
     limit: thresholds ``xi_max`` must lie in ``(0, E_b)``), limits (bracket of all orbits of
     energy <= barrier_energy: barrier, the point where V exceeds it, or ``+-inf`` on a side open
-    at infinity), omega0 (= sqrt(V''(0)), finite differences), interpolation_error (largest
-    trailing-coefficient estimate of the energy interpolants, dominated by the panels within
-    ~1e-12 E_b of the separatrix).
+    at infinity), bottom_integral (where V is evaluated as ``int_0^q V'``: the given V cancels
+    near the bottom, e.g. ``1 - cos q``; None if it does not), omega0 (= sqrt(V''(0)), finite
+    differences), interpolation_error (largest trailing-coefficient estimate of the energy
+    interpolants, dominated by the panels within ~1e-12 E_b of the separatrix).
 
     Beyond :class:`~safebasins.wells.base.Well` (what a slow flow needs): ``period``,
     ``dJ_dE`` (= 1/omega), ``harmonic_amplitude`` (|q_1|, eq 20's G),
@@ -235,6 +236,14 @@ class NumericWell(WellShape, Well):
     @property
     def asymptotes(self):
         return self._asymptotes
+
+    @property
+    def bottom_integral(self):
+        """``(q_left, q_right)`` where the given V loses relative accuracy at the bottom and
+        :meth:`V` is ``int_0^q V'`` for ``-q_left < q < q_right`` (:mod:`safebasins.wells.bottom`),
+        else None."""
+        b = self._V_bottom
+        return None if b is None else (b.q_left, b.q_right)
 
     def turning_points(self, E):
         E = self.check_energy("E", E, allow_separatrix=True)
