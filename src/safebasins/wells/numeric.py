@@ -22,7 +22,8 @@ How (details in :mod:`safebasins.wells.orbit_quadrature` and
 * period, ``J/E``, ``|q_1|/sqrt(E)``, ``theta_minus``, the turning points etc. as adaptive
   piecewise Chebyshev interpolants in ``sqrt(E)`` (well bottom) and ``log(E_b - E)``
   (separatrix, or the approach to the limit of an open side), built once at construction
-  (~0.02 s CPU, 420 orbits for the quartic; 0.05-0.3 s, 460 orbits, for Morse and sech^2);
+  (~0.02 s CPU, 420 orbits for the quartic; 0.07-0.16 s, 460 orbits, for Morse, sech^2 and
+  algebraic tails);
 * ``angle_energy`` evaluates the time integral from the nearer turning point for every point
   (no interpolation in ``q``; near a turning point the position on the orbit is taken from
   ``p``, which is well conditioned there); ``phase_point`` inverts it by safeguarded Newton.
@@ -41,10 +42,10 @@ in ``H0(q, p)`` moves theta by ~``eps E_b / (E_b - E)``).  The asymmetric quarti
 agree with DOP853 orbits and scipy quad to 1e-14 .. 1e-12 (limited by the references).
 
 Wells open at infinity (docs/wells.md; closed forms of Morse ``D (1 - e^{-a q})^2`` and of
-``tanh^2 q``): omega, J, ``|q_1|``, ``arg q_1`` within 1e-13 relative for every float
-``E < E_b`` (the last one included; J within 2e-13 where the interpolation tolerance 1e-13
-dominates), ``phase_point`` within 4e-13 (as an angle) up to ``E_b - E = 1e-12 E_b``; DOP853
-orbits agree to their own accuracy (~1e-12).  Such wells need ``V'`` accurate to relative
+``tanh^2 q``): omega, J, ``q_1``, ``arg q_1`` within 1.2e-13 relative for every float
+``E < E_b`` (the last one included; J of tanh^2 within 2.1e-13, the interpolation tolerance),
+``phase_point`` within 1.2e-13 for ``E <= 0.99 E_b`` and 1.7e-13 as an angle up to
+``E_b - E = 1e-12 E_b``; DOP853 orbits agree to their own accuracy (~1e-12).  Such wells need ``V'`` accurate to relative
 precision in the tail (``2 tanh(q) / cosh(q)^2``, not ``2 tanh(q) (1 - tanh(q)^2)``: ValueError
 naming dV).  ``V`` may lose relative accuracy at the bottom (``1 - cos q``, ``(1 - exp(-q))^2``):
 this is detected and V is evaluated there as ``int_0^q V'`` (:mod:`safebasins.wells.bottom`).
