@@ -10,7 +10,7 @@ import xarray as xr
 
 from safebasins.analysis.safe import CRITERIA, is_safe
 
-__all__ = ["iou", "pixel_agreement", "mask_agreement", "criteria_counts"]
+__all__ = ["iou", "pixel_agreement", "mask_agreement", "criteria_counts", "criteria_table", "chart_agreement"]
 
 
 def _boolean(name, a):
@@ -84,3 +84,67 @@ def criteria_counts(chart, t_eval, groups):
         s = np.asarray(is_safe(chart[var].isel({thr: 0}).values, t_eval))
         out.append(s.reshape(groups, n // groups).sum(axis=1).astype(np.int64))
     return out[0], out[1]
+
+
+def criteria_table(charts, F, *, n_ic, repeats, seeds, cycles):
+    """Energy versus displacement criterion (paper Appendix, Fig 19): ``A_E``, ``A_q`` (safe counts
+    at ``cycles``) and ``rel_diff = (A_q - A_E) / A_E`` over ``(F, repeat)``, from one escape chart
+    per F over ``n_ic * repeats`` random samples (``repeats`` consecutive groups of ``n_ic``,
+    seeded by ``seeds``)."""
+    A_E = np.zeros((len(charts), repeats), dtype=np.int64)
+    A_q = np.zeros((len(charts), repeats), dtype=np.int64)
+    for i, ds in enumerate(charts):
+        if ds.sizes["sample"] != n_ic * repeats:
+            raise ValueError(f"chart {i}: {ds.sizes['sample']} samples, expected n_ic * repeats = {n_ic * repeats}")
+        A_E[i], A_q[i] = criteria_counts(ds, cycles, repeats)
+        print(f"F={F[i]}: A_E={A_E[i].tolist()} A_q={A_q[i].tolist()}", flush=True)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = np.where(A_E > 0, (A_q - A_E) / np.maximum(A_E, 1), np.nan)
+    return xr.Dataset(
+        {"A_E": (("F", "repeat"), A_E), "A_q": (("F", "repeat"), A_q), "rel_diff": (("F", "repeat"), rel)},
+        coords={"F": ("F", np.asarray(F, dtype=float)), "repeat": ("repeat", np.arange(repeats)),
+                "seed": ("repeat", np.asarray(seeds, dtype=np.int64))},
+    )
+
+
+def chart_agreement(chart, basin, t_eval, scan):
+    """The escape chart with its agreement with the analytic basin, per value of ``scan``.
+
+    numeric safe = ``escape_cycle_energy > t_eval``; analytic safe = not ``escapes``
+    (slow_flow_escapes); ``chart`` and ``basin`` on the same (q0, p0) grid and ``scan`` values
+    ("xi_max": one chart serves every threshold; "F": stacked charts with one threshold).
+    Adds ``iou``, ``pixel_agreement``, ``safe_analytic``, ``safe_numeric`` (over ``scan``) and
+    the attributes ``agreement_t_eval``, ``agreement_definition``, ``iou_mean``, ``iou_min``,
+    ``pixel_agreement_mean``, ``pixel_agreement_min``."""
+    numeric_safe = is_safe(chart["escape_cycle_energy"], t_eval)
+    if scan == "F":
+        numeric_safe = numeric_safe.isel(xi_max=0, drop=True)
+    analytic_safe = ~basin["escapes"].astype(bool).reset_coords(drop=True)  # no saddle_* coords in the chart
+    numeric_safe = numeric_safe.reset_coords(drop=True)
+    for ax in ("q0", "p0"):
+        a, n = np.asarray(analytic_safe[ax].values), np.asarray(numeric_safe[ax].values)
+        if a.shape != n.shape or not np.allclose(a, n, rtol=0, atol=1e-12):
+            raise ValueError(f"analytic and numeric grids differ along {ax}")
+    a, n = np.asarray(analytic_safe[scan].values, float), np.asarray(numeric_safe[scan].values, float)
+    if a.shape != n.shape or not np.allclose(a, n, rtol=1e-12, atol=0):
+        raise ValueError(f"analytic and numeric {scan} values differ: {a} vs {n}")
+    analytic_safe = analytic_safe.assign_coords({c: numeric_safe[c] for c in ("q0", "p0", scan)})
+    analytic_safe = analytic_safe.transpose(*numeric_safe.dims)
+    i, pixel = mask_agreement(analytic_safe, numeric_safe)
+    out = chart.copy()
+    # fresh attributes (the CF table fills them): arithmetic would pass on those of its operands
+    out["iou"] = i.drop_attrs(deep=False)
+    out["pixel_agreement"] = pixel.drop_attrs(deep=False)
+    out["safe_analytic"] = analytic_safe.sum(("q0", "p0")).astype(np.int64).drop_attrs(deep=False)
+    out["safe_numeric"] = numeric_safe.sum(("q0", "p0")).astype(np.int64).drop_attrs(deep=False)
+    out.attrs.update(
+        agreement_t_eval=t_eval,
+        agreement_definition=("numeric safe = escape_cycle_energy > t_eval (= cycles); analytic safe = not "
+                              "escapes (slow_flow_escapes); iou = |A and N| / |A or N|; pixel_agreement = "
+                              "mean(A == N) over the (q0, p0) grid"),
+        iou_mean=float(i.mean()), iou_min=float(i.min()),
+        pixel_agreement_mean=float(pixel.mean()), pixel_agreement_min=float(pixel.min()),
+    )
+    for v, a_, px in zip(np.atleast_1d(i[scan].values), np.atleast_1d(i.values), np.atleast_1d(pixel.values)):
+        print(f"{scan} = {v}: IoU = {a_:.4f}, pixel agreement = {px:.4f}")
+    return out

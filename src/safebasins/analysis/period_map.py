@@ -41,6 +41,7 @@ import numpy as np
 from safebasins import checks
 
 __all__ = ["birkhoff_weights", "weighted_birkhoff", "rotation_numbers", "island_chains", "classify_orbits",
+           "portrait_with_criteria",
            "periodic_orbit", "minimal_period", "strobe_step", "chain_orbits", "period_map_portrait",
            "ORBIT_CLASSES"]
 
@@ -449,4 +450,29 @@ def period_map_portrait(q0, p0, F, Omega, Psi, *, n_keep, n_iter=3000, xi_max=No
                         "chaotic: birkhoff_digits < min_digits; chain of period k: k sub-orbits in k "
                         "disjoint islands and k * rotation_number integral, confirmed by an elliptic "
                         "periodic orbit of minimal period k (Newton on the k-th iterate)"))
+    return out
+
+
+def portrait_with_criteria(q0, p0, origin, F, Omega, Psi, *, criterion, xi_max, q_max, n_keep, n_iter,
+                           steps_per_cycle, threads=None, min_digits=5.0, max_period=40):
+    """Fig 18: :func:`period_map_portrait` of the candidates (q0, p0) under one escape
+    ``criterion`` ("energy": H0 > xi_max, "displacement": |q| > q_max), with each kept orbit's
+    ``origin`` label and its escape cycle under BOTH criteria (``escape_cycle_energy``,
+    ``escape_cycle_displacement``: one escape chart of the kept ICs, paired samples)."""
+    from safebasins.numerics import escape_chart
+
+    thresholds = dict(xi_max=xi_max) if criterion == "energy" else dict(q_max=q_max)
+    out = period_map_portrait(q0, p0, F, Omega, Psi, n_keep=n_keep, n_iter=n_iter, steps_per_cycle=steps_per_cycle,
+                              threads=threads, min_digits=min_digits, max_period=max_period, **thresholds)
+    cand = np.asarray(out["candidate"].values)
+    out["origin"] = ("sample", np.array([origin[i] for i in cand]), {"long_name": "where the IC comes from (line | random)"})
+    other = escape_chart(np.asarray(out["q0"].values, float), np.asarray(out["p0"].values, float), F, Omega, Psi,
+                         xi_max=(xi_max,), q_max=(q_max,), cycles=n_iter, steps_per_cycle=steps_per_cycle,
+                         threads=threads, grid=False)
+    out["escape_cycle_energy"] = ("sample", np.asarray(other["escape_cycle_energy"].isel(xi_max=0).values, float),
+                                  {"units": "1", "long_name": "escape time in forcing cycles, energy criterion "
+                                                              "H0 > xi_max (inf: no escape)"})
+    out["escape_cycle_displacement"] = ("sample", np.asarray(other["escape_cycle_displacement"].isel(q_max=0).values, float),
+                                        {"units": "1", "long_name": "escape time in forcing cycles, displacement "
+                                                                    "criterion |q| > q_max (inf: no escape)"})
     return out

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import math
-import tempfile
 from pathlib import Path
 
 import click
@@ -13,6 +12,19 @@ from safebasins.cli.options import (DISPLACEMENT, ENERGY, FINITE, OPTION_OF, POS
                                     joined, lib_check, library_errors, numerics_options, out_option)
 from safebasins.cli.output import chatter, describe, draw, finish, fmt, job, progress, write_outputs
 
+
+
+def well_of(params):
+    """The run's well with its first harmonic (the pipeline's values.well)."""
+    from safebasins.pipeline.values import well
+
+    return well(params)
+
+
+def grid_axes(grid):
+    from safebasins.pipeline.values import grid_axes as axes
+
+    return axes(grid)
 
 
 def well_label(spec):
@@ -94,33 +106,31 @@ def chart(F, Omega, Psi, xi_max, q_max, grid, n, cycles, steps_per_cycle, thread
         click.echo(f"xi_max = {fmt(x)}: IoU = {a:.4f}, pixel agreement = {px:.4f} (t_eval = {cycles} EC)")
 
 
-def chart_tiles(params, tiles, job, quiet):
-    """The chart's row tiles (contiguous q0 blocks), each the pipeline's own tile job."""
-    from safebasins.pipeline.registry import KINDS
+def chart_dataset(params, tiles, job, quiet):
+    """(chart with agreement, analytic basins): the chart integrated in row tiles (one progress
+    step each; the chart does not depend on the tiling), gathered, and compared with the slow-flow
+    basins by the library functions the pipeline's basin_chart kind calls."""
+    from safebasins.analysis.agreement import chart_agreement
+    from safebasins.analysis.ic_basins import analytic_basin_stack
+    from safebasins.io.gather import gather_chart, gather_tiles
+    from safebasins.numerics import escape_chart
+    from safebasins.pipeline.values import grid_axes, tile_slice, well
 
-    kind = KINDS[params["kind"]]
+    q0, p0 = grid_axes(params["grid"])
+    w = well(params)
     parts = []
     with progress(tiles, "escape chart", "tile", quiet) as bar:
         for k in range(tiles):
-            parts.append(kind.compute_tile(params, 0, k, tiles, job))
+            parts.append(escape_chart(q0[tile_slice(q0.size, tiles, k)], p0, params["F"], params["Omega"],
+                                      params["Psi"], xi_max=tuple(params["xi_max"]), q_max=tuple(params["q_max"]),
+                                      cycles=params["cycles"], steps_per_cycle=params["steps_per_cycle"],
+                                      threads=job.threads, grid=True, backend=job.backend, well=w))
             bar.update(1)
-    return parts
-
-
-def chart_dataset(params, tiles, job, quiet):
-    """(chart with agreement, analytic basins) through the pipeline's own gather and agreement code:
-    it reads tile and basin files, so they go to a temporary folder as the pipeline rules write them."""
-    from safebasins.io.datasets import finalize, write_netcdf
-    from safebasins.pipeline.kinds.basins import build_basin_stack, build_chart_agreement
-
-    parts = chart_tiles(params, tiles, job, quiet)
-    basins = build_basin_stack(params, {}, job)
-    with tempfile.TemporaryDirectory(prefix="safebasins-chart-") as tmp:
-        paths = [write_netcdf(ds, Path(tmp) / f"tile{k:04d}.nc") for k, ds in enumerate(parts)]
-        basin_path = write_netcdf(finalize(basins.copy(), title="analytic basins", params=params),
-                                  Path(tmp) / "basin.nc")
-        ds = build_chart_agreement(params, {"tiles": paths, "basin": basin_path}, job)
-    return ds, basins
+    chart = gather_chart([gather_tiles(parts)], cycles=params["cycles"], scan="xi_max", t_eval=params["t_eval"])
+    basins = analytic_basin_stack("xi_max", params["xi_max"], params["F"], params["Omega"], params["Psi"], None, q0,
+                                  p0, well=w, n_points=params["n_points"], label=params["experiment"])
+    basins.attrs.update(F=params["F"], Omega=params["Omega"], Psi=params["Psi"], fourier=params["fourier"])
+    return chart_agreement(chart, basins, params["cycles"], "xi_max"), basins
 
 
 def n_scan_check(n):
@@ -197,10 +207,12 @@ def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cyc
                              "tol": tol, "F_bracket": F_bracket, "n_scan": n_scan, "criterion": criterion,
                              "steps_per_cycle": steps_per_cycle}
     params["title"] = f"Critical forcing F_cr(Omega), {well_label(well)} well (safebasins fcr {name})"
-    from safebasins.pipeline.kinds.fcr import build_fcr_analytic
+    from safebasins.analysis.fcr_curves import analytic_fcr_curves
 
     with library_errors(), chatter(verbose):
-        ana = finish(build_fcr_analytic(params, {}, job(threads, backend)), title=params["title"], params=params)
+        ana = analytic_fcr_curves(params["Omega"], curves, well=well_of(params), label=name)
+        ana.attrs["fourier"] = fourier
+        ana = finish(ana, title=params["title"], params=params)
         outputs = [(f"{out}.nc", ana)]
         num = None
         if numeric:
@@ -230,16 +242,19 @@ def fcr_numeric(params, job, quiet):
     import numpy as np
     import xarray as xr
 
-    from safebasins.pipeline.kinds.fcr import build_fcr_numeric
+    from safebasins.analysis.fcr_curves import numeric_fcr_curves
 
-    Om = params["numeric"]["Omega"]
+    n = params["numeric"]
+    Om = n["Omega"]
     size = max(4, math.ceil(len(Om) / 20))
     parts = []
     with progress(len(Om), "numeric F_cr", "Omega", quiet) as bar:
         for i in range(0, len(Om), size):
-            chunk = {**params, "numeric": {**params["numeric"], "Omega": Om[i:i + size]}}
-            parts.append(build_fcr_numeric(chunk, {}, job))
-            bar.update(len(chunk["numeric"]["Omega"]))
+            parts.append(numeric_fcr_curves(Om[i:i + size], params["curves"], well=well_of(params), cycles=n["cycles"],
+                                            tol=n["tol"], F_bracket=n["F_bracket"], criterion=n["criterion"],
+                                            n_scan=n["n_scan"], steps_per_cycle=n["steps_per_cycle"],
+                                            threads=job.threads, backend=job.backend, label=params["experiment"]))
+            bar.update(len(Om[i:i + size]))
     out = xr.concat(parts, dim="Omega", data_vars="minimal", coords="minimal", compat="override",
                     combine_attrs="override")
     # bisection_levels (an attribute, or a coordinate over curve where curves differ) counts the
@@ -299,10 +314,15 @@ def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, fouri
                   manifold={"n_gamma": n_gamma, "n_xi": n_xi, "xi_top": xi_top})
     params["title"] = (f"Analytic safe basin, {well_label(well)} well, F = {fmt(F)}, Omega = {fmt(Omega)}, "
                        f"Psi = {fmt(Psi, angle=True)}, xi_max = {fmt(xi_max)} (safebasins basin {name})")
-    from safebasins.pipeline.kinds.basins import build_basin_single
+    from safebasins.analysis.ic_basins import add_resonance_manifold, analytic_basin
 
     with library_errors(), chatter(verbose):
-        ds = finish(build_basin_single(params, {}, job(None, "cpu")), title=params["title"], params=params)
+        w = well_of(params)
+        q0, p0 = grid_axes(params["grid"])
+        ds = analytic_basin(F, Omega, Psi, xi_max, q0, p0, well=w, n_points=n_points, label=name)
+        ds = add_resonance_manifold(ds, F, Omega, xi_max, n_gamma=n_gamma, n_xi=n_xi, xi_top=xi_top, well=w)
+        ds.attrs.update(F=F, Omega=Omega, Psi=Psi, xi_max=xi_max, fourier=fourier)
+        ds = finish(ds, title=params["title"], params=params)
         fig = None
         if not no_plot:
             from safebasins.plotting.basins import figure_rm_basin

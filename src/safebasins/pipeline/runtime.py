@@ -75,6 +75,26 @@ def _job(smk):
     return params, KINDS[params["kind"]]
 
 
+def load_inputs(inputs, ntasks) -> dict:
+    """The datasets a product reads, loaded: ``tiles`` as one list of tile Datasets per task
+    (task-major), every other named input (a path or a list of paths) as Dataset(s); the
+    parameter file is read by the rule itself."""
+    from safebasins.io.datasets import load
+    from safebasins.io.gather import load_blocks
+
+    out = {}
+    for k, v in inputs.items():
+        if k == "params":
+            continue
+        if k == "tiles":
+            out[k] = load_blocks(list(v), ntasks)
+        elif isinstance(v, str):
+            out[k] = load(v)
+        else:
+            out[k] = [load(f) for f in v]
+    return out
+
+
 def make_dataset(smk):
     """Rules ``analytic`` / ``numeric`` / ``extras``: build, finalize and write one product."""
     from safebasins.io.datasets import finalize, params_hash, write_netcdf
@@ -82,8 +102,8 @@ def make_dataset(smk):
     params, kind = _job(smk)
     out = str(smk.output[0])
     product = next(p for p in kind.products(params["experiment"], params) if p.path == out)
-    inputs = {k: (list(v) if k == "tiles" else v) for k, v in smk.input.items()}
-    ds = product.build(params, inputs, Job(threads=smk.threads, backend=smk.params.backend))
+    ds = product.build(params, load_inputs(smk.input, len(kind.tasks(params))),
+                       Job(threads=smk.threads, backend=smk.params.backend))
     finalize(ds, title=product.title, params=params, config_hash=params_hash(params),
              history=f"{product.history} (rule {smk.rule})")
     write_netcdf(ds, out)

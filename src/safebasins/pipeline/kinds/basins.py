@@ -37,22 +37,6 @@ def chart_contract(scan=()):
             "escape_cycle_displacement": (*scan, "q_max", "q0", "p0")}
 
 
-def _one_basin(params, F, Omega, Psi, xi_max):
-    """Boundaries + per-IC analytic escape mask on the experiment's (q0, p0) grid."""
-    import xarray as xr
-
-    from safebasins.theory import safe_basin_boundaries, slow_flow_escapes
-
-    qa, pa = values.grid_axes(params["grid"])
-    Q, P = np.meshgrid(qa, pa, indexing="ij")
-    print(f"{params['experiment']}: basin F={F} Omega={Omega} Psi={Psi} xi_max={xi_max}")
-    w = values.well(params)
-    b = safe_basin_boundaries(F, Omega, Psi, xi_max, well=w, n_points=params["n_points"])
-    esc = slow_flow_escapes(Q, P, F, Omega, Psi, xi_max, well=w)
-    b["escapes"] = xr.DataArray(np.asarray(esc, dtype=bool), dims=("q0", "p0"))
-    return b.assign_coords(q0=("q0", qa), p0=("p0", pa))
-
-
 def _basin_attrs(out, params):
     for k in ("F", "Omega", "Psi", "xi_max"):
         if k not in out.dims and k not in out.coords:
@@ -61,136 +45,52 @@ def _basin_attrs(out, params):
     return out
 
 
-def build_basin_single(params, inputs, job):
+def build_basin_single(params, data, job):
     """One analytic basin (Fig 18); with a ``manifold`` grid also C and escapes_rm (Figs 5-9); with
-    ``check_cycles`` also the numeric check of its connected parts (:func:`_numeric_check`)."""
-    from safebasins.theory import escapes_on_manifold, first_integral
+    ``check_cycles`` also the numeric check of its connected parts (safebasins.analysis.ic_basins)."""
+    from safebasins.analysis import ic_basins
 
-    out = _one_basin(params, params["F"], params["Omega"], params["Psi"], params["xi_max"])
+    q0, p0 = values.grid_axes(params["grid"])
+    w = values.well(params)
+    F, Omega, Psi, xi = params["F"], params["Omega"], params["Psi"], params["xi_max"]
+    out = ic_basins.analytic_basin(F, Omega, Psi, xi, q0, p0, well=w, n_points=params["n_points"],
+                                   label=params["experiment"])
     m = params.get("manifold")
     if m is not None:
-        g = np.linspace(-np.pi, np.pi, m["n_gamma"])
-        x = np.linspace(0.0, m["xi_top"], m["n_xi"])
-        G, X = np.meshgrid(g, x, indexing="ij")
-        w = values.well(params)
-        C = first_integral(G, X, params["F"], params["Omega"], well=w)
-        E = escapes_on_manifold(G, X, params["F"], params["Omega"], params["xi_max"], well=w)
-        out = out.assign_coords(gamma_rm=("gamma_rm", g), xi_rm=("xi_rm", x))
-        out["C"] = (("gamma_rm", "xi_rm"), np.asarray(C, dtype=float))
-        out["escapes_rm"] = (("gamma_rm", "xi_rm"), np.asarray(E, dtype=bool))
+        out = ic_basins.add_resonance_manifold(out, F, Omega, xi, n_gamma=m["n_gamma"], n_xi=m["n_xi"],
+                                               xi_top=m["xi_top"], well=w)
     if params.get("check_cycles"):
-        out = _numeric_check(out, params, job)
+        out = ic_basins.numeric_check(out, F, Omega, Psi, xi, cycles=params["check_cycles"],
+                                      steps_per_cycle=params["steps_per_cycle"], well=w, threads=job.threads,
+                                      label=params["experiment"])
     return _basin_attrs(out, params)
 
 
-def _numeric_check(out, params, job):
-    """Integrate the analytic-safe ICs of the grid for ``check_cycles`` and store, per connected
-    part of the analytic basin, the fraction the numerics keep (safebasins.analysis.confirm)."""
-    from safebasins.analysis.confirm import confirm_regions
-    from safebasins.numerics import escape_chart
-
-    safe = ~np.asarray(out["escapes"].transpose("q0", "p0").values, bool)
-    Q, P = np.meshgrid(out["q0"].values, out["p0"].values, indexing="ij")
-    ec = np.full(safe.shape, np.nan)
-    if safe.any():
-        ch = escape_chart(Q[safe], P[safe], params["F"], params["Omega"], params["Psi"], xi_max=(params["xi_max"],),
-                          cycles=params["check_cycles"], steps_per_cycle=params["steps_per_cycle"],
-                          threads=job.threads, grid=False, well=values.well(params))
-        ec[safe] = np.asarray(ch["escape_cycle_energy"].isel(xi_max=0).values, float)
-    lab, size, frac = confirm_regions(safe, ec, params["check_cycles"])
-    out["escape_cycle_numeric"] = (("q0", "p0"), ec, {
-        "units": "1", "long_name": "numeric escape time of the analytic-safe ICs in forcing cycles, energy criterion "
-                                   "(inf: not within check_cycles; NaN: analytic escape, not integrated)"})
-    out["region"] = (("q0", "p0"), lab, {"units": "1", "long_name": "connected part of the analytic safe basin "
-                                                                   "(0: analytic escape; 1 = largest)"})
-    out["region_size"] = ("region_index", size, {"units": "1", "long_name": "grid points of the region"})
-    out["region_numeric_safe"] = ("region_index", frac, {
-        "units": "1", "long_name": "fraction of the region's ICs that do not escape numerically within check_cycles"})
-    out = out.assign_coords(region_index=("region_index", np.arange(1, size.size + 1)))
-    out.attrs["check_cycles"] = int(params["check_cycles"])
-    print(f"{params['experiment']}: numeric check of {int(safe.sum())} analytic-safe ICs over "
-          f"{params['check_cycles']} cycles: regions {size.tolist()}, kept {np.round(frac, 3).tolist()}")
-    return out
-
-
-def build_basin_stack(params, inputs, job):
+def build_basin_stack(params, data, job):
     """Analytic basins stacked over the scanned parameter (Figs 13-17)."""
-    from safebasins.io.datasets import stack
+    from safebasins.analysis.ic_basins import analytic_basin_stack
 
-    scan = params["scan"]
-    vals = params[scan]
-    parts = [_one_basin(params, v if scan == "F" else params["F"], params["Omega"], params["Psi"],
-                        v if scan == "xi_max" else params["xi_max"]) for v in vals]
-    # per-basin saddle point: always a coordinate along the scanned dimension
-    saddle = {k: [float(b.attrs.get(k, np.nan)) for b in parts] for k in ("saddle_gamma", "saddle_xi")}
-    out = stack(parts, scan, vals, coords=saddle)
-    out.attrs["scan"] = scan
+    q0, p0 = values.grid_axes(params["grid"])
+    out = analytic_basin_stack(params["scan"], params[params["scan"]], params["F"], params["Omega"], params["Psi"],
+                               params["xi_max"], q0, p0, well=values.well(params), n_points=params["n_points"],
+                               label=params["experiment"])
     return _basin_attrs(out, params)
 
 
-def gather_chart(params, tiles):
+def gather_chart(params, blocks):
     """The escape chart of every task gathered from its tiles (stacked over F for F scans)."""
-    from safebasins.io.datasets import stack
-    from safebasins.io.gather import task_charts
+    from safebasins.io.gather import gather_chart as gather, task_charts
 
-    charts = task_charts(tiles, len(params["tasks"]))
-    if params.get("scan") == "F":
-        out = stack(charts, "F", [t["F"] for t in params["tasks"]], pad=())
-        out.attrs["scan"] = "F"
-    else:
-        out = charts[0]
-        if "scan" in params:
-            out.attrs["scan"] = params["scan"]
-    if "t_eval" in params:
-        out.attrs["t_eval"] = params["t_eval"]
-    out.attrs.setdefault("cycles", params["cycles"])
-    return out
+    return gather(task_charts(blocks), cycles=params["cycles"], scan=params.get("scan"),
+                  F=[t["F"] for t in params["tasks"]], t_eval=params.get("t_eval"))
 
 
-def build_chart_agreement(params, inputs, job):
-    """Gathered chart + IoU and pixel agreement with the analytic basin, per scanned value.
+def build_chart_agreement(params, data, job):
+    """Gathered chart + IoU and pixel agreement with the analytic basin, per scanned value
+    (safebasins.analysis.agreement.chart_agreement at t_eval = cycles)."""
+    from safebasins.analysis.agreement import chart_agreement
 
-    numeric safe = escape_cycle_energy > t_eval (= cycles); analytic safe = not escapes.
-    """
-    from safebasins.analysis.agreement import mask_agreement
-    from safebasins.analysis.safe import is_safe
-    from safebasins.io.datasets import load
-
-    chart = gather_chart(params, inputs["tiles"])
-    basin = load(inputs["basin"])
-    cycles, scan = params["cycles"], params["scan"]
-    numeric_safe = is_safe(chart["escape_cycle_energy"], cycles)
-    if scan == "F":
-        numeric_safe = numeric_safe.isel(xi_max=0, drop=True)
-    analytic_safe = ~basin["escapes"].astype(bool).reset_coords(drop=True)  # no saddle_* coords in the chart
-    numeric_safe = numeric_safe.reset_coords(drop=True)
-    for ax in ("q0", "p0"):
-        a, n = np.asarray(analytic_safe[ax].values), np.asarray(numeric_safe[ax].values)
-        if a.shape != n.shape or not np.allclose(a, n, rtol=0, atol=1e-12):
-            raise ValueError(f"analytic and numeric grids differ along {ax}")
-    a, n = np.asarray(analytic_safe[scan].values, float), np.asarray(numeric_safe[scan].values, float)
-    if a.shape != n.shape or not np.allclose(a, n, rtol=1e-12, atol=0):
-        raise ValueError(f"analytic and numeric {scan} values differ: {a} vs {n}")
-    analytic_safe = analytic_safe.assign_coords({c: numeric_safe[c] for c in ("q0", "p0", scan)})
-    analytic_safe = analytic_safe.transpose(*numeric_safe.dims)
-    iou, pixel = mask_agreement(analytic_safe, numeric_safe)
-    out = chart.copy()
-    # fresh attributes (the CF table fills them): arithmetic would pass on those of its operands
-    out["iou"] = iou.drop_attrs(deep=False)
-    out["pixel_agreement"] = pixel.drop_attrs(deep=False)
-    out["safe_analytic"] = analytic_safe.sum(("q0", "p0")).astype(np.int64).drop_attrs(deep=False)
-    out["safe_numeric"] = numeric_safe.sum(("q0", "p0")).astype(np.int64).drop_attrs(deep=False)
-    out.attrs.update(
-        agreement_t_eval=cycles,
-        agreement_definition=("numeric safe = escape_cycle_energy > t_eval (= cycles); analytic safe = not "
-                              "escapes (slow_flow_escapes); iou = |A and N| / |A or N|; pixel_agreement = "
-                              "mean(A == N) over the (q0, p0) grid"),
-        iou_mean=float(iou.mean()), iou_min=float(iou.min()),
-        pixel_agreement_mean=float(pixel.mean()), pixel_agreement_min=float(pixel.min()),
-    )
-    for v, a_, px in zip(np.atleast_1d(iou[scan].values), np.atleast_1d(iou.values), np.atleast_1d(pixel.values)):
-        print(f"{scan} = {v}: IoU = {a_:.4f}, pixel agreement = {px:.4f}")
-    return out
+    return chart_agreement(gather_chart(params, data["tiles"]), data["basin"], params["cycles"], params["scan"])
 
 
 def strobe_candidates(params):
@@ -209,34 +109,20 @@ def strobe_candidates(params):
     return np.r_[ql, np.asarray(qr, float)], np.r_[pl, np.asarray(pr, float)], origin
 
 
-def build_strobe(params, inputs, job):
+def build_strobe(params, data, job):
     """Stroboscopic map of the first ``n_trajectories`` non-escaping candidates (the line of ICs
-    first, then seeded random ones), classified (:func:`safebasins.analysis.period_map.
-    period_map_portrait`: main-island tori, island chains, chaotic orbits); under the
-    displacement criterion each kept orbit also gets its energy-criterion escape cycle."""
-    from safebasins.analysis.period_map import period_map_portrait
-    from safebasins.numerics import escape_chart
+    first, then seeded random ones), classified, each kept orbit with both criteria's escape
+    cycles (safebasins.analysis.period_map.portrait_with_criteria)."""
+    from safebasins.analysis.period_map import portrait_with_criteria
 
     q0, p0, origin = strobe_candidates(params)
-    energy = params["criterion"] == "energy"
-    thresholds = dict(xi_max=params["xi_max"]) if energy else dict(q_max=params["q_max"])
     c = params["classification"]
-    out = period_map_portrait(q0, p0, params["F"], params["Omega"], params["Psi"], n_keep=params["n_trajectories"],
-                              n_iter=params["n_iter"], steps_per_cycle=params["steps_per_cycle"], threads=job.threads,
-                              min_digits=c["min_digits"], max_period=c["max_period"], **thresholds)
+    out = portrait_with_criteria(q0, p0, origin, params["F"], params["Omega"], params["Psi"],
+                                 criterion=params["criterion"], xi_max=params["xi_max"], q_max=params["q_max"],
+                                 n_keep=params["n_trajectories"], n_iter=params["n_iter"],
+                                 steps_per_cycle=params["steps_per_cycle"], threads=job.threads,
+                                 min_digits=c["min_digits"], max_period=c["max_period"])
     cand = np.asarray(out["candidate"].values)
-    out["origin"] = ("sample", np.array([origin[i] for i in cand]), {"long_name": "where the IC comes from (line | random)"})
-    # the other criterion on the same ICs (one escape chart of the kept ICs, paired samples)
-    other = escape_chart(np.asarray(out["q0"].values, float), np.asarray(out["p0"].values, float), params["F"],
-                         params["Omega"], params["Psi"], xi_max=(params["xi_max"],), q_max=(params["q_max"],),
-                         cycles=params["n_iter"], steps_per_cycle=params["steps_per_cycle"], threads=job.threads,
-                         grid=False)
-    out["escape_cycle_energy"] = ("sample", np.asarray(other["escape_cycle_energy"].isel(xi_max=0).values, float),
-                                  {"units": "1", "long_name": "escape time in forcing cycles, energy criterion "
-                                                              "H0 > xi_max (inf: no escape)"})
-    out["escape_cycle_displacement"] = ("sample", np.asarray(other["escape_cycle_displacement"].isel(q_max=0).values, float),
-                                        {"units": "1", "long_name": "escape time in forcing cycles, displacement "
-                                                                    "criterion |q| > q_max (inf: no escape)"})
     n_line = int(params["line"]["n"]) if params.get("line") else 0
     print(f"{out.attrs['n_non_escaping']} of {q0.size} candidates never escape in {params['n_iter']} iterations "
           f"({params['criterion']} criterion); kept {out.sizes['sample']}: {out.attrs['n_main']} main island, "

@@ -15,40 +15,26 @@ from safebasins.pipeline.registry import GridChartKind, Kind, Product, dataset_p
 Q_MAX = {"type": "number", "exclusiveMinimum": 0, "maximum": 1}
 
 
-def build_criteria(params, inputs, job):
-    """A_E, A_q (safe counts by the energy and displacement criterion) per (F, repeat)."""
-    import xarray as xr
-
-    from safebasins.analysis.agreement import criteria_counts
+def build_criteria(params, data, job):
+    """A_E, A_q (safe counts by the energy and displacement criterion) per (F, repeat)
+    (safebasins.analysis.agreement.criteria_table)."""
+    from safebasins.analysis.agreement import criteria_table
     from safebasins.io.gather import task_charts
 
-    reps, cycles = params["repeats"], params["cycles"]
-    charts = task_charts(inputs["tiles"], len(params["tasks"]))
-    A_E = np.zeros((len(charts), reps), dtype=np.int64)
-    A_q = np.zeros((len(charts), reps), dtype=np.int64)
-    for i, ds in enumerate(charts):
-        if ds.sizes["sample"] != params["n_ic"] * reps:
-            raise ValueError(f"task {i}: {ds.sizes['sample']} samples, expected n_ic * repeats = {params['n_ic'] * reps}")
-        A_E[i], A_q[i] = criteria_counts(ds, cycles, reps)
-        print(f"F={params['F'][i]}: A_E={A_E[i].tolist()} A_q={A_q[i].tolist()}", flush=True)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rel = np.where(A_E > 0, (A_q - A_E) / np.maximum(A_E, 1), np.nan)
-    out = xr.Dataset(
-        {"A_E": (("F", "repeat"), A_E), "A_q": (("F", "repeat"), A_q), "rel_diff": (("F", "repeat"), rel)},
-        coords={"F": ("F", np.asarray(params["F"], dtype=float)), "repeat": ("repeat", np.arange(reps)),
-                "seed": ("repeat", np.asarray(params["seeds"], dtype=np.int64))},
-    )
+    charts = task_charts(data["tiles"])
+    out = criteria_table(charts, params["F"], n_ic=params["n_ic"], repeats=params["repeats"], seeds=params["seeds"],
+                         cycles=params["cycles"])
     out.attrs.update({k: charts[-1].attrs[k] for k in ("integrator", "steps_per_cycle")})
     out.attrs.update(Omega=params["Omega"], Psi=params["Psi"], xi_max=params["xi_max"], q_max=params["q_max"],
-                     n_ic=params["n_ic"], cycles=cycles, box=np.asarray(params["box"], dtype=float).ravel(),
+                     n_ic=params["n_ic"], cycles=params["cycles"], box=np.asarray(params["box"], dtype=float).ravel(),
                      criterion_note=("safe = escape_cycle > cycles; A_E energy (H0 > xi_max), A_q displacement "
                                      "(|q| > q_max)"))
     return out
 
 
-def build_chart(params, inputs, job):
+def build_chart(params, data, job):
     """The escape chart gathered from its tiles (attributes ``t_eval``, ``cycles``)."""
-    return gather_chart(params, inputs["tiles"])
+    return gather_chart(params, data["tiles"])
 
 
 @register

@@ -22,11 +22,11 @@ T_EVAL_LIST = {"description": "evaluation times in forcing cycles (each <= cycle
                          {"type": "array", "minItems": 1, "items": {"type": "number", "minimum": 0}}]}
 
 
-def _grid_charts(params, tiles, attr):
+def _grid_charts(params, blocks, attr):
     """The chart of every task, each tagged with its task value ``attr`` (F or Psi) and cycles."""
     from safebasins.io.gather import task_charts
 
-    charts = task_charts(tiles, len(params["tasks"]))
+    charts = task_charts(blocks)
     for c, t in zip(charts, params["tasks"]):
         c.attrs.update({attr: t[attr], "cycles": params["cycles"]})
     return charts
@@ -41,7 +41,7 @@ def _level_crossings(ds, level):
     return ds
 
 
-def build_erosion_analytic(params, inputs, job):
+def build_erosion_analytic(params, data, job):
     """GIM / LIM / IF versus F from the slow flow on the chart grid, per first-harmonic variant."""
     from safebasins.analysis.erosion import erosion_profile_analytic
 
@@ -56,17 +56,17 @@ def build_erosion_analytic(params, inputs, job):
     return ds
 
 
-def build_erosion_numeric(params, inputs, job):
+def build_erosion_numeric(params, data, job):
     """GIM / LIM / IF versus (F, xi_max, t_eval) from one escape chart per F."""
     from safebasins.analysis.erosion import profile_from_charts
 
-    ds = profile_from_charts(_grid_charts(params, inputs["tiles"], "F"), params["t_eval"], stack_dim="F")
+    ds = profile_from_charts(_grid_charts(params, data["tiles"], "F"), params["t_eval"], stack_dim="F")
     ds = _level_crossings(ds, params["level"])
     ds.attrs.update(level=params["level"], xi_max=params["xi_max"], cycles=params["cycles"])
     return ds
 
 
-def build_true_basin_analytic(params, inputs, job):
+def build_true_basin_analytic(params, data, job):
     """Per-phase analytic basins, their intersection and the all-phase basin H0 < xi_true."""
     from safebasins.analysis.phase_invariant import true_safe_basin_analytic
 
@@ -83,19 +83,23 @@ def build_true_basin_analytic(params, inputs, job):
     return ds.merge(b.assign_coords({c: ds[c] for c in b.coords if c in ds.coords}))
 
 
-def build_true_basin_numeric(params, inputs, job):
+def build_true_basin_numeric(params, data, job):
     """Intersection over Psi of the numeric safe basins (one escape chart per Psi)."""
     from safebasins.analysis.phase_invariant import true_safe_basin_from_charts
 
-    return true_safe_basin_from_charts(_grid_charts(params, inputs["tiles"], "Psi"), params["t_eval"])
+    return true_safe_basin_from_charts(_grid_charts(params, data["tiles"], "Psi"), params["t_eval"])
 
 
-def build_fourier(params, inputs, job, *, what, source):
+def _fourier_source(what, source):
+    """The numeric dataset of experiment ``source`` that a fourier_compare product reads."""
+    return dataset_path("numeric", f"{'fcr' if what == 'fcr' else 'chart'}_{source}")
+
+
+def build_fourier(params, data, job, *, what, source):
     """Paper vs exact first harmonic against the numerics of experiment ``source``."""
     from safebasins.analysis import fourier_compare as fc
-    from safebasins.io.datasets import load
 
-    src = load(inputs["source"])
+    src = data["source"]
     if what == "fcr":
         ds = fc.fcr_fourier_comparison_from_numeric(src)
         if "curve" in ds.dims:  # per-curve parameters of the source (attributes would conflict across curves)
@@ -103,7 +107,7 @@ def build_fourier(params, inputs, job, *, what, source):
                                    if c in src.coords and src[c].dims == ("curve",)})
     else:
         ds = fc.iou_fourier_comparison(src, params["t_eval"])
-    ds.attrs.update(source_experiment=source, source_file=str(inputs["source"]),
+    ds.attrs.update(source_experiment=source, source_file=_fourier_source(what, source),
                     source_config_hash=src.attrs.get("config_hash", "none"))
     return ds
 
@@ -294,13 +298,13 @@ class FourierCompare(Kind):
 
     def products(self, experiment, params):
         out = []
-        for what, label, src_name in (("fcr", "F_cr", "fcr"), ("iou", "safe-basin IoU", "chart")):
+        for what, label in (("fcr", "F_cr"), ("iou", "safe-basin IoU")):
             for source in params[what]:
                 out.append(Product(
                     dataset_path("extras", f"{experiment}_{what}_{source}"), "extras",
                     partial(build_fourier, what=what, source=source), heavy=True,
                     title=f"{params['title']}: {label} of {source}",
-                    inputs={"source": dataset_path("numeric", f"{src_name}_{source}")},
+                    inputs={"source": _fourier_source(what, source)},
                     contract=({"rel_error": ("curve", "fourier", "Omega"), "rms_rel_error": ("curve", "fourier")}
                               if what == "fcr" else {"mean_iou": ("fourier",)}),
                     history=f"safebasins.analysis.fourier_compare on the numerics of {source} ({experiment})"))

@@ -9,8 +9,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from safebasins.pipeline import values
 from safebasins.pipeline.registry import Kind, Product, dataset_path, register
 
@@ -51,48 +49,24 @@ def _check_curves(block, key, ctx):
                      f"initial energy {b} must be below the truncation level xi_max = {a}")
 
 
-def build_fcr_analytic(params, inputs, job):
+def build_fcr_analytic(params, data, job):
     """One theory.critical_forcing per curve, stacked over ``curve``."""
-    from safebasins.io.datasets import stack
-    from safebasins.theory import critical_forcing
+    from safebasins.analysis.fcr_curves import analytic_fcr_curves
 
-    Omega = np.asarray(params["Omega"], dtype=float)
-    curves = params["curves"]
-    parts = []
-    for c in curves:
-        print(f"{params['experiment']}: critical_forcing for {c['label']}")
-        parts.append(critical_forcing(Omega, c["xi_max"], xi_ini=c["xi_ini"], gamma_ini=c["gamma_ini"],
-                                      well=values.well(params)))
-    coords = {k: [c[k] for c in curves] for k in ("xi_max", "xi_ini", "gamma_ini", "label")}
-    if all("Psi" in c for c in curves):
-        coords["Psi"] = [c["Psi"] for c in curves]
-    out = stack(parts, "curve", coords=coords)
+    out = analytic_fcr_curves(params["Omega"], params["curves"], well=values.well(params), label=params["experiment"])
     out.attrs["fourier"] = params["fourier"]
     return out
 
 
-def build_fcr_numeric(params, inputs, job):
+def build_fcr_numeric(params, data, job):
     """One numerics.critical_forcing_numeric per curve (IC from (xi_ini, gamma_ini, Psi))."""
-    from safebasins.io.datasets import stack
-    from safebasins.numerics import critical_forcing_numeric
-    from safebasins.theory import initial_condition
+    from safebasins.analysis.fcr_curves import numeric_fcr_curves
 
-    num = params["numeric"]
-    w = values.well(params)
-    Omega = np.asarray(num["Omega"], dtype=float)
-    parts, q0s, p0s = [], [], []
-    for c in params["curves"]:
-        q0, p0 = (float(v) for v in initial_condition(c["xi_ini"], c["gamma_ini"], c["Psi"], well=w))
-        q0s.append(q0)
-        p0s.append(p0)
-        print(f"{params['experiment']}: {c['label']}: IC (q0, p0) = ({q0:.6f}, {p0:.6f})", flush=True)
-        parts.append(critical_forcing_numeric(
-            Omega, c["xi_max"], q0=q0, p0=p0, Psi=c["Psi"], cycles=num["cycles"], tol=num["tol"],
-            F_bracket=tuple(num["F_bracket"]), criterion=num["criterion"], n_scan=num["n_scan"],
-            steps_per_cycle=num["steps_per_cycle"], threads=job.threads, backend=job.backend, well=w))
-    coords = {k: [c[k] for c in params["curves"]] for k in ("xi_max", "xi_ini", "gamma_ini", "Psi", "label")}
-    coords.update(q0=q0s, p0=p0s)
-    return stack(parts, "curve", coords=coords)
+    n = params["numeric"]
+    return numeric_fcr_curves(n["Omega"], params["curves"], well=values.well(params), cycles=n["cycles"],
+                              tol=n["tol"], F_bracket=n["F_bracket"], criterion=n["criterion"], n_scan=n["n_scan"],
+                              steps_per_cycle=n["steps_per_cycle"], threads=job.threads, backend=job.backend,
+                              label=params["experiment"])
 
 
 @register

@@ -17,7 +17,7 @@ from safebasins.pipeline.registry import Kind, Product, dataset_path, register
 MEASURES = ("GIM", "LIM", "IF")
 
 
-def build_analytic(params, inputs, job):
+def build_analytic(params, data, job):
     from safebasins.analysis.integrity_map import erosion_front, integrity_map_analytic
 
     q0, p0 = values.grid_axes(params["grid"])
@@ -31,18 +31,16 @@ def build_analytic(params, inputs, job):
     return ds
 
 
-def build_numeric(params, inputs, job):
+def build_numeric(params, data, job):
     """Tiles (one Omega x a block of F each) gathered; numeric - analytic difference; fronts."""
     import xarray as xr
 
     from safebasins.analysis.integrity_map import erosion_front
-    from safebasins.io.datasets import load
-    from safebasins.io.gather import task_blocks
 
-    rows = [xr.concat([load(f) for f in block], dim="F") for block in task_blocks(inputs["tiles"], len(params["tasks"]))]
+    rows = [xr.concat(block, dim="F") for block in data["tiles"]]
     ds = xr.concat(rows, dim="Omega").transpose("Omega", "F", "t_eval")
     ds = ds[list(MEASURES)]
-    analytic = load(inputs["analytic"])
+    analytic = data["analytic"]
     for k in MEASURES:
         ds[f"{k}_diff"] = (ds[k] - analytic[k]).assign_attrs(
             units="1", long_name=f"{k} numeric - analytic (slow flow)")

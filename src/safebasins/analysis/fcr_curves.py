@@ -1,0 +1,53 @@
+"""Critical-forcing curves F_cr(Omega), analytic and numeric, stacked over ``curve`` (Figs 1-4, 10-12).
+
+A curve is a dict with ``label``, ``xi_max``, ``xi_ini``, ``gamma_ini`` and, for the numerics,
+``Psi`` (safebasins.pipeline.values.curves makes them from a config block); the pipeline's
+``fcr_theory`` / ``fcr_compare`` kinds and ``safebasins fcr`` call these functions.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["analytic_fcr_curves", "numeric_fcr_curves"]
+
+
+def analytic_fcr_curves(Omega, curves, *, well=None, label=""):
+    """One :func:`safebasins.theory.critical_forcing` per curve (eqs 22-26), stacked over ``curve``
+    with the coordinates xi_max, xi_ini, gamma_ini, label (and Psi when every curve has one)."""
+    from safebasins.io.datasets import stack
+    from safebasins.theory import critical_forcing
+
+    Omega = np.asarray(Omega, dtype=float)
+    parts = []
+    for c in curves:
+        print(f"{label}: critical_forcing for {c['label']}")
+        parts.append(critical_forcing(Omega, c["xi_max"], xi_ini=c["xi_ini"], gamma_ini=c["gamma_ini"], well=well))
+    coords = {k: [c[k] for c in curves] for k in ("xi_max", "xi_ini", "gamma_ini", "label")}
+    if all("Psi" in c for c in curves):
+        coords["Psi"] = [c["Psi"] for c in curves]
+    return stack(parts, "curve", coords=coords)
+
+
+def numeric_fcr_curves(Omega, curves, *, well=None, cycles, tol, F_bracket, criterion, n_scan, steps_per_cycle,
+                       threads=None, backend="cpu", label=""):
+    """One :func:`safebasins.numerics.critical_forcing_numeric` per curve, from the IC
+    ``theory.initial_condition(xi_ini, gamma_ini, Psi)``, stacked over ``curve`` with the
+    coordinates xi_max, xi_ini, gamma_ini, Psi, label, q0, p0."""
+    from safebasins.io.datasets import stack
+    from safebasins.numerics import critical_forcing_numeric
+    from safebasins.theory import initial_condition
+
+    Omega = np.asarray(Omega, dtype=float)
+    parts, q0s, p0s = [], [], []
+    for c in curves:
+        q0, p0 = (float(v) for v in initial_condition(c["xi_ini"], c["gamma_ini"], c["Psi"], well=well))
+        q0s.append(q0)
+        p0s.append(p0)
+        print(f"{label}: {c['label']}: IC (q0, p0) = ({q0:.6f}, {p0:.6f})", flush=True)
+        parts.append(critical_forcing_numeric(
+            Omega, c["xi_max"], q0=q0, p0=p0, Psi=c["Psi"], cycles=cycles, tol=tol, F_bracket=tuple(F_bracket),
+            criterion=criterion, n_scan=n_scan, steps_per_cycle=steps_per_cycle, threads=threads, backend=backend,
+            well=well))
+    coords = {k: [c[k] for c in curves] for k in ("xi_max", "xi_ini", "gamma_ini", "Psi", "label")}
+    coords.update(q0=q0s, p0=p0s)
+    return stack(parts, "curve", coords=coords)
