@@ -37,8 +37,9 @@ Accuracy (measured for the quartic against the closed forms, asserted with margi
 ``tests/wells``): J, omega, ``|q_1|`` within 5e-15 relative for ``E <= 0.249``, 1e-15 at 0.2499,
 <= 3e-11 at ``E_b - E = 1e-12`` and ~1e-9 at the last float below ``E_b``; ``d|q_1|/dE``
 within 4e-12 for ``E <= 0.249``; angles within 2e-13 (``E <= 0.249``) and 1e-13 at 0.2499.
-Closer to the separatrix the angle of a given point is ill-conditioned (an error ``eps E_b``
-in ``H0(q, p)`` moves theta by ~``eps E_b / (E_b - E)``).  The asymmetric quartic and the cubic
+Closer to the separatrix (or to the limit of a side open at infinity) the angle of a given point
+is ill-conditioned (an error ``eps E_b`` in ``H0(q, p)`` moves theta by ~``eps E_b / (E_b - E)``:
+4e-5 at ``E_b - E = 1e-12`` for Morse written as ``(1 - exp(-q))^2``).  The asymmetric quartic and the cubic
 agree with DOP853 orbits and scipy quad to 1e-14 .. 1e-12 (limited by the references).
 
 Wells open at infinity (docs/wells.md; closed forms of Morse ``D (1 - e^{-a q})^2`` and of
@@ -165,7 +166,7 @@ class NumericWell(WellShape, Well):
                                  "separatrix behaviour assumed by the interpolation in E does not hold")
         self._V_bottom = cancellation_fix(partial(_call, V), partial(_call, dV), self._bottom_scales())
         V_acc = partial(_call, V) if self._V_bottom is None else self._V_bottom
-        opened = ({"tails": self._tails, "core": min(self._bottom_scales()), "n_mean": 8}
+        opened = ({"tails": self._tails, "core": max(self._bottom_scales()), "n_mean": 8}
                   if self.open_at_infinity else {})
         self._quad = OrbitQuadrature(V_acc, partial(_call, dV), self.limits, found, kappa, **opened)
         self._interp = EnergyInterpolant(self._orbit_table, self._E_b, tol=tol, noise=self._noise)

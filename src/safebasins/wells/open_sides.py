@@ -122,8 +122,9 @@ class Tail:
                     raise ValueError(
                         f"dV: V' has lost its relative precision at |q| ~ {x!r} on the {self.where} side, where V is "
                         f"within {self.A - float(V_at(x)):.3g} of its limit {self.A!r}: the orbits near the escape energy "
-                        "reach that far and cannot be computed.  Write V' so that it stays accurate as V tends to "
-                        "its limit (2 tanh(q) / cosh(q)^2, not 2 tanh(q) (1 - tanh(q)^2) whose 1 - tanh^2 cancels)")
+                        "reach that far and cannot be computed.  Write V' without terms that cancel as V tends to "
+                        "its limit (2 tanh(q) / cosh(q)^2, not 2 tanh(q) (1 - tanh(q)^2); 2 q / (1 + q^2)^2, not "
+                        "2 q / (1 + q^2) - 2 q^3 / (1 + q^2)^2)")
                 continue
             parts.append(halves)
             x += h
