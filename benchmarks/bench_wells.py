@@ -17,10 +17,12 @@ Jobs (kernel only: kernels.ensemble with the arrays engine.run_ensemble would pa
   chart  the 100x100 chart of bench_escape.py (quartic: F = 0.0876, Omega = 0.95, Psi = pi,
          xi_max = 0.25, 300 cycles; cubic: F = 0.06, Omega = 0.85, xi_max = 1/6), steps
          counted to the escape step or the horizon.
-Wells: the quartic's closed-form path (flag QUARTIC: before and after; QUARTIC_SIGNED: the
-same arithmetic with signed maxima, for asymmetric displacement bounds) and the polynomial
-path (POLY4: the cubic V = q^2/2 - q^3/3 and the quartic written as coefficients
-[0, 0, 0.5, 0, -0.25]; POLY8: the cubic run in the degree-8 class, i.e. a degree 5-8 well).
+Wells, each in its one compiled form (Well.compiled, numerics.wellcode): the quartic's closed
+form (before and after; its signed variant: the same arithmetic with signed maxima, for
+asymmetric displacement bounds), the polynomial codes (the cubic V = q^2/2 - q^3/3 and the
+quartic written as coefficients [0, 0, 0.5, 0, -0.25] in the degree-4 class; the cubic in the
+degree-8 class, i.e. a degree 5-8 well) and the generic V, dV code of an expression well (the
+cubic as an expression, and the pendulum 1 - cos q: transcendental, the lane loop stays scalar).
 
 Measured (docs/numerics.md, "Wells"): Intel Xeon with AVX-512 (16 cores, idle), 1 thread,
 SRKN6b: quartic after / before 1.006 dense, 0.992 chart; time per step vs the quartic
@@ -110,27 +112,23 @@ def H_quartic(q, p):
     return 0.5 * p * p + 0.5 * q * q - 0.25 * q ** 4
 
 
-def H_cubic(q, p):
+def H_cubic(q, p):  # noqa: D103
     return 0.5 * p * p + 0.5 * q * q - q ** 3 / 3.0
 
 
 class Job:
     """One kernels.ensemble call with fixed arrays; run() returns the escape steps."""
 
-    def __init__(self, name, mod, Q, P, F, Omega, Psi, xi_max, cycles, S, integrator, threads, flag=None,
-                 coefs=None, barriers=(-1.0, 1.0)):
+    def __init__(self, name, mod, Q, P, F, Omega, Psi, xi_max, cycles, S, integrator, threads, code=None):
         from safebasins.numerics import engine, kernels
-        self.name, self.mod, self.flag, self.cycles, self.S = name, mod, flag, cycles, S
+        self.name, self.mod, self.cycles, self.S = name, mod, cycles, S
         self.Q, self.P = Q, P
         N = Q.size
         self.args = (Q, P, np.zeros(N, np.int64), kernels.lane_coefficients([Omega], S, integrator),
                      kernels.step_sizes([Omega], S), np.array([F]), kernels.sine_table(S, Psi, integrator),
                      np.array([2.0 * xi_max]), np.zeros(0), cycles, False,
                      max(1, min(-(-N // engine.LANES), threads)), engine.LANES)
-        self.kw = {}
-        if flag is not None:
-            cls, wpar = kernels.well_parameters(barriers, coefs)
-            self.kw = dict(well=flag, wpar=wpar, thrQlo=np.zeros(0))
+        self.kw = {} if code is None else dict(well=code, thrQlo=np.zeros(0))
         self.out = None
 
     def run(self):
@@ -176,7 +174,8 @@ def main(argv=None):
 
     import numba
     numba.set_num_threads(args.threads)
-    from safebasins.numerics import kernels
+    from safebasins import wells
+    from safebasins.numerics import kernels, wellcode
     print("machine:", machine())
     print(f"numba {numba.__version__}, threads {args.threads}, steps_per_cycle {args.steps_per_cycle}, "
           f"best of {args.repeat} interleaved runs, kernel only (kernels.ensemble)")
@@ -190,7 +189,13 @@ def main(argv=None):
     cq, cp = grid_ics(CHART_CUBIC["box"])
     cq_ = {k: CHART_QUARTIC[k] for k in ("F", "Omega", "Psi", "xi_max")}
     cc_ = {k: CHART_CUBIC[k] for k in ("F", "Omega", "Psi", "xi_max")}
-    cubic_bar = (-np.inf, 1.0)
+    quartic = wells.QUARTIC.compiled
+    quartic_poly = wells.polynomial(QUARTIC_COEFS).compiled
+    cubic = wells.cubic().compiled
+    cubic8 = wellcode.polynomial_code(CUBIC_COEFS, (-np.inf, 1.0), "cubic", degree_class=8)
+    cubic_expr = wells.expression("q**2/2 - q**3/3").compiled
+    pendulum = wells.resolve_well("pendulum")
+    qp, pp = disc_ics(args.dense_n, lambda q, p: 0.5 * p * p + pendulum.V(q), 1.0, seed=2)
     for integ in args.integrators:
         dense = dict(F=0.0, Omega=1.0, Psi=0.0, xi_max=0.25, cycles=args.dense_cycles, S=S, integrator=integ,
                      threads=args.threads)
@@ -198,42 +203,40 @@ def main(argv=None):
         chart = dict(cycles=args.chart_cycles, S=S, integrator=integ, threads=args.threads)
         jobs = [
             Job("quartic dense, before", before, qd, pd, **dense),
-            Job("quartic dense, after (QUARTIC)", kernels, qd, pd, **dense, flag=kernels.QUARTIC),
-            Job("quartic dense, QUARTIC_SIGNED", kernels, qd, pd, **dense, flag=kernels.QUARTIC_SIGNED),
-            Job("quartic dense, POLY4 coefficients", kernels, qd, pd, **dense, flag=kernels.POLY4,
-                coefs=QUARTIC_COEFS),
-            Job("cubic dense, POLY4", kernels, cd_q, cd_p, **dense_c, flag=kernels.POLY4, coefs=CUBIC_COEFS,
-                barriers=cubic_bar),
-            Job("cubic dense, POLY8 class", kernels, cd_q, cd_p, **dense_c, flag=kernels.POLY8, coefs=CUBIC_COEFS,
-                barriers=cubic_bar),
+            Job("quartic dense, after", kernels, qd, pd, **dense, code=quartic),
+            Job("quartic dense, signed", kernels, qd, pd, **dense, code=quartic.signed()),
+            Job("quartic dense, coefficients", kernels, qd, pd, **dense, code=quartic_poly),
+            Job("cubic dense, degree-4 class", kernels, cd_q, cd_p, **dense_c, code=cubic),
+            Job("cubic dense, degree-8 class", kernels, cd_q, cd_p, **dense_c, code=cubic8),
+            Job("cubic dense, expression", kernels, cd_q, cd_p, **dense_c, code=cubic_expr),
+            Job("pendulum dense, expression", kernels, qp, pp, **dict(dense, xi_max=2.0), code=pendulum.compiled),
             Job("quartic chart, before", before, qc, pc, **cq_, **chart),
-            Job("quartic chart, after (QUARTIC)", kernels, qc, pc, **cq_, **chart, flag=kernels.QUARTIC),
-            Job("cubic chart, POLY4", kernels, cq, cp, **cc_, **chart, flag=kernels.POLY4, coefs=CUBIC_COEFS,
-                barriers=cubic_bar),
+            Job("quartic chart, after", kernels, qc, pc, **cq_, **chart, code=quartic),
+            Job("cubic chart, degree-4 class", kernels, cq, cp, **cc_, **chart, code=cubic),
         ]
         t = time.perf_counter()
         best, cpu = bench(jobs, args.repeat)
         print(f"\n=== {integ} (compile or cache load + runs: {time.perf_counter() - t:.0f} s) ===")
         by = {j.name: j for j in jobs}
-        for a, b in (("quartic dense, before", "quartic dense, after (QUARTIC)"),
-                     ("quartic chart, before", "quartic chart, after (QUARTIC)")):
+        for a, b in (("quartic dense, before", "quartic dense, after"),
+                     ("quartic chart, before", "quartic chart, after")):
             same = np.array_equal(by[a].out, by[b].out)
             print(f"escape steps {a.split(',')[0]}: before == after: {same}")
             if not same:
                 raise SystemExit("the quartic path changed its results")
-        ref = by["quartic dense, after (QUARTIC)"]
+        ref = by["quartic dense, after"]
         ref_rate = ref.steps() / best[ref.name]
         print(f"{'job':36s} {'traj-steps':>11s} {'wall [s]':>9s} {'steps/s':>10s} {'CPU s':>7s} "
-              f"{'vs QUARTIC dense':>16s}")
+              f"{'vs quartic dense':>16s}")
         for j in jobs:
             n = j.steps()
             r = n / best[j.name]
             print(f"{j.name:36s} {n:11.4g} {best[j.name]:9.4f} {r:10.4g} {cpu[j.name]:7.3f} {r / ref_rate:16.3f}")
         for kind in ("dense", "chart"):
-            b, a = by[f"quartic {kind}, before"], by[f"quartic {kind}, after (QUARTIC)"]
+            b, a = by[f"quartic {kind}, before"], by[f"quartic {kind}, after"]
             print(f"quartic {kind}: after / before = {best[b.name] / best[a.name]:.3f} (steps/s ratio; 1 = same speed)")
-        for name in ("cubic dense, POLY4", "quartic dense, POLY4 coefficients", "cubic dense, POLY8 class",
-                     "quartic dense, QUARTIC_SIGNED"):
+        for name in ("cubic dense, degree-4 class", "quartic dense, coefficients", "cubic dense, degree-8 class",
+                     "quartic dense, signed", "cubic dense, expression", "pendulum dense, expression"):
             j = by[name]
             print(f"{name}: time per step / quartic's = {ref_rate / (j.steps() / best[name]):.3f}")
     print("\nmachine after:", machine())

@@ -252,7 +252,7 @@ def test_horner_classes():
     c3 = [0.0, 0.0, 0.5, -1.0 / 3.0]
     code3 = wellcode.polynomial_code(c3, (-np.inf, 1.0))
     assert "class 4" in code3.name
-    as8 = wellcode.WellCode("cubic in class 8", code6.make, code3.wpar, False, code6.source)   # same coefficients
+    as8 = wellcode.polynomial_code(c3, (-np.inf, 1.0), degree_class=8)
     h4 = _horner_of(code3)
     for q, p in ((0.3, -0.2), (-0.7, 0.4)):
         assert h4(code3.wpar, q, p) == h8(code3.wpar, q, p)

@@ -228,14 +228,17 @@ def poly8_energy2(w, q, p):
 _POLY_MAKE = {4: _plain(poly4_force, poly4_energy2), 8: _plain(poly8_force, poly8_energy2)}
 
 
-def polynomial_code(coefficients, barriers, name="polynomial") -> WellCode:
+def polynomial_code(coefficients, barriers, name="polynomial", degree_class=None) -> WellCode:
     """Code of ``V = sum_k c_k q^k`` (c_0 = c_1 = 0, degree <= 8) with its barriers: one compiled
-    kernel per degree class (the coefficients are run-time numbers)."""
+    kernel per degree class (the coefficients are run-time numbers); ``degree_class`` (4 or 8)
+    forces a class at least the degree's (None: the smallest)."""
     c = np.trim_zeros(np.asarray(coefficients, dtype=float), "b")
     n = c.size - 1
     if c.ndim != 1 or n < 2 or c[0] != 0.0 or c[1] != 0.0:
         raise ValueError(f"coefficients must be c_0 = 0, c_1 = 0, c_2, ... (degree >= 2), got {coefficients!r}")
-    cls = next((d for d in POLY_DEGREES if n <= d), None)
+    if degree_class is not None and degree_class not in POLY_DEGREES:
+        raise ValueError(f"degree_class must be one of {POLY_DEGREES}, got {degree_class!r}")
+    cls = next((d for d in POLY_DEGREES if n <= d and (degree_class is None or d >= degree_class)), None)
     if cls is None:
         raise ValueError(f"coefficients: degree {n} exceeds the largest compiled polynomial class {max(POLY_DEGREES)} "
                          "(write the well as an expression: {'expression': ...})")
