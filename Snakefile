@@ -5,6 +5,7 @@
 #   snakemake -j2                                        # all datasets, figures, archive
 #   snakemake -j2 --configfile config/quick.yaml         # the same DAG at coarse resolution
 #   snakemake -j2 escape_equation                       # the cubic-well study only (issue 12)
+#   snakemake -j2 other_wells                           # the pendulum and sech^2 study (issue 16)
 #   snakemake -j2 archive                                # results/archive/*.tar.gz
 #   snakemake --report results/report.html               # HTML report
 import os
@@ -52,6 +53,13 @@ rule escape_equation:
     input:
         [p for e in RUN.experiments.values() if e.key.startswith("escape_equation.") for p in e.dataset_files()],
         [p for e in RUN.experiments.values() if e.key.startswith("escape_equation.") for p in (e.figure.png, e.figure.pdf)],
+
+
+rule other_wells:
+    """The pendulum and sech^2 study (config block `other_wells`): datasets and figures."""
+    input:
+        [p for e in RUN.experiments.values() if e.key.startswith("other_wells.") for p in e.dataset_files()],
+        [p for e in RUN.experiments.values() if e.key.startswith("other_wells.") for p in (e.figure.png, e.figure.pdf)],
 
 
 rule experiments:

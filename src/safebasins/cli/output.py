@@ -77,10 +77,10 @@ def write_outputs(datasets, fig, png):
     if fig is not None:
         import matplotlib.pyplot as plt
 
-        from safebasins.plotting.style import DEFAULT_DPI
+        from safebasins.plotting.style import save_figure
 
-        with atomic_path(png) as tmp:
-            fig.savefig(tmp, format="png", dpi=DEFAULT_DPI, bbox_inches="tight")
+        with atomic_path(png) as tmp:       # provenance of the datasets in the PNG (and the well named)
+            save_figure(fig, tmp, datasets=[ds for _, ds in datasets])
         plt.close(fig)
         click.echo(f"wrote {png}")
 

@@ -337,15 +337,16 @@ def _ir_identity(arg, fn):
         raise ValueError(f"{arg} must be a callable, got {fn!r}")
     try:
         d = njit(py)
-        cres = d.compile((types.float64,))
+        d.compile((types.float64,))
         ir = d.inspect_llvm((types.float64,))
+        returns = d.overloads[(types.float64,)].signature.return_type
     except errors.NumbaError as exc:
         head = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise ValueError(f"{arg}: the compiled engines need {arg}(q) as a scalar function numba can compile "
                          f"(numpy/math calls on a float; numba said: {head}); or write the well as an expression "
                          "{'expression': ...}") from None
-    if cres.signature.return_type not in (types.float64, types.int64):
-        raise ValueError(f"{arg}(q) must return a float for a float q, numba infers {cres.signature.return_type}")
+    if returns not in (types.float64, types.int64):
+        raise ValueError(f"{arg}(q) must return a float for a float q, numba infers {returns}")
     return py, re.sub(r"_ZN\w+", "_Z", ir)
 
 

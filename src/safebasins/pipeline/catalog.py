@@ -371,4 +371,36 @@ DECLARATIONS += (
               "bar); dotted oval: the analytic all-phase basin H0 = ξ_true.")),
 )
 
+# ---------------------------------------------------------------- other wells (issue 16)
+# The same kinds on the pendulum and the sech^2 well (config block `other_wells`), named
+# expression wells: non-polynomial potentials, one with an asymptote instead of a barrier.
+_OTHER = "Other wells: pendulum and sech²"
+_PENDULUM_NOTE = ("Pendulum q'' + sin q = F sin(Ωt + Ψ) (V = 1 - cos q, barriers q = ±π with energy 2, ω₀ = 1: "
+                  "escape is capsize), written as the expression well '1 - cos(q)'.")
+_SECH2_NOTE = ("Pöschl–Teller well V = tanh² q = 1 - sech² q (ω₀ = √2): no barrier, V tends to 1 on both sides, "
+               "so the escape energy is the asymptote E_b = 1 and every truncation level lies below it.")
+DECLARATIONS += tuple(
+    d for well, note in (("pendulum", _PENDULUM_NOTE), ("sech2", _SECH2_NOTE)) for d in (
+        Declaration(
+            name=f"{well}_fcr", kind="fcr_compare", key=("other_wells", f"{well}_fcr"), stem=f"{well}_fcr_zero_ic",
+            label=f"{'Pendulum' if well == 'pendulum' else 'sech² well'}: F_cr(Ω), zero IC", category=_OTHER,
+            options={'layout': 'panels', 'bracket': True, 'F_max': None},
+            title=f"{'Pendulum' if well == 'pendulum' else 'sech^2 well'}: analytic versus numeric F_cr(Omega), "
+                  "zero IC, three truncation levels",
+            caption=note + " Escape threshold versus forcing frequency for three truncation levels and the zero "
+                           "IC (the analogue of Figure 10).",
+            look=("One panel per ξ_max. Line: slow-flow theory (numeric action-angle variables, exact first "
+                  "harmonic); dots: numeric bisection F_cr (energy criterion). Black bars with caps mark "
+                  "non-monotone escape brackets.")),
+        Declaration(
+            name=f"{well}_basins", kind="basin_chart", key=("other_wells", f"{well}_basins"),
+            stem=f"{well}_sb_xi_max", label=f"{'Pendulum' if well == 'pendulum' else 'sech² well'}: safe basins",
+            category=_OTHER, options={},
+            title=f"{'Pendulum' if well == 'pendulum' else 'sech^2 well'}: safe basins versus xi_max, analytic "
+                  "and numeric",
+            caption=note + " Safe basins for three truncation levels at one forcing (the analogue of Figures "
+                           "13-15).",
+            look=_NESTED),
+    ))
+
 BY_NAME = {d.name: d for d in DECLARATIONS}

@@ -88,9 +88,11 @@ def save_figure(fig, png=None, pdf=None, *, dpi=DEFAULT_DPI, datasets=()):
     from safebasins.plotting.data import provenance
 
     meta = provenance(*datasets, fig=fig)
+    label_well(fig, meta.get("well"))
     summary = ", ".join(f"{k} {meta[k]}" for k in ("safebasins_version", "git_commit", "config_hash", "well")
                         if k in meta).replace("\n", " / ")
-    for path, kw in ((png, dict(dpi=dpi, metadata=meta)), (pdf, dict(metadata={"Subject": summary} if summary else {}))):
+    for path, kw in ((png, dict(format="png", dpi=dpi, metadata=meta)),
+                     (pdf, dict(format="pdf", metadata={"Subject": summary} if summary else {}))):
         if path:
             d = os.path.dirname(os.fspath(path))
             if d:
@@ -98,6 +100,15 @@ def save_figure(fig, png=None, pdf=None, *, dpi=DEFAULT_DPI, datasets=()):
             fig.savefig(path, bbox_inches="tight", **kw)
     return fig
 
+
+
+def label_well(fig, well):
+    """Name the potential well in the figure's top-left corner unless it is the paper's quartic
+    (``well``: the datasets' ``well`` attribute; several wells: one a line)."""
+    if not well or well == "quartic" or getattr(fig, "_safebasins_well_label", None) == well:
+        return
+    fig.text(0.005, 0.998, "well: " + well.replace("\n", ", "), ha="left", va="top", fontsize=8, color="0.25")
+    fig._safebasins_well_label = well
 
 
 def fmt_value(v, name=None):
