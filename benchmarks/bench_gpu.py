@@ -15,10 +15,12 @@ flags, cores, GPU name and SMs) and
      Omega = 0.95, Psi = pi, xi_max = 0.25, q_max = 1, 11,000 cycles of 32 steps: GPU kernel time
      (CUDA events) and wall time, CPU time (all rows, or --cpu-sample rows), and the number of
      escape steps that differ between CPU and GPU (must be 0).
---wells adds (c): the kernel per well flag (steps.py) on the GPU: the dense job (F = 0, nothing
-escapes) in the quartic (QUARTIC; QUARTIC_SIGNED with asymmetric bounds), the cubic
-V = q^2/2 - q^3/3 (POLY4) and a degree-6 well (POLY8), trajectory-steps/s and the ratio to the
-quartic, PTX contractible pairs of the polynomial kernel, and a --wells-n x --wells-n cubic chart
+--wells adds (c): the kernel per compiled well (numerics/wellcode.py) on the GPU: the dense job
+(F = 0, nothing escapes) in the quartic (|q| tracking; signed tracking with asymmetric bounds),
+the cubic V = q^2/2 - q^3/3 (degree-4 polynomial class), a degree-6 well (degree-8 class) and the
+pendulum (an expression well: libdevice sin/cos on the GPU, glibc on the CPU, so its escape
+steps may differ in rare threshold-grazing trajectories), trajectory-steps/s and the ratio to the
+quartic, PTX contractible pairs of each kernel, and a --wells-n x --wells-n cubic chart
 (energy + asymmetric bounds, --wells-cycles cycles) whose escape steps are compared with the CPU
 engine's (must be equal).
 --json PATH writes every figure as JSON as well.  Targets on one H100: >= 2e11 trajectory-steps/s
@@ -51,20 +53,13 @@ import numba
 import numpy as np
 from numba import cuda
 
-from safebasins.numerics import cuda_engine, cuda_kernels, engine, steps
+from safebasins import wells
+from safebasins.numerics import cuda_engine, cuda_kernels, engine
 
-# wells of section (c), duck-typed for numerics.criteria.resolve_well
-CUBIC = dict(name="cubic", coefficients=[0.0, 0.0, 0.5, -1.0 / 3.0], barriers=(-np.inf, 1.0), barrier_energy=1.0 / 6.0)
-
-
-def sextic():
-    """V = q^2/2 - q^4/4 + 0.01 q^6 (kernel class POLY8): barriers at the roots of V'."""
-    c = np.array([0.0, 0.0, 0.5, 0.0, -0.25, 0.0, 0.01])
-    dc = np.polynomial.polynomial.polyder(c)
-    r = np.polynomial.polynomial.polyroots(dc)
-    qb = float(np.min(r[(np.abs(r.imag) < 1e-12) & (r.real > 0)].real))
-    return dict(name="sextic", coefficients=c.tolist(), barriers=(-qb, qb),
-                barrier_energy=float(np.polynomial.polynomial.polyval(qb, c)))
+# wells of section (c), as the config names them (safebasins.wells.resolve_well)
+CUBIC = "cubic"
+SEXTIC = {"polynomial": [0.0, 0.0, 0.5, 0.0, -0.25, 0.0, 0.01]}     # the degree-8 polynomial class
+PENDULUM = "pendulum"                                               # an expression well (sin, cos)
 
 FIG21 = dict(F=0.0876, Omega=0.95, Psi=np.pi, xi_max=[0.25], q_max=[1.0], cycles=11000, steps_per_cycle=32)
 
@@ -94,12 +89,13 @@ def machine():
     return info
 
 
-def ptx_report(integrator="srkn6b", well=steps.QUARTIC):
+def ptx_report(integrator="srkn6b", well=None):
     """f64 instruction counts of the compiled kernel and contractible mul -> add/sub pairs."""
     if cuda_kernels.SIMULATOR:
         return dict(integrator=integrator, well=well, ptx_f64_ops="simulator: no PTX", contractible_pairs=None,
                     sass=None)
-    kernel = cuda_kernels.ensemble_kernel(integrator, True, cuda_kernels.BLOCK, cuda_kernels.WARP, well)
+    code = wells.resolve_well(well).compiled
+    kernel = cuda_kernels.ensemble_kernel(integrator, True, cuda_kernels.BLOCK, cuda_kernels.WARP, code)
     asm = kernel.inspect_asm()
     ptx = next(iter(asm.values())) if isinstance(asm, dict) else asm
     ops = collections.Counter()
@@ -114,7 +110,7 @@ def ptx_report(integrator="srkn6b", well=steps.QUARTIC):
             mul_dst.add(dst)
         elif op.startswith(("add", "sub")):
             uses.extend(re.findall(r"%fd\d+", srcs))
-    rep = dict(integrator=integrator, well=well, ptx_f64_ops=dict(ops),
+    rep = dict(integrator=integrator, well=code.name, ptx_f64_ops=dict(ops),
                contractible_pairs=sum(u in mul_dst for u in uses))
     try:
         sass = kernel.inspect_sass()
@@ -214,22 +210,20 @@ def fig21(n=300, cpu_sample=None, cpu_result=None, cycles=FIG21["cycles"], integ
 
 
 def wells_section(n_dense, cycles, chart_n, chart_cycles, cpu_rows, integrator="srkn6b"):
-    """(c): dense steps/s per well flag on the GPU (and the CPU engine), a cubic chart CPU vs GPU."""
-    from types import SimpleNamespace
+    """(c): dense steps/s per compiled well on the GPU (and the CPU engine), a cubic chart CPU vs GPU."""
     S = 32
     rng = np.random.default_rng(3)
     q = rng.uniform(-0.25, 0.25, n_dense)
     p = rng.uniform(-0.25, 0.25, n_dense)      # H0 < 0.07 in all three wells: nothing escapes with F = 0
     pidx = np.zeros(n_dense, np.int64)
-    sx = sextic()
-    jobs = [("quartic (QUARTIC)", None, dict(xi_max=[0.25], q_max=[1.0])),
-            ("quartic, asymmetric bounds (QUARTIC_SIGNED)", None, dict(xi_max=[0.25], q_bounds=[[-0.9, 1.0]])),
-            ("cubic (POLY4)", CUBIC, dict(xi_max=[1.0 / 6.0], q_bounds=[[-0.5, 1.0]])),
-            ("sextic (POLY8)", sx, dict(xi_max=[0.2], q_max=[1.0]))]
+    jobs = [("quartic", None, dict(xi_max=[0.25], q_max=[1.0])),
+            ("quartic, asymmetric bounds (signed tracking)", None, dict(xi_max=[0.25], q_bounds=[[-0.9, 1.0]])),
+            ("cubic (degree-4 class)", CUBIC, dict(xi_max=[1.0 / 6.0], q_bounds=[[-0.5, 1.0]])),
+            ("sextic (degree-8 class)", SEXTIC, dict(xi_max=[0.2], q_max=[1.0])),
+            ("pendulum (expression, libdevice vs glibc sin/cos)", PENDULUM, dict(xi_max=[1.9], q_max=[3.0]))]
     out = dict(integrator=integrator, n=n_dense, cycles=cycles, steps_per_cycle=S, dense={}, ptx=[])
     steps_n = n_dense * cycles * S
-    for name, w, thr in jobs:
-        well = None if w is None else SimpleNamespace(**w)
+    for name, well, thr in jobs:
         kw = dict(cycles=cycles, steps_per_cycle=S, integrator=integrator, well=well, **thr)
         cuda_engine.run_ensemble_cuda(q[:256], p[:256], pidx[:256], [0.95], [0.0], np.pi, **dict(kw, cycles=2))
         tm = {}
@@ -241,15 +235,14 @@ def wells_section(n_dense, cycles, chart_n, chart_cycles, cpu_rows, integrator="
         out["dense"][name] = dict(kernel_s=tm["kernel_s"], gpu_steps_per_s=steps_n / tm["kernel_s"],
                                   regs=tm.get("regs_per_thread"), cpu_s=cpu_s, cpu_steps_per_s=steps_n / cpu_s,
                                   escaped=int((gE >= 0).sum() + (gQ >= 0).sum()), E=compare(cE, gE), Q=compare(cQ, gQ))
-    for flag in (steps.POLY4, steps.QUARTIC_SIGNED):
-        out["ptx"].append(ptx_report(integrator, flag))
+    for well in (None, CUBIC, SEXTIC, PENDULUM):
+        out["ptx"].append(ptx_report(integrator, well))
     # the cubic chart: energy thresholds and asymmetric bounds, CPU vs GPU escape steps
     qa = np.linspace(-0.6, 1.0, chart_n)
     pa = np.linspace(-0.6, 0.6, chart_n)
     Q, P = (a.ravel() for a in np.meshgrid(qa, pa, indexing="ij"))
-    well = SimpleNamespace(**CUBIC)
     kw = dict(xi_max=[0.12, 1.0 / 6.0], q_bounds=[[-0.43, 0.65], [-np.inf, 0.9]], cycles=chart_cycles,
-              steps_per_cycle=S, integrator=integrator, well=well)
+              steps_per_cycle=S, integrator=integrator, well=CUBIC)
     args = ([0.85], [0.02], 0.3)
     runs = []
     for _ in range(2):
@@ -279,7 +272,7 @@ def main():
                     "(srkn6b; other integrators get the suffix _<integrator>)")
     ap.add_argument("--integrators", default="srkn6b", help="comma-separated: srkn6b,rk4")
     ap.add_argument("--blocks", default="", help="comma-separated threads per block to sweep on the dense job (GPU)")
-    ap.add_argument("--wells", action="store_true", help="section (c): the kernel per well flag")
+    ap.add_argument("--wells", action="store_true", help="section (c): the kernel per compiled well")
     ap.add_argument("--wells-only", action="store_true", help="only section (c)")
     ap.add_argument("--wells-n", type=int, default=200, help="cubic chart of (c): n x n ICs")
     ap.add_argument("--wells-cycles", type=int, default=2000)
@@ -305,7 +298,7 @@ def main():
                       f"quartic's time per step, {d['regs']} regs); CPU {d['cpu_steps_per_s']:.3g} steps/s; "
                       f"crossings {d['escaped']}; CPU == GPU: E {d['E']['bitwise_equal']}, Q {d['Q']['bitwise_equal']}")
             for r in w["ptx"]:
-                print(f"    PTX well flag {r['well']}: f64 ops {r['ptx_f64_ops']}; contractible pairs "
+                print(f"    PTX well {r['well']}: f64 ops {r['ptx_f64_ops']}; contractible pairs "
                       f"{r['contractible_pairs']}; SASS {r['sass']}")
             c = w["cubic_chart"]
             print(f"    cubic chart {c['n']}x{c['n']}, {c['cycles']} cycles: GPU kernel {c['kernel_s']:.4f} s, "

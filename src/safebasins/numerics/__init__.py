@@ -6,7 +6,8 @@ critical_forcing_numeric         bisection.py
 stroboscopic_map                 maps.py
 random_initial_conditions        initial_conditions.py
 displacement_bounds              criteria.py  (asymmetric displacement bounds from energy levels)
-Every function takes ``well=`` (None: the quartic; a polynomial well: criteria.resolve_well).
+Every function takes ``well=``: any form safebasins.wells.resolve_well reads (None: the quartic),
+integrated in its one compiled form (``Well.compiled``, numerics.wellcode).
 """
 from safebasins.numerics.bisection import critical_forcing_numeric
 from safebasins.numerics.charts import escape_chart, escape_chart_batch

@@ -279,7 +279,7 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
     thrLo, thrHi (>= max(nQ, 1),) the nested displacement bounds, inside out (|q| tracking: thrHi
     = sorted q_max, thrLo unused); A: scrambling multiplier (coprime to N); counter (1,) int64
     = 0; outE (N*nE,), outQ (N*nQ,) int64 pre-filled with -1; wpar (steps.N_WPAR,) the well's
-    barriers and coefficients (steps.well_parameters).
+    barriers and coefficients (wellcode.WellCode.wpar).
     """
     W = WIDTHS[kernels.check_integrator(integrator)]
     UW = np.uint64(W)
