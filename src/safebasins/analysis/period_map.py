@@ -456,7 +456,7 @@ def period_map_portrait(q0, p0, F, Omega, Psi, *, n_keep, n_iter=3000, xi_max=No
 def portrait_with_criteria(q0, p0, origin, F, Omega, Psi, *, criterion, xi_max, q_max, n_keep, n_iter,
                            steps_per_cycle, threads=None, min_digits=5.0, max_period=40):
     """Fig 18: :func:`period_map_portrait` of the candidates (q0, p0) under one escape
-    ``criterion`` ("energy": H0 > xi_max, "displacement": |q| > q_max), with each kept orbit's
+    ``criterion`` ("energy": H0 > xi_max, "displacement": ``|q| > q_max``), with each kept orbit's
     ``origin`` label and its escape cycle under BOTH criteria (``escape_cycle_energy``,
     ``escape_cycle_displacement``: one escape chart of the kept ICs, paired samples)."""
     from safebasins.numerics import escape_chart

@@ -29,7 +29,7 @@ from scipy import optimize
 __all__ = ["geometric_values", "converged_limit", "Tail", "TAIL_START", "CONVERGED"]
 
 EPS = np.finfo(float).eps
-#: relative agreement of RUN consecutive values of V along the geometric sequence (|q| growing by
+#: relative agreement of RUN consecutive values of V along the geometric sequence (``|q|`` growing by
 #: 2^RUN) that counts as converged
 CONVERGED = 4 * EPS
 RUN = 8
