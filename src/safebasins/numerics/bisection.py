@@ -65,7 +65,7 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
         raise ValueError(f"criterion must be 'energy' or 'displacement', got {criterion!r}")
     if isinstance(n_scan, bool) or not isinstance(n_scan, (int, np.integer)) or n_scan < 0 or n_scan == 1:
         raise ValueError(f"n_scan must be 0 (no scan) or an integer >= 2, got {n_scan!r}")
-    spc = engine.check_steps_per_cycle(steps_per_cycle)
+    spc = engine.check_step(Om, engine.check_steps_per_cycle(steps_per_cycle), w)
     threads = engine.check_threads(threads)
     kernels.check_integrator(integrator)
     bounds = {}

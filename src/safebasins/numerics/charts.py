@@ -99,7 +99,7 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=()
     w = resolve_well(well)
     xi, qm, qb = _thresholds(w, xi_max, q_max, q_bounds)
     cycles = engine.check_cycles("cycles", cycles)
-    spc = engine.check_steps_per_cycle(steps_per_cycle)
+    spc = engine.check_step(Omega, engine.check_steps_per_cycle(steps_per_cycle), w)
     threads = engine.check_threads(threads)
     kernels.check_integrator(integrator)
 
@@ -163,7 +163,7 @@ def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bou
     w = resolve_well(well)
     xi, qm, qb = _thresholds(w, xi_max, q_max, q_bounds)
     cycles = engine.check_cycles("cycles", cycles)
-    spc = engine.check_steps_per_cycle(steps_per_cycle)
+    spc = engine.check_step(Omega, engine.check_steps_per_cycle(steps_per_cycle), w)
     threads = engine.check_threads(threads)
     kernels.check_integrator(integrator)
     K, n = F.size, Q.size

@@ -49,6 +49,33 @@ def check_steps_per_cycle(steps_per_cycle):
     return n
 
 
+#: largest h * omega_max accepted (numerics docs): half of SRKN6b's stability limit 3.16 for
+#: the harmonic oscillator and below RK4's 2.83 (|R(i x)| <= 1); phase error 1.2e-4 per step there
+STEP_LIMIT = 1.5
+
+
+def check_step(Omega, steps_per_cycle, well=None):
+    """Refuse a step ``h = 2 pi / (Omega steps_per_cycle)`` the schemes cannot integrate: ValueError
+    (naming steps_per_cycle) when ``h * max(omega_max, Omega) > STEP_LIMIT`` for the smallest
+    Omega, omega_max being the well's largest local frequency sqrt(max |V''|) (Well.omega_max).
+    Beyond it the schemes lose their accuracy and, past ~3, blow up to NaN (which the kernels
+    count as escape, never as safe: a chart would be all escape, not an answer)."""
+    Om = np.atleast_1d(np.asarray(Omega, dtype=float))
+    w = resolve_well(well)
+    om_min = float(Om.min())
+    h = 2.0 * math.pi / (om_min * steps_per_cycle)
+    fastest = max(w.omega_max, om_min)
+    x = h * fastest
+    if x > STEP_LIMIT:
+        need = math.ceil(2.0 * math.pi * fastest / (om_min * STEP_LIMIT))
+        raise ValueError(
+            f"steps_per_cycle: {steps_per_cycle} steps per forcing cycle at Omega = {om_min:.6g} give a step "
+            f"h = {h:.4g}, and h * {fastest:.4g} = {x:.4g} exceeds {STEP_LIMIT} ({fastest:.4g} = the larger of Omega "
+            f"and the {w.name} well's largest local frequency sqrt(max |V''|) = {w.omega_max:.4g}): the integrator "
+            f"is inaccurate or unstable there; use steps_per_cycle >= {need} (or a larger Omega)")
+    return steps_per_cycle
+
+
 def check_cycles(name, cycles):
     if isinstance(cycles, (float, np.floating)) and float(cycles).is_integer() and cycles >= 1:
         cycles = int(cycles)

@@ -58,7 +58,7 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
     if not xi and not qm and not qb.shape[0]:
         raise ValueError("xi_max, q_max and q_bounds: at least one escape threshold is required")
     engine.displacement_pairs(qm, qb)
-    spc = engine.check_steps_per_cycle(steps_per_cycle)
+    spc = engine.check_step(Omega, engine.check_steps_per_cycle(steps_per_cycle), w)
     threads = engine.check_threads(threads)
     kernels.check_integrator(integrator)
 

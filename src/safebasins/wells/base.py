@@ -251,6 +251,21 @@ class Well(abc.ABC):
         return (lo, hi), (-pm, pm)
 
     @property
+    def omega_max(self) -> float:
+        """The well's largest local frequency ``sqrt(max |V''(q)|)`` over the IC window's q range
+        (:meth:`ic_window`), from central differences of V' on 4001 points: the frequency an
+        integrator step must resolve (numerics.engine.check_step)."""
+        om = self.__dict__.get("_omega_max")
+        if om is None:
+            (lo, hi), _ = self.ic_window()
+            q = np.linspace(lo, hi, 4001)
+            h = 1e-5 * max(1.0, hi - lo)
+            d2 = (np.asarray(self.dV(q + h), float) - np.asarray(self.dV(q - h), float)) / (2.0 * h)
+            om = float(np.sqrt(np.nanmax(np.abs(d2))))
+            self.__dict__["_omega_max"] = om
+        return om
+
+    @property
     def compiled(self):
         """The well's one compiled form (:class:`safebasins.numerics.wellcode.WellCode`: force and
         energy for the CPU and CUDA engines), built on first use and kept."""

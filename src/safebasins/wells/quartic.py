@@ -233,6 +233,11 @@ class QuarticWell(Well):
     def potential_text(self):
         return "q^2/2 - q^4/4"
 
+    @property
+    def omega_max(self):
+        """``sqrt(max |V''|)`` on ``|q| <= 1``: ``V'' = 1 - 3 q^2`` is -2 at the barriers."""
+        return float(np.sqrt(2.0))
+
     def barrier_text(self):
         return "|q| > 1"
 
