@@ -8,14 +8,37 @@ from __future__ import annotations
 import numpy as np
 
 
+#: relative distance below an escape energy within which a value counts as at it: the computed
+#: energy of a numeric well's barrier may lie a few ulps off its exact value (the cubic's 1/6 is
+#: 0.16666666666666669), so 1/6 given as a float would pass a strict ``x < E_b``
+BARRIER_RTOL = 1e-12
+
+
 def as_array(name, value):
-    """``value`` as a float ndarray; ValueError naming ``name`` if not numeric or NaN."""
+    """``value`` as a float ndarray; ValueError naming ``name`` if not numeric, complex or NaN."""
     try:
-        a = np.asarray(value, dtype=float)
+        raw = np.asarray(value)
+        complex_ = np.iscomplexobj(raw)
+        a = None if complex_ else raw.astype(float, copy=False)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{name} must be numeric, got {value!r}") from exc
+    if complex_:    # (a float conversion would drop the imaginary part with only a warning)
+        raise ValueError(f"{name} must be real, got the complex value {value_repr(raw)}")
     if np.isnan(a).any():
         raise ValueError(f"{name} must not contain NaN")
+    return a
+
+
+def reaches(values, level):
+    """Where ``values`` lie at or above ``level`` (an escape energy), counting values within a
+    relative :data:`BARRIER_RTOL` below it as at it."""
+    return np.asarray(values, dtype=float) >= level - BARRIER_RTOL * abs(level)
+
+
+def check_nonempty(name, a):
+    """``a`` (an array) with at least one element."""
+    if np.size(a) == 0:
+        raise ValueError(f"{name} must not be empty")
     return a
 
 
@@ -61,7 +84,7 @@ def check_1d(name, value, check):
     a = np.atleast_1d(check(name, value)).astype(float)
     if a.ndim != 1:
         raise ValueError(f"{name} must be a scalar or a 1-D sequence, got shape {a.shape}")
-    return a
+    return check_nonempty(name, a)
 
 
 def value_repr(a):

@@ -80,7 +80,7 @@ def test_basin_touching_grid_edge_counts_outside_as_unsafe():
 
 
 def test_empty_mask():
-    m = integrity_measures(np.zeros((N, N - 20), bool), Q, P, xi_max=0.2)
+    m = integrity_measures(np.zeros((N, N - 20), bool), Q, P, xi_max=0.2, well="quartic")
     assert m["area"] == 0 and m["r_local"] == 0 and m["r_global"] == 0
     assert m["GIM"] == 0 and m["LIM"] == 0 and m["IF"] == 0
     assert np.isnan(m["if_q0"])
@@ -91,7 +91,7 @@ def test_unforced_normalisation_is_one_and_matches_analytic(xi):
     q = np.linspace(-1, 1, 201)
     p = np.linspace(-0.75, 0.75, 151)
     S0 = unforced_safe_mask(q, p, xi)
-    m = integrity_measures(S0, q, p, xi)
+    m = integrity_measures(S0, q, p, xi, well="quartic")
     assert m["GIM"] == 1 and m["LIM"] == 1 and m["IF"] == 1
     diag = np.hypot(q[1] - q[0], p[1] - p[0])
     # analytic values of the normalisers: r = sqrt(2 xi), area = 2 pi J(xi)
@@ -108,12 +108,12 @@ def test_stack_vectorised_and_normalised_per_threshold():
     xi = np.array([0.1, 0.2, 0.25])
     S0 = unforced_safe_mask(q, q, xi)             # (3, 81, 81)
     stack = np.stack([S0, S0 & (QUARTIC.H0(*np.meshgrid(q, q, indexing="ij")) < 0.05)])  # (2, 3, 81, 81)
-    m = integrity_measures(stack, q, q, xi)
+    m = integrity_measures(stack, q, q, xi, well="quartic")
     assert m["GIM"].shape == (2, 3)
     np.testing.assert_array_equal(m["GIM"][0], 1.0)
     assert (m["GIM"][1] < 1).all() and (np.diff(m["GIM"][1]) < 0).all()
     # each element equals the single-mask computation
-    one = integrity_measures(stack[1, 2], q, q, 0.25)
+    one = integrity_measures(stack[1, 2], q, q, 0.25, well="quartic")
     for k in ("GIM", "LIM", "IF", "area", "r_global"):
         assert m[k][1, 2] == one[k]
 
@@ -128,7 +128,7 @@ def test_xarray_in_dataset_out():
     data = np.stack([S0 & (hh < 0.2 - 4 * f) for f in F])  # shrinking with F
     da = xr.DataArray(data, dims=("F", "xi_max", "q0", "p0"),
                       coords={"F": F, "xi_max": xi, "q0": q, "p0": p})
-    ds = integrity_measures(da)  # xi_max taken from the coordinate
+    ds = integrity_measures(da, well="quartic")  # xi_max taken from the coordinate
     assert isinstance(ds, xr.Dataset)
     assert ds["GIM"].dims == ("F", "xi_max")
     assert ds["GIM"].attrs["units"] == "1" and "long_name" in ds["LIM"].attrs
@@ -136,10 +136,10 @@ def test_xarray_in_dataset_out():
     for k in ("GIM", "LIM", "IF"):
         assert (ds[k].diff("F") <= 0).all()
     # transposed input gives the same numbers
-    ds2 = integrity_measures(da.transpose("p0", "xi_max", "q0", "F"))
+    ds2 = integrity_measures(da.transpose("p0", "xi_max", "q0", "F"), well="quartic")
     xr.testing.assert_allclose(ds["GIM"], ds2["GIM"].transpose("F", "xi_max"))
     # scalar threshold on a DataArray without xi_max coordinate
-    ds3 = integrity_measures(da.isel(xi_max=0, drop=True), xi_max=0.12)
+    ds3 = integrity_measures(da.isel(xi_max=0, drop=True), xi_max=0.12, well="quartic")
     np.testing.assert_allclose(ds3["GIM"].values, ds["GIM"].isel(xi_max=0).values)
 
 
@@ -150,7 +150,7 @@ def test_argument_errors():
     with pytest.raises(ValueError, match="uniform"):
         integrity_measures(np.ones((11, 11), bool), q ** 3, q)
     with pytest.raises(ValueError, match="xi_max"):
-        integrity_measures(np.ones((11, 11), bool), q, q, 0.3)
+        integrity_measures(np.ones((11, 11), bool), q, q, 0.3, well="quartic")
     with pytest.raises(ValueError, match="shape"):
         integrity_measures(np.ones((11, 10), bool), q, q)
 

@@ -30,7 +30,7 @@ def test_numeric_map_is_the_integrity_of_each_chart():
         for j, f in enumerate(FF):
             c = escape_chart(Q, P, f, om, np.pi, xi_max=(0.18,), cycles=60)
             safe = is_safe(c["escape_cycle_energy"].isel(xi_max=0), 60)
-            ref = integrity_measures(safe.values, Q, P, 0.18)
+            ref = integrity_measures(safe.values, Q, P, 0.18, well="quartic")
             for k in ("GIM", "LIM", "IF"):
                 assert m[k].values[i, j, -1] == ref[k], (k, om, f)
     np.testing.assert_allclose(m["GIM"].sel(F=0.0), 1.0)
@@ -41,7 +41,7 @@ def test_analytic_map_per_phase_and_all_phase():
     a = integrity_map_analytic(OM, FF, np.pi, 0.18, Q, P, n_gamma=32, n_xi=16)
     Qm, Pm = np.meshgrid(Q, P, indexing="ij")
     direct = ~slow_flow_escapes(Qm, Pm, 0.02, 0.85, np.pi, 0.18) & QUARTIC.unforced_safe(Qm, Pm, 0.18)
-    assert a["GIM"].sel(Omega=0.85, F=0.02) == integrity_measures(direct, Q, P, 0.18)["GIM"]
+    assert a["GIM"].sel(Omega=0.85, F=0.02) == integrity_measures(direct, Q, P, 0.18, well="quartic")["GIM"]
     np.testing.assert_allclose(a[["GIM", "LIM", "GIM_true", "LIM_true"]].sel(F=0.0).to_array(), 1.0)
     # the basin safe for every phase lies inside the basin of one phase (one pixel of slack)
     assert (a["GIM_true"] <= a["GIM"] + 0.05).all() and (a["LIM_true"] <= a["LIM"] + 0.1).all()

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from safebasins.analysis.safe import CRITERIA, is_safe
+from safebasins.analysis.safe import CRITERIA, check_chart, check_t_eval, is_safe
 
 __all__ = ["iou", "pixel_agreement", "mask_agreement", "criteria_counts", "criteria_table", "chart_agreement"]
 
@@ -19,13 +19,28 @@ def _boolean(name, a):
         raise ValueError(f"{name} must be a boolean mask (True = safe), got dtype {dtype}")
 
 
-def _pair(a, b, dims):
-    _boolean("a", a)
-    _boolean("b", b)
+def _pair(a, b, dims, names=("a", "b")):
+    _boolean(names[0], a)
+    _boolean(names[1], b)
     if isinstance(a, xr.DataArray) or isinstance(b, xr.DataArray):
-        a, b = xr.align(a, b, join="exact")
+        for name, m in zip(names, (a, b)):
+            if not isinstance(m, xr.DataArray):
+                raise ValueError(f"{name} must be a DataArray like the other mask (or give two numpy arrays)")
+            missing = [d for d in dims if d not in m.dims]
+            if missing:
+                raise ValueError(f"{name} has no dimension {missing[0]!r} to reduce over (dims: {m.dims}); name the "
+                                 f"grid dims with dims= (default ('q0', 'p0'))")
+        try:
+            a, b = xr.align(a, b, join="exact")
+        except ValueError as exc:
+            raise ValueError(f"{names[0]} and {names[1]} must share their coordinates ({exc})") from None
         n = int(np.prod([a.sizes[d] for d in dims]))
     else:
+        for name, m in zip(names, (a, b)):
+            nd = np.ndim(m)
+            if any(not isinstance(d, (int, np.integer)) or not -nd <= d < nd for d in dims):
+                raise ValueError(f"{name} with shape {np.shape(m)} has no axes {tuple(dims)} to reduce over (numpy "
+                                 "masks: the (q0, p0) grid is the last two axes)")
         try:
             a, b = np.broadcast_arrays(np.asarray(a), np.asarray(b))
         except ValueError as exc:
@@ -36,13 +51,13 @@ def _pair(a, b, dims):
     return a, b
 
 
-def iou(a, b, dims=("q0", "p0")):
+def iou(a, b, dims=("q0", "p0"), *, names=("a", "b")):
     """Intersection over union ``|A and B| / |A or B|`` of two boolean masks (1 when both are
     empty: perfect agreement).  DataArrays reduce over the named ``dims``; numpy arrays over the
     axes ``dims`` (default: the last two)."""
     if not isinstance(a, xr.DataArray) and not isinstance(b, xr.DataArray) and dims == ("q0", "p0"):
         dims = (-2, -1)
-    a, b = _pair(a, b, dims)
+    a, b = _pair(a, b, dims, names)
     if isinstance(a, xr.DataArray):
         inter = (a & b).sum(dims)
         union = (a | b).sum(dims)
@@ -52,11 +67,11 @@ def iou(a, b, dims=("q0", "p0")):
     return np.where(union > 0, inter / np.maximum(union, 1), 1.0)
 
 
-def pixel_agreement(a, b, dims=("q0", "p0")):
+def pixel_agreement(a, b, dims=("q0", "p0"), *, names=("a", "b")):
     """Fraction of grid points on which two boolean masks agree."""
     if not isinstance(a, xr.DataArray) and not isinstance(b, xr.DataArray) and dims == ("q0", "p0"):
         dims = (-2, -1)
-    a, b = _pair(a, b, dims)
+    a, b = _pair(a, b, dims, names)
     if isinstance(a, xr.DataArray):
         return (a == b).mean(dims).astype(float)
     return (a == b).mean(axis=dims)
@@ -64,7 +79,9 @@ def pixel_agreement(a, b, dims=("q0", "p0")):
 
 def mask_agreement(analytic_safe, numeric_safe, dims=("q0", "p0")):
     """``(iou, pixel_agreement)`` of two boolean safe masks (DataArrays), reduced over ``dims``."""
-    return iou(analytic_safe, numeric_safe, dims), pixel_agreement(analytic_safe, numeric_safe, dims)
+    names = ("analytic_safe", "numeric_safe")
+    return (iou(analytic_safe, numeric_safe, dims, names=names),
+            pixel_agreement(analytic_safe, numeric_safe, dims, names=names))
 
 
 def criteria_counts(chart, t_eval, groups):
@@ -75,8 +92,17 @@ def criteria_counts(chart, t_eval, groups):
     ``(A_E, A_q)``: int64 arrays of length ``groups``, the number of ICs that have not escaped by
     ``t_eval`` under the energy (ESB) and the displacement (DSB) criterion.
     """
+    check_chart(chart)
+    for var, thr in CRITERIA.values():
+        if "sample" not in chart[var].dims:
+            raise ValueError(f"chart must be an escape chart of paired ICs (dim 'sample', numerics.escape_chart "
+                             f"with grid=False), got {var} with dims {chart[var].dims}")
+        if chart.sizes.get(thr, 0) < 1:
+            raise ValueError(f"chart has no {thr} threshold: criteria counts need one xi_max and one q_max")
+    if check_t_eval(t_eval, chart.attrs.get("cycles")).ndim:
+        raise ValueError(f"t_eval must be one evaluation time here, got {t_eval!r}")
     n = chart.sizes["sample"]
-    if groups < 1 or n % groups:
+    if isinstance(groups, bool) or not isinstance(groups, (int, np.integer)) or groups < 1 or n % groups:
         raise ValueError(f"groups must divide the {n} samples into equal repetitions, got {groups}")
     out = []
     for crit in ("energy", "displacement"):

@@ -58,8 +58,8 @@ def analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier=None, well
     F = as_1d("F_values", F_values, checks.check_nonnegative)
     fl, wl, scalar = well_variants(well, fourier)
     xi = as_1d("xi_max", xi_max, wl[0].check_threshold)
-    Omega = float(checks.check_positive("Omega", Omega))
-    Psi = float(checks.check_finite("Psi", Psi))
+    Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
+    Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
     q, p, Q, P = mesh(q0, p0)
     S0 = unforced_safe_mask(q, p, xi, wl[0])
     out = np.zeros((len(fl), F.size, xi.size, q.size, p.size), dtype=bool)
@@ -168,6 +168,8 @@ def erosion_profile_numeric(F_values, Omega, Psi, xi_max, q0, p0, t_eval=None, c
     F = as_1d("F_values", F_values, checks.check_nonnegative)
     xi = as_1d("xi_max", xi_max, resolve_well(well).check_threshold)
     checks.check_positive_int("cycles", cycles)
+    checks.check_scalar("Omega", Omega, checks.check_positive)
+    checks.check_scalar("Psi", Psi, checks.check_finite)
     q, p, _, _ = mesh(q0, p0)
     charts = []
     for Fi in F:
@@ -188,9 +190,18 @@ def level_crossing(profile, level=0.5, dim="F"):
     starts below.  Vectorised over all other dims.
     """
     if isinstance(profile, xr.Dataset):
+        if not any(k in profile for k in ("GIM", "LIM", "IF")):
+            raise ValueError(f"profile has none of GIM, LIM, IF (variables: {sorted(map(str, profile.data_vars))})")
         out = xr.Dataset({k: level_crossing(profile[k], level, dim) for k in ("GIM", "LIM", "IF")
                           if k in profile})
         return out.assign_attrs(level=float(level), dim=dim)
+    if not isinstance(profile, xr.DataArray):
+        raise ValueError(f"profile must be a DataArray or Dataset of measures over {dim!r}, got {type(profile).__name__}")
+    if dim not in profile.dims:
+        raise ValueError(f"dim {dim!r} is not a dimension of the profile (dims: {profile.dims})")
+    if profile.sizes[dim] == 0:
+        raise ValueError(f"the profile is empty along dim {dim!r}")
+    checks.check_scalar("level", level, checks.check_finite)
     x = profile[dim].values.astype(float)
     if x.size > 1 and (np.diff(x) <= 0).any():
         raise ValueError(f"{dim} must be increasing along the profile")

@@ -212,8 +212,8 @@ def iou_fourier_comparison(chart, t_eval=None, *, criterion="energy"):
     ds["iou"].attrs.update(units="1", long_name="IoU of analytic and numeric safe basins")
     ds["pixel_agreement"] = pixel_agreement(an_da, num).transpose("fourier", *stack_dims, "xi_max", "t_eval")
     ds["pixel_agreement"].attrs.update(units="1", long_name="fraction of agreeing nodes")
-    ds["GIM_analytic"] = integrity_measures(an_da)["GIM"]
-    ds["GIM_numeric"] = integrity_measures(num)["GIM"].transpose(*stack_dims, "xi_max", "t_eval")
+    ds["GIM_analytic"] = integrity_measures(an_da, well=QUARTIC)["GIM"]
+    ds["GIM_numeric"] = integrity_measures(num, well=QUARTIC)["GIM"].transpose(*stack_dims, "xi_max", "t_eval")
     ds["mean_iou"] = ds["iou"].mean([d for d in ds["iou"].dims if d != "fourier"]).assign_attrs(
         units="1", long_name="mean IoU over charts, thresholds and t_eval")
     ds.attrs.update({k: v for k, v in chart.attrs.items() if k in ("F", "Omega", "Psi", "cycles")})

@@ -18,7 +18,8 @@ IF
 Normalisation
 -------------
 Each measure is divided by its value for the *unforced* safe set of the well
-(``well.unforced_safe``; None: the paper's quartic)
+(``well.unforced_safe``; :func:`integrity_measures` needs ``well=`` for it unless the mask's
+attributes name the well: a mask alone does not tell which well it is a basin of)
 
     S0(xi_max) = {H0(q0, p0) < xi_max,  q_minus(xi_max) < q0 < q_plus(xi_max)}   (eqs 4, 7)
 
@@ -76,7 +77,7 @@ import xarray as xr
 from scipy import ndimage
 
 from safebasins import checks
-from safebasins.wells import resolve_well
+from safebasins.wells import from_attrs, resolve_well, well_attrs
 
 __all__ = [
     "unforced_safe_mask",
@@ -224,6 +225,11 @@ def _measures_numpy(safe, q0, p0, xi_max, bottom, well=None):
     out = {k: v.reshape(lead) for k, v in raw.items()}
 
     if xi_max is not None:
+        if well is None:
+            raise ValueError("well is required to normalise GIM, LIM and IF: the unforced safe set S0(xi_max) "
+                             "depends on the well, and the mask does not name one (a DataArray may carry its "
+                             "well in the attributes 'well', ...). Pass well='quartic' for the paper's well, or "
+                             "well=safebasins.analysis.safe.chart_well(chart) for an escape chart's")
         xi = resolve_well(well).check_threshold("xi_max", xi_max)
         try:
             xi_b = np.broadcast_to(xi, lead)
@@ -255,8 +261,12 @@ def integrity_measures(safe, q0=None, p0=None, xi_max=None, *, bottom=(0.0, 0.0)
         DataArray it defaults to its ``xi_max`` coordinate (a dimension or a scalar
         coordinate).  ``None`` with numpy input: only the raw measures are returned.
     bottom : the well bottom (centre of the LIM disk), default ``(0, 0)``.
-    well : the potential well of the normalising unforced set (safebasins.wells; None: the
-        paper's quartic).
+    well : the potential well of the normalising unforced set (any form of safebasins.wells:
+        ``"quartic"`` for the paper's well).  Required whenever the measures are normalised
+        (``xi_max`` given or a coordinate) unless ``safe`` is a DataArray whose attributes name
+        its well (``well``, ``well_coefficients``, ...: :func:`safebasins.wells.spec_attrs`); a
+        mask carries no trace of its well, and the quartic's S0 would silently misnormalise the
+        basin of another well (for a chart: ``safebasins.analysis.safe.chart_well(chart)``).
 
     Returns
     -------
@@ -273,10 +283,25 @@ def integrity_measures(safe, q0=None, p0=None, xi_max=None, *, bottom=(0.0, 0.0)
     return _measures_numpy(safe, q0, p0, xi_max, bottom, well)
 
 
+def _mask_well(safe, well):
+    """``well``, or the well the mask's attributes name (``wells.spec_attrs``); ValueError naming
+    ``well`` when both are given and differ."""
+    if "well" not in safe.attrs:
+        return well
+    if well is None:
+        return from_attrs(safe.attrs)
+    given = well_attrs(resolve_well(well))["well"]
+    if given != safe.attrs["well"]:
+        raise ValueError(f"well: the mask names the {safe.attrs['well']} well (attribute 'well'), not the {given} "
+                         "well given")
+    return well
+
+
 def _measures_xarray(safe, q0, p0, xi_max, bottom, well):
     for d in ("q0", "p0"):
         if d not in safe.dims:
             raise ValueError(f"safe must have dims (..., 'q0', 'p0'), got {safe.dims}")
+    well = _mask_well(safe, well)
     safe = safe.transpose(..., "q0", "p0")
     q = safe["q0"].values if q0 is None else q0
     p = safe["p0"].values if p0 is None else p0

@@ -95,6 +95,8 @@ def integrity_map_numeric(Omega, F, Psi, xi_max, q0, p0, *, cycles=1000, t_eval=
     """Numeric integrity map over (Omega, F, t_eval): one escape chart per control point (all
     control points in one ensemble), safe = escape_cycle > t_eval."""
     Om, Fv = _control(Omega, F)
+    checks.check_scalar("Psi", Psi, checks.check_finite)
+    checks.check_scalar("xi_max", xi_max, checks.check_positive)
     OO, FF = np.meshgrid(Om, Fv, indexing="ij")
     charts = escape_chart_batch(q0, p0, FF.ravel(), OO.ravel(), Psi, xi_max=(float(xi_max),), cycles=cycles,
                                 well=well, **chart_kwargs)

@@ -14,7 +14,7 @@ import xarray as xr
 from safebasins import checks
 from safebasins.io import cf
 
-__all__ = ["is_safe", "check_t_eval", "safe_mask", "safe_area", "safe_stack", "escape_variable", "chart_well",
+__all__ = ["is_safe", "check_t_eval", "check_chart", "safe_mask", "safe_area", "safe_stack", "escape_variable", "chart_well",
            "displacement_energy", "q_max_energy"]
 
 #: escape-time variable and threshold dimension of each criterion
@@ -36,10 +36,24 @@ def escape_variable(chart, criterion):
     if criterion not in known:
         raise ValueError(f"criterion must be one of {sorted(known)}, got {criterion!r}")
     var, thr = known[criterion]
+    check_chart(chart, variables=())
     if var not in chart:
         raise ValueError(f"criterion {criterion!r}: the chart has no {var!r} (make it with the thresholds "
                          f"{thr!r} of numerics.escape_chart)")
     return chart[var], thr
+
+
+def check_chart(chart, name="chart", variables=tuple(v for v, _ in CRITERIA.values())):
+    """``chart`` is an escape chart Dataset (numerics.escape_chart) with ``variables``; ValueError
+    naming ``name`` otherwise."""
+    if not isinstance(chart, xr.Dataset):
+        raise ValueError(f"{name} must be an escape chart (an xarray Dataset from numerics.escape_chart), "
+                         f"got {type(chart).__name__}")
+    missing = [v for v in variables if v not in chart]
+    if missing:
+        raise ValueError(f"{name} is not an escape chart: it has no {', '.join(map(repr, missing))} (variables: "
+                         f"{sorted(map(str, chart.data_vars)) or 'none'}); make it with numerics.escape_chart")
+    return chart
 
 
 def chart_well(chart):
@@ -90,7 +104,7 @@ def q_max_energy(well, q_max):
 
 def check_t_eval(t_eval, cycles):
     """Validated evaluation times (scalar or 1-D, forcing cycles), each <= the horizon ``cycles``."""
-    t = checks.check_nonnegative("t_eval", t_eval)
+    t = checks.check_nonempty("t_eval", checks.check_nonnegative("t_eval", t_eval))
     if t.ndim > 1:
         raise ValueError(f"t_eval must be a scalar or 1-D, got shape {t.shape}")
     if cycles is not None and (t > float(cycles) * (1 + 1e-12)).any():
@@ -109,7 +123,7 @@ def safe_mask(chart, t_eval):
     Returns a Dataset with bool ``safe_energy`` (xi_max, ...) and ``safe_displacement``
     (q_max, ...).  A 1-D t_eval adds a leading dim ``t_eval``; a scalar gives a scalar coordinate.
     """
-    t = check_t_eval(t_eval, chart.attrs.get("cycles"))
+    t = check_t_eval(t_eval, check_chart(chart).attrs.get("cycles"))
     tda = _t_eval_array(t)
     out = xr.Dataset({f"safe_{c}": is_safe(chart[CRITERIA[c][0]], tda) for c in CRITERIA})
     out = out.assign_coords(t_eval=tda)
@@ -174,6 +188,9 @@ def safe_stack(chart, t_eval=None, criterion="energy"):
     S0(V(q_max))).
     """
     esc, thr = escape_variable(chart, criterion)
+    if not {"q0", "p0"} <= set(esc.dims):
+        raise ValueError(f"chart must be an escape chart on a (q0, p0) grid (integrity needs a grid), got dims "
+                         f"{esc.dims}")
     cycles = chart.attrs.get("cycles")
     t = np.atleast_1d(check_t_eval(float(cycles) if t_eval is None else t_eval, cycles)).astype(float)
     tda = xr.DataArray(t, dims="t_eval", coords={"t_eval": t},

@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import functools
 
+import numpy as np
+
 from safebasins.wells.base import Well
 from safebasins.wells.quartic import FOURIER_VARIANTS, QUARTIC, QuarticWell
 # (bound here, after the submodule import, so the package attribute is the function)
@@ -146,11 +148,19 @@ def well_attrs(well: Well) -> dict:
 
 def from_attrs(attrs) -> Well:
     """The well a dataset was made with (its :func:`spec_attrs` attributes)."""
+    if not hasattr(attrs, "get"):
+        raise ValueError(f"attrs must be a dataset's attributes (a mapping), got {type(attrs).__name__}")
     if "well" not in attrs:
         raise ValueError("the dataset names no well (attribute 'well'): pass well= explicitly")
     name = attrs["well"]
+    if not isinstance(name, str):
+        raise ValueError(f"the dataset's attribute 'well' must be a well's name, got {name!r}: pass well= explicitly")
+    needs = {"polynomial": "well_coefficients", "expression": "well_expression"}.get(name)
+    if needs is not None and needs not in attrs:
+        raise ValueError(f"the dataset's well is {name!r} but it lacks the attribute {needs!r} that defines it: "
+                         "pass well= explicitly")
     if name == "polynomial":
-        return from_spec({"polynomial": [float(c) for c in attrs["well_coefficients"]]})
+        return from_spec({"polynomial": [float(c) for c in np.atleast_1d(attrs["well_coefficients"])]})
     if name == "expression":
         return from_spec({"expression": str(attrs["well_expression"])})
     if name not in NAMED_WELLS:

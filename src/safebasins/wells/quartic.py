@@ -261,11 +261,15 @@ class QuarticWell(Well):
         return _H0(q, p)
 
     def q_max(self, xi_max):
-        """Displacement threshold of an energy threshold, eq (4) (``xi_max`` in (0, 1/4])."""
+        """Displacement threshold of an energy threshold, eq (4) (``xi_max`` in (0, 1/4]: else
+        ValueError naming it)."""
+        self.check_threshold("xi_max", xi_max)
         return _q_max(xi_max)
 
     def xi_from_q_max(self, q_max):
-        """Energy ``V(q_max)`` equivalent to a displacement threshold ``q_max`` in (0, 1]."""
+        """Energy ``V(q_max)`` equivalent to a displacement threshold ``q_max`` in (0, 1] (else
+        ValueError naming it)."""
+        self.check_displacement("q_max", q_max)
         return _V(q_max)
 
     def turning_points(self, E):
