@@ -257,7 +257,7 @@ def energy_error(integrator, S, cycles):
                 if integrator == "rk4":
                     q[j], p[j] = kernels.rk4_step(q[j], p[j], c[0], c[1], c[2], 0.0, 0.0, 0.0)
                 else:
-                    q[j], p[j] = kernels.bm6_step(q[j], p[j], *c, *np.zeros(7))
+                    q[j], p[j] = kernels.bm6_step(q[j], p[j], *c[:7], *np.zeros(7))
     return float(np.abs(worst).max()), float(worst[np.argmax(np.abs(worst))])
 
 

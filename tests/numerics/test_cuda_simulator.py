@@ -12,7 +12,7 @@ trajectory reaches exactly, where a one-ulp difference in the state would move t
 step (this is what catches a multiply-add rounded twice).  Other wells: the cubic (kernel flag
 code: Horner from run-time coefficients, one barrier) with asymmetric displacement bounds, the
 quartic with asymmetric bounds (signed tracking), several parameter sets, and a rational well
-written as an expression (generated V, dV).  Subprocess: ~10-15 s.
+written as an expression (generated V, dV); the damped schemes (beta = 0.1, three parameter sets).  Subprocess: ~10-15 s.
 """
 from __future__ import annotations
 
@@ -58,7 +58,7 @@ def _knife_edges(integrator, ics, Omega, F, Psi, S, n_steps, per_ic=2):
             if integrator == "rk4":
                 q, p = kernels.rk4_step(q, p, c[0], c[1], c[2], row[0], row[1], row[2])
             else:
-                q, p = kernels.bm6_step(q, p, *c, *row)
+                q, p = kernels.bm6_step(q, p, *c[:7], *row)
             e = kernels.energy2(q, p)
             if e > emax and abs(q) <= 1.0:
                 emax = e
@@ -99,6 +99,11 @@ def _cases():
             args=[Qc.tolist(), Pc.tolist(), (np.arange(Q.size) % 2).tolist(), [0.85, 0.9], [0.02, 0.03], 0.3],
             kw=dict(xi_max=[0.12, 1.0 / 6.0], q_bounds=[[-0.43, 0.65], [-math.inf, 0.9]], cycles=20,
                     steps_per_cycle=16, integrator=integrator),
+            well=CUBIC)
+        yield f"{integrator}/damped", dict(     # several parameter sets: the per-lane coefficient columns
+            args=[Qc.tolist(), Pc.tolist(), (np.arange(Q.size) % 3).tolist(), [0.85, 0.9, 0.8], [0.05, 0.06, 0.04], 0.3],
+            kw=dict(xi_max=[0.12, 1.0 / 6.0], q_bounds=[[-0.43, 0.65]], cycles=25, steps_per_cycle=16,
+                    integrator=integrator, damping=0.1),
             well=CUBIC)
         yield f"{integrator}/expression", dict(
             args=[(0.9 * Q).tolist(), (0.9 * P).tolist(), zero, [0.8], [0.05], 1.0],

@@ -65,7 +65,7 @@ def _steps_one_by_one(q, p, F, Om, Psi, S, n_steps):
     out[0] = q, p
     for n in range(n_steps):
         f = tab[n % S]
-        q, p = kernels.bm6_step(q, p, *c, *f)
+        q, p = kernels.bm6_step(q, p, *c[:7], *f)
         out[n + 1] = q, p
     return out
 

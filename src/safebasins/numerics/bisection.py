@@ -13,19 +13,19 @@ from safebasins.numerics import kernels
 DEFAULT_N_SCAN = 301
 
 
-def _escapes(q0, p0, Omega, F, Psi, thr_kw, cycles, spc, threads, integrator, backend, w):
+def _escapes(q0, p0, Omega, F, Psi, thr_kw, cycles, spc, threads, integrator, backend, w, damping):
     """One compiled ensemble: trajectory k with (Omega[k], F[k]); True where it escapes."""
     n = Omega.size
     sE, sQ = engine.integrate(np.full(n, q0), np.full(n, p0), np.arange(n), Omega, F, Psi, cycles=cycles,
                               steps_per_cycle=spc, threads=threads, stop_any=True, integrator=integrator,
-                              backend=backend, well=w, **thr_kw)
+                              backend=backend, well=w, damping=damping, **thr_kw)
     return ((sE >= 0).any(axis=1)) | ((sQ >= 0).any(axis=1))
 
 
 def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3000, tol=5e-5,
                              F_bracket=(0.0, 0.3), criterion="energy", n_scan=DEFAULT_N_SCAN,
                              steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None,
-                             integrator=engine.DEFAULT_INTEGRATOR, backend="cpu", well=None):
+                             integrator=engine.DEFAULT_INTEGRATOR, backend="cpu", well=None, damping=0.0):
     """Numeric escape threshold F_cr(Omega) for the IC (q0, p0) (Section 3.1, Figs 10-12).
 
     Bisection: all Omega points advance together, one compiled ensemble per bisection level,
@@ -39,7 +39,8 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     equally spaced F in F_bracket (one ensemble, Omega x F) also gives F_escape_low (lowest
     escaping F), F_escape_all (lowest F above which every scanned F escapes) and non_monotone
     (F_escape_all - F_escape_low > tol).  n_scan=0 skips the scan (variables NaN / False).
-    integrator: "srkn6b" (default) or "rk4"; backend: "cpu", "cuda" or "auto" (see escape_chart).
+    integrator: "srkn6b" (default) or "rk4"; backend: "cpu", "cuda" or "auto"; damping: beta >= 0 of
+    q'' + beta q' + V'(q) = F sin(...) (see escape_chart).
 
     Returns xr.Dataset over Omega: F_cr, F_cr_low, F_cr_high (final bracket), F_escape_low,
     F_escape_all, non_monotone; attrs xi_max, q0, p0, Psi, cycles, tol, criterion, F_bracket,
@@ -56,6 +57,7 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     q0 = checks.check_scalar("q0", q0, checks.check_finite)
     p0 = checks.check_scalar("p0", p0, checks.check_finite)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
+    damping = engine.check_damping(damping)
     cycles = engine.check_cycles("cycles", cycles)
     tol = checks.check_scalar("tol", tol, checks.check_positive)
     br = checks.check_nonnegative("F_bracket", F_bracket)
@@ -83,7 +85,7 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     nO = Om.size
     # ---- bracket ends (one ensemble)
     ends = _escapes(q0, p0, np.concatenate([Om, Om]), np.concatenate([np.full(nO, br[0]), np.full(nO, br[1])]),
-                    Psi, thr_kw, cycles, spc, threads, integrator, backend, w)
+                    Psi, thr_kw, cycles, spc, threads, integrator, backend, w, damping)
     valid = ~ends[:nO] & ends[nO:]
     lo = np.full(nO, br[0])
     hi = np.full(nO, br[1])
@@ -92,7 +94,7 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     while active.any():
         idx = np.flatnonzero(active)
         mid = 0.5 * (lo[idx] + hi[idx])
-        esc = _escapes(q0, p0, Om[idx], mid, Psi, thr_kw, cycles, spc, threads, integrator, backend, w)
+        esc = _escapes(q0, p0, Om[idx], mid, Psi, thr_kw, cycles, spc, threads, integrator, backend, w, damping)
         hi[idx[esc]] = mid[esc]
         lo[idx[~esc]] = mid[~esc]
         levels += 1
@@ -109,7 +111,7 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
         Fs = np.linspace(br[0], br[1], int(n_scan))
         OO, FF = np.meshgrid(Om, Fs, indexing="ij")
         esc = _escapes(q0, p0, OO.ravel(), FF.ravel(), Psi, thr_kw, cycles, spc, threads, integrator, backend,
-                       w).reshape(nO, Fs.size)
+                       w, damping).reshape(nO, Fs.size)
         for k in range(nO):
             e = esc[k]
             if e.any():
@@ -132,10 +134,10 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
         coords={"Omega": ("Omega", Om, {**u, "long_name": "forcing frequency"})},
     )
     ds.attrs.update(xi_max=xi, q0=q0, p0=p0, Psi=Psi, cycles=cycles, tol=tol, criterion=criterion,
-                    F_bracket=br, n_scan=int(n_scan), steps_per_cycle=spc, integrator=kernels.INTEGRATORS[integrator],
+                    F_bracket=br, n_scan=int(n_scan), steps_per_cycle=spc, integrator=engine.integrator_text(integrator, damping),
                     bisection_levels=levels,
                     F_scan_step=float((br[1] - br[0]) / (n_scan - 1)) if n_scan else np.nan,
                     escape_criteria=(f"energy ({w.energy_criterion()})" if criterion == "energy" else
                                      "displacement: q < q_lower or q > q_upper, the turning points of xi_max"),
-                    **bounds, **w.numerics_attrs())
+                    **bounds, **w.numerics_attrs(), **engine.damping_attrs(damping))
     return ds

@@ -47,7 +47,7 @@ def _thresholds(w, xi_max, q_max, q_bounds):
 
 def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=(), well=None, cycles=3000,
                  steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None, grid=None,
-                 integrator=engine.DEFAULT_INTEGRATOR, backend="cpu"):
+                 integrator=engine.DEFAULT_INTEGRATOR, backend="cpu", damping=0.0):
     """Escape time (forcing cycles) of every initial condition, for every threshold.
 
     Parameters
@@ -58,7 +58,11 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=()
         strictly monotonic arrays are axes (a grid), anything else is paired.  Random ICs are
         therefore paired automatically; pass grid=False for paired ICs that happen to be sorted
         (e.g. points on a line) and grid=True/False explicitly in library code.
-    F, Omega, Psi : forcing amplitude (>= 0), frequency (> 0), phase of q'' + V'(q) = F sin(Omega t + Psi).
+    F, Omega, Psi : forcing amplitude (>= 0), frequency (> 0), phase of
+        q'' + beta q' + V'(q) = F sin(Omega t + Psi).
+    damping : beta >= 0 (default 0: the paper's undamped equation, results bitwise as before
+        damping existed); > 0 integrates with the scheme's damped variant (SRKN6b: conformal
+        symplectic, order 4; steps.DAMPED_INTEGRATORS) and records ``damping`` in the attributes.
     well : the potential (None: the paper's quartic V = q^2/2 - q^4/4, eq 1); a polynomial well
         (an object with `coefficients`, e.g. safebasins.wells.polynomial.cubic()) runs in the
         same compiled engine (numerics.criteria).  Dataset attrs `well`, `well_potential`,
@@ -96,6 +100,7 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=()
     F = checks.check_scalar("F", F, checks.check_nonnegative)
     Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
+    damping = engine.check_damping(damping)
     w = resolve_well(well)
     xi, qm, qb = _thresholds(w, xi_max, q_max, q_bounds)
     cycles = engine.check_cycles("cycles", cycles)
@@ -105,7 +110,7 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=()
 
     sE, sQ = engine.integrate(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
                               q_bounds=qb, cycles=cycles, steps_per_cycle=spc, threads=threads, integrator=integrator,
-                              backend=backend, well=w)
+                              backend=backend, well=w, damping=damping)
     tE = engine.steps_to_cycles(sE, spc).T   # (nE, N)
     tQ = engine.steps_to_cycles(sQ, spc).T   # (nQ + nB, N)
     if is_grid:
@@ -128,9 +133,9 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=()
                                        cf.attrs("escape_cycle_bounds"))
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(
-        F=F, Omega=Omega, Psi=Psi, cycles=cycles, steps_per_cycle=spc, integrator=kernels.INTEGRATORS[integrator],
+        F=F, Omega=Omega, Psi=Psi, cycles=cycles, steps_per_cycle=spc, integrator=engine.integrator_text(integrator, damping),
         grid=int(is_grid), escape_criteria=criteria.criteria_text(w),
-        safe_basin="escape_cycle > t_eval (t_eval <= cycles)", **w.numerics_attrs(),
+        safe_basin="escape_cycle > t_eval (t_eval <= cycles)", **w.numerics_attrs(), **engine.damping_attrs(damping),
     )
     return ds
 
@@ -143,7 +148,7 @@ def _bounds_coords(qb):
 
 def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=(), well=None, cycles=3000,
                        steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None,
-                       integrator=engine.DEFAULT_INTEGRATOR, backend="cpu"):
+                       integrator=engine.DEFAULT_INTEGRATOR, backend="cpu", damping=0.0):
     """Escape charts of one IC grid for several control points ``(F[k], Omega[k])`` in ONE ensemble.
 
     Every trajectory carries its control point (the lanes refill across charts, so a control
@@ -160,6 +165,7 @@ def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bou
     if F.size != Omega.size or F.size == 0:
         raise ValueError(f"F and Omega must be 1-D of the same non-zero length, got {F.size} and {Omega.size}")
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
+    damping = engine.check_damping(damping)
     w = resolve_well(well)
     xi, qm, qb = _thresholds(w, xi_max, q_max, q_bounds)
     cycles = engine.check_cycles("cycles", cycles)
@@ -169,7 +175,7 @@ def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bou
     K, n = F.size, Q.size
     sE, sQ = engine.integrate(np.tile(Q, K), np.tile(P, K), np.repeat(np.arange(K), n), Omega, F, Psi,
                               xi_max=xi, q_max=qm, q_bounds=qb, cycles=cycles, steps_per_cycle=spc, threads=threads,
-                              integrator=integrator, backend=backend, well=w)
+                              integrator=integrator, backend=backend, well=w, damping=damping)
     shape = (K, qa.size, pa.size)
     nQ, nB = qm.size, qb.shape[0]
     tE = np.moveaxis(engine.steps_to_cycles(sE, spc).reshape(shape + (xi.size,)), -1, 1)
@@ -185,7 +191,7 @@ def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bou
         coords.update(_bounds_coords(qb))
         data["escape_cycle_bounds"] = (("control", "q_bounds", "q0", "p0"), tQ[:, nQ:], cf.attrs("escape_cycle_bounds"))
     ds = xr.Dataset(data, coords=coords)
-    ds.attrs.update(Psi=Psi, cycles=cycles, steps_per_cycle=spc, integrator=kernels.INTEGRATORS[integrator],
+    ds.attrs.update(Psi=Psi, cycles=cycles, steps_per_cycle=spc, integrator=engine.integrator_text(integrator, damping),
                     escape_criteria=criteria.criteria_text(w), safe_basin="escape_cycle > t_eval (t_eval <= cycles)",
-                    **w.numerics_attrs())
+                    **w.numerics_attrs(), **engine.damping_attrs(damping))
     return ds

@@ -73,7 +73,8 @@ def launch_grid(kernel, n, block, smem):
 
 
 def run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bounds=(), cycles, steps_per_cycle,
-                      stop_any=False, integrator="srkn6b", well=None, block=None, grid=None, timing=None):
+                      stop_any=False, integrator="srkn6b", well=None, damping=0.0, block=None, grid=None,
+                      timing=None):
     """Integrate trajectories i from (q0[i], p0[i]) with Omega[pidx[i]], F[pidx[i]] on the GPU.
 
     Returns (steps_E (N, nE), steps_Q (N, nQ)): int64 step of first crossing of each threshold,
@@ -82,7 +83,7 @@ def run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bou
     then the q_bounds pairs (nested: engine.displacement_pairs).  A trajectory stops once every
     threshold is crossed (stop_any: once any is).  integrator: "srkn6b" (default) or "rk4";
     well: any form safebasins.wells.resolve_well reads (None: the quartic), its compiled form as
-    on the CPU.
+    on the CPU; damping: beta >= 0, the scheme's damped variant for beta > 0 (as on the CPU).
 
     block, grid: threads per block (default 128, simulator 32) and blocks (default: as many as
     stay resident; the simulator: 2); results do not depend on them.  timing: a dict to receive
@@ -115,7 +116,7 @@ def run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bou
     outQ = np.full((N, nQ), -1, dtype=np.int64)
     if N:
         # the host forms every product the CPU forms outside an fma (cuda_kernels docstring)
-        coef = np.ascontiguousarray(kernels.lane_coefficients(Omega, S, integrator)).ravel()
+        coef = np.ascontiguousarray(kernels.lane_coefficients(Omega, S, integrator, damping)).ravel()
         sintab = kernels.sine_table(S, Psi, integrator)
         FS = np.ascontiguousarray(F[:, None, None] * sintab[None, :, :]).ravel()
         thrE2 = np.zeros(max(nE, 1))
@@ -128,7 +129,7 @@ def run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bou
         shared = FS.nbytes <= cuda_kernels.SHARED_TABLE_BYTES
         smem = FS.nbytes if shared else 0
         warp = SIMULATOR_WARP if cuda_kernels.SIMULATOR else cuda_kernels.WARP
-        kernel = cuda_kernels.ensemble_kernel(integrator, shared, blk, math.gcd(blk, warp), code)
+        kernel = cuda_kernels.ensemble_kernel(integrator, shared, blk, math.gcd(blk, warp), code, damping > 0)
         nblk = int(grid) if grid is not None else launch_grid(kernel, N, blk, smem)
 
         d_outE = cuda.to_device(np.full(max(N * nE, 1), -1, dtype=np.int64))

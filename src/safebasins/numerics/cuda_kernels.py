@@ -67,7 +67,7 @@ Kernel organisation (one thread = one trajectory at a time)
 * Forcing table in shared memory when it fits (one parameter set: S * 7 doubles); many
   parameter sets (bisection) read it from global memory (cached).
 * The well is the kernel factory's compiled well (wellcode.WellCode): its force -V'(q) + f and
-  energy 2 H0 compiled from the one source (make_well, the coefficients w loaded from `wpar`
+  energy 2 H0 compiled from the one source (make_step, the coefficients w loaded from `wpar`
   once per thread) and its escape tests (make_criteria): |q| tracking compares |q| with the
   q_max thresholds and the barrier, signed tracking compares q with the bound pairs (lo, hi)
   and the barriers (q_left, q_right), as kernels._check_state.
@@ -82,7 +82,7 @@ from numba import cuda, float64, int32, int64, uint64
 from numba.cuda.core import config as cuda_config
 
 from safebasins.numerics import kernels
-from safebasins.numerics import wellcode
+from safebasins.numerics import steps, wellcode
 
 SIMULATOR = bool(cuda_config.ENABLE_CUDASIM)
 WIDTHS = {"srkn6b": 7, "rk4": 3}     # forcing values per step (the scheme of a table)
@@ -92,7 +92,7 @@ WARP = 32
 # select and add per load, five 64-bit integer instructions on each of the 7 loads of a step,
 # which made the step issue-bound); unsigned + unsigned stays unsigned (unsigned + signed would
 # be float64 in numba's typing)
-U1, U2, U3, U4, U5, U6 = (np.uint64(j) for j in range(1, 7))
+U1, U2, U3, U4, U5, U6, U7, U8, U9 = (np.uint64(j) for j in range(1, 10))
 # forcing tables up to this size go to shared memory (48 KiB needs no opt-in; leave room for
 # the compaction buffers and for several blocks per SM)
 SHARED_TABLE_BYTES = 16 * 1024
@@ -120,66 +120,35 @@ if not SIMULATOR:
 fma = wellcode.fma
 
 
-# ------------------------------------------------------------------------------- the well
-def make_well(code):
-    """(force(q, f, w), energy2(q, p, w)) device functions of a compiled well (wellcode.WellCode):
-    its one source compiled for the GPU, w = the 14 coefficients of wpar (steps.wtuple)."""
-    force_w, energy_w = code.make(_device)
+# ------------------------------------------------------------------------------- the well and the scheme
+def make_step(code, scheme):
+    """(step, energy2) device functions of a compiled well (wellcode.WellCode) and a scheme flag
+    (steps.SRKN6B, RK4, SRKN6B_DAMPED, RK4_DAMPED): the well's one source and the schemes' one
+    source (steps.scheme_steps), compiled for the GPU.
 
-    @_device
-    def force(q, f, w):
-        return force_w(w, q, f)
+    step(q, p, c1, ..., c10, tab, o, w) -> (q, p) reads the forcing values tab[o], tab[o+1], ...
+    (already multiplied by F; o unsigned) and calls the scheme's step with them; c1..c10 as
+    kernels.lane_coefficients, w the well's 14 coefficients (steps.wtuple).
+    energy2(q, p, w) = 2 H0 of the well."""
+    force, energy_w = code.make(_device)
+    inner = _device(steps.scheme_steps(force)[scheme])
+
+    if scheme in (steps.SRKN6B, steps.SRKN6B_DAMPED):
+        @_device
+        def step(q, p, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, tab, o, w):
+            return inner(w, q, p, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, tab[o], tab[o + U1], tab[o + U2],
+                         tab[o + U3], tab[o + U4], tab[o + U5], tab[o + U6])
+    else:
+        @_device
+        def step(q, p, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, tab, o, w):
+            return inner(w, q, p, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, tab[o], tab[o + U1], tab[o + U2],
+                         0.0, 0.0, 0.0, 0.0)
 
     @_device
     def energy2w(q, p, w):
         return energy_w(w, q, p)
 
-    return force, energy2w
-
-
-# ------------------------------------------------------------------------------- schemes
-def make_steps(force):
-    """Device steps for a force(q, f, w) (make_well): (bm6_step, rk4_step), each
-    step(q, p, c1, ..., c7, tab, o, w) -> (q, p) with the forcing values tab[o], tab[o+1], ...
-    (already multiplied by F; o unsigned), c1..c7 as kernels.lane_coefficients and w the well's
-    coefficients.  Same operations in the same order as steps.well_bm6_step / well_rk4_step."""
-    @_device
-    def bm6_step(q, p, a1, a2, a3, b1, b2, b3, b4, tab, o, w):
-        p = fma(b1, force(q, tab[o], w), p)
-        q = fma(a1, p, q)
-        p = fma(b2, force(q, tab[o + U1], w), p)
-        q = fma(a2, p, q)
-        p = fma(b3, force(q, tab[o + U2], w), p)
-        q = fma(a3, p, q)
-        p = fma(b4, force(q, tab[o + U3], w), p)
-        q = fma(a3, p, q)
-        p = fma(b3, force(q, tab[o + U4], w), p)
-        q = fma(a2, p, q)
-        p = fma(b2, force(q, tab[o + U5], w), p)
-        q = fma(a1, p, q)
-        p = fma(b1, force(q, tab[o + U6], w), p)
-        return q, p
-
-    @_device
-    def rk4_step(q, p, hh, h, h6, c4, c5, c6, c7, tab, o, w):
-        f2 = tab[o + U1]
-        k1 = force(q, tab[o], w)
-        q2 = fma(hh, p, q)
-        p2 = fma(hh, k1, p)
-        k2 = force(q2, f2, w)
-        q3 = fma(hh, p2, q)
-        p3 = fma(hh, k2, p)
-        k3 = force(q3, f2, w)
-        q4 = fma(h, p3, q)
-        p4 = fma(h, k3, p)
-        k4 = force(q4, tab[o + U2], w)
-        sq = p2 + p3
-        sp = k2 + k3
-        q = fma(h6, (p + p4) + (sq + sq), q)
-        p = fma(h6, (k1 + k4) + (sp + sp), p)
-        return q, p
-
-    return bm6_step, rk4_step
+    return step, energy2w
 
 
 # ------------------------------------------------------------------------------- escape bookkeeping
@@ -263,18 +232,20 @@ def finished(iE, iQ, nE, nQ, stop_any):
 
 # ------------------------------------------------------------------------------- the kernel
 @functools.lru_cache(maxsize=None)
-def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WARP, well=None):
+def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WARP, well=None, damped=False):
     """The compiled ensemble kernel for one scheme and well (cached per argument set).
 
     integrator: "srkn6b" | "rk4"; shared_table: copy the forcing table into dynamic shared
     memory (launch with its size in bytes); block: threads per block (static shared buffers);
     warp: compaction granularity (32 on a GPU; smaller values exercise compaction in the
-    simulator); well: the compiled well (wellcode.WellCode; None: the quartic).
+    simulator); well: the compiled well (wellcode.WellCode; None: the quartic); damped: the
+    scheme's damped variant (steps.DAMPED_INTEGRATORS; coefficients from lane_coefficients with
+    the damping).
 
     Launch: kernel[grid, block, 0, table_bytes if shared_table else 0](
         q0, p0, pidx, coef, FS, thrE2, nE, thrLo, thrHi, nQ, N, S, cycles, stop_any, A, counter,
         outE, outQ, wpar)
-    q0, p0 (N,) float64; pidx (N,) int64; coef (P*7,) lane_coefficients; FS (P*S*W,) the
+    q0, p0 (N,) float64; pidx (N,) int64; coef (P*N_COEF,) lane_coefficients; FS (P*S*W,) the
     forcing products F[k] * sine_table (W = 7 or 3); thrE2 (>= max(nE, 1),) sorted 2*xi_max;
     thrLo, thrHi (>= max(nQ, 1),) the nested displacement bounds, inside out (|q| tracking: thrHi
     = sorted q_max, thrLo unused); A: scrambling multiplier (coprime to N); counter (1,) int64
@@ -286,10 +257,9 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
     code = wellcode.quartic_code() if well is None else well
     if not isinstance(code, wellcode.WellCode):
         raise ValueError(f"well must be a compiled well (wellcode.WellCode), got {well!r}")
-    force, energy2w = make_well(code)
+    step, energy2w = make_step(code, steps.SCHEMES[(integrator, bool(damped))])
     crossed, check_state, next_filters = make_criteria(code.abs_tracking)
-    bm6_step, rk4_step = make_steps(force)
-    step = rk4_step if integrator == "rk4" else bm6_step
+    NC = np.uint64(steps.N_COEF)
     SHARED = bool(shared_table)
     BLK = int(block)
     WRP = int(warp)
@@ -336,7 +306,7 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
         tE = math.inf
         tQ = math.inf
         tN = math.inf
-        c1 = c2 = c3 = c4 = c5 = c6 = c7 = 0.0
+        c1 = c2 = c3 = c4 = c5 = c6 = c7 = c8 = c9 = c10 = 0.0
         reload = False
         while True:
             # ---------------------------------------------- take the next trajectory
@@ -392,21 +362,24 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
                 # of idle lanes issues no arithmetic and only waits at the barriers
                 continue
             if reload:
-                o = k * 7
+                o = uint64(k) * NC
                 c1 = coef[o]
-                c2 = coef[o + 1]
-                c3 = coef[o + 2]
-                c4 = coef[o + 3]
-                c5 = coef[o + 4]
-                c6 = coef[o + 5]
-                c7 = coef[o + 6]
+                c2 = coef[o + U1]
+                c3 = coef[o + U2]
+                c4 = coef[o + U3]
+                c5 = coef[o + U4]
+                c6 = coef[o + U5]
+                c7 = coef[o + U6]
+                c8 = coef[o + U7]
+                c9 = coef[o + U8]
+                c10 = coef[o + U9]
                 tE, tQ, tN = next_filters(iE, iQ, thrE2, nE, thrLo, thrHi, nQ, qL, qR)
                 reload = False
             # ---------------------------------------------- one forcing period
             o = uint64(k) * uSW
             base = per * S
             for s in range(S):
-                q, p = step(q, p, c1, c2, c3, c4, c5, c6, c7, tab, o, w)
+                q, p = step(q, p, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, tab, o, w)
                 o += UW
                 e = energy2w(q, p, w)
                 if crossed(e, q, tE, tQ, tN):

@@ -8,7 +8,7 @@ import numba
 import numpy as np
 
 from safebasins import checks
-from safebasins.numerics import kernels
+from safebasins.numerics import kernels, steps
 from safebasins.wells import resolve_well
 
 DEFAULT_STEPS_PER_CYCLE = 32
@@ -76,6 +76,22 @@ def check_step(Omega, steps_per_cycle, well=None):
     return steps_per_cycle
 
 
+def check_damping(damping):
+    """The damping beta of q'' + beta q' + V'(q) = F sin(Omega t + Psi): a finite scalar >= 0."""
+    return checks.check_scalar("damping", damping, checks.check_nonnegative)
+
+
+def damping_attrs(damping):
+    """``{"damping": beta}`` for a damped run; nothing for the undamped equation (datasets of the
+    paper's equation keep their attributes: no damping attribute means beta = 0)."""
+    return {"damping": damping} if damping > 0 else {}
+
+
+def integrator_text(integrator, damping):
+    """The integrator of a dataset in words (its damped variant for damping > 0)."""
+    return steps.DAMPED_INTEGRATORS[integrator] if damping > 0 else steps.INTEGRATORS[integrator]
+
+
 def check_cycles(name, cycles):
     if isinstance(cycles, (float, np.floating)) and float(cycles).is_integer() and cycles >= 1:
         cycles = int(cycles)
@@ -116,14 +132,16 @@ def engine_code(well, q_max=(), q_bounds=()):
 
 
 def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bounds=(), cycles, steps_per_cycle,
-                 threads=None, stop_any=False, store=False, integrator=DEFAULT_INTEGRATOR, well=None):
+                 threads=None, stop_any=False, store=False, integrator=DEFAULT_INTEGRATOR, well=None, damping=0.0):
     """Integrate trajectories i from (q0[i], p0[i]) with Omega[pidx[i]], F[pidx[i]] in `well`.
 
     Returns (steps_E (N, nE), steps_Q (N, nQ), store or None): int64 first-crossing steps in the
     order of the given thresholds (-1: not within `cycles`), and period-map iterates.  The
     displacement columns are the q_max thresholds (|q| > q_max) followed by the q_bounds pairs
     (q < lo or q > hi); all of them must be nested (displacement_pairs).
-    integrator: "srkn6b" (default) or "rk4" (kernels.INTEGRATORS); well: any form
+    integrator: "srkn6b" (default) or "rk4" (kernels.INTEGRATORS), with ``damping`` beta > 0 of
+    q'' + beta q' + V'(q) = F sin(...) their damped variants (steps.DAMPED_INTEGRATORS; 0: the
+    undamped schemes, bitwise as before damping existed); well: any form
     safebasins.wells.resolve_well reads (None: the quartic), integrated in its compiled form.
     Thresholds are not checked against the well here (the public functions do that).
     """
@@ -142,7 +160,7 @@ def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bounds=(
     outQ = np.full((N, hi.size), -1, dtype=np.int64)
     st = np.full((N, cycles + 1, 2), np.nan) if store else np.empty((0, 0, 2))
     if N:
-        coef = np.ascontiguousarray(kernels.lane_coefficients(Omega, steps_per_cycle, integrator))
+        coef = np.ascontiguousarray(kernels.lane_coefficients(Omega, steps_per_cycle, integrator, damping))
         sintab = kernels.sine_table(steps_per_cycle, Psi, integrator)
         with thread_count(threads) as nthreads:
             # one task per thread: trajectories are interleaved over tasks (i % n_tasks), so each
@@ -151,6 +169,7 @@ def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bounds=(
             kernels.ensemble(q0, p0, pidx, coef, kernels.step_sizes(Omega, steps_per_cycle), np.ascontiguousarray(F), sintab,
                        np.ascontiguousarray(2.0 * xi[oE_sorted]), np.ascontiguousarray(hi[oQ_sorted]),
                        int(cycles), bool(stop_any), int(n_tasks), LANES, outE, outQ, st, bool(store),
+                       scheme=kernels.scheme_of(integrator, damping),
                        well=code, thrQlo=np.ascontiguousarray(lo[oQ_sorted]))
     # back to the caller's threshold order
     steps_E = np.empty_like(outE)

@@ -4,8 +4,8 @@ The step (schemes, forcing tables) lives in steps.py, the vectorised period loop
 lanes in periods.py, the well's force and energy in its compiled form (wellcode.py); this module
 holds the lane machinery: escape detection, replay, refill, compaction, and the entry points.
 
-Schemes and wells are compile-time constants of the inline period bodies: `rk4` (the width of
-the forcing table: 3 RK4, 7 SRKN6b) and `well`, the kernel key of a compiled well
+Schemes and wells are compile-time constants of the inline period bodies: `scheme` (steps.SRKN6B,
+RK4 and their damped variants; the forcing table's width 7 or 3 matches it) and `well`, the kernel key of a compiled well
 (wellcode.WellCode.key), which _run_task forces to a numba literal (`literally`): every key is
 its own compiled kernel, cached on disk and compiled on first use, and holds only its own
 well's code (numba @overload on the literal, resolved at typing time).  Keys hash the
@@ -49,9 +49,9 @@ from numba import literally, njit, typeof, types
 
 from safebasins.numerics.steps import (  # noqa: F401  (re-exported: the step API of the engine)
     BM6_DRIFT, BM6_KICK, BM6_KICK_TIMES, DRIFT1, DRIFT2, DRIFT3, INTEGRATOR, INTEGRATORS, KICK1, KICK2, KICK3,
-    KICK4, N_KICKS, RK4_C1, RK4_C2, RK4_C3, RK4_COEF, RK4_TIMES, bm6_step, check_integrator, energy, energy2,
-    force, lane_coefficients, lane_coefs, rk4_step, row, sine_table, step, step_sizes, well_bm6_step,
-    well_rk4_step, wtuple)
+    KICK4, N_COEF, N_KICKS, RK4, RK4_C1, RK4_C2, RK4_C3, RK4_COEF, RK4_DAMPED, RK4_TIMES, SRKN6B, SRKN6B_DAMPED,
+    bm6_step, check_integrator, energy, energy2, force, lane_coefficients, lane_coefs, rk4_step, row, scheme_of,
+    sine_table, step, step_sizes, wtuple)
 from safebasins.numerics.periods import _period_lanes, _period_shared
 from safebasins.numerics.wellcode import WellCode, abs_tracking, quartic_code, well_energy2
 
@@ -115,8 +115,15 @@ def _filters(well, wpar, iE, iQ, thrE2, thrLo, thrHi):
     return tE, tQ, tN
 
 
+@njit(cache=True, inline="always")
+def _scaled_row(tab, s, scheme, F):
+    """F times row s of the forcing table (the products the vector loop forms)."""
+    t1, t2, t3, t4, t5, t6, t7 = row(tab, s, scheme)
+    return F * t1, F * t2, F * t3, F * t4, F * t5, F * t6, F * t7
+
+
 @njit(cache=True)
-def _replay(well, wpar, i, q, p, period, s0, s1, sintab, c, F, thrE2, thrLo, thrHi, iE, iQ, outE, outQ,
+def _replay(scheme, well, wpar, i, q, p, period, s0, s1, sintab, c, F, thrE2, thrLo, thrHi, iE, iQ, outE, outQ,
             stop_any):
     """Scalar replay of steps [s0, s1) of a period from the state before step s0 (same
     arithmetic as the vector loop); records the step of first crossing of every threshold
@@ -124,17 +131,12 @@ def _replay(well, wpar, i, q, p, period, s0, s1, sintab, c, F, thrE2, thrLo, thr
     S = sintab.shape[0]
     nE = thrE2.shape[0]
     nQ = thrHi.shape[0]
-    rk4 = sintab.shape[1] == 3
     w = wtuple(wpar)
     base = period * S
+    c1, c2, c3, c4, c5, c6, c7, c8, c9, c10 = c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9]
     for s in range(s0, s1):
-        if rk4:
-            q, p = well_rk4_step(well, w, q, p, c[0], c[1], c[2], F * sintab[s, 0], F * sintab[s, 1],
-                                 F * sintab[s, 2])
-        else:
-            q, p = well_bm6_step(well, w, q, p, c[0], c[1], c[2], c[3], c[4], c[5], c[6],
-                                 F * sintab[s, 0], F * sintab[s, 1], F * sintab[s, 2], F * sintab[s, 3],
-                                 F * sintab[s, 4], F * sintab[s, 5], F * sintab[s, 6])
+        f1, f2, f3, f4, f5, f6, f7 = _scaled_row(sintab, s, scheme, F)
+        q, p = step(scheme, well, w, q, p, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, f1, f2, f3, f4, f5, f6, f7)
         iE, iQ = _check_state(well, wpar, i, q, p, base + s + 1, thrE2, thrLo, thrHi, iE, iQ, outE, outQ)
         if _finished(iE, iQ, nE, nQ, stop_any):
             break
@@ -142,12 +144,14 @@ def _replay(well, wpar, i, q, p, period, s0, s1, sintab, c, F, thrE2, thrLo, thr
 
 
 @njit(cache=True, nogil=True)
-def _run_task(well, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrLo, thrHi,
+def _run_task(well, scheme, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrLo, thrHi,
               cycles, stop_any, outE, outQ, store, do_store):
     """Trajectories task, task + n_tasks, ... (one thread): the lane machinery of the module
-    docstring.  `well` is the kernel key of a compiled well (a numba literal: one specialised,
-    cached kernel per key)."""
+    docstring.  `well` is the kernel key of a compiled well and `scheme` the scheme flag
+    (numba literals: one specialised, cached kernel per pair, compiled on first use)."""
     literally(well)
+    literally(scheme)
+    damped = scheme == SRKN6B_DAMPED or scheme == RK4_DAMPED
     N = q0.shape[0]
     S = sintab.shape[0]
     nE = thrE2.shape[0]
@@ -185,6 +189,7 @@ def _run_task(well, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, 
     FS = Fpar[0] * sintab        # (S, 7) or (S, 3), shared path
     HL = np.zeros(Lmem)          # per-lane path
     FL = np.zeros(Lmem)
+    CL = np.zeros((N_COEF, Lmem if damped else 1))     # per-lane coefficient columns (damped schemes)
 
     nxt = np.int64(task)
     nact = np.int64(0)
@@ -212,6 +217,9 @@ def _run_task(well, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, 
                 Q[l] = q0[i]; P[l] = p0[i]
                 HL[l] = hpar[k]
                 FL[l] = Fpar[k]
+                if damped:
+                    for j in range(N_COEF):
+                        CL[j, l] = coef[k, j]
                 traj[l] = i; per[l] = 0; lE[l] = iE; lQ[l] = iQ
                 tE[l], tQ[l], tN[l] = _filters(well, wpar, iE, iQ, thrE2, thrLo, thrHi)
                 done[l] = False
@@ -230,6 +238,9 @@ def _run_task(well, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, 
                 Q[l] = Q[last]; P[l] = P[last]
                 HL[l] = HL[last]
                 FL[l] = FL[last]
+                if damped:
+                    for j in range(N_COEF):
+                        CL[j, l] = CL[j, last]
                 traj[l] = traj[last]; per[l] = per[last]; lE[l] = lE[last]; lQ[l] = lQ[last]
                 tE[l] = tE[last]; tQ[l] = tQ[last]; tN[l] = tN[last]; done[l] = done[last]
             nact -= 1
@@ -249,9 +260,10 @@ def _run_task(well, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, 
                 SP[g, l] = P[l]
             # segment maxima go straight into the rows SME[g], SMQ[g] (, SMN[g])
             if shared:
-                _period_shared(well, wpar, M, Q, P, SME[g], SMQ[g], SMN[g], coef[0], FS, seg[g], seg[g + 1])
+                _period_shared(scheme, well, wpar, M, Q, P, SME[g], SMQ[g], SMN[g], coef[0], FS, seg[g], seg[g + 1])
             else:
-                _period_lanes(well, wpar, M, Q, P, SME[g], SMQ[g], SMN[g], HL, FL, sintab, seg[g], seg[g + 1])
+                _period_lanes(scheme, well, wpar, M, Q, P, SME[g], SMQ[g], SMN[g], HL, CL, FL, sintab, seg[g],
+                              seg[g + 1])
         # ---------------------------------------------------- period boundary
         # vectorised test first: only lanes whose maxima crossed a threshold (or, for the
         # map, every lane) need the scalar bookkeeping below
@@ -286,8 +298,9 @@ def _run_task(well, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, 
                 for g in range(G):
                     if not SME[g, l] <= tE[l] or not SMQ[g, l] <= tQ[l] or (not abs_tracking(well) and not SMN[g, l] <= tN[l]):
                         k = pidx[i]
-                        iE, iQ = _replay(well, wpar, i, SQ[g, l], SP[g, l], per[l] - 1, seg[g], seg[g + 1], sintab,
-                                         coef[k], Fpar[k], thrE2, thrLo, thrHi, iE, iQ, outE, outQ, stop_any)
+                        iE, iQ = _replay(scheme, well, wpar, i, SQ[g, l], SP[g, l], per[l] - 1, seg[g], seg[g + 1],
+                                         sintab, coef[k], Fpar[k], thrE2, thrLo, thrHi, iE, iQ, outE, outQ,
+                                         stop_any)
                         lE[l] = iE
                         lQ[l] = iQ
                         tE[l], tQ[l], tN[l] = _filters(well, wpar, iE, iQ, thrE2, thrLo, thrHi)
@@ -302,11 +315,12 @@ def _run_task(well, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, 
             done[l] = d
 
 
-def specialised(dispatcher, args):
-    """The compiled entry point of ``dispatcher`` for ``args``, whose first argument is a kernel key
-    taken as a numba literal (compiled, or loaded from the on-disk cache, on first use).  Calling
-    it skips numba's dispatch, which would first try the non-literal signature at every call."""
-    sig = (types.literal(args[0]),) + tuple(typeof(a) for a in args[1:])
+def specialised(dispatcher, args, n_literal=2):
+    """The compiled entry point of ``dispatcher`` for ``args``, whose first ``n_literal`` arguments
+    (the kernel key, the scheme flag) are taken as numba literals (compiled, or loaded from the
+    on-disk cache, on first use).  Calling it skips numba's dispatch, which would first try the
+    non-literal signature at every call."""
+    sig = tuple(types.literal(a) for a in args[:n_literal]) + tuple(typeof(a) for a in args[n_literal:])
     entry = _ENTRIES.get((dispatcher, sig))
     if entry is None:
         dispatcher.compile(sig)
@@ -336,7 +350,7 @@ def _check_code(well):
 
 
 def ensemble(q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQ, cycles, stop_any, n_tasks, lanes,
-             outE, outQ, store, do_store, well=None, thrQlo=None):
+             outE, outQ, store, do_store, well=None, thrQlo=None, scheme=None):
     """Integrate every trajectory i from (q0[i], p0[i]) with parameter set pidx[i]
     (coef[pidx[i]] = step coefficients from lane_coefficients, hpar[pidx[i]] = the step h
     from step_sizes, Fpar[pidx[i]] = F) for at most
@@ -350,57 +364,69 @@ def ensemble(q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQ, cycles, stop_a
     A trajectory stops when every threshold is crossed (stop_any: when any is crossed); a NaN
     or inf state is beyond every threshold.
     store (N, cycles+1, 2): period-map iterates when do_store (pre-filled with NaN).
-    The scheme is the width of sintab (sine_table / lane_coefficients of the same integrator);
-    the well is its compiled form `well` (wellcode.WellCode; None: the quartic).
+    scheme: the scheme flag (steps.SRKN6B, RK4, SRKN6B_DAMPED, RK4_DAMPED; None: the undamped
+    scheme of the table's width, 7 SRKN6b, 3 RK4), with sine_table / lane_coefficients of the same
+    integrator and damping; the well is its compiled form `well` (wellcode.WellCode; None: the
+    quartic).
     Trajectory i is run by task i % n_tasks (one thread each); the results do not depend on
     n_tasks, lanes or the thread count (each trajectory is the same sequence of IEEE operations).
     """
     code = quartic_code() if well is None else _check_code(well)
     thrQ = np.ascontiguousarray(thrQ, dtype=float)
     thrQlo = -thrQ if thrQlo is None else np.ascontiguousarray(thrQlo, dtype=float)
-    args = [code.key, code.wpar, 0, int(n_tasks), int(lanes), q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQlo,
-            thrQ, int(cycles), bool(stop_any), outE, outQ, store, bool(do_store)]
+    scheme = _scheme(scheme, sintab, coef)
+    args = [code.key, scheme, code.wpar, 0, int(n_tasks), int(lanes), q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2,
+            thrQlo, thrQ, int(cycles), bool(stop_any), outE, outQ, store, bool(do_store)]
     entry = specialised(_run_task, args)
-    run_tasks(lambda task: entry(*args[:2], task, *args[3:]), n_tasks)
+    run_tasks(lambda task: entry(*args[:3], task, *args[4:]), n_tasks)
+
+
+def _scheme(scheme, sintab, coef):
+    """The scheme flag, checked against the forcing table's width and the coefficient table."""
+    width = {SRKN6B: 7, RK4: 3, SRKN6B_DAMPED: 7, RK4_DAMPED: 3}
+    if scheme is None:
+        scheme = RK4 if sintab.shape[1] == 3 else SRKN6B
+    if scheme not in width or sintab.shape[1] != width[scheme]:
+        raise ValueError(f"scheme {scheme!r} does not match a forcing table of width {sintab.shape[1]}")
+    if coef.ndim != 2 or coef.shape[1] != N_COEF:
+        raise ValueError(f"coef must be lane_coefficients, shape (n, {N_COEF}), got {coef.shape}")
+    return int(scheme)
 
 
 @njit(cache=True, nogil=True)
-def _final_states(well, wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods, task, n_tasks, qo, po):
+def _final_states(well, scheme, wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods, task, n_tasks, qo, po):
     literally(well)
+    literally(scheme)
     N = q0.shape[0]
     S = sintab.shape[0]
-    rk4 = sintab.shape[1] == 3
     w = wtuple(wpar)
     for i in range(task, N, n_tasks):
         k = pidx[i]
         F = Fpar[k]
         c = coef[k]
+        c1, c2, c3, c4, c5, c6, c7, c8, c9, c10 = c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9]
         q = q0[i]
         p = p0[i]
         for n in range(n_periods):
             for s in range(S):
-                if rk4:
-                    q, p = well_rk4_step(well, w, q, p, c[0], c[1], c[2], F * sintab[s, 0], F * sintab[s, 1],
-                                         F * sintab[s, 2])
-                else:
-                    q, p = well_bm6_step(well, w, q, p, c[0], c[1], c[2], c[3], c[4], c[5], c[6],
-                                         F * sintab[s, 0], F * sintab[s, 1], F * sintab[s, 2],
-                                         F * sintab[s, 3], F * sintab[s, 4], F * sintab[s, 5],
-                                         F * sintab[s, 6])
+                f1, f2, f3, f4, f5, f6, f7 = _scaled_row(sintab, s, scheme, F)
+                q, p = step(scheme, well, w, q, p, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, f1, f2, f3, f4, f5, f6,
+                            f7)
         qo[i] = q
         po[i] = p
 
 
-def final_states(q0, p0, pidx, coef, Fpar, sintab, n_periods, well=None, n_tasks=2):
+def final_states(q0, p0, pidx, coef, Fpar, sintab, n_periods, well=None, n_tasks=2, scheme=None):
     """Plain integration (no escape checks) for n_periods periods; returns (q, p).
     Scalar per trajectory; used by tests (convergence order, energy drift).  well: a compiled
-    well (None: the quartic)."""
+    well (None: the quartic); scheme: as ensemble."""
     code = quartic_code() if well is None else _check_code(well)
     q0 = np.ascontiguousarray(q0, dtype=float)
     qo, po = np.empty(q0.shape), np.empty(q0.shape)
     n_tasks = max(1, min(int(n_tasks), q0.size))
-    args = [code.key, code.wpar, q0, np.ascontiguousarray(p0, dtype=float), pidx, coef, Fpar, sintab, int(n_periods), 0,
-            n_tasks, qo, po]
+    scheme = _scheme(scheme, sintab, coef)
+    args = [code.key, scheme, code.wpar, q0, np.ascontiguousarray(p0, dtype=float), pidx, coef, Fpar, sintab,
+            int(n_periods), 0, n_tasks, qo, po]
     entry = specialised(_final_states, args)
-    run_tasks(lambda t: entry(*args[:9], t, *args[10:]), n_tasks)
+    run_tasks(lambda t: entry(*args[:10], t, *args[11:]), n_tasks)
     return qo, po

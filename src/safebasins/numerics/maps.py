@@ -13,7 +13,8 @@ from safebasins.numerics import kernels
 
 
 def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=None, q_bounds=None, well=None,
-                     steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None, integrator=engine.DEFAULT_INTEGRATOR):
+                     steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None, integrator=engine.DEFAULT_INTEGRATOR,
+                     damping=0.0):
     """Period-map iterates (q(nT), p(nT)), T = 2 pi / Omega, n = 0..n_iter, of paired ICs.
 
     Parameters
@@ -49,6 +50,7 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
     Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
     n_iter = engine.check_cycles("n_iter", n_iter)
+    damping = engine.check_damping(damping)
     w = resolve_well(well)
     xi = () if xi_max is None else (checks.check_scalar("xi_max", xi_max, w.check_threshold),)
     qm = () if q_max is None else (checks.check_scalar("q_max", q_max, w.check_displacement),)
@@ -64,7 +66,7 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
 
     sE, sQ, st = engine.run_ensemble(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
                                      q_bounds=qb, cycles=n_iter, steps_per_cycle=spc, threads=threads, stop_any=True,
-                                     store=True, integrator=integrator, well=w)
+                                     store=True, integrator=integrator, well=w, damping=damping)
     steps = np.concatenate([sE, sQ], axis=1).astype(float)
     steps[steps < 0] = np.inf
     first = steps.min(axis=1)
@@ -85,10 +87,10 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
         },
     )
     ds.attrs.update(F=F, Omega=Omega, Psi=Psi, xi_max=xi[0] if xi else np.nan, q_max=qm[0] if qm else np.nan,
-                    n_iter=n_iter, steps_per_cycle=spc, integrator=kernels.INTEGRATORS[integrator],
+                    n_iter=n_iter, steps_per_cycle=spc, integrator=engine.integrator_text(integrator, damping),
                     map="eq (29): (q(t), p(t)) -> (q(t + T), p(t + T)), T = 2 pi / Omega; NaN after escape",
                     escape_criteria=f"energy ({w.energy_criterion()}); displacement: |q| > q_max, q < q_lower or "
-                                    "q > q_upper", **w.numerics_attrs())
+                                    "q > q_upper", **w.numerics_attrs(), **engine.damping_attrs(damping))
     if qb.shape[0]:
         ds.attrs.update(q_lower=float(qb[0, 0]), q_upper=float(qb[0, 1]))
     return ds
