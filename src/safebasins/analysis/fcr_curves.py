@@ -8,9 +8,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from safebasins.io.provenance import api_provenance
+
 __all__ = ["analytic_fcr_curves", "numeric_fcr_curves"]
 
 
+@api_provenance
 def analytic_fcr_curves(Omega, curves, *, well=None, label=""):
     """One :func:`safebasins.theory.critical_forcing` per curve (eqs 22-26), stacked over ``curve``
     with the coordinates xi_max, xi_ini, gamma_ini, label (and Psi when every curve has one)."""
@@ -28,6 +31,7 @@ def analytic_fcr_curves(Omega, curves, *, well=None, label=""):
     return stack(parts, "curve", coords=coords)
 
 
+@api_provenance
 def numeric_fcr_curves(Omega, curves, *, well=None, cycles, tol, F_bracket, criterion, n_scan, steps_per_cycle,
                        threads=None, backend="cpu", label=""):
     """One :func:`safebasins.numerics.critical_forcing_numeric` per curve, from the IC

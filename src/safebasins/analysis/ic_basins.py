@@ -17,9 +17,12 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
+from safebasins.io.provenance import api_provenance
+
 __all__ = ["analytic_basin", "analytic_basin_stack", "add_resonance_manifold", "numeric_check"]
 
 
+@api_provenance
 def analytic_basin(F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, label=None):
     """Boundaries + per-IC analytic escape mask on the (q0, p0) grid of 1-D axes ``q0``, ``p0``.
 
@@ -36,6 +39,7 @@ def analytic_basin(F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, l
     return b.assign_coords(q0=("q0", qa), p0=("p0", pa))
 
 
+@api_provenance
 def analytic_basin_stack(scan, values, F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, label=None):
     """Analytic basins stacked over the scanned parameter ``scan`` ("F" or "xi_max", taking
     ``values``; the other one is the scalar argument).  Each basin's saddle point is a coordinate
@@ -68,6 +72,7 @@ def add_resonance_manifold(basin, F, Omega, xi_max, *, n_gamma, n_xi, xi_top, we
     return out
 
 
+@api_provenance
 def numeric_check(basin, F, Omega, Psi, xi_max, *, cycles, steps_per_cycle, well=None, threads=None, label=None):
     """Integrate the analytic-safe ICs of ``basin``'s grid for ``cycles`` forcing cycles (energy
     criterion) and store, per connected part of the analytic basin, the fraction the numerics

@@ -213,10 +213,14 @@ def stack(datasets, dim: str, values=None, *, coords: dict | None = None,
     datasets become coordinates along `dim`; equal ones stay attributes. Dimensions in `pad`
     are padded (NaN / -1 / "" / False) to their largest length first.
     """
+    from safebasins.io.compare import PROVENANCE_ATTRS
+
     datasets = [d.copy() for d in datasets]
     n = len(datasets)
     if n == 0:
         raise ValueError("datasets must not be empty")
+    for d in datasets:          # each part's provenance (API calls) is not a coordinate of the stack
+        d.attrs = {k: v for k, v in d.attrs.items() if k not in PROVENANCE_ATTRS}
     keys = set().union(*(d.attrs.keys() for d in datasets))
     varying = sorted(k for k in keys if k != dim and not all(
         k in d.attrs and _same(d.attrs[k], datasets[0].attrs.get(k)) for d in datasets))

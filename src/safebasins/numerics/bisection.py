@@ -5,10 +5,9 @@ import numpy as np
 import xarray as xr
 
 from safebasins import checks
-from safebasins.numerics import criteria
+from safebasins.io.provenance import api_provenance
+from safebasins.numerics import criteria, engine, kernels
 from safebasins.wells import QuarticWell, resolve_well
-from safebasins.numerics import engine
-from safebasins.numerics import kernels
 
 DEFAULT_N_SCAN = 301
 
@@ -22,6 +21,7 @@ def _escapes(q0, p0, Omega, F, Psi, thr_kw, cycles, spc, threads, integrator, ba
     return ((sE >= 0).any(axis=1)) | ((sQ >= 0).any(axis=1))
 
 
+@api_provenance
 def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3000, tol=5e-5,
                              F_bracket=(0.0, 0.3), criterion="energy", n_scan=DEFAULT_N_SCAN,
                              steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None,

@@ -6,10 +6,9 @@ import xarray as xr
 
 from safebasins import checks
 from safebasins.io import cf
-from safebasins.numerics import criteria
+from safebasins.io.provenance import api_provenance
+from safebasins.numerics import criteria, engine, kernels
 from safebasins.wells import resolve_well
-from safebasins.numerics import engine
-from safebasins.numerics import kernels
 
 def _monotone(a):
     d = np.diff(a)
@@ -45,6 +44,7 @@ def _thresholds(w, xi_max, q_max, q_bounds):
     return xi, qm, qb
 
 
+@api_provenance
 def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=(), well=None, cycles=3000,
                  steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None, grid=None,
                  integrator=engine.DEFAULT_INTEGRATOR, backend="cpu", damping=0.0):
@@ -146,6 +146,7 @@ def _bounds_coords(qb):
             "q_upper": ("q_bounds", qb[:, 1], cf.attrs("q_upper"))}
 
 
+@api_provenance
 def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=(), well=None, cycles=3000,
                        steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None,
                        integrator=engine.DEFAULT_INTEGRATOR, backend="cpu", damping=0.0):

@@ -6,12 +6,12 @@ import xarray as xr
 
 from safebasins import checks
 from safebasins.io import cf
-from safebasins.numerics import criteria
+from safebasins.io.provenance import api_provenance
+from safebasins.numerics import criteria, engine, kernels
 from safebasins.wells import resolve_well
-from safebasins.numerics import engine
-from safebasins.numerics import kernels
 
 
+@api_provenance
 def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=None, q_bounds=None, well=None,
                      steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None, integrator=engine.DEFAULT_INTEGRATOR,
                      damping=0.0):

@@ -1,0 +1,32 @@
+"""Datasets the public API returns carry their provenance (issue 19): version, commit, date, the
+call's parameters and the well, as the pipeline's datasets do."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from safebasins import __version__
+from safebasins.io.compare import PROVENANCE_ATTRS
+from safebasins.io.datasets import stack
+from safebasins.numerics import critical_forcing_numeric, escape_chart
+
+
+def test_api_datasets_carry_provenance():
+    q = np.linspace(-0.5, 0.5, 30)
+    ch = escape_chart(q, q[:4], 0.01, 0.9, np.pi, xi_max=(0.1,), cycles=5, well={"polynomial": [0, 0, 0.5, -1 / 3]})
+    a = ch.attrs
+    assert a["safebasins_version"] == __version__ and a["git_commit"] and a["date_created"]
+    assert a["history"].startswith("safebasins.numerics") and a["well"] == "polynomial"
+    p = json.loads(a["parameters"])
+    assert p["F"] == 0.01 and p["cycles"] == 5 and p["well"] == {"polynomial": [0, 0, 0.5, -1 / 3]}
+    assert p["q0"] == {"shape": [30], "min": -0.5, "max": 0.5} and p["p0"] == q[:4].tolist()
+    f = critical_forcing_numeric([0.9], 0.1, cycles=5, n_scan=0, tol=1e-2)
+    assert f.attrs["well"] == "quartic" and json.loads(f.attrs["parameters"])["Omega"] == [0.9]
+
+
+def test_stack_drops_the_parts_provenance():
+    q = np.linspace(-0.5, 0.5, 5)
+    parts = [escape_chart(q, q, F, 0.9, np.pi, xi_max=(0.1,), cycles=3) for F in (0.01, 0.02)]
+    out = stack(parts, "F", [0.01, 0.02], pad=())
+    assert not set(PROVENANCE_ATTRS) & set(out.coords) and not set(PROVENANCE_ATTRS) & set(out.attrs)
