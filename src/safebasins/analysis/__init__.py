@@ -8,4 +8,6 @@ phase_invariant  the safe basin for every forcing phase
 fourier_compare  the paper's first harmonic (eq 20) versus the exact one
 period_map       rotation numbers, island chains and chaotic orbits of the period map (Fig 18)
 confirm          numeric check of the connected parts of an analytic safe basin (Figs 5-9)
+melnikov         Melnikov threshold F_M(Omega) of the hilltop saddle: first homoclinic/heteroclinic tangency
 """
+from safebasins.analysis.melnikov import melnikov_curve, melnikov_threshold  # noqa: F401,E402
