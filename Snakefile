@@ -12,10 +12,16 @@ import os
 
 from snakemake.utils import min_version
 
+from safebasins.pipeline.config import load_yaml as _check_config_file
+
 min_version("9.0")
 
 
-# found beside this Snakefile, whatever the working directory (`-s path/Snakefile`)
+# found beside this Snakefile, whatever the working directory (`-s path/Snakefile`); read first by
+# safebasins' loader, whose errors name the file and line (a syntax error, a key given twice)
+_check_config_file(os.path.join(workflow.basedir, "config", "config.yaml"))
+
+
 configfile: os.path.join(workflow.basedir, "config", "config.yaml")
 
 
@@ -63,7 +69,12 @@ rule other_wells:
 
 
 rule experiments:
-    """The datasets and figures of the experiments declared in the config under `experiments:`."""
+    """The datasets and figures of the experiments under `experiments:`: those the --configfile
+    files name there, else all of the config's (common.smk, TARGET_EXPERIMENTS)."""
     input:
-        [p for e in RUN.experiments.values() if e.key.startswith("experiments.") for p in e.dataset_files()],
-        figure_targets("Experiments"),
+        [p for e in TARGET_EXPERIMENTS for p in e.dataset_files()],
+        [p for e in TARGET_EXPERIMENTS if e.figure is not None for p in (e.figure.png, e.figure.pdf)],
+
+
+# the cost of the requested targets, refused above the budgets before any job runs (common.smk)
+cost_guard()

@@ -65,7 +65,7 @@ def test_defaults_filled_from_the_schema(base):
     validate_config(cfg)
     assert cfg["fourier"] == "paper" and cfg["numerics"] == {"steps_per_cycle": 32, "threads": 1, "tiles": 1,
                                                             "budget_core_hours": 1.0, "allow_expensive": False,
-                                                            "backend": "cpu"}
+                                                            "budget_analytic_evaluations": 2e9, "backend": "cpu"}
     assert cfg["figures"]["fig13"]["cycles"] == 3000
     assert cfg["extensions"] == []
 

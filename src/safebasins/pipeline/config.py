@@ -20,6 +20,7 @@ from pathlib import Path
 
 import yaml
 
+from safebasins.checks import reaches
 from safebasins.pipeline import catalog
 from safebasins.pipeline.registry import KINDS
 from safebasins.pipeline.validation import CheckContext, ConfigError, fail, indexed, key_path
@@ -34,8 +35,46 @@ __all__ = ["ConfigError", "load_yaml", "merge_config", "build_schema", "validate
 
 
 def load_yaml(path):
-    with open(path) as fh:
-        return yaml.safe_load(fh)
+    """A YAML file as Python data; ConfigError naming the file and the line for a syntax error or
+    a key given twice in one mapping (YAML would keep the later value silently)."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            loader = yaml.SafeLoader(fh)
+            try:
+                node = loader.get_single_node()
+                if node is None:
+                    return None
+                _check_unique_keys(path, node)
+                return loader.construct_document(node)
+            finally:
+                loader.dispose()
+    except OSError as exc:
+        raise ConfigError(f"config file {path}: cannot be read ({exc.strerror or exc})") from None
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        where = f", line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+        ctx = exc.context and (f"{exc.context} (line {exc.context_mark.line + 1})" if exc.context_mark else exc.context)
+        what = "; ".join(str(x) for x in (ctx, exc.problem) if x)
+        raise ConfigError(f"config file {path}{where}: not valid YAML ({what})") from None
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"config file {path}: not valid YAML ({exc})") from None
+
+
+def _check_unique_keys(path, node, keys=()):
+    """ConfigError for the first key that a mapping of the YAML node tree repeats."""
+    if isinstance(node, yaml.MappingNode):
+        seen = {}
+        for k, v in node.value:
+            if isinstance(k, yaml.ScalarNode):
+                if k.value in seen:
+                    raise ConfigError(f"config file {path}, line {k.start_mark.line + 1}: key "
+                                      f"{key_path((*keys, k.value))} is given twice (first on line {seen[k.value]}); "
+                                      "YAML would keep the later value silently: remove one")
+                seen[k.value] = k.start_mark.line + 1
+            _check_unique_keys(path, v, (*keys, k.value if isinstance(k, yaml.ScalarNode) else "?"))
+    elif isinstance(node, yaml.SequenceNode):
+        for i, v in enumerate(node.value):
+            _check_unique_keys(path, v, (*keys, i))
 
 
 def merge_config(base: dict, override: dict) -> dict:
@@ -241,13 +280,17 @@ def _check_well(block, key, well, kind):
         fail(f"{key}.fourier", f"'paper' is the quartic's truncated first harmonic (eq 20); the {well.name} well "
                                "uses its exact first harmonic: set fourier to exact (or [exact])")
     top = well.barrier_energy
+    # strict: an energy level of the action-angle map (an orbit exists below the escape energy
+    # only); xi_max may equal a barrier's energy, not an asymptote's (the orbit there is unbounded)
+    levels = (("xi_max", well.open_at_infinity), ("xi_ini", True), ("xi_top", True))
     for sub, blk in [("", block)] + [(f".{k}", v) for k, v in block.items() if isinstance(v, dict)]:
-        for name, strict in (("xi_max", False), ("xi_ini", True)):
+        for name, strict in levels:
             vals = blk.get(name)
             for i, x in enumerate(vals if isinstance(vals, list) else [] if vals is None else [vals]):
                 if not isinstance(x, (int, float)):
                     continue
-                if x > top or (strict and x >= top):
+                if x > top or (strict and reaches(x, top)):
                     what = "below" if strict else "at most"
                     fail(indexed(f"{key}{sub}.{name}", vals, i),
-                         f"{x} must be {what} the barrier energy {top:.6g} of the {well.name} well")
+                         f"{x} must be {what} the barrier energy {top:.6g} of the {well.name} well"
+                         + (" (within a relative 1e-12 of it, which counts as at it)" if x < top else ""))

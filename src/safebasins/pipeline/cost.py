@@ -1,14 +1,19 @@
-"""Cost estimate and cost guard: upper-bound trajectory-steps of every experiment.
+"""Cost estimate and cost guard: upper-bound work of every experiment, numeric and analytic.
 
 Each kind's ``cost`` counts the trajectory-steps its numerics integrate if no trajectory
-escapes early (the real cost is lower).  ``scripts/estimate_cost.py`` prints the table; the
-Snakefile prints the total with the expected time and refuses, before any job runs, a
-configuration above ``numerics.budget_core_hours`` unless ``numerics.allow_expensive: true``.
-:func:`job_cost` and :func:`resources` turn the same estimate into each job's ``runtime`` and
-``mem_mb`` for a cluster scheduler (workflow/rules/common.smk, the SLURM profile).
+escapes early (the real cost is lower); :func:`analytic_cost` counts the slow-flow evaluations
+of its analytic products (IC grid points x basins, resonance-manifold points, F_cr xi nodes
+x Omega points x curves).  ``scripts/estimate_cost.py`` prints the table; the Snakefile prints
+the totals of the requested targets with the expected time and refuses, before any job runs, a
+run above ``numerics.budget_core_hours`` (numerics) or ``numerics.budget_analytic_evaluations``
+(analytic) unless ``numerics.allow_expensive: true``.  :func:`job_cost` and :func:`resources`
+turn the numeric estimate into each job's ``runtime`` and ``mem_mb`` for a cluster scheduler
+(workflow/rules/common.smk, the SLURM profile).
 """
 from __future__ import annotations
 
+import functools
+import inspect
 import math
 
 from safebasins.pipeline.validation import fail
@@ -16,6 +21,10 @@ from safebasins.pipeline.validation import fail
 #: trajectory-steps per second and core of the CPU engine on an escape chart (benchmarks/
 #: bench_escape.py: 1.0e9 on 2 cores of an AMD EPYC Zen 4 with AVX-512 at 2.6 GHz; 1.35e9 dense)
 RATE_PER_CORE = 5.0e8
+#: slow-flow evaluations per second and core, to the order of magnitude (same machine:
+#: 2e6 per IC of the quartic, 4e5 of a numeric well, 1e6 per resonance-manifold point, 2e7 per
+#: xi node of F_cr)
+ANALYTIC_RATE = 1.0e6
 
 
 def exp_cost(exp) -> int:
@@ -24,11 +33,78 @@ def exp_cost(exp) -> int:
     return int(exp.kind.cost(exp.params))
 
 
-def costs(run) -> dict[str, int]:
-    """Experiment -> upper-bound trajectory-steps of its numerics."""
-    return {n: exp_cost(e) for n, e in run.experiments.items()}
+def costs(run, experiments=None) -> dict[str, int]:
+    """Experiment -> upper-bound trajectory-steps of its numerics (``experiments``: the names to
+    count, default all)."""
+    return {n: exp_cost(e) for n, e in run.experiments.items() if experiments is None or n in experiments}
 
 
+# ---------------------------------------------------------------------- analytic work
+@functools.cache
+def _default(func, arg):
+    """A library default (``"module:function"``), read from its signature, never restated."""
+    import importlib
+
+    mod, _, name = func.partition(":")
+    return inspect.signature(getattr(importlib.import_module(mod), name)).parameters[arg].default
+
+
+def _grid(p):
+    nq, np_ = p["grid"]["n"]
+    return int(nq) * int(np_)
+
+
+def _n(v):
+    """Length of a list-valued parameter (1 for a scalar)."""
+    return len(v) if isinstance(v, (list, tuple)) else 1
+
+
+def _fcr(p):
+    # critical_forcing solves each (Omega, curve) on an xi grid of n_grid nodes
+    return len(p["Omega"]) * len(p["curves"]) * _default("safebasins.theory:critical_forcing", "n_grid")
+
+
+def _xi_true(n_gamma, n_xi=None):
+    # xi_true_analytic: n_gamma x n_xi points per refinement level
+    f = "safebasins.analysis.phase_invariant:xi_true_analytic"
+    return n_gamma * (n_xi or _default(f, "n_xi")) * _default(f, "levels")
+
+
+#: kind name -> slow-flow evaluations of its analytic products (resolved params; run for the
+#: kinds that read other experiments).  A kind may instead define ``analytic_cost(params)``.
+ANALYTIC_COSTS = {
+    "fcr_theory": lambda p, run: _fcr(p),
+    "fcr_compare": lambda p, run: _fcr(p),
+    "basin_rm": lambda p, run: _grid(p) + p["manifold"]["n_gamma"] * p["manifold"]["n_xi"] + p["n_points"],
+    "basin_chart": lambda p, run: (_grid(p) + p["n_points"]) * _n(p[p["scan"]]),
+    "strobe": lambda p, run: _grid(p) + p["n_points"],
+    "erosion": lambda p, run: _n(p["fourier"]) * _n(p["F"]) * _n(p["xi_max"]) * p["analytic_n"] ** 2,
+    "true_basin": lambda p, run: _n(p["fourier"]) * _n(p["xi_max"]) * (
+        _n(p["Psi"]) * (_grid(p) + p["n_points"]) + _xi_true(p["n_gamma"])),
+    "integrity_map": lambda p, run: _n(p["Omega"]) * _n(p["F"]) * (_grid(p) + _xi_true(p["n_gamma"], p["n_xi"])),
+    # both first harmonics of the F_cr curves and basins it compares
+    "fourier_compare": lambda p, run: 2 * sum(analytic_cost(run.experiments[n], run)
+                                              for n in (*p["fcr"], *p["iou"]) if n in run.experiments),
+}
+
+
+def analytic_cost(exp, run=None) -> int:
+    """Upper-bound slow-flow evaluations of one experiment's analytic products: its kind's
+    ``analytic_cost(params)`` if it has one, else :data:`ANALYTIC_COSTS` (0 for a kind without
+    analytic products)."""
+    own = getattr(exp.kind, "analytic_cost", None)
+    if own is not None:
+        return int(own(exp.params))
+    f = ANALYTIC_COSTS.get(exp.kind.name)
+    return int(f(exp.params, run)) if f is not None else 0
+
+
+def analytic_costs(run, experiments=None) -> dict[str, int]:
+    """Experiment -> upper-bound slow-flow evaluations (``experiments``: the names, default all)."""
+    return {n: analytic_cost(e, run) for n, e in run.experiments.items() if experiments is None or n in experiments}
+
+
+# ---------------------------------------------------------------------- report and guard
 def _duration(seconds: float) -> str:
     if seconds < 120:
         return f"{seconds:.0f} s"
@@ -37,31 +113,52 @@ def _duration(seconds: float) -> str:
     return f"{seconds / 3600:.1f} h"
 
 
-def report(run, cores=1, rate=RATE_PER_CORE) -> list[str]:
-    """One line per experiment with numerics, and the total."""
-    c = costs(run)
-    lines = [f"{e:18s} {s:10.3e} steps  <= {_duration(s / rate / cores):>8s}" for e, s in c.items() if s]
-    total = sum(c.values())
-    lines.append(f"{'total':18s} {total:10.3e} steps  <= {_duration(total / rate / cores):>8s} on {cores} core(s) "
-                 f"at {rate:.1e} steps/s per core")
+def report(run, cores=1, rate=RATE_PER_CORE, experiments=None) -> list[str]:
+    """One line per experiment with numerics or analytic work, and the totals."""
+    c, a = costs(run, experiments), analytic_costs(run, experiments)
+    lines = [f"{e:22s} {c[e]:10.3e} steps  <= {_duration(c[e] / rate / cores):>8s}   "
+             f"{a[e]:10.3e} slow-flow evaluations  ~ {_duration(a[e] / ANALYTIC_RATE / cores):>8s}"
+             for e in c if c[e] or a[e]]
+    total, atotal = sum(c.values()), sum(a.values())
+    lines.append(f"{'total':22s} {total:10.3e} steps  <= {_duration(total / rate / cores):>8s}   "
+                 f"{atotal:10.3e} slow-flow evaluations  ~ {_duration(atotal / ANALYTIC_RATE / cores):>8s}"
+                 f"   on {cores} core(s) at {rate:.1e} steps/s and {ANALYTIC_RATE:.0e} evaluations/s per core")
     return lines
 
 
-def guard(run, cores=1, rate=RATE_PER_CORE) -> str:
-    """The cost summary line; ConfigError naming ``numerics.budget_core_hours`` if over budget."""
-    c = costs(run)
-    total = sum(c.values())
+def _largest(c, scale, unit):
+    top = sorted(c.items(), key=lambda kv: -kv[1])[:3]
+    return ", ".join(f"{e} {s / scale:.3g} {unit}" for e, s in top if s)
+
+
+def guard(run, cores=1, rate=RATE_PER_CORE, experiments=None) -> str:
+    """The cost summary line of ``experiments`` (default: all); ConfigError naming
+    ``numerics.budget_core_hours`` or ``numerics.budget_analytic_evaluations`` if over budget
+    (unless ``numerics.allow_expensive``)."""
+    c, a = costs(run, experiments), analytic_costs(run, experiments)
+    total, atotal = sum(c.values()), sum(a.values())
     core_hours = total / rate / 3600
     num = run.config["numerics"]
-    summary = (f"safebasins cost estimate: at most {total:.2e} trajectory-steps = {core_hours:.3g} core-hours, "
-               f"<= {_duration(total / rate / max(cores, 1))} on {cores} core(s) at {rate:.1e} steps/s per core")
-    if core_hours > num["budget_core_hours"] and not num["allow_expensive"]:
-        top = sorted(c.items(), key=lambda kv: -kv[1])[:3]
-        names = ", ".join(f"{e} {s / rate / 3600:.3g} core-h" for e, s in top if s)
+    what = ("this configuration" if experiments is None else "the requested targets ("
+            + (", ".join(sorted(c)) if len(c) <= 4 else f"{len(c)} experiments") + ")")
+    summary = (f"safebasins cost estimate ({what}): at most {total:.2e} trajectory-steps = {core_hours:.3g} "
+               f"core-hours, <= {_duration(total / rate / max(cores, 1))} on {cores} core(s) at {rate:.1e} steps/s "
+               f"per core; {atotal:.2e} slow-flow evaluations (~{_duration(atotal / ANALYTIC_RATE / max(cores, 1))})")
+    if num["allow_expensive"]:
+        return summary
+    if core_hours > num["budget_core_hours"]:
         fail("numerics.budget_core_hours",
-             f"this configuration costs up to {core_hours:.3g} core-hours ({total:.2e} trajectory-steps; "
-             f"largest: {names}), above the budget of {num['budget_core_hours']:g} core-hours. Reduce grids, "
-             "cycles or scans, raise numerics.budget_core_hours, or set numerics.allow_expensive: true")
+             f"{what} costs up to {core_hours:.3g} core-hours ({total:.2e} trajectory-steps; "
+             f"largest: {_largest(c, rate * 3600, 'core-h')}), above the budget of {num['budget_core_hours']:g} "
+             "core-hours. Reduce grids, cycles or scans, raise numerics.budget_core_hours, or set "
+             "numerics.allow_expensive: true")
+    if atotal > num["budget_analytic_evaluations"]:
+        fail("numerics.budget_analytic_evaluations",
+             f"the analytic products of {what} need {atotal:.2e} slow-flow evaluations "
+             f"(largest: {_largest(a, 1, 'evaluations')}; ~{_duration(atotal / ANALYTIC_RATE)} at "
+             f"{ANALYTIC_RATE:.0e}/s), above the budget of {num['budget_analytic_evaluations']:.3g}. Reduce Omega "
+             "lists, grids, manifold or boundary resolutions, raise numerics.budget_analytic_evaluations, or set "
+             "numerics.allow_expensive: true")
     return summary
 
 

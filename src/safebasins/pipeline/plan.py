@@ -9,13 +9,16 @@ report and the cost estimate read.
 """
 from __future__ import annotations
 
+import os
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
 from safebasins import wells
 from safebasins.pipeline.config import experiment_blocks, load_yaml, merge_config, validate_config
-from safebasins.pipeline.registry import (KINDS, PARTS_DIR, Experiment, FigureSpec, Product, params_path)
+from safebasins.pipeline.validation import fail
+from safebasins.pipeline.registry import (KINDS, PARAMS_DIR, PARTS_DIR, Experiment, FigureSpec, Product,
+                                          params_path)
 
 __all__ = ["Plan", "ResolveContext", "plan", "tile_path", "load_config"]
 
@@ -54,6 +57,16 @@ def _figure(name, kind, params, decl):
                       packaged=False)
 
 
+def _check_compiled(exp, spec):
+    """The well of an experiment with numerics has a compiled form (a polynomial up to the degree
+    of numerics.wellcode.POLY_DEGREES): refused here, naming the key, not when its job runs."""
+    if spec["name"] == "polynomial" and exp.kind.cost(exp.params) > 0:
+        try:
+            wells.from_spec(spec).compiled
+        except ValueError as exc:
+            fail(f"{exp.key}.well", f"the numerics of this experiment cannot integrate this well: {exc}")
+
+
 class Plan:
     """Experiments of one validated config, in catalog order then config order."""
 
@@ -75,6 +88,7 @@ class Plan:
             exp = Experiment(name=name, kind=kind, key=key, params=params, figure=_figure(name, kind, params, decl),
                              products=tuple(kind.products(name, params)), tasks=tuple(kind.tasks(params)))
             self.experiments[name] = exp
+            _check_compiled(exp, well)
             for prod in exp.products:
                 if prod.path in self._products:
                     other = self._products[prod.path][0].name
@@ -116,6 +130,45 @@ class Plan:
 
     def figures(self) -> list[FigureSpec]:
         return [e.figure for e in self.experiments.values() if e.figure is not None]
+
+    def experiments_for(self, files) -> set[str] | None:
+        """The experiments whose datasets building ``files`` (snakemake target files) needs: a
+        dataset, its chart tiles or a figure of an experiment, and the datasets of other
+        experiments these read.  None (= every experiment) when that is all of them, or when a file
+        under results/ is none of these (a parameter file needs no computation; files outside
+        results/ are sources)."""
+        figures = {}
+        for f in self.figures():
+            for p in (f.png, f.pdf, f.executed_notebook, f"results/captions/{f.name}.rst"):
+                figures[p] = f
+        need, todo = set(), []
+        for path in map(_relative, files):
+            if path in self._products:
+                todo.append(path)
+            elif path in figures:
+                todo += figures[path].dataset_files()
+            elif path.startswith(f"{PARTS_DIR}/") and path.split("/")[4] in self.experiments:
+                need.add(path.split("/")[4])
+            elif path.startswith(f"{PARAMS_DIR}/") or path.startswith("results/notebooks/templates/"):
+                continue
+            elif path.startswith("results/"):
+                return None
+        seen = set()
+        while todo:
+            path = todo.pop()
+            if path in seen or path not in self._products:
+                continue
+            seen.add(path)
+            need.add(self.experiment_of(path).name)
+            todo += [x for v in self.product_inputs(path).values() for x in (v if isinstance(v, (list, tuple)) else [v])
+                     if isinstance(x, str)]
+        return None if {n for n, e in self.experiments.items() if e.products} <= need else need
+
+
+def _relative(path) -> str:
+    """A target path as the plan names it (relative to the working directory, normalised)."""
+    p = Path(path)
+    return Path(os.path.relpath(p) if p.is_absolute() else os.path.normpath(p)).as_posix()
 
 
 def load_config(paths) -> dict:

@@ -7,6 +7,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from safebasins.checks import reaches
+
 
 class ConfigError(ValueError):
     """A configuration error; the message starts with the offending key."""
@@ -118,10 +120,11 @@ class CheckContext:
         """Analytic products need xi_max strictly below the well's barrier energy."""
         top = well.barrier_energy
         for i, x in enumerate(values if isinstance(values, (list, tuple)) else [values]):
-            if x >= top:
+            if reaches(x, top):
                 fail(indexed(key, values, i),
                      f"{what} needs xi_max < {top:.6g}, the barrier energy of the {well.name} well (the "
-                     f"action-angle map is singular on the separatrix), got {x}")
+                     f"action-angle map is singular on the separatrix), got {x!r}"
+                     + (" (within a relative 1e-12 of it, which counts as at it)" if x < top else ""))
 
     def check_t_eval_within(self, key, t_eval, cycles):
         t = t_eval if isinstance(t_eval, (list, tuple)) else [t_eval]
