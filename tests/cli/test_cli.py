@@ -219,6 +219,11 @@ BAD = [
     (["fcr", "--xi-max", "0.15", "--Omega-range", "1,0.5,10"], "'--Omega-range'", "empty range"),
     (["basin", "--F", "0.01", "--Omega", "0.9", "--xi-max", "0.2", "--n", "5", "--n-points", "2"],
      "'--n-points'", "n_points must be >= 3"),                    # raised by the library, mapped to the option
+    (["chart", "--F", "0.01", "--Omega", "0.9", "--Psi", "pi/0", "--xi-max", "0.15"], "'--Psi'", "divides by zero"),
+    (["chart", "--F", "0.01", "--Omega", "0.02", "--xi-max", "0.15"], "'--steps-per-cycle'",
+     "use steps_per_cycle >= 297"),                                # checked before anything is integrated
+    (["fcr", "--xi-max", "0.15", "--numeric", "--numeric-Omega", "0.01,0.02,2"], "'--steps-per-cycle'",
+     "steps_per_cycle >="),
     (["info", "not_netcdf.txt"], "'FILE'", "not a readable netCDF file"),
 ]
 
@@ -247,3 +252,38 @@ def test_choices_are_the_librarys():
     from safebasins.wells.quartic import FOURIER_VARIANTS
 
     assert tuple(BACKENDS) == tuple(engine.BACKENDS) and tuple(FOURIER) == tuple(FOURIER_VARIANTS)
+
+
+@pytest.mark.parametrize("args, text", [
+    (["chart", "--F", "0.01", "--Omega", "0.9", "--xi-max", "0.15", "--n", "30000x30000", "--cycles", "5000"],
+     "core-hours"),
+    (["basin", "--F", "0.01", "--Omega", "0.9", "--xi-max", "0.15", "--n-gamma", "50000", "--n-xi", "50000"],
+     "slow-flow evaluations"),
+])
+def test_cost_guard_refuses_before_computing_unless_allowed(tmp_path, args, text):
+    """The pipeline's default budgets guard the CLI too: refused with exit 2 naming
+    --allow-expensive, before anything is computed or written."""
+    res = run([*args, "-o", "x"], tmp_path)
+    assert res.returncode == 2 and "Traceback" not in res.stderr, res.stderr
+    last = res.stderr.strip().splitlines()[-1]
+    assert text in last and "--allow-expensive" in last, last
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_cost_of_a_command_is_the_pipelines():
+    from safebasins.cli.options import cost_guard
+    from safebasins.pipeline.cost import budgets
+
+    b = budgets()
+    assert b["budget_core_hours"] > 0 and b["budget_analytic_evaluations"] > 0
+    assert cost_guard("basin_rm", {}, allow_expensive=True) is None    # allowed: nothing is estimated
+
+
+def test_unwritable_output_is_refused_before_computing(tmp_path):
+    target = tmp_path / "file"
+    target.write_text("")
+    res = run([*CHART[:9], "-o", str(target / "run")], tmp_path)      # a file where a folder should be
+    assert res.returncode == 2 and "'--out'" in res.stderr and "is a file, not a folder" in res.stderr, res.stderr
+    (tmp_path / "run.nc").mkdir()
+    res = run([*CHART[:9], "-o", "run"], tmp_path)
+    assert res.returncode == 2 and "run.nc is a folder" in res.stderr, res.stderr

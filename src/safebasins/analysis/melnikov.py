@@ -88,7 +88,7 @@ N_MEAN = 8
 END_FLOOR = 1e-8
 #: time window of the manifold flows (manifold_splitting)
 _SEGMENT = 1.5
-#: the smallest |I2| accepted, in units of the rounding level eps * (total variation of q0)
+#: the smallest ``|I2|`` accepted, in units of the rounding level eps * (total variation of q0)
 MIN_SIGNAL = 1e6
 
 _EPS = np.finfo(float).eps

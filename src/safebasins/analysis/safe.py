@@ -43,7 +43,10 @@ def escape_variable(chart, criterion):
     return chart[var], thr
 
 
-def check_chart(chart, name="chart", variables=tuple(v for v, _ in CRITERIA.values())):
+_CHART_VARIABLES = tuple(v for v, _ in CRITERIA.values())
+
+
+def check_chart(chart, name="chart", variables=_CHART_VARIABLES):
     """``chart`` is an escape chart Dataset (numerics.escape_chart) with ``variables``; ValueError
     naming ``name`` otherwise."""
     if not isinstance(chart, xr.Dataset):

@@ -7,11 +7,20 @@ from pathlib import Path
 import click
 
 from safebasins.cli.options import (DISPLACEMENT, ENERGY, FINITE, OPTION_OF, POSITIVE, Deferred, Fields, Number,
-                                    NumberList, analytic_threshold, checked, common_options, current_well,
+                                    NumberList, analytic_threshold, checked, common_options, cost_guard, current_well,
                                     forcing_options, fourier_of, from_library, from_schema, grid_options, grid_params,
                                     joined, lib_check, library_errors, numerics_options, out_option)
 from safebasins.cli.output import chatter, describe, draw, finish, fmt, job, progress, write_outputs
 
+
+
+def check_step(Omega, steps_per_cycle):
+    """The engine's step check (numerics.engine.check_step) before anything is computed: a usage
+    error naming --steps-per-cycle (the message says which value works, or a larger --Omega)."""
+    from safebasins.numerics.engine import check_step as check
+
+    with library_errors():
+        check(Omega, steps_per_cycle, current_well(click.get_current_context()))
 
 
 def well_of(params):
@@ -68,7 +77,7 @@ def main():
 @common_options
 @out_option("chart")
 def chart(F, Omega, Psi, xi_max, q_max, grid, n, cycles, steps_per_cycle, threads, backend, t_eval, n_points, tiles,
-          fourier, well, no_plot, quiet, verbose, out):
+          fourier, well, no_plot, quiet, verbose, allow_expensive, out):
     """Numeric escape chart on an IC grid with the analytic safe basins and their IoU.
 
     One integration serves every threshold.  PREFIX.nc is the chart in the layout of the
@@ -93,6 +102,8 @@ def chart(F, Omega, Psi, xi_max, q_max, grid, n, cycles, steps_per_cycle, thread
                   tasks=[{"F": F, "xi_max": xi_max, "q_max": q_max}])
     params["title"] = (f"Escape chart and slow-flow safe basins, {well_label(well)} well, F = {fmt(F)}, "
                        f"Omega = {fmt(Omega)}, Psi = {fmt(Psi, angle=True)} (safebasins chart {name})")
+    check_step(Omega, steps_per_cycle)
+    cost_guard("basin_chart", params, allow_expensive)
     with library_errors(), chatter(verbose):
         ds, basins = chart_dataset(params, tiles, job(threads, backend), quiet)
         finish(ds, title=params["title"], params=params)
@@ -170,7 +181,8 @@ def n_scan_check(n):
 @common_options
 @out_option("fcr")
 def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cycles, steps_per_cycle,
-        threads, backend, tol, n_scan, F_bracket, criterion, fourier, well, no_plot, quiet, verbose, out):
+        threads, backend, tol, n_scan, F_bracket, criterion, fourier, well, no_plot, quiet, verbose, allow_expensive,
+        out):
     """Critical forcing F_cr(Omega): analytic curves, optionally with the numeric bisection.
 
     Curves come from --xi-max / --xi-ini / --gamma-ini (equal lengths or length 1).  Writes
@@ -207,6 +219,9 @@ def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cyc
                              "tol": tol, "F_bracket": F_bracket, "n_scan": n_scan, "criterion": criterion,
                              "steps_per_cycle": steps_per_cycle}
     params["title"] = f"Critical forcing F_cr(Omega), {well_label(well)} well (safebasins fcr {name})"
+    if numeric:
+        check_step(params["numeric"]["Omega"], steps_per_cycle)
+    cost_guard("fcr_compare" if numeric else "fcr_theory", params, allow_expensive)
     from safebasins.analysis.fcr_curves import analytic_fcr_curves
 
     with library_errors(), chatter(verbose):
@@ -291,7 +306,7 @@ def fcr_numeric(params, job, quiet):
 @common_options
 @out_option("basin")
 def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, fourier, well, no_plot, quiet, verbose,
-          out):
+          allow_expensive, out):
     """Analytic safe basin of the slow flow, on the resonance manifold and on the IC plane.
 
     PREFIX.nc has the layout of the pipeline's Figs 5-9: boundary curves (`gamma`, `xi`,
@@ -314,6 +329,7 @@ def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, fouri
                   manifold={"n_gamma": n_gamma, "n_xi": n_xi, "xi_top": xi_top})
     params["title"] = (f"Analytic safe basin, {well_label(well)} well, F = {fmt(F)}, Omega = {fmt(Omega)}, "
                        f"Psi = {fmt(Psi, angle=True)}, xi_max = {fmt(xi_max)} (safebasins basin {name})")
+    cost_guard("basin_rm", params, allow_expensive, numeric=False)
     from safebasins.analysis.ic_basins import add_resonance_manifold, analytic_basin
 
     with library_errors(), chatter(verbose):

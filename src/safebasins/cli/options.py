@@ -38,7 +38,10 @@ def parse_number(text, angle=False) -> float:
     m = _ANGLE.match(s) if angle else None
     if m:
         sign = -1.0 if m.group(1) == "-" else 1.0
-        return sign * float(m.group(2) or 1.0) * math.pi / float(m.group(3) or 1.0)
+        den = float(m.group(3) or 1.0)
+        if den == 0:
+            raise ValueError(f"{text!r} divides by zero")
+        return sign * float(m.group(2) or 1.0) * math.pi / den
     try:
         return float(s)
     except ValueError:
@@ -323,7 +326,55 @@ def out_prefix(ctx, param, value):
     if Path(value).is_dir() or not Path(value).name:
         raise click.BadParameter(f"{value!r} is a directory: give a file prefix such as {value.rstrip('/')}/run1",
                                  ctx, param)
+    try:
+        check_writable(Path(value))
+    except OSError as exc:
+        raise click.BadParameter(f"cannot write {value}.nc: {exc}", ctx, param) from None
     return value
+
+
+def check_writable(prefix: Path):
+    """OSError unless PREFIX.nc / PREFIX.png can be written: the nearest existing folder above
+    them is a folder in which a file can be created (probed, then removed: read-only mounts and
+    permissions alike); checked before anything is computed."""
+    import tempfile
+
+    folder = prefix.absolute().parent
+    while not folder.exists():
+        folder = folder.parent
+    if not folder.is_dir():
+        raise OSError(f"{folder} is a file, not a folder")
+    for ext in (".nc", ".png"):
+        if prefix.with_name(prefix.name + ext).is_dir():
+            raise OSError(f"{prefix}{ext} is a folder")
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as exc:
+        raise OSError(f"no file can be created in {folder} ({exc.strerror or exc})") from None
+
+
+def cost_guard(kind, params, allow_expensive, numeric=True):
+    """The pipeline's cost guard (safebasins.pipeline.cost, the config schema's default budgets)
+    for one command: a usage error naming --allow-expensive above a budget."""
+    from safebasins.pipeline.cost import ANALYTIC_RATE, RATE_PER_CORE, budgets, params_cost
+
+    if allow_expensive:
+        return
+    steps, evaluations = params_cost(kind, params, numeric)
+    b = budgets()
+    core_hours = steps / RATE_PER_CORE / 3600
+    if core_hours > b["budget_core_hours"]:
+        raise click.UsageError(
+            f"this run integrates up to {steps:.2e} trajectory-steps = {core_hours:.3g} core-hours (at "
+            f"{RATE_PER_CORE:.1e} steps/s per core), above the budget of {b['budget_core_hours']:g} core-hours: "
+            "reduce --n, --cycles or the scanned values, or pass --allow-expensive")
+    if evaluations > b["budget_analytic_evaluations"]:
+        raise click.UsageError(
+            f"the analytic part of this run needs {evaluations:.2e} slow-flow evaluations (~"
+            f"{evaluations / ANALYTIC_RATE / 3600:.3g} h at {ANALYTIC_RATE:.0e}/s), above the budget of "
+            f"{b['budget_analytic_evaluations']:.3g}: reduce --n, --n-points, --n-gamma/--n-xi or the Omega range, "
+            "or pass --allow-expensive")
 
 
 # ----------------------------------------------------------------------------------------------
@@ -355,6 +406,9 @@ def well_option(f):
 
 
 def common_options(f):
+    f = click.option("--allow-expensive", "allow_expensive", is_flag=True,
+                     help="Run even above the pipeline's default cost budgets (config keys "
+                          "numerics.budget_core_hours, numerics.budget_analytic_evaluations).")(f)
     f = click.option("--verbose", "-v", is_flag=True, help="Log lines of the pipeline build functions on stderr.")(f)
     f = click.option("--quiet", "-q", is_flag=True, help="No progress bar on stderr.")(f)
     f = click.option("--no-plot", "no_plot", is_flag=True, help="Write only the netCDF file.")(f)

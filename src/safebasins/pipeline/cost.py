@@ -104,6 +104,28 @@ def analytic_costs(run, experiments=None) -> dict[str, int]:
     return {n: analytic_cost(e, run) for n, e in run.experiments.items() if experiments is None or n in experiments}
 
 
+def params_cost(kind, params, numeric=True) -> tuple[int, int]:
+    """(trajectory-steps, slow-flow evaluations) of one run of ``kind`` (a registered kind's name)
+    with resolved ``params`` (the command line's runs; ``numeric=False``: analytic only)."""
+    from safebasins.pipeline.config import load_kinds
+    from safebasins.pipeline.registry import KINDS, Experiment
+
+    load_kinds()
+    k = KINDS[kind]
+    exp = Experiment(name=params.get("experiment", kind), kind=k, key=kind, params=params, figure=None, products=(),
+                     tasks=())
+    return (exp_cost(exp) if numeric else 0), analytic_cost(exp)
+
+
+def budgets() -> dict:
+    """The default budgets of the config schema (its one home): ``budget_core_hours``,
+    ``budget_analytic_evaluations``."""
+    from safebasins.pipeline.config import SCHEMA_PATH, load_yaml
+
+    props = load_yaml(SCHEMA_PATH)["properties"]["numerics"]["properties"]
+    return {k: props[k]["default"] for k in ("budget_core_hours", "budget_analytic_evaluations")}
+
+
 # ---------------------------------------------------------------------- report and guard
 def _duration(seconds: float) -> str:
     if seconds < 120:

@@ -169,7 +169,7 @@ class _Printer:
         return f"math.pow({self(b)}, {self(x)})"
 
 
-#: where the candidate forms of V' are compared with a 40-digit evaluation: |q| from 1e-4 to 30
+#: where the candidate forms of V' are compared with a 40-digit evaluation: ``|q|`` from 1e-4 to 30
 _PROBE = np.concatenate([-np.geomspace(1e-4, 30.0, 40)[::-1], np.geomspace(1e-4, 30.0, 40)])
 
 
