@@ -50,6 +50,20 @@ def test_displacement_criterion_not_below_energy():
     assert d.attrs["criterion"] == "displacement"
 
 
+def test_bracket_too_small_warns_naming_F_bracket():
+    """A bracket whose upper end does not escape gives NaN with a warning, never silently."""
+    from safebasins.numerics.bisection import BracketWarning
+
+    with pytest.warns(BracketWarning, match=r"F_bracket = \(0, 0.001\) did not contain the escape threshold.*"
+                                            r"F_bracket\[1\] = 0.001 does not escape within 100 cycles at "
+                                            r"Omega = 0.9, 1 \(2 of 2\).*F_bracket=\(0, 0.004\)"):
+        ds = critical_forcing_numeric([0.9, 1.0], 0.2, cycles=100, n_scan=0, F_bracket=(0.0, 0.001))
+    assert np.isnan(ds["F_cr"]).all()
+    with pytest.warns(BracketWarning, match=r"F_bracket\[0\] = 0.5 already escapes at Omega = 0.9 .*"
+                                            r"F_bracket=\(0, 0.6\)"):
+        critical_forcing_numeric([0.9], 0.2, cycles=100, n_scan=0, F_bracket=(0.5, 0.6))
+
+
 @pytest.mark.parametrize("kw,name", [(dict(Omega=-1), "Omega"), (dict(xi_max=0.3), "xi_max"),
                                      (dict(tol=0), "tol"), (dict(F_bracket=(0.2, 0.1)), "F_bracket"),
                                      (dict(criterion="foo"), "criterion"), (dict(n_scan=1), "n_scan"),

@@ -1,6 +1,8 @@
 """Numeric critical forcing F_cr(Omega): ensemble bisection (Section 3.1) plus a fine F scan."""
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import xarray as xr
 
@@ -10,6 +12,33 @@ from safebasins.numerics import criteria, engine, kernels
 from safebasins.wells import QuarticWell, resolve_well
 
 DEFAULT_N_SCAN = 301
+
+
+class BracketWarning(RuntimeWarning):
+    """F_bracket did not contain the escape threshold at some Omega (their F_cr is NaN)."""
+
+
+def _warn_bracket(Om, br, ends, cycles):
+    """Name the Omega whose F_cr is NaN because F_bracket misses the threshold, and a bracket to try."""
+    n = Om.size
+    low_escapes, high_safe = ends[:n], ~ends[n:]
+    lo, hi = float(br[0]), float(br[1])
+    parts = []
+    if high_safe.any():
+        parts.append(f"F_bracket[1] = {hi:g} does not escape within {cycles} cycles at Omega = "
+                     f"{_list(Om[high_safe])} ({int(high_safe.sum())} of {n})")
+    if low_escapes.any():
+        parts.append(f"F_bracket[0] = {lo:g} already escapes at Omega = {_list(Om[low_escapes])} "
+                     f"({int(low_escapes.sum())} of {n})")
+    suggest = (0.0 if low_escapes.any() else lo, 4.0 * hi if high_safe.any() else hi)
+    warnings.warn(f"F_bracket = ({lo:g}, {hi:g}) did not contain the escape threshold: " + "; ".join(parts)
+                  + f". F_cr is NaN there; try a larger bracket, e.g. F_bracket=({suggest[0]:g}, {suggest[1]:g}).",
+                  BracketWarning, stacklevel=4)  # the caller of critical_forcing_numeric (api_provenance)
+
+
+def _list(values, most=6):
+    text = ", ".join(f"{v:g}" for v in values[:most])
+    return text + (f", ... ({values.size - most} more)" if values.size > most else "")
 
 
 def _escapes(q0, p0, Omega, F, Psi, thr_kw, cycles, spc, threads, integrator, backend, w, damping):
@@ -30,7 +59,8 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
 
     Bisection: all Omega points advance together, one compiled ensemble per bisection level,
     until the bracket [F_lo (no escape within `cycles`), F_hi (escape)] is narrower than tol;
-    F_cr = (F_lo + F_hi) / 2 (NaN where F_bracket[1] does not escape or F_bracket[0] does).
+    F_cr = (F_lo + F_hi) / 2 (NaN where F_bracket[1] does not escape or F_bracket[0] does; a
+    :class:`BracketWarning` then names those Omega and suggests a larger bracket).
     criterion "energy": escape when H0 > xi_max (or q beyond a barrier: ``|q| > 1`` for the quartic);
     "displacement": q outside the turning points of the energy level xi_max, ``|q| > q_max(xi_max)``
     (eq 4) for the quartic, q < q_minus(xi_max) or q > q_plus(xi_max) (well.turning_points) for
@@ -87,6 +117,8 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     ends = _escapes(q0, p0, np.concatenate([Om, Om]), np.concatenate([np.full(nO, br[0]), np.full(nO, br[1])]),
                     Psi, thr_kw, cycles, spc, threads, integrator, backend, w, damping)
     valid = ~ends[:nO] & ends[nO:]
+    if not valid.all():
+        _warn_bracket(Om, br, ends, cycles)
     lo = np.full(nO, br[0])
     hi = np.full(nO, br[1])
     levels = 0
