@@ -3,12 +3,13 @@ from __future__ import annotations
 
 import contextlib
 import json
-import math
 import os
 import shlex
 import sys
 
 import click
+
+from safebasins.pipeline.values import fmt  # the one number/angle formatter (commands import it from here)
 
 #: global attributes shown under "provenance" (never among the physical parameters)
 PROVENANCE = ("safebasins_version", "git_commit", "date_created", "config_hash", "source", "history",
@@ -83,17 +84,6 @@ def write_outputs(datasets, fig, png):
             save_figure(fig, tmp, datasets=[ds for _, ds in datasets])
         plt.close(fig)
         click.echo(f"wrote {png}")
-
-
-def fmt(v, angle=False):
-    """Compact number for titles and reports; angles that are simple multiples of pi with pi."""
-    if angle and v != 0:
-        for den in (1, 2, 3, 4, 6):
-            num = v / math.pi * den
-            if abs(num - round(num)) < 1e-12:
-                num = round(num)
-                return f"{'-' if num < 0 else ''}{abs(num) if abs(num) != 1 else ''}pi{f'/{den}' if den > 1 else ''}"
-    return f"{v:.6g}"
 
 
 def describe(path, show_params=True, width=100):

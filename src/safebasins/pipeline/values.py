@@ -21,10 +21,20 @@ def angle(v) -> float:
     return float(v)
 
 
-def fmt(v) -> str:
+def fmt(v, angle=False) -> str:
+    """Compact number for titles, labels and captions (``%g``; a string stays as it is).  With
+    ``angle=True`` a simple multiple of pi is written with pi: ``pi``, ``-pi/2``, ``3pi/4``
+    (the one angle formatter of the command line and the pipeline's texts)."""
     if isinstance(v, str):
         return v
-    return f"{float(v):g}"
+    v = float(v)
+    if angle and v != 0:
+        for den in (1, 2, 3, 4, 6):
+            num = v / math.pi * den
+            if abs(num - round(num)) < 1e-12:
+                num = round(num)
+                return f"{'-' if num < 0 else ''}{abs(num) if abs(num) != 1 else ''}pi{f'/{den}' if den > 1 else ''}"
+    return f"{v:g}"
 
 
 def range_values(r) -> list[float]:

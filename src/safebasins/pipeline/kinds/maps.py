@@ -141,7 +141,7 @@ class IntegrityMap(Kind):
 
     def default_figure_text(self, experiment, params):
         caption = (f"Integrity over the control plane: GIM and LIM of the safe basin for xi_max = {params['xi_max']:g}, "
-                   f"Psi = {params['Psi']:.4g}, on a {len(params['Omega'])} x {len(params['F'])} grid of (Omega, F), "
+                   f"Psi = {values.fmt(params['Psi'], angle=True)}, on a {len(params['Omega'])} x {len(params['F'])} grid of (Omega, F), "
                    f"{params['grid']['n'][0]} x {params['grid']['n'][1]} ICs per point, {params['cycles']} cycles.")
         look = ("Top: slow-flow (analytic) maps and, dashed, the all-phase basin's erosion front; middle: numeric maps "
                 "at the last evaluation time; bottom: numeric minus analytic. Lines: the erosion fronts (F at which "
