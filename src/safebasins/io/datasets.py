@@ -8,7 +8,9 @@ Every file the pipeline writes goes through :func:`finalize` and :func:`write_ne
   ``git_commit``, ``config_hash``, ``parameters`` as JSON, ``seeds`` when the parameters have
   them; numeric datasets carry ``integrator`` and ``steps_per_cycle`` from safebasins.numerics);
 * :func:`write_netcdf` writes netCDF4 with zlib compression to a temporary file in the target
-  directory and renames it over the target (atomic: a killed job never leaves a half file).
+  directory and renames it over the target (atomic: a killed job never leaves a half file);
+  it and :func:`load` go through :mod:`safebasins.io.netcdf`, whose errors name the file and
+  the likely cause (a full disk, a corrupted or truncated file).
 
 Compare datasets by content with :mod:`safebasins.io.compare`, never by file bytes:
 ``date_created`` and ``git_commit`` legitimately differ between runs.
@@ -27,7 +29,7 @@ import xarray as xr
 
 from safebasins import __version__
 from safebasins.io.cf import INSTITUTION, REFERENCE, annotate
-from safebasins.io.files import atomic_path
+from safebasins.io import netcdf
 
 @lru_cache(maxsize=1)
 def git_commit() -> str:
@@ -124,11 +126,9 @@ def _encoding(ds: xr.Dataset) -> dict:
 
 
 def write_netcdf(ds: xr.Dataset, path) -> Path:
-    """Write `ds` to netCDF4 (zlib) atomically (:func:`safebasins.io.files.atomic_path`)."""
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        ds.to_netcdf(tmp, format="NETCDF4", engine="netcdf4", encoding=_encoding(ds))
-    return path
+    """Write `ds` to netCDF4 (zlib) atomically (:func:`safebasins.io.netcdf.write`: no half file
+    survives a failure; a full disk is a :class:`~safebasins.io.netcdf.NetCDFFileError` naming the file)."""
+    return netcdf.write(ds, path, format="NETCDF4", engine="netcdf4", encoding=_encoding(ds))
 
 
 def params_hash(params: dict) -> str:
@@ -137,8 +137,9 @@ def params_hash(params: dict) -> str:
 
 
 def load(path) -> xr.Dataset:
-    """Read a dataset fully into memory and close the file."""
-    return xr.load_dataset(path, engine="netcdf4")
+    """Read a dataset fully into memory and close the file (:func:`safebasins.io.netcdf.read`: a
+    corrupted or truncated file is a :class:`~safebasins.io.netcdf.NetCDFFileError` naming it)."""
+    return netcdf.read(path)
 
 
 # --------------------------------------------------------------------------------------

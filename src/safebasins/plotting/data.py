@@ -17,11 +17,13 @@ import yaml
 
 def open_dataset(src):
     """Path -> fully loaded Dataset (file closed again; its path kept in ``encoding["source"]``);
-    a Dataset passes through; None stays None."""
+    a Dataset passes through; None stays None.  A corrupted or truncated file is a
+    :class:`~safebasins.io.netcdf.NetCDFFileError` naming it."""
+    from safebasins.io.netcdf import read
+
     if src is None or isinstance(src, (xr.Dataset, xr.DataArray)):
         return src
-    with xr.open_dataset(src) as ds:
-        out = ds.load()
+    out = read(src)
     out.encoding["source"] = os.fspath(src)
     return out
 
