@@ -157,14 +157,56 @@ def unforced_radii2(xi, well=None, *, n=1001):
     V2 = 2.0 * np.asarray(w.V(q), float)
     r_local2 = 2.0 * xi - float(np.max(V2 - q * q))
 
-    def worst(c):            # max_q (2 V(q) - (q - c)^2) for every centre c
-        return np.max(V2[None, :] - (q[None, :] - c[:, None]) ** 2, axis=1)
-
-    m = worst(q)
-    k = int(np.argmin(m))
+    # worst(c) = max_q (2 V(q) - (q - c)^2); k = argmin over c = q, then the min over c_fine
+    best, k = _min_worst(V2, q, q, np.inf, -1)
     c_fine = np.union1d(np.linspace(q[max(k - 1, 0)], q[min(k + 1, q.size - 1)], n), [q[k]])
-    r_global2 = 2.0 * xi - float(min(m[k], np.min(worst(c_fine))))
+    r_global2 = 2.0 * xi - float(min(best, _min_worst(V2, q, c_fine, best, -1)[0]))
     return r_local2, r_global2
+
+
+def _worst_rows(V2, q, c):
+    """``worst(c) = max_q (V2 - (q - c)^2)`` per centre and the q index of each maximum."""
+    M = V2[None, :] - (q[None, :] - c[:, None]) ** 2
+    return np.max(M, axis=1), np.argmax(M, axis=1)
+
+
+def _min_worst(V2, q, c, best, kbest, stride=32, chunk=128):
+    """Smallest ``(worst(c_i), i)`` (lexicographic: the first index of the minimum, as
+    ``np.argmin``) that beats ``(best, kbest)``, as ``(value, index)``; ``(best, kbest)`` if none.
+
+    Exact (the values are those of the full ``(c, q)`` matrix, the same expression element by
+    element; max and min select, they do not round): every ``stride``-th centre is evaluated in
+    full; any other centre whose value at the maxima of its two evaluated neighbours (a lower
+    bound of its max) already loses is skipped; the rest are evaluated in full."""
+    nc = c.size
+    if not np.isfinite(V2).all():          # NaN ordering: the plain matrix
+        vals = _worst_rows(V2, q, c)[0]
+        i = int(np.argmin(vals))
+        return _lexmin(best, kbest, vals[i], i)
+    sub = np.unique(np.concatenate([np.arange(0, nc, stride), [nc - 1]]))
+    vals, arg = _worst_rows(V2, q, c[sub])
+    i = int(np.argmin(vals))
+    best, kbest = _lexmin(best, kbest, vals[i], int(sub[i]))
+    rest = np.setdiff1d(np.arange(nc), sub)
+    if rest.size == 0:
+        return best, kbest
+    pos = np.searchsorted(sub, rest)
+    cr = c[rest]
+    jl, jr = arg[pos - 1], arg[np.minimum(pos, sub.size - 1)]
+    lb = np.maximum(V2[jl] - (q[jl] - cr) ** 2, V2[jr] - (q[jr] - cr) ** 2)
+    todo = rest[~((lb > best) | ((lb == best) & (rest > kbest)))]
+    for s in range(0, todo.size, chunk):
+        idx = todo[s:s + chunk]
+        v = _worst_rows(V2, q, c[idx])[0]
+        i = int(np.argmin(v))
+        best, kbest = _lexmin(best, kbest, v[i], int(idx[i]))
+    return best, kbest
+
+
+def _lexmin(best, kbest, v, i):
+    if v < best or (v == best and i < kbest):
+        return v, i
+    return best, kbest
 
 
 # --------------------------------------------------------------------------- core

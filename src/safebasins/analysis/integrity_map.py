@@ -24,12 +24,11 @@ import xarray as xr
 from safebasins import checks
 from safebasins.analysis.common import as_1d, mesh, variant_well
 from safebasins.analysis.erosion import level_crossing
-from safebasins.analysis.integrity import integrity_measures, unforced_safe_mask
-from safebasins.analysis.phase_invariant import closed_measures, xi_true_analytic
+from safebasins.analysis._grid_slow_flow import GridSlowFlow
+from safebasins.analysis.integrity import integrity_measures, unforced_radii2, unforced_safe_mask
 from safebasins.analysis.safe import chart_well, safe_stack
 from safebasins.io.cf import annotate
 from safebasins.numerics import escape_chart_batch
-from safebasins.theory import slow_flow_escapes
 from safebasins.wells import well_attrs
 
 __all__ = ["integrity_map_analytic", "integrity_map_numeric", "integrity_from_batch", "erosion_front"]
@@ -56,11 +55,17 @@ def integrity_map_analytic(Omega, F, Psi, xi_max, q0, p0, *, fourier=None, n_gam
     S0 = unforced_safe_mask(q, p, xi, w)
     safe = np.zeros((Om.size, Fv.size, q.size, p.size), bool)
     xt = np.zeros((Om.size, Fv.size))
+    # = slow_flow_escapes and xi_true_analytic per control point, bit for bit, with the grid's and
+    # the threshold's shared quantities evaluated once (issue 20)
+    grid = GridSlowFlow(Q, P, Psi, xi, w)
+    checks.check_positive_int("n_gamma", n_gamma)
     for i, om in enumerate(Om):
         for j, f in enumerate(Fv):
-            safe[i, j] = ~np.asarray(slow_flow_escapes(Q, P, f, om, Psi, xi, well=w), bool) & S0
-            xt[i, j] = xi_true_analytic(f, om, xi, n_gamma=n_gamma, n_xi=n_xi, well=w)
-    closed = {x: closed_measures(x, xi, w) for x in np.unique(xt)}
+            prof = grid.profile(checks.check_scalar("F", f, checks.check_nonnegative),
+                                checks.check_scalar("Omega", om, checks.check_positive))
+            safe[i, j] = ~grid.escapes(prof) & S0
+            xt[i, j] = grid.xi_true(prof, n_gamma=n_gamma, n_xi=n_xi)
+    closed = _closed_measures(np.unique(xt), xi, w)
     cm = np.array([closed[x] for x in xt.ravel()]).reshape(xt.shape + (3,))
     da = xr.DataArray(safe, dims=("Omega", "F", "q0", "p0"), coords={"Omega": Om, "F": Fv, "q0": q, "p0": p})
     m = integrity_measures(da, xi_max=xi, well=w)
@@ -79,6 +84,22 @@ def integrity_map_analytic(Omega, F, Psi, xi_max, q0, p0, *, fourier=None, n_gam
     ds.attrs.update(kind="analytic", Psi=Psi, xi_max=xi, fourier=w.fourier, n_gamma=int(n_gamma), n_xi=int(n_xi),
                     method="slow_flow_escapes on the grid per control point; xi_true_analytic for all phases")
     return annotate(ds)
+
+
+def _closed_measures(xis, xi_max, well):
+    """``{x: closed_measures(x, xi_max, well)}`` with the radii of ``xi_max`` computed once."""
+    out = {}
+    ref = None
+    for x in xis:
+        if x <= 0:
+            out[x] = (0.0, 0.0, 0.0)
+            continue
+        if ref is None:
+            ref = unforced_radii2(xi_max, well), well.J(xi_max)
+        (loc_m, glob_m), J_m = ref
+        loc_t, glob_t = unforced_radii2(x, well)
+        out[x] = (float(well.J(x) / J_m), float(np.sqrt(loc_t / loc_m)), float(np.sqrt(glob_t / glob_m)))
+    return out
 
 
 def integrity_from_batch(charts, t_eval=None):
