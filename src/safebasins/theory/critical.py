@@ -43,6 +43,7 @@ import numpy as np
 import xarray as xr
 
 from safebasins.checks import check_finite, check_positive
+from safebasins.theory.damped import check_damping
 from safebasins.theory.slow_flow import _scalar, _xi_grid, unshear
 from safebasins.wells import resolve_well
 
@@ -98,7 +99,8 @@ def _interior_max(L, valid, xi, refine_fun, n_iter=60):
     return x_out, v_out, exists
 
 
-def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_grid=2001, well=None):
+def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_grid=2001, well=None,
+                     damping=0.0):
     """Critical forcing amplitude F_cr(Omega) of the slow flow (eqs 22-26).
 
     Parameters
@@ -117,11 +119,19 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
         initial point enters through cos(gamma_ini + delta(xi_ini)).
     n_grid : int
         Nodes of the xi grid used to bracket the maxima (refined by bisection).
+    damping : float, >= 0
+        beta of ``q'' + beta q' + V'(q) = F sin(Omega tau + Psi)``.  0 (default): the conservative
+        slow flow, eqs (22)-(26), as below.  beta > 0: F_cr is the smallest F for which the
+        trajectory of the damped slow flow from (gamma_ini, xi_ini) reaches xi_max before it settles
+        on an attractor (:func:`safebasins.theory.damped_escape.damped_critical_forcing`, by a scan
+        in F and bisection; docs/damping.md); the Dataset then has ``F_cr``, ``F_settle``,
+        ``F_cr_undamped``, ``F_min``, ``xi_attractor``, ``t_escape``, ``undecided`` (F_cr is NaN
+        where an undecided trajectory leaves it unknown) instead of the mechanism branches.
 
     Returns
     -------
     xarray.Dataset
-        Over ``Omega``, with
+        Over ``Omega`` (damping = 0), with
 
         * ``F_cr``: smallest F at which the level curve through (gamma_ini, xi_ini) reaches
           xi_max (NaN if it never does);
@@ -151,6 +161,11 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
     g0 = _scalar("gamma_ini", gamma_ini, check_finite)
     if not isinstance(n_grid, (int, np.integer)) or n_grid < 16:
         raise ValueError("n_grid must be an integer >= 16")
+    beta = check_damping(damping)
+    if beta > 0:
+        from safebasins.theory.damped_escape import damped_critical_forcing
+        F0 = critical_forcing(Om, xm, x0, g0, n_grid=n_grid, well=w)["F_cr"].values
+        return damped_critical_forcing(Om, xm, x0, g0, beta, w, F_undamped=F0)
 
     nO = Om.size
     xi = _xi_grid(x0, xm, int(n_grid))

@@ -35,9 +35,9 @@ from __future__ import annotations
 import numpy as np
 from scipy import optimize
 
-from safebasins.checks import check_finite, check_nonnegative, check_positive
+from safebasins.checks import check_finite, check_nonnegative, check_positive, check_scalar
 from safebasins.wells import resolve_well
-from safebasins.wells.quartic import XI_SEPARATRIX, _G, _J, _dG_dxi, _ell, _omega
+from safebasins.wells.quartic import XI_SEPARATRIX, _G, _J, _dG_dxi, _ell, _omega, check_fourier
 
 __all__ = ["first_integral", "escapes_on_manifold", "slow_flow_escapes", "slow_flow_profile",
            "slow_flow_rhs", "xi_from_J", "saddles"]
@@ -209,15 +209,23 @@ def escapes_on_manifold(gamma, xi, F, Omega, xi_max, fourier=None, well=None):
     return _escapes_rm(gamma, xi, prof)
 
 
-def slow_flow_escapes(q0, p0, F, Omega, Psi, xi_max, fourier=None, well=None):
+def slow_flow_escapes(q0, p0, F, Omega, Psi, xi_max, fourier=None, well=None, damping=0.0):
     """Analytic escape prediction for initial conditions ``(q0, p0)`` at tau = 0.
 
     Each IC is mapped to ``(theta0, xi_ini)`` (eqs 7, 14), ``gamma_ini = theta0 - Psi``, and
     classified by whether the level curve of C (eq 18) through ``(gamma_ini, xi_ini)`` reaches
     ``xi_max`` (eq 21).  ICs with ``H0 >= xi_max`` or beyond a barrier escape.  Broadcasts q0
     and p0; F, Omega, Psi, xi_max are scalars.  Returns a bool array (True = escapes).
+
+    ``damping`` (beta >= 0, default 0: the above): for beta > 0 the level curves of C are no longer
+    trajectories; an IC is safe iff its trajectory of the damped slow flow settles on an attractor
+    without reaching xi_max (:func:`safebasins.theory.damped_escape.slow_flow_outcomes`,
+    docs/damping.md).  Undecided trajectories count as escaping, with an ``UndecidedWarning``.
     """
     w = resolve_well(well, fourier)
+    if check_scalar("damping", damping, check_nonnegative) > 0:
+        from safebasins.theory.damped_escape import damped_escapes
+        return damped_escapes(q0, p0, F, Omega, Psi, xi_max, damping, well=w)
     q0 = check_finite("q0", q0)
     p0 = check_finite("p0", p0)
     _scalar("Psi", Psi, check_finite)
@@ -266,11 +274,21 @@ def slow_flow_rhs(X, Y, F, Omega, fourier="paper"):
     With ``J' = -F G sin(gamma)`` and ``gamma' = omega - Omega - F omega G'(xi) cos(gamma)``:
     ``X' = J' cos(gamma)/r - Y gamma'``, ``Y' = J' sin(gamma)/r + X gamma'`` (``r^2 = 2J``).
     Regular at the well bottom (there ``X' = 0``, ``Y' = -F/2`` for ``G ~ r/2``).  Returns
-    ``(dX, dY)``; C (eq 18) is conserved.
+    ``(dX, dY)``; C (eq 18) is conserved.  ``F >= 0``, ``Omega > 0`` (finite scalars or arrays),
+    ``fourier`` "paper" | "exact", ``X^2 + Y^2 <= 2 J(1/4)``; a ValueError names the argument
+    otherwise.  With damping see :func:`safebasins.theory.damped.rhs_gamma_frame`.
     """
+    check_nonnegative("F", F)
+    check_positive("Omega", Omega)
+    check_fourier(fourier)
+    check_finite("X", X)
+    check_finite("Y", Y)
     X = np.asarray(X, float)
     Y = np.asarray(Y, float)
     r2 = X * X + Y * Y
+    if (0.5 * r2 > float(_J(np.asarray(XI_SEPARATRIX)))).any():
+        raise ValueError("X, Y must lie inside the separatrix: X^2 + Y^2 <= 2 J(1/4) = "
+                         f"{2 * float(_J(np.asarray(XI_SEPARATRIX)))!r}")
     r = np.sqrt(r2)
     xi = xi_from_J(0.5 * r2)
     small = r < 1e-12
