@@ -10,6 +10,7 @@ options   option types and checks (library checks, library/schema defaults)
 output    provenance, progress bars, figures, atomic files, the `info` summary
 commands  the click group ``main`` (console script ``safebasins``) and its commands
 explore   the ``explore`` command: the interactive explorer (safebasins.explore) in a browser
+interrupt Ctrl-C (SIGINT) exits 130, never 0 (the group class of ``main``)
 """
 from safebasins.cli.commands import main
 from safebasins.cli.explore import explore

@@ -10,6 +10,7 @@ from safebasins.cli.options import (DISPLACEMENT, ENERGY, FINITE, OPTION_OF, POS
                                     NumberList, analytic_threshold, checked, common_options, cost_guard, current_well,
                                     forcing_options, fourier_of, from_library, from_schema, grid_options, grid_params,
                                     joined, lib_check, library_errors, numerics_options, out_option)
+from safebasins.cli.interrupt import InterruptibleGroup
 from safebasins.cli.output import chatter, describe, draw, finish, fmt, job, progress, write_outputs
 
 
@@ -41,7 +42,7 @@ def well_label(spec):
     return spec.get("expression", spec["name"]) if spec["name"] == "expression" else spec["name"]
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
+@click.group(cls=InterruptibleGroup, context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
 @click.version_option(package_name="safebasins")
 def main():
     """Safe basins of q'' + V'(q) = F sin(Omega t + Psi): analytic (slow flow) and numeric.

@@ -53,7 +53,9 @@ def make_server(host: str = "127.0.0.1", port: int | None = None):
 
 
 def serve(host: str = "127.0.0.1", port: int | None = None, open_browser: bool = True, announce=print):
-    """Run the explorer until interrupted (Ctrl-C); ``announce`` receives the URL."""
+    """Run the explorer until interrupted (Ctrl-C); ``announce`` receives the URL.  The interrupt
+    (``KeyboardInterrupt``) is raised again once the server has stopped, so that a command that
+    was interrupted does not exit as if it had completed (``safebasins explore`` exits 130)."""
     server = make_server(host, port)
     url = f"http://{host}:{server.port}/"
     announce(f"safebasins explorer at {url}  (Ctrl-C stops it)")
@@ -63,5 +65,6 @@ def serve(host: str = "127.0.0.1", port: int | None = None, open_browser: bool =
         server.io_loop.start()
     except KeyboardInterrupt:
         announce("stopped")
+        raise
     finally:
         server.stop()
