@@ -5,8 +5,13 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 JOBS   ?= 2
+# what `make reproduce` / `make recover` build, and extra Snakemake options (last on the line, e.g.
+# SNAKEMAKE_ARGS="--configfile config/quick.yaml"); REPORT= (empty) skips the HTML report
+TARGETS ?= all archive
+SNAKEMAKE_ARGS ?=
+REPORT ?= results/report.html
 
-.PHONY: reproduce test quick report archive lock clean-results unlock
+.PHONY: reproduce test quick report archive lock clean-results unlock recover
 
 $(STAMP): environment.lock pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -17,11 +22,18 @@ $(STAMP): environment.lock pyproject.toml
 
 ## Full reproduction at paper resolution: every dataset, figure, the archive and the HTML report.
 reproduce: $(STAMP)
-	@$(BIN)/snakemake -j$(JOBS) --rerun-incomplete all archive || { \
-	  if [ -n "$$(ls -A .snakemake/locks 2>/dev/null)" ]; then \
-	    echo "A killed run left Snakemake's lock on results/. Run:  make unlock  then  make reproduce"; fi; \
+	@$(BIN)/snakemake -j$(JOBS) --rerun-incomplete $(TARGETS) $(SNAKEMAKE_ARGS) || { \
+	  if [ -n "$$(ls -A .snakemake/locks 2>/dev/null; ls -A .snakemake/incomplete 2>/dev/null)" ]; then \
+	    echo "A killed run left Snakemake's lock or incomplete-file markers in .snakemake/. Run:  make recover"; fi; \
 	  exit 1; }
-	$(BIN)/snakemake -j$(JOBS) --report results/report.html
+	$(if $(REPORT),$(BIN)/snakemake -j$(JOBS) --report $(REPORT) $(SNAKEMAKE_ARGS))
+
+## After a killed run (the next run stops with a LockException or an IncompleteFilesException):
+## release the stale lock, then `make reproduce` (--rerun-incomplete redoes the interrupted jobs).
+## Nothing finished is deleted. Only while no other Snakemake runs in this directory.
+recover: $(STAMP)
+	$(BIN)/snakemake --unlock $(SNAKEMAKE_ARGS)
+	$(MAKE) -f $(firstword $(MAKEFILE_LIST)) reproduce
 
 ## After a killed run: release Snakemake's lock on the working directory (nothing is deleted).
 unlock: $(STAMP)
