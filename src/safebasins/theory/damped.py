@@ -39,6 +39,7 @@ import weakref
 import numpy as np
 
 from safebasins.checks import check_nonnegative, check_scalar
+from safebasins.theory.slow_flow import unshear
 from safebasins.wells.quartic import QuarticWell
 
 __all__ = ["check_damping", "coefficients", "xi_of_J", "SlowTables", "slow_tables", "flow_tilde",
@@ -214,8 +215,7 @@ def to_tilde(well, gamma, xi):
 def from_tilde(well, Xt, Yt):
     """``(gamma, xi)`` of points of the sheared Cartesian frame, gamma in (-pi, pi]."""
     xi = xi_of_J(well, 0.5 * (Xt * Xt + Yt * Yt))
-    g = np.arctan2(Yt, Xt) - well.harmonic_shift(xi)
-    return np.pi - np.mod(np.pi - g, 2.0 * np.pi), xi
+    return unshear(np.arctan2(Yt, Xt), well.harmonic_shift(xi)), xi
 
 
 def rhs_exact(well, Xt, Yt, F, Omega, beta):

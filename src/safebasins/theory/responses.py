@@ -21,6 +21,7 @@ import xarray as xr
 
 from safebasins.checks import check_1d, check_nonnegative, check_positive, check_positive_int, check_scalar
 from safebasins.theory.damped import TOP_GAP, check_damping, coefficients, slow_tables
+from safebasins.theory.slow_flow import unshear
 from safebasins.wells import resolve_well
 
 __all__ = ["steady_responses", "fixed_points", "FixedPoints", "KINDS"]
@@ -188,8 +189,7 @@ def fixed_points(F, Omega, beta, well, xi_hi, n_grid=1200, n_newton=30):
         out.J[sp, slot] = cc["J"]
         out.Xt[sp, slot] = r * np.cos(f)
         out.Yt[sp, slot] = r * np.sin(f)
-        g = f - cc["delta"]
-        out.gamma[sp, slot] = np.pi - np.mod(np.pi - g, 2.0 * np.pi)
+        out.gamma[sp, slot] = unshear(f, cc["delta"])
         out.det[sp, slot] = a22 * (-om * a11) - om * a21 * (-a12)
         out.converged[sp, slot] = True
     zero = np.nonzero(~pos)[0]
@@ -343,7 +343,7 @@ def steady_responses(Omega, F, damping, well=None, xi_max=None, fourier=None, n_
             parts.append((Oc[seq], grid[seq], gam[seq], np.full(grid.size, sg, np.int8), (sg * dO > 0)[seq]))
         Oc, xc, gc, bc, sc = (np.concatenate([p[k] for p in parts]) for k in range(5))
         xc = np.where(np.isfinite(Oc), xc, np.nan)
-        gc = np.pi - np.mod(np.pi - np.where(np.isfinite(Oc), gc, np.nan), 2.0 * np.pi)
+        gc = unshear(np.where(np.isfinite(Oc), gc, np.nan), 0.0)
         folds = _folds(w, c, grid, F, beta)
     else:
         Oc = xc = gc = np.empty(0)
@@ -352,7 +352,7 @@ def steady_responses(Omega, F, damping, well=None, xi_max=None, fourier=None, n_
     with np.errstate(invalid="ignore"):
         backbone = np.where(np.isfinite(xc), w.omega(np.nan_to_num(np.minimum(xc, top))), np.nan)
     fo = np.array(folds, float).reshape(-1, 4)
-    fo[:, 2] = np.pi - np.mod(np.pi - fo[:, 2], 2.0 * np.pi)
+    fo[:, 2] = unshear(fo[:, 2], 0.0)
 
     one = {"units": "1"}
     ds = xr.Dataset(
