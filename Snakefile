@@ -6,6 +6,7 @@
 #   snakemake -j2 --configfile config/quick.yaml         # the same DAG at coarse resolution
 #   snakemake -j2 escape_equation                       # the cubic-well study only (issue 12)
 #   snakemake -j2 other_wells                           # the pendulum and sech^2 study (issue 16)
+#   snakemake -j2 damped                                # the damped study (issue 17)
 #   snakemake -j2 archive                                # results/archive/*.tar.gz
 #   snakemake --report results/report.html               # HTML report
 import os
@@ -59,6 +60,13 @@ rule escape_equation:
     input:
         [p for e in RUN.experiments.values() if e.key.startswith("escape_equation.") for p in e.dataset_files()],
         [p for e in RUN.experiments.values() if e.key.startswith("escape_equation.") for p in (e.figure.png, e.figure.pdf)],
+
+
+rule damped:
+    """The damped study (config block `damped`): datasets and figures."""
+    input:
+        [p for e in RUN.experiments.values() if e.key.startswith("damped.") for p in e.dataset_files()],
+        [p for e in RUN.experiments.values() if e.key.startswith("damped.") for p in (e.figure.png, e.figure.pdf)],
 
 
 rule other_wells:

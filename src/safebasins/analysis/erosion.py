@@ -139,7 +139,7 @@ def profile_from_charts(charts, t_eval=None, *, criterion="energy", stack_dim="F
     ds = ds.transpose(*lead, "t_eval", ...)
     ds["t_eval"].attrs.update(cf.attrs("t_eval"))
     ds.attrs.update({k: v for k, v in chart.attrs.items() if k in ("Omega", "Psi", "F", "cycles",
-                                                                       "steps_per_cycle", "integrator")})
+                                                                       "steps_per_cycle", "integrator", "damping")})
     ds.attrs.update(well_attrs(well))
     ds.attrs.update({"kind": "numeric", "criterion": criterion,
                      "method": "safe = escape_cycle > t_eval from safebasins.numerics.escape_chart"})

@@ -403,4 +403,27 @@ DECLARATIONS += tuple(
             look=_NESTED),
     ))
 
+# ---------------------------------------------------------------- damping (issue 17)
+# q'' + beta q' + V'(q) = F sin(Omega t + Psi) (config block `damped`): Thompson's escape equation
+# at beta = 0.1, Omega = 0.85 across the Melnikov tangency of its hilltop saddle.
+_DAMPED = "Damping: the escape equation across the Melnikov tangency"
+DECLARATIONS += (
+    Declaration(
+        name="damped_tangency", kind="tangency", key=("damped", "escape_equation"), stem="damped_tangency",
+        label="Damped escape equation: erosion across the Melnikov tangency", category=_DAMPED, options={},
+        seed_offset=31000,
+        title="Damped escape equation (beta = 0.1, Omega = 0.85): integrity, boundary fractality and basins "
+              "across the Melnikov tangency",
+        caption=("Thompson's escape equation with damping, q'' + 0.1 q' + q - q² = F sin(0.85 t), the classic "
+                 "benchmark of basin erosion: the safe basin (energy criterion H0 > 1/6, the hilltop) of the "
+                 "long-time response versus the forcing amplitude F. The Melnikov threshold F_M (first order in "
+                 "F and β, docs/melnikov.md) is where the hilltop saddle's stable and unstable manifolds first "
+                 "touch; past it the basin boundary becomes fractal and the basin erodes."),
+        look=("(a) GIM, LIM and IF versus F (faint: the early evaluation time, solid: the long-time basin) with "
+              "the dashed Melnikov line; (b) the uncertainty exponent α of the basin boundary (α = 1 smooth, "
+              "α < 1 fractal) from seeded paired initial conditions; (c, d) the long-time safe basin (blue) "
+              "before and after the tangency. Expect LIM and IF to collapse close to F_M and α to drop below 1 "
+              "past it.")),
+)
+
 BY_NAME = {d.name: d for d in DECLARATIONS}

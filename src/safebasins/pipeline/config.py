@@ -29,7 +29,8 @@ REPO_ROOT = Path(__file__).resolve().parents[3]
 SCHEMA_PATH = REPO_ROOT / "workflow" / "schemas" / "config.schema.yaml"
 #: the kind modules of the package (importing them registers the kinds)
 KIND_MODULES = ("safebasins.pipeline.kinds.fcr", "safebasins.pipeline.kinds.basins",
-                "safebasins.pipeline.kinds.charts", "safebasins.pipeline.kinds.extras", "safebasins.pipeline.kinds.maps")
+                "safebasins.pipeline.kinds.charts", "safebasins.pipeline.kinds.extras", "safebasins.pipeline.kinds.maps",
+                "safebasins.pipeline.kinds.damped")
 
 __all__ = ["ConfigError", "load_yaml", "merge_config", "build_schema", "validate_config", "experiment_blocks", "SCHEMA_PATH"]
 
@@ -122,6 +123,8 @@ def build_schema(base=None) -> dict:
         defs[name] = copy.deepcopy(kind.schema)
         # every experiment may name its well (issue 12); the quartic keeps the paper's results
         defs[name].setdefault("properties", {})["well"] = {"$ref": "#/$defs/well", "default": "quartic"}
+        # and its damping (issue 17): a kind may declare its own form (a list of curves' values)
+        defs[name]["properties"].setdefault("damping", {"$ref": "#/$defs/damping", "default": 0.0})
     props = schema["properties"]
     for d in catalog.DECLARATIONS:
         block, key = d.key
@@ -270,6 +273,10 @@ def _check_well(block, key, well, kind):
     """What depends on the experiment's well: the kind accepts it; every ``xi_max`` (truncation
     level) at most, every ``xi_ini`` below, its barrier energy (the schema only knows they are
     positive); the paper's first harmonic and symmetric displacement bounds only for the quartic."""
+    beta = block.get("damping", 0.0)
+    if not kind.damped and any(b > 0 for b in (beta if isinstance(beta, list) else [beta])):
+        fail(f"{key}.damping", f"kind {kind.name!r} is written for the undamped equation (its theory or figure has "
+                               "no damping): remove damping or set it to 0")
     if well.name != "quartic" and not kind.any_well:
         fail(f"{key}.well", f"kind {kind.name!r} is written for the paper's quartic only, not the {well.name} well")
     if well.name != "quartic" and block.get("q_max") not in (None, []):

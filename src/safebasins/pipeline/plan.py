@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from safebasins import wells
+from safebasins.pipeline import values
 from safebasins.pipeline.config import experiment_blocks, load_yaml, merge_config, validate_config
 from safebasins.pipeline.validation import fail
 from safebasins.pipeline.registry import (KINDS, PARAMS_DIR, PARTS_DIR, Experiment, FigureSpec, Product,
@@ -84,7 +85,8 @@ class Plan:
                                  steps_per_cycle=int(num["steps_per_cycle"]),
                                  seed=int(config["seed"]) + _seed_offset(name, decl))
             title = decl.title if decl is not None else blk.get("title", f"{name} ({kind_name})")
-            params = {"experiment": name, "kind": kind_name, "title": title, "well": well, **kind.resolve(blk, ctx)}
+            params = {"experiment": name, "kind": kind_name, "title": title, "well": well,
+                      **values.damping_param(blk["damping"]), **kind.resolve(blk, ctx)}
             exp = Experiment(name=name, kind=kind, key=key, params=params, figure=_figure(name, kind, params, decl),
                              products=tuple(kind.products(name, params)), tasks=tuple(kind.tasks(params)))
             self.experiments[name] = exp

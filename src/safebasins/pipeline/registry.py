@@ -125,6 +125,10 @@ class Kind:
     #: False: the kind is written for the paper's quartic only (a config naming another well
     #: for it is rejected); True: it takes the experiment's ``well:`` (params["well"])
     any_well: ClassVar[bool] = True
+    #: True: the kind integrates/averages the damped equation q'' + beta q' + V'(q) = ... with the
+    #: experiment's ``damping`` (params["damping"], safebasins.pipeline.values.damping); False: a
+    #: config with damping > 0 for it is refused, naming the key
+    damped: ClassVar[bool] = False
 
     def check(self, block: dict, key: str, ctx) -> None:
         """Checks beyond the schema; raise ``ctx.fail(key + ".field", message)``."""

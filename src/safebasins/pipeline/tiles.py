@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from safebasins.pipeline.values import base_well, tile_slice
+from safebasins.pipeline.values import base_well, damping, tile_slice
 
 
 def chart_tile(kind, params, k, tile, tiles, job):
@@ -27,7 +27,8 @@ def chart_tile(kind, params, k, tile, tiles, job):
           f"ICs={q0.size}x{p0.size if grid else 1}", flush=True)
     ds = escape_chart(q0, p0, task["F"], Omega, Psi, xi_max=tuple(task["xi_max"]), q_max=tuple(task["q_max"]),
                       cycles=params["cycles"], steps_per_cycle=params["steps_per_cycle"], threads=job.threads,
-                      grid=grid, backend=job.backend, well=base_well(params))
+                      grid=grid, backend=job.backend, well=base_well(params),
+                      damping=damping(params))
     if not grid:
         ds = ds.assign_coords(sample=np.arange(sl.start, sl.stop))
     return ds

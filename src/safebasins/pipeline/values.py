@@ -118,3 +118,21 @@ def base_well(params):
     from safebasins import wells
 
     return wells.from_spec(params["well"])
+
+
+def damping_param(beta) -> dict:
+    """``{"damping": beta}`` (a float, or a list for kinds whose curves vary it) of an experiment
+    with damping; nothing for the undamped equation, whose parameter files (and datasets) stay
+    the paper's: no ``damping`` parameter means beta = 0."""
+    vals = [float(b) for b in as_list(beta)]
+    if not any(b > 0 for b in vals):
+        return {}
+    return {"damping": vals if isinstance(beta, list) else vals[0]}
+
+
+def damping(params) -> float:
+    """The damping beta of resolved parameters (0 for the undamped equation; :func:`damping_param`)."""
+    beta = params.get("damping", 0.0)
+    if isinstance(beta, list):
+        raise ValueError(f"experiment {params['experiment']!r}: damping is a list of curves' values here")
+    return float(beta)

@@ -32,6 +32,7 @@ SYMBOLS = {
     "xi_ini": r"$\xi_{ini}$",
     "gamma_ini": r"$\gamma_{ini}$",
     "t_eval": r"$t_{eval}$",
+    "damping": r"$\beta$",
 }
 
 
