@@ -39,11 +39,17 @@ def test_toy_kind_resolves_and_joins_the_catalog():
 
 
 def test_kind_names_are_unique():
+    from safebasins.pipeline.config import load_kinds
+
+    load_kinds()                     # the package's kinds registered (this test may run first)
+    before = dict(KINDS)
+
     class Clash(Kind):
         name = "chart"
 
     with pytest.raises(ValueError, match="registered twice"):
         register(Clash)
+    assert KINDS == before
 
 
 @pytest.mark.pipeline
