@@ -5,7 +5,9 @@ Library functions taking arrays and returning Datasets; the pipeline's experimen
 
 * :func:`analytic_basin` -- boundary curves of :func:`safebasins.theory.safe_basin_boundaries`
   (dims ``curve``, ``vertex``) plus the per-IC classification ``escapes(q0, p0)`` of
-  :func:`safebasins.theory.slow_flow_escapes` (eqs 18-28);
+  :func:`safebasins.theory.slow_flow_escapes` (eqs 18-28); with damping (beta > 0, issue 17) the
+  classification of the damped slow flow and, as its boundary, the outline of the safe mask
+  (:func:`mask_outline`: the level curves of C are no trajectories there);
 * :func:`analytic_basin_stack` -- the same stacked over a scanned ``F`` or ``xi_max``;
 * :func:`add_resonance_manifold` -- the first integral ``C`` and ``escapes_rm`` on a
   ``(gamma_rm, xi_rm)`` grid of the resonance manifold;
@@ -19,19 +21,97 @@ import xarray as xr
 
 from safebasins.io.provenance import api_provenance
 
-__all__ = ["analytic_basin", "analytic_basin_stack", "add_resonance_manifold", "numeric_check"]
+__all__ = ["analytic_basin", "analytic_basin_stack", "add_resonance_manifold", "numeric_check", "mask_outline",
+           "MASK_OUTLINE"]
+
+#: ``kind`` of the boundary curves of a damped basin (:func:`mask_outline`) and the value of its
+#: attribute ``boundary``
+MASK_OUTLINE = "mask_outline"
+
+
+def mask_outline(safe, q0, p0, Psi, *, well=None):
+    """The outline of a safe mask on the IC grid as boundary curves in the layout of
+    :func:`safebasins.theory.safe_basin_boundaries` (dims ``curve``, ``vertex``).
+
+    ``safe``: bool array over (q0, p0) (1-D axes ``q0``, ``p0``).  The curves are the 1/2 level
+    of the mask (marching squares: vertices half-way between a safe and an escaping grid point;
+    a curve ends where it meets the grid's edge), ``kind`` ``"mask_outline"``; ``C_level``,
+    ``ray``, ``xi_top`` are NaN and ``safe_sign`` 0 (no level of C bounds a damped basin);
+    ``gamma`` (slow phase ``theta - Psi`` wrapped to [-pi, pi], NaN at a wrap so that a curve on
+    the resonance manifold is split there) and ``xi`` of each vertex from the well's action-angle
+    map (NaN outside the well).  The outline is as fine as the grid: within half a grid step of
+    the true boundary of the classification."""
+    import contourpy
+
+    from safebasins.wells import resolve_well
+
+    w = resolve_well(well)
+    qa, pa = np.asarray(q0, float), np.asarray(p0, float)
+    S = np.asarray(safe, bool)
+    if S.shape != (qa.size, pa.size):
+        raise ValueError(f"safe must have shape (len(q0), len(p0)) = {(qa.size, pa.size)}, got {S.shape}")
+    lines = []
+    if S.any() and not S.all() and qa.size > 1 and pa.size > 1:
+        gen = contourpy.contour_generator(qa, pa, S.T.astype(float), line_type="Separate")
+        lines = [ln for ln in gen.lines(0.5) if len(ln) > 1]
+    qv = np.concatenate([ln[:, 0] for ln in lines]) if lines else np.empty(0)
+    pv = np.concatenate([ln[:, 1] for ln in lines]) if lines else np.empty(0)
+    idx = np.concatenate([np.full(len(ln), k, np.int64) for k, ln in enumerate(lines)]) if lines else \
+        np.empty(0, np.int64)
+    gam, xi = np.full(qv.shape, np.nan), np.full(qv.shape, np.nan)
+    inside = w.in_well(qv) & (w.H0(qv, pv) < w.barrier_energy) if qv.size else np.zeros(0, bool)
+    if inside.any():
+        th, x = w.angle_energy(qv[inside], pv[inside])
+        gam[inside] = np.angle(np.exp(1j * (np.asarray(th, float) - float(Psi))))
+        xi[inside] = x
+    wrap = np.r_[False, (np.abs(np.diff(gam)) > np.pi) & (idx[1:] == idx[:-1])] if gam.size else np.zeros(0, bool)
+    gam[wrap] = xi[wrap] = np.nan
+    n = len(lines)
+    return xr.Dataset(
+        {
+            "kind": ("curve", np.full(n, MASK_OUTLINE), {"long_name": "safe-basin boundary type (mask_outline: "
+                                                                      "outline of the analytic safe mask)"}),
+            "C_level": ("curve", np.full(n, np.nan), {"units": "1", "long_name": "value of the first integral C "
+                                                                             "(eq 18) on the boundary (none here)"}),
+            "ray": ("curve", np.full(n, np.nan), {"units": "rad", "long_name": "slow phase of the tangency or "
+                                                                               "saddle point (none here)"}),
+            "xi_top": ("curve", np.full(n, np.nan), {"units": "1", "long_name": "energy of the tangency or saddle "
+                                                                               "point (none here)"}),
+            "safe_sign": ("curve", np.zeros(n, np.int8), {"long_name": "safe side (0: not a level curve of C)"}),
+            "gamma": ("vertex", gam, {"units": "rad", "long_name": "slow phase gamma = theta - Psi - Omega tau"}),
+            "xi": ("vertex", xi, {"units": "1", "long_name": "averaged energy"}),
+            "q0_vertex": ("vertex", qv, {"units": "1", "long_name": "initial displacement"}),
+            "p0_vertex": ("vertex", pv, {"units": "1", "long_name": "initial momentum"}),
+            "curve_index": ("vertex", idx, {"long_name": "index of the curve a vertex belongs to"}),
+        },
+        attrs={"boundary": MASK_OUTLINE})
 
 
 @api_provenance
-def analytic_basin(F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, label=None):
+def analytic_basin(F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, label=None, damping=0.0):
     """Boundaries + per-IC analytic escape mask on the (q0, p0) grid of 1-D axes ``q0``, ``p0``.
 
     ``well``: any form :func:`safebasins.wells.resolve_well` reads (its first harmonic included);
-    ``label`` is printed in the log line."""
+    ``label`` is printed in the log line.  ``damping`` (beta >= 0, default 0: the paper's
+    conservative slow flow, output as before damping existed): for beta > 0 ``escapes`` is the
+    classification of the damped slow flow (``slow_flow_escapes(..., damping=beta)``,
+    docs/damping.md; undecided trajectories count as escaping) and the boundary curves are the
+    outline of its safe mask (:func:`mask_outline`, attribute ``boundary = "mask_outline"``;
+    ``n_points`` unused), attribute ``damping``."""
     from safebasins.theory import safe_basin_boundaries, slow_flow_escapes
+    from safebasins.theory.damped import check_damping
 
+    beta = check_damping(damping)
     qa, pa = np.asarray(q0, float), np.asarray(p0, float)
     Q, P = np.meshgrid(qa, pa, indexing="ij")
+    if beta > 0:
+        print(f"{label or 'basin'}: damped basin F={F} Omega={Omega} Psi={Psi} xi_max={xi_max} beta={beta}")
+        esc = np.asarray(slow_flow_escapes(Q, P, F, Omega, Psi, xi_max, well=well, damping=beta), dtype=bool)
+        b = mask_outline(~esc, qa, pa, Psi, well=well)
+        b.attrs.update(F=float(F), Omega=float(Omega), Psi=float(Psi), xi_max=float(xi_max), damping=beta,
+                       saddle_gamma=np.nan, saddle_xi=np.nan)
+        b["escapes"] = xr.DataArray(esc, dims=("q0", "p0"))
+        return b.assign_coords(q0=("q0", qa), p0=("p0", pa))
     print(f"{label or 'basin'}: basin F={F} Omega={Omega} Psi={Psi} xi_max={xi_max}")
     b = safe_basin_boundaries(F, Omega, Psi, xi_max, well=well, n_points=n_points)
     esc = slow_flow_escapes(Q, P, F, Omega, Psi, xi_max, well=well)
@@ -40,16 +120,18 @@ def analytic_basin(F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, l
 
 
 @api_provenance
-def analytic_basin_stack(scan, values, F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, label=None):
+def analytic_basin_stack(scan, values, F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, label=None,
+                         damping=0.0):
     """Analytic basins stacked over the scanned parameter ``scan`` ("F" or "xi_max", taking
     ``values``; the other one is the scalar argument).  Each basin's saddle point is a coordinate
-    along ``scan`` (``saddle_gamma``, ``saddle_xi``); attribute ``scan``."""
+    along ``scan`` (``saddle_gamma``, ``saddle_xi``; NaN for a damped basin); attribute ``scan``.
+    ``damping``: as :func:`analytic_basin`."""
     from safebasins.io.datasets import stack
 
     if scan not in ("F", "xi_max"):
         raise ValueError(f"scan must be 'F' or 'xi_max', got {scan!r}")
     parts = [analytic_basin(v if scan == "F" else F, Omega, Psi, v if scan == "xi_max" else xi_max, q0, p0,
-                            well=well, n_points=n_points, label=label) for v in values]
+                            well=well, n_points=n_points, label=label, damping=damping) for v in values]
     saddle = {k: [float(b.attrs.get(k, np.nan)) for b in parts] for k in ("saddle_gamma", "saddle_xi")}
     out = stack(parts, scan, values, coords=saddle)
     out.attrs["scan"] = scan

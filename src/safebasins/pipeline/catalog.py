@@ -424,6 +424,22 @@ DECLARATIONS += (
               "α < 1 fractal) from seeded paired initial conditions; (c, d) the long-time safe basin (blue) "
               "before and after the tangency. Expect LIM and IF to collapse close to F_M and α to drop below 1 "
               "past it.")),
+    Declaration(
+        name="damped_quartic_basins", kind="basin_chart", key=("damped", "quartic_basins"),
+        stem="damped_quartic_basins", label="Damped quartic: safe basins versus ξ_max (Fig. 14's forcing)",
+        category=_DAMPED, options={},
+        title="Paper's quartic with small damping: damped slow-flow safe basins versus numerics at Fig 14's forcing",
+        caption=("Figure 14's case (the paper's quartic, same forcing and window) with linear damping β q' added "
+                 "to eq. (1), at two truncation levels; β and the other parameters are in the title. With "
+                 "damping C is no longer conserved and its level curves bound no basin: an IC is analytically "
+                 "safe when its trajectory of the damped slow flow J' = -∂C/∂γ - βJ, γ' = ∂C/∂J "
+                 "(docs/damping.md) settles on an attractor below ξ_max, and the analytic boundary is the "
+                 "outline of that safe mask on the IC grid. The numerics integrate the damped equation."),
+        look=(_NESTED.replace("Coloured curves: analytic boundaries", "Coloured curves: outlines of the damped "
+                                                                      "slow flow's safe masks")
+              + " Compare with Fig. 14: damping lets ICs whose undamped slow trajectory reaches ξ_max spiral in "
+                "instead, so both the numeric and the analytic basins grow; the IoU in the legend and the notes "
+                "measures how well the damped slow flow tracks that growth.")),
 )
 
 BY_NAME = {d.name: d for d in DECLARATIONS}

@@ -64,6 +64,17 @@ def _fcr(p):
     return len(p["Omega"]) * len(p["curves"]) * _default("safebasins.theory:critical_forcing", "n_grid")
 
 
+#: slow-flow evaluations one IC of a damped analytic basin costs (its slow trajectory is integrated
+#: until it settles or escapes: 1e4 ICs of the quartic in 1.3-2.5 s at beta = 0.005-0.01, Fig 14's
+#: forcing, on 2 shared cores of the machine of ANALYTIC_RATE)
+DAMPED_BASIN_EVALUATIONS = 200
+
+
+def _basin_ic(p):
+    # the IC grid of an analytic basin: one level-curve test per IC, or a damped slow trajectory
+    return _grid(p) * (DAMPED_BASIN_EVALUATIONS if p.get("damping", 0.0) > 0 else 1)
+
+
 def _xi_true(n_gamma, n_xi=None):
     # xi_true_analytic: n_gamma x n_xi points per refinement level
     f = "safebasins.analysis.phase_invariant:xi_true_analytic"
@@ -75,8 +86,8 @@ def _xi_true(n_gamma, n_xi=None):
 ANALYTIC_COSTS = {
     "fcr_theory": lambda p, run: _fcr(p),
     "fcr_compare": lambda p, run: _fcr(p),
-    "basin_rm": lambda p, run: _grid(p) + p["manifold"]["n_gamma"] * p["manifold"]["n_xi"] + p["n_points"],
-    "basin_chart": lambda p, run: (_grid(p) + p["n_points"]) * _n(p[p["scan"]]),
+    "basin_rm": lambda p, run: _basin_ic(p) + p["manifold"]["n_gamma"] * p["manifold"]["n_xi"] + p["n_points"],
+    "basin_chart": lambda p, run: (_basin_ic(p) + p["n_points"]) * _n(p[p["scan"]]),
     "strobe": lambda p, run: _grid(p) + p["n_points"],
     "erosion": lambda p, run: _n(p["fourier"]) * _n(p["F"]) * _n(p["xi_max"]) * p["analytic_n"] ** 2,
     "true_basin": lambda p, run: _n(p["fourier"]) * _n(p["xi_max"]) * (

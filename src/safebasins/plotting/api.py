@@ -54,7 +54,9 @@ def plot_escape_chart(chart, *, t_eval=None, xi_max=None, basin=None, ax=None):
     basin : xarray.Dataset or path, optional
         Analytic boundaries to overlay: :func:`safebasins.theory.safe_basin_boundaries` (one
         basin: drawn with the threshold equal to its ``xi_max``, or its ``F`` for a chart stacked
-        over F) or a pipeline basin stack (``basin_<experiment>.nc``).
+        over F) or a pipeline basin stack (``basin_<experiment>.nc``).  A damped basin
+        (attribute ``damping``) must match the chart's damping; its lines are the outline of its
+        safe mask.
     ax : matplotlib.axes.Axes, optional
         Draw into this axes (legend to its right); default: a new figure.
 
@@ -109,7 +111,7 @@ def plot_escape_chart(chart, *, t_eval=None, xi_max=None, basin=None, ax=None):
     draw_nested_chart(ax, chart, scan=scan, t_eval=t, basins=basin, criterion=criterion, strict=False,
                       show_iou=t_eval is None)
     head = f"Numeric safe basins ({criterion} criterion, $t_{{eval}}$ = {fmt_value(t)} EC)"
-    fixed = _attrs_text(chart, [k for k in FORCING if k != scan])
+    fixed = _attrs_text(chart, [k for k in (*FORCING, "damping") if k != scan])
     ax.set_title(head + (f"\n{fixed}" if fixed else ""), fontsize=10)
     return fig
 
@@ -140,7 +142,10 @@ def plot_basin(basin, *, ax=None):
         the pipeline (``basin_<experiment>.nc``, also stacked over ``xi_max`` or ``F``: one colour
         per value).  Where it holds the per-IC mask ``escapes(q0, p0)`` (e.g. from
         :func:`safebasins.theory.slow_flow_escapes`, see the example) the basin is filled grey;
-        the attributes ``xi_max`` and ``well`` add the well edge ``H0 = xi_max``.
+        the attributes ``xi_max`` and ``well`` add the well edge ``H0 = xi_max``.  A damped basin
+        (:func:`safebasins.analysis.ic_basins.analytic_basin` with ``damping > 0``, attribute
+        ``damping``) is drawn the same way; its boundary curves are the outline of its safe mask,
+        named so in the legend, and beta is in the title.
     ax : matplotlib.axes.Axes, optional
         Draw into this axes; default: a new figure.
 
@@ -174,9 +179,12 @@ def plot_basin(basin, *, ax=None):
     fig, ax = new_axes(ax, figsize=(6.2, 5.2))
     data.attach(fig, basin)
     has_well = "well" in basin.attrs
+    damped = float(basin.attrs.get("damping", 0.0)) > 0
+    flow = "damped slow flow" if damped else "slow flow"
     if dim is None:
         draw_ic_basin(ax, basin, well=has_well and "xi_max" in basin.attrs)
-        handles = [Line2D([], [], color=SB_EDGE, lw=1.8, label="safe-basin boundary (slow flow)")]
+        handles = [Line2D([], [], color=SB_EDGE, lw=1.8, label="safe-basin boundary (" + (
+            "damped slow flow, mask outline" if damped else "slow flow") + ")")]
     else:
         vals = np.asarray(var(basin, dim), float)
         slices = [basin.isel({dim: i}) for i in range(vals.size)]
@@ -198,10 +206,13 @@ def plot_basin(basin, *, ax=None):
     if has_well and ("xi_max" in basin.attrs or dim == "xi_max"):
         handles.append(Line2D([], [], color="0.35", ls=(0, (4, 2)), lw=0.9, label=r"well edge $H_0 = \xi_{max}$"))
     if "escapes" in basin.variables:
-        handles.insert(0, Patch(facecolor=SB_FACE, label="safe (slow flow)"))
+        handles.insert(0, Patch(facecolor=SB_FACE, label=f"safe ({flow})"))
+    if damped and dim is not None:
+        handles.append(Line2D([], [], color="0.3", lw=1.8, label="lines: damped slow flow (mask outline)"))
     ax.legend(handles=handles, loc="best", fontsize=8)
-    shown = _attrs_text(basin, [k for k in (*FORCING, "xi_max") if k != dim])
-    ax.set_title("Analytic safe basin" + (f": {shown}" if shown else ""), fontsize=10)
+    shown = _attrs_text(basin, [k for k in (*FORCING, "xi_max", "damping") if k != dim])
+    ax.set_title(("Analytic damped safe basin" if damped else "Analytic safe basin") + (f": {shown}" if shown else ""),
+                 fontsize=10)
     return fig
 
 

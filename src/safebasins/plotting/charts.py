@@ -149,13 +149,23 @@ def coincident_groups(curves, tol):
 COINCIDE_PIXELS = 2.5
 
 
+def basin_damping(ds):
+    """The damping beta of a dataset (attribute ``damping``; 0 without it: the undamped equation)."""
+    return float(ds.attrs.get("damping", 0.0)) if ds is not None else 0.0
+
+
 def draw_nested_chart(ax, chart, *, scan, t_eval, basins=None, criterion="energy", boundary_only=True,
                       strict=True, show_iou=True):
     """Numeric safe basins of a chart nested by ``scan`` (lighter contains darker) with the
-    analytic boundaries of ``basins`` (optional) as curves, legend on the right.  Boundaries of
+    analytic boundaries of ``basins`` (optional) as curves, legend on the right; a damped basin's
+    boundaries are the outline of its safe mask (attribute ``boundary = "mask_outline"``,
+    :func:`safebasins.analysis.ic_basins.mask_outline`), named so in the legend.  Boundaries of
     several values that stay within COINCIDE_PIXELS of each other are drawn in alternating
     colours.  Returns ``(values, shared)``: the scanned values and [(values, largest
     distance), ...] of the coinciding boundaries."""
+    if basins is not None and basin_damping(basins) != basin_damping(chart):
+        raise ValueError(f"{source(chart)}: the numeric chart has damping {basin_damping(chart)} but the analytic "
+                         f"basin {basin_damping(basins)} (attribute damping; none = 0)")
     vals, masks = scan_masks(chart, scan, t_eval, criterion)
     shade = draw_nested_safe(ax, masks)
     theory = theory_slices(basins, scan, vals, strict=strict) if basins is not None else [None] * len(vals)
@@ -189,6 +199,7 @@ def draw_nested_chart(ax, chart, *, scan, t_eval, basins=None, criterion="energy
                        zorder=6, dash_capstyle="butt")
         shared.append((sorted({float(vals[curves[k][0]]) for k in members}), d / px if px else 0.0))
     drawn = {i for i, _, _ in curves}
+    outline = basins is not None and basin_damping(basins) > 0
     hs, ls_ = [], []
     for i in np.argsort(vals):  # legend in parameter order
         col, ls = style[i]
@@ -212,7 +223,8 @@ def draw_nested_chart(ax, chart, *, scan, t_eval, basins=None, criterion="energy
     ax.set_ylabel(LABELS["p0"])
     ax.legend(hs, ls_, handler_map={tuple: HandlerTuple(ndivide=None, pad=0)}, loc="upper left",
               bbox_to_anchor=(1.02, 1.0), borderaxespad=0,
-              title="numeric SB (grey)" + (" / theory (lines)" if curves else ""), title_fontsize=8)
+              title="numeric SB (grey)" + ((" / damped slow flow\n(mask outline, lines)" if outline else
+                                           " / theory (lines)") if curves else ""), title_fontsize=8)
     return vals, shared
 
 
@@ -228,7 +240,10 @@ def figure_nested_basins(analytic, numeric, *, title=None, t_eval=None, figsize=
     agreement's evaluation time (else the horizon); ``boundary_only``: draw only the theory
     curves that border the analytic safe mask; ``analytic`` may be None (numerics only).
     Boundaries of several parameter values that coincide (e.g. a saddle-type curve below every
-    threshold) are drawn as one line of alternating colours, each colour still visible."""
+    threshold) are drawn as one line of alternating colours, each colour still visible.  Damped
+    data (attribute ``damping``, issue 17): beta in the title and a note, the analytic boundary
+    is the outline of the damped slow flow's safe mask (the numeric and analytic damping must be
+    equal)."""
     chart = open_dataset(numeric)
     basins = open_dataset(analytic)
     scan = chart_scan(chart)
@@ -239,12 +254,18 @@ def figure_nested_basins(analytic, numeric, *, title=None, t_eval=None, figsize=
     strict = basins is not None and scan in basins.dims
     vals, shared = draw_nested_chart(ax, chart, scan=scan, t_eval=t_ev, basins=basins, boundary_only=boundary_only,
                                      strict=strict, show_iou=t_eval is None)
-    fixed = {k: param(chart, k) for k in ("F", "Omega", "Psi", "xi_max") if k != scan and
+    fixed = {k: param(chart, k) for k in ("F", "Omega", "Psi", "xi_max", "damping") if k != scan and
              (k in chart.attrs or (k in chart.coords and chart[k].size == 1))}
-    ax.set_title(title or (f"Safe basins vs {SYMBOLS.get(scan, scan)}: " + param_text(fixed) +
-                           f"\n(numeric: {resolution(chart)} ICs, {fmt_value(t_ev)} EC; "
+    beta = basin_damping(chart)
+    ax.set_title(title or (("Damped safe basins" if beta > 0 else "Safe basins") + f" vs {SYMBOLS.get(scan, scan)}: "
+                           + param_text(fixed) + f"\n(numeric: {resolution(chart)} ICs, {fmt_value(t_ev)} EC; "
                            "lighter regions contain darker ones)"))
     name = {"xi_max": "ξ_max", "F": "F"}.get(scan, scan)
+    if beta > 0:
+        add_note(fig, f"Damped equation q'' + β q' + V'(q) = F sin(Ω t + Ψ), β = {fmt_value(beta)}: the numerics "
+                      "integrate it; the analytic basin is the damped slow flow's (an IC is safe when its slow "
+                      "trajectory settles on an attractor below ξ_max, docs/damping.md), its boundary drawn as the "
+                      "outline of the analytic safe mask (level curves of C bound no damped basin).")
     add_note(fig, f"Numeric basins: {resolution(chart)} ICs, energy criterion, safe = no escape within "
                   f"{fmt_value(t_ev)} EC" + (f" (agreement evaluated at {fmt_value(agreement_time(chart))} EC)."
                                              if "iou" in chart.variables else "."))
@@ -463,4 +484,4 @@ def figure_area_vs_time(numeric, params, *, t_evals=None, title=None, figsize=(1
 
 __all__ = ["figure_nested_basins", "figure_criteria", "figure_dsb_esb", "figure_area_vs_time",
            "draw_nested_safe", "draw_nested_chart", "draw_dsb_esb", "scan_masks", "theory_slices", "chart_scan",
-           "chart_thresholds", "coincident_groups", "settle_time"]
+           "chart_thresholds", "coincident_groups", "settle_time", "basin_damping"]

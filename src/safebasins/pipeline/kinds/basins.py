@@ -5,7 +5,8 @@ The analytic product of each is ``basin_<experiment>.nc``: the boundary curves o
 classification ``escapes(q0, p0)`` of :func:`safebasins.theory.slow_flow_escapes` on the
 experiment's grid; ``basin_rm`` adds the first integral ``C`` and ``escapes_rm`` on the
 resonance-manifold grid ``(gamma_rm, xi_rm)``; ``basin_chart`` stacks the basins over the
-scanned parameter (``xi_max`` or ``F``).  ``basin_chart``'s numeric product is the escape chart
+scanned parameter (``xi_max`` or ``F``; with damping, issue 17: the damped slow flow's
+classification and the outline of its safe mask, ``kind = "mask_outline"``).  ``basin_chart``'s numeric product is the escape chart
 gathered from its tiles with the analytic/numeric agreement stored in it; ``strobe``'s is the
 classified period map (:func:`safebasins.analysis.period_map.period_map_portrait`).
 """
@@ -67,13 +68,14 @@ def build_basin_single(params, data, job):
 
 
 def build_basin_stack(params, data, job):
-    """Analytic basins stacked over the scanned parameter (Figs 13-17)."""
+    """Analytic basins stacked over the scanned parameter (Figs 13-17); with damping (issue 17) the
+    damped slow flow's classification and the outline of its safe mask (analytic_basin)."""
     from safebasins.analysis.ic_basins import analytic_basin_stack
 
     q0, p0 = values.grid_axes(params["grid"])
     out = analytic_basin_stack(params["scan"], params[params["scan"]], params["F"], params["Omega"], params["Psi"],
                                params["xi_max"], q0, p0, well=values.well(params), n_points=params["n_points"],
-                               label=params["experiment"])
+                               label=params["experiment"], damping=values.damping(params))
     return _basin_attrs(out, params)
 
 
@@ -142,7 +144,9 @@ def build_strobe(params, data, job):
 def _basin_product(experiment, params, build, contract):
     return Product(dataset_path("analytic", f"basin_{experiment}"), "analytic", build, title=params["title"],
                    contract=contract,
-                   history=f"safebasins.theory.safe_basin_boundaries + slow_flow_escapes ({experiment})")
+                   history=(f"safebasins.theory.slow_flow_escapes (damped slow flow) + mask outline ({experiment})"
+                            if values.damping(params) > 0 else
+                            f"safebasins.theory.safe_basin_boundaries + slow_flow_escapes ({experiment})"))
 
 
 @register
@@ -209,6 +213,7 @@ class BasinChart(GridChartKind):
     name = "basin_chart"
     description = ("numeric escape chart with its analytic counterpart; exactly one of F / xi_max may be a "
                    "list (the scanned parameter: one chart serves every xi_max, one chart per F)")
+    damped = True  # the damped slow flow's basin (outline of its mask) against the damped numerics
     builder = "safebasins.plotting.charts:figure_nested_basins"
     schema = {
         "description": description,
