@@ -110,3 +110,40 @@ def test_cli_explore_options():
     assert result.exit_code == 2 and "--port" in result.output
     result = runner.invoke(main, ["explore", "--host", "no-such-host.invalid", "--no-browser"])
     assert result.exit_code == 2 and "--host" in result.output
+
+
+def test_damped_pictures_are_the_damped_slow_flow():
+    """beta > 0 (issue 17): the IC plane is slow_flow_escapes(damping) on the coarser damped grid,
+    outlined; the manifold classifies each point by its damped slow trajectory, with no levels."""
+    r = ranges.well_ranges("quartic")
+    f = analytic.Forcing(F=0.01, Omega=0.9, Psi=np.pi, xi_max=0.18, damping=0.01)
+    pic = analytic.ic_plane(r, f, 161)
+    n = analytic.DAMPED_IC_GRID
+    q0, p0 = analytic.ic_grid(r, n)
+    want = ~theory.slow_flow_escapes(q0[:, None], p0[None, :], F=0.01, Omega=0.9, Psi=np.pi, xi_max=0.18,
+                                     damping=0.01)
+    np.testing.assert_array_equal(pic["safe"], want)
+    assert set(pic["boundaries"][2]) == {"mask_outline"}
+    rm = analytic.manifold(r, f, 241, 161)
+    assert rm["escapes"].shape == analytic.DAMPED_MANIFOLD_GRID[::-1] and rm["levels"].size == 0
+    i = np.argmin(np.abs(rm["xi"] - 0.05))                 # low energies settle, xi >= xi_max escapes
+    assert not rm["escapes"][i].all() and rm["escapes"][rm["xi"] >= 0.18].all()
+
+
+def test_damping_slider_redraws_damped(explorer):
+    c = explorer.controls
+    assert c.sliders["damping"].value == 0.0
+    c.sliders["damping"].value = 0.01
+    explorer.redraw()
+    assert "damped slow flow redrawn" in c.status.text, c.status.text
+    assert "C is not conserved" in explorer.key.text and "beta = 0.01" in explorer.figures.ic.title.text
+    assert "C not conserved" in explorer.figures.rm.title.text
+    assert not explorer.figures.levels.visible
+    c.grid.value, c.cycles.value = "41", "100"
+    explorer.on_run()
+    for _ in range(600):
+        if not explorer.running:
+            break
+        __import__("time").sleep(0.05)
+    value = float(c.iou.text.split("IoU = ")[1][:5])
+    assert 0.85 < value <= 1.0, c.iou.text                 # the damped theory against the damped numerics

@@ -109,3 +109,28 @@ def test_slider_redraws_and_numerics_report_iou(explorer_url, tmp_path):
         page.wait_for_timeout(300)
         page.screenshot(path=str(shots / "explore_numerics.png"))
         assert errors == []
+
+
+def test_damping_slider_changes_the_picture(explorer_url, tmp_path):
+    """beta > 0 (issue 17): the damped slow flow's basin (its mask outlined), titles and key say so."""
+    shots = screenshot_dir(tmp_path)
+    with chromium_page(tmp_path) as (page, errors):
+        page.goto(explorer_url)
+        page.wait_for_function(READY, timeout=60_000)
+        page.wait_for_timeout(500)
+        ic_plane = page.locator(".bk-Figure").first
+        before_xs, before_px = _boundary(page), _pixels(ic_plane)
+        group = page.locator(".bk-input-group", has=page.locator(".bk-slider-title", has_text="Damping beta"))
+        group.locator(".noUi-handle").focus()
+        for _ in range(20):                                # 20 steps of 0.0005: beta = 0.01
+            page.keyboard.press("ArrowRight")
+        page.wait_for_function(f"() => {MODEL}('damping').value > 0.009")
+        page.wait_for_function(f"() => {MODEL}('status').text.includes('damped slow flow redrawn')", timeout=60_000)
+        page.wait_for_function(f"() => {MODEL}('key').text.includes('beta = 0.01:')", timeout=60_000)
+        assert "beta = 0.01" in page.evaluate(f"() => {MODEL}('ic_plane').title.text")
+        assert _boundary(page) != before_xs
+        page.wait_for_timeout(300)
+        changed = np.any(_pixels(ic_plane) != before_px, axis=-1).mean()
+        assert changed > 0.01, f"only {changed:.2%} of the IC-plane pixels changed"
+        page.screenshot(path=str(shots / "explore_damped.png"))
+        assert errors == []

@@ -7,6 +7,14 @@
 * :func:`manifold`: the first integral C(gamma, xi) on the resonance manifold (eq 18,
   :func:`~safebasins.theory.slow_flow.first_integral`) with the escaping region
   (:func:`~safebasins.theory.slow_flow.escapes_on_manifold`).
+
+With damping (beta > 0, issue 17) C is not conserved and its level curves bound nothing: the IC
+plane shows the damped slow flow's classification
+(:func:`~safebasins.theory.slow_flow.slow_flow_escapes` with ``damping``) on a coarser grid
+(``DAMPED_IC_GRID``: each IC's slow trajectory is integrated) with the outline of its mask
+(:func:`~safebasins.analysis.ic_basins.mask_outline`) as the boundary, and the resonance manifold
+classifies each point (gamma, xi) by its damped slow trajectory (the IC at tau = 0 with
+theta0 = gamma + Psi) on ``DAMPED_MANIFOLD_GRID``, without level curves.
 """
 from __future__ import annotations
 
@@ -17,12 +25,17 @@ import numpy as np
 from safebasins import theory
 from safebasins.explore.ranges import WellRanges
 
-__all__ = ["Forcing", "ic_grid", "ic_safe", "ic_plane", "manifold", "level_values"]
+__all__ = ["Forcing", "ic_grid", "ic_safe", "ic_plane", "manifold", "level_values", "DAMPED_IC_GRID",
+           "DAMPED_MANIFOLD_GRID"]
 
 #: vertices per branch of each analytic boundary curve
 BOUNDARY_POINTS = 200
 #: level curves of C drawn on the resonance manifold
 N_LEVELS = 24
+#: largest IC grid and (gamma, xi) grid of the damped pictures (one slow trajectory per point:
+#: about 1e4 points per second on one core)
+DAMPED_IC_GRID = 81
+DAMPED_MANIFOLD_GRID = (97, 65)
 
 
 @dataclass(frozen=True)
@@ -33,6 +46,7 @@ class Forcing:
     Omega: float
     Psi: float
     xi_max: float
+    damping: float = 0.0
 
 
 def ic_grid(r: WellRanges, n: int):
@@ -44,7 +58,7 @@ def ic_safe(r: WellRanges, f: Forcing, n: int):
     """Slow-flow safe mask on the ``n x n`` grid, shape (q0, p0) (True = safe)."""
     q0, p0 = ic_grid(r, n)
     return ~theory.slow_flow_escapes(q0[:, None], p0[None, :], F=f.F, Omega=f.Omega, Psi=f.Psi, xi_max=f.xi_max,
-                                     well=r.well)
+                                     well=r.well, damping=f.damping)
 
 
 def _polylines(boundaries):
@@ -69,9 +83,19 @@ def _orbit(r: WellRanges, xi):
 
 
 def ic_plane(r: WellRanges, f: Forcing, n: int) -> dict:
-    """The IC-plane picture: ``safe`` (q0, p0), ``boundaries`` (xs, ys, kinds), ``orbit`` (q, p)."""
-    bounds = theory.safe_basin_boundaries(f.F, f.Omega, f.Psi, f.xi_max, well=r.well, n_points=BOUNDARY_POINTS)
-    return {"safe": ic_safe(r, f, n), "boundaries": _polylines(bounds), "orbit": _orbit(r, f.xi_max)}
+    """The IC-plane picture: ``safe`` (q0, p0), ``boundaries`` (xs, ys, kinds), ``orbit`` (q, p).
+    Damped (``f.damping > 0``): on at most ``DAMPED_IC_GRID`` points per axis, the boundaries the
+    outline of the safe mask."""
+    if f.damping > 0:
+        from safebasins.analysis.ic_basins import mask_outline
+
+        n = min(n, DAMPED_IC_GRID)
+        safe = ic_safe(r, f, n)
+        bounds = mask_outline(safe, *ic_grid(r, n), f.Psi, well=r.well)
+    else:
+        bounds = theory.safe_basin_boundaries(f.F, f.Omega, f.Psi, f.xi_max, well=r.well, n_points=BOUNDARY_POINTS)
+        safe = ic_safe(r, f, n)
+    return {"safe": safe, "boundaries": _polylines(bounds), "orbit": _orbit(r, f.xi_max)}
 
 
 def level_values(C, n_levels=N_LEVELS):
@@ -85,9 +109,21 @@ def level_values(C, n_levels=N_LEVELS):
 
 def manifold(r: WellRanges, f: Forcing, n_gamma: int, n_xi: int) -> dict:
     """The resonance-manifold picture over ``gamma`` in [-pi, pi], ``xi`` in [0, xi_top]:
-    ``C`` and ``escapes`` (xi, gamma), ``levels`` of C, the axes ``gamma`` and ``xi``."""
+    ``C`` and ``escapes`` (xi, gamma), ``levels`` of C, the axes ``gamma`` and ``xi``.  Damped
+    (``f.damping > 0``): ``escapes`` of each point's damped slow trajectory on at most
+    ``DAMPED_MANIFOLD_GRID`` points, no levels (C is not conserved)."""
+    if f.damping > 0:
+        n_gamma, n_xi = min(n_gamma, DAMPED_MANIFOLD_GRID[0]), min(n_xi, DAMPED_MANIFOLD_GRID[1])
     gamma = np.linspace(-np.pi, np.pi, n_gamma)
     xi = np.linspace(0.0, r.xi_top, n_xi)
     C = theory.first_integral(gamma[None, :], xi[:, None], f.F, f.Omega, well=r.well)
+    if f.damping > 0:
+        G, X = np.meshgrid(gamma, xi)
+        escapes = np.ones(G.shape, bool)
+        below = X < f.xi_max           # at or above xi_max: escaped at once
+        q0, p0 = r.well.phase_point(G[below] + f.Psi, X[below])
+        escapes[below] = theory.slow_flow_escapes(q0, p0, F=f.F, Omega=f.Omega, Psi=f.Psi, xi_max=f.xi_max,
+                                                  well=r.well, damping=f.damping)
+        return {"gamma": gamma, "xi": xi, "C": C, "escapes": escapes, "levels": np.array([])}
     escapes = theory.escapes_on_manifold(gamma[None, :], xi[:, None], f.F, f.Omega, f.xi_max, well=r.well)
     return {"gamma": gamma, "xi": xi, "C": C, "escapes": escapes, "levels": level_values(C)}

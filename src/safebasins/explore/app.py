@@ -32,9 +32,10 @@ REDRAW_DELAY_MS = 40
 IC_GRID = 161
 MANIFOLD_GRID = (241, 161)
 
-HEADER = ("<b>safebasins explorer</b>: q'' + V'(q) = F sin(Omega t + Psi). Left: initial conditions "
-          "(q0, p0) that the slow flow keeps below xi_max (eq 21). Right: the slow flow on the resonance "
-          "manifold (gamma, xi).")
+HEADER = ("<b>safebasins explorer</b>: q'' + beta q' + V'(q) = F sin(Omega t + Psi). Left: initial conditions "
+          "(q0, p0) that the slow flow keeps below xi_max (eq 21; with damping beta > 0: whose damped slow "
+          "trajectory settles below xi_max, docs/damping.md). Right: the slow flow on the resonance manifold "
+          "(gamma, xi).")
 
 
 class Explorer:
@@ -48,6 +49,7 @@ class Explorer:
         self.figures = Figures(self.ranges, analytic.ic_plane(self.ranges, f, IC_GRID),
                                analytic.manifold(self.ranges, f, *MANIFOLD_GRID))
         self.figures.threshold.location = f.xi_max
+        self.key = Div(name="key", text=key(), width=1000)
         self.version = 0          # bumped by every parameter change: a numeric run checks it
         self.pending = None       # the scheduled redraw
         self.running = False
@@ -60,8 +62,7 @@ class Explorer:
         c.run.on_click(self.on_run)
         doc.title = "safebasins explorer"
         doc.add_root(column(Div(text=HEADER, width=1340),
-                            row(column(*c.widgets()), column(row(self.figures.ic, self.figures.rm),
-                                                             Div(text=key(), width=1000))),
+                            row(column(*c.widgets()), column(row(self.figures.ic, self.figures.rm), self.key)),
                             name="layout"))
 
     # ------------------------------------------------------------------ analytic pictures
@@ -95,8 +96,10 @@ class Explorer:
         except Exception as exc:  # noqa: BLE001
             self.status(f"{type(exc).__name__}: {exc}")
             return
-        self.figures.show(r, f.xi_max, ic, rm)
-        self.status(f"slow flow redrawn in {1e3 * (time.perf_counter() - t0):.0f} ms")
+        self.figures.show(r, f.xi_max, ic, rm, f.damping)
+        self.key.text = key(f.damping)
+        self.status(f"{'damped ' if f.damping > 0 else ''}slow flow redrawn in "
+                    f"{1e3 * (time.perf_counter() - t0):.0f} ms")
 
     def status(self, text):
         self.controls.status.text = text

@@ -1,4 +1,4 @@
-"""The explorer's widgets: well, Omega, F, Psi, xi_max; the numeric run's grid, horizon, button,
+"""The explorer's widgets: well, Omega, F, Psi, xi_max, damping beta; the numeric run's grid, horizon, button,
 progress bar; the IoU and status lines.  Every widget has a name (its Bokeh model name)."""
 from __future__ import annotations
 
@@ -14,7 +14,8 @@ __all__ = ["Controls", "make_controls", "set_ranges", "forcing"]
 
 #: slider titles and number formats (numbro)
 SLIDERS = {"Omega": ("Forcing frequency Omega", "0.000"), "F": ("Forcing amplitude F", "0.0000"),
-           "Psi": ("Forcing phase Psi", "0.000"), "xi_max": ("Escape threshold xi_max", "0.0000")}
+           "Psi": ("Forcing phase Psi", "0.000"), "xi_max": ("Escape threshold xi_max", "0.0000"),
+           "damping": ("Damping beta (0: undamped)", "0.0000")}
 
 
 @dataclass
@@ -71,4 +72,4 @@ def set_ranges(c: Controls, r: WellRanges):
 def forcing(c: Controls) -> Forcing:
     """The sliders' current point."""
     v = {name: slider.value for name, slider in c.sliders.items()}
-    return Forcing(F=v["F"], Omega=v["Omega"], Psi=v["Psi"], xi_max=v["xi_max"])
+    return Forcing(F=v["F"], Omega=v["Omega"], Psi=v["Psi"], xi_max=v["xi_max"], damping=v["damping"])

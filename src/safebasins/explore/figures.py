@@ -8,6 +8,10 @@
   C (grey), the limiting phase trajectory C = 0 through the well bottom (black) and the
   threshold xi = xi_max (red dashed).
 
+With damping (beta > 0) the analytic pictures are the damped slow flow's (``explore.analytic``):
+the red lines on the IC plane outline its safe mask, the manifold shows no level curves (C is not
+conserved), and the titles and the key say so.
+
 Models carry names (``Bokeh.documents[0].get_model_by_name(...)`` in the browser, and the tests).
 """
 from __future__ import annotations
@@ -19,7 +23,7 @@ from bokeh.plotting.contour import contour_data
 
 from safebasins.explore.ranges import WellRanges
 
-__all__ = ["Figures", "key"]
+__all__ = ["Figures", "key", "titles"]
 
 SAFE_COLOR = "#9ecae1"
 NUMERIC_COLOR = "#404040"
@@ -35,13 +39,29 @@ def _swatch(color, alpha=1.0, dashed=False):
             'vertical-align:middle"></span>')
 
 
-def key() -> str:
-    """HTML key of the colours of both figures."""
-    items = [(_swatch(SAFE_COLOR), "slow-flow safe"), (_swatch(NUMERIC_COLOR, 0.55), "numeric safe (after a run)"),
-             (_swatch(BOUNDARY_COLOR), "analytic boundary (eqs 27-28), xi = xi_max"),
-             (_swatch(None, dashed=True), "unforced orbit H0 = xi_max"),
-             (_swatch(LEVEL_COLOR), "level curves of C"), (_swatch("black"), "C = 0 through the well bottom")]
-    return " &nbsp; ".join(f"{sw}&nbsp;{label}" for sw, label in items)
+def key(damping: float = 0.0) -> str:
+    """HTML key of the colours of both figures (``damping`` > 0: those of the damped slow flow)."""
+    if damping > 0:
+        items = [(_swatch(SAFE_COLOR), f"damped slow-flow safe (beta = {damping:g}: the slow trajectory settles "
+                                       "below xi_max)"),
+                 (_swatch(NUMERIC_COLOR, 0.55), "numeric safe, damped equation (after a run)"),
+                 (_swatch(BOUNDARY_COLOR), "outline of the damped slow-flow safe mask, xi = xi_max"),
+                 (_swatch(None, dashed=True), "unforced orbit H0 = xi_max"),
+                 (None, "no level curves of C: with damping C is not conserved")]
+    else:
+        items = [(_swatch(SAFE_COLOR), "slow-flow safe"), (_swatch(NUMERIC_COLOR, 0.55), "numeric safe (after a run)"),
+                 (_swatch(BOUNDARY_COLOR), "analytic boundary (eqs 27-28), xi = xi_max"),
+                 (_swatch(None, dashed=True), "unforced orbit H0 = xi_max"),
+                 (_swatch(LEVEL_COLOR), "level curves of C"), (_swatch("black"), "C = 0 through the well bottom")]
+    return " &nbsp; ".join(f"{sw or ''}&nbsp;{label}" for sw, label in items)
+
+
+def titles(damping: float = 0.0) -> tuple[str, str]:
+    """Titles of the IC-plane and manifold figures."""
+    if damping > 0:
+        return (f"Damped slow-flow safe basin (beta = {damping:g})",
+                f"Damped slow flow (beta = {damping:g}): C not conserved")
+    return "Initial conditions: slow-flow safe basin", "Resonance manifold: level curves of C (eq 18)"
 
 
 def _mask_image(mask, x_window, y_window):
@@ -102,8 +122,9 @@ class Figures:
         self.ic.y_range.update(start=r.p_window[0], end=r.p_window[1])
         self.rm.y_range.update(start=0.0, end=r.xi_top)
 
-    def show(self, r: WellRanges, xi_max: float, ic: dict, rm: dict):
+    def show(self, r: WellRanges, xi_max: float, ic: dict, rm: dict, damping: float = 0.0):
         """Redraw both pictures (the numeric basin is hidden: it belongs to other parameters)."""
+        self.ic.title.text, self.rm.title.text = titles(damping)
         self.numeric.visible = False
         self.analytic_source.data = _mask_image(ic["safe"].T, r.q_window, r.p_window)
         xs, ys, _ = ic["boundaries"]
@@ -111,8 +132,10 @@ class Figures:
         q, p = ic["orbit"]
         self.orbit_source.data = {"q": q, "p": p}
         self.rm_source.data = self._rm_image(rm)
-        self.levels.set_data(contour_data(rm["gamma"], rm["xi"], rm["C"], rm["levels"], want_fill=False))
-        self.lpt.set_data(contour_data(rm["gamma"], rm["xi"], rm["C"], [0.0], want_fill=False))
+        self.levels.visible = self.lpt.visible = not damping > 0   # C is not conserved with damping
+        if not damping > 0:
+            self.levels.set_data(contour_data(rm["gamma"], rm["xi"], rm["C"], rm["levels"], want_fill=False))
+            self.lpt.set_data(contour_data(rm["gamma"], rm["xi"], rm["C"], [0.0], want_fill=False))
         self.threshold.location = xi_max
 
     def show_numeric(self, r: WellRanges, safe):

@@ -4,7 +4,7 @@ to stop when the sliders move), and its agreement with the slow flow.
 Numeric safe = not escaped over the energy threshold within the horizon
 (:func:`~safebasins.analysis.safe.is_safe` of :func:`~safebasins.numerics.charts.escape_chart`
 at ``t_eval = cycles``); the agreement is the intersection over union
-(:func:`~safebasins.analysis.agreement.iou`).
+(:func:`~safebasins.analysis.agreement.iou`).  With damping the chart integrates the damped equation.
 """
 from __future__ import annotations
 
@@ -36,7 +36,7 @@ def numeric_safe(r: WellRanges, f: Forcing, n: int, cycles: int, *, blocks: int 
         if stop is not None and stop():
             return None
         chart = numerics.escape_chart(q0[rows], p0, f.F, f.Omega, f.Psi, xi_max=(f.xi_max,), cycles=cycles,
-                                      well=r.well, grid=True)
+                                      well=r.well, grid=True, damping=f.damping)
         safe[rows] = is_safe(chart["escape_cycle_energy"].isel(xi_max=0).values, cycles)
         if progress is not None:
             progress(k + 1, len(parts))

@@ -17,6 +17,9 @@ __all__ = ["Slider", "WellRanges", "well_names", "well_description", "well_range
 
 #: highest threshold offered, as a fraction of the barrier energy (the slow flow is singular at E_b)
 TOP = 0.98
+#: largest damping of the slider, in units of omega(0) (beta = 0.05 for the quartic: Q = 20, still
+#: small against omega, where the isolated-resonance theory applies, docs/damping.md)
+DAMPING_MAX = 0.05
 
 
 def well_names() -> list[str]:
@@ -51,8 +54,8 @@ class WellRanges:
         The well's name and its :class:`~safebasins.wells.base.Well` object.
     barrier_energy, omega0
         Escape energy E_b and small-oscillation frequency omega(0).
-    Omega, F, Psi, xi_max
-        The sliders.
+    Omega, F, Psi, xi_max, damping
+        The sliders (damping: beta of q'' + beta q' + V'(q) = ..., from 0, the undamped equation).
     q_window, p_window
         The plane of initial conditions shown: the orbit of the highest threshold with a margin.
     xi_top
@@ -67,6 +70,7 @@ class WellRanges:
     F: Slider
     Psi: Slider
     xi_max: Slider
+    damping: Slider
     q_window: tuple[float, float]
     p_window: tuple[float, float]
     xi_top: float
@@ -89,4 +93,5 @@ def well_ranges(name: str) -> WellRanges:
         F=Slider(0.0, 0.4 * Eb, Eb / 1000, 0.01 if quartic else 0.04 * Eb),
         Psi=Slider(-np.pi, np.pi, np.pi / 180, np.pi),
         xi_max=Slider(0.02 * Eb, top, Eb / 1000, 0.18 if quartic else 0.72 * Eb),
+        damping=Slider(0.0, DAMPING_MAX * omega0, 0.0005 * omega0, 0.0),
         q_window=(q_lo - pad, q_hi + pad), p_window=(-p_hi, p_hi), xi_top=top)
