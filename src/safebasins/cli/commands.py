@@ -8,6 +8,7 @@ import click
 
 from safebasins.cli.options import (DISPLACEMENT, ENERGY, FINITE, OPTION_OF, POSITIVE, Deferred, Fields, Number,
                                     NumberList, analytic_threshold, checked, common_options, cost_guard, current_well,
+                                    damping_option,
                                     forcing_options, fourier_of, from_library, from_schema, grid_options, grid_params,
                                     joined, lib_check, library_errors, numerics_options, out_option)
 from safebasins.cli.interrupt import InterruptibleGroup
@@ -75,19 +76,24 @@ def main():
 @click.option("--tiles", type=click.IntRange(min=1), default=None,
               help="Row tiles (blocks of q0) integrated one after another; the progress bar counts them "
                    "[default: min(NQ, 10)]. The chart does not depend on it.")
+@damping_option()
 @common_options
 @out_option("chart")
 def chart(F, Omega, Psi, xi_max, q_max, grid, n, cycles, steps_per_cycle, threads, backend, t_eval, n_points, tiles,
-          fourier, well, no_plot, quiet, verbose, allow_expensive, out):
+          damping, fourier, well, no_plot, quiet, verbose, allow_expensive, out):
     """Numeric escape chart on an IC grid with the analytic safe basins and their IoU.
 
     One integration serves every threshold.  PREFIX.nc is the chart in the layout of the
     pipeline's Figs 13-15 (`escape_cycle_energy(xi_max, q0, p0)`, `iou(xi_max)`,
     `pixel_agreement(xi_max)`, numeric safe = escape cycle > cycles); PREFIX.png shows the
-    numeric safe basins (grey, nested) with the slow-flow boundaries (lines).
+    numeric safe basins (grey, nested) with the slow-flow boundaries (lines).  With --damping
+    beta > 0 the numerics integrate the damped equation and the analytic basins are the damped slow
+    flow's (docs/damping.md), their boundary the outline of the safe mask.
 
     Example: safebasins chart --F 0.01 --Omega 0.9 --Psi pi --xi-max 0.14,0.18 --n 100 --cycles 1000
     """
+    from safebasins.pipeline.values import damping_param
+
     t_eval = float(cycles) if t_eval is None else t_eval
     if t_eval > cycles:
         raise click.BadParameter(f"evaluation time {t_eval} beyond the horizon --cycles {cycles}",
@@ -100,9 +106,10 @@ def chart(F, Omega, Psi, xi_max, q_max, grid, n, cycles, steps_per_cycle, thread
     params = dict(command="chart", kind="basin_chart", experiment=name, fourier=fourier, well=well, scan="xi_max", F=F,
                   xi_max=xi_max, q_max=q_max, Omega=Omega, Psi=Psi, grid=grid_params(grid, n), cycles=cycles,
                   t_eval=[t_eval], n_points=n_points, steps_per_cycle=steps_per_cycle,
-                  tasks=[{"F": F, "xi_max": xi_max, "q_max": q_max}])
-    params["title"] = (f"Escape chart and slow-flow safe basins, {well_label(well)} well, F = {fmt(F)}, "
-                       f"Omega = {fmt(Omega)}, Psi = {fmt(Psi, angle=True)} (safebasins chart {name})")
+                  tasks=[{"F": F, "xi_max": xi_max, "q_max": q_max}], **damping_param(damping))
+    params["title"] = (f"Escape chart and {'damped ' if damping > 0 else ''}slow-flow safe basins, "
+                       f"{well_label(well)} well, F = {fmt(F)}, Omega = {fmt(Omega)}, Psi = {fmt(Psi, angle=True)}"
+                       + (f", beta = {fmt(damping)}" if damping > 0 else "") + f" (safebasins chart {name})")
     check_step(Omega, steps_per_cycle)
     cost_guard("basin_chart", params, allow_expensive)
     with library_errors(), chatter(verbose):
@@ -126,21 +133,22 @@ def chart_dataset(params, tiles, job, quiet):
     from safebasins.analysis.ic_basins import analytic_basin_stack
     from safebasins.io.gather import gather_chart, gather_tiles
     from safebasins.numerics import escape_chart
-    from safebasins.pipeline.values import grid_axes, tile_slice, well
+    from safebasins.pipeline.values import damping, grid_axes, tile_slice, well
 
     q0, p0 = grid_axes(params["grid"])
     w = well(params)
+    beta = damping(params)
     parts = []
     with progress(tiles, "escape chart", "tile", quiet) as bar:
         for k in range(tiles):
             parts.append(escape_chart(q0[tile_slice(q0.size, tiles, k)], p0, params["F"], params["Omega"],
                                       params["Psi"], xi_max=tuple(params["xi_max"]), q_max=tuple(params["q_max"]),
                                       cycles=params["cycles"], steps_per_cycle=params["steps_per_cycle"],
-                                      threads=job.threads, grid=True, backend=job.backend, well=w))
+                                      threads=job.threads, grid=True, backend=job.backend, well=w, damping=beta))
             bar.update(1)
     chart = gather_chart([gather_tiles(parts)], cycles=params["cycles"], scan="xi_max", t_eval=params["t_eval"])
     basins = analytic_basin_stack("xi_max", params["xi_max"], params["F"], params["Omega"], params["Psi"], None, q0,
-                                  p0, well=w, n_points=params["n_points"], label=params["experiment"])
+                                  p0, well=w, n_points=params["n_points"], label=params["experiment"], damping=beta)
     basins.attrs.update(F=params["F"], Omega=params["Omega"], Psi=params["Psi"], fourier=params["fourier"])
     return chart_agreement(chart, basins, params["cycles"], "xi_max"), basins
 
@@ -304,19 +312,32 @@ def fcr_numeric(params, job, quiet):
 @click.option("--xi-top", "xi_top", type=Number("xi_top", ENERGY), default=None,
               help="Top of the resonance-manifold panel (< E_b) [default: the basin_rm schema's 0.2499 for the "
                    "quartic, 0.9996 E_b for any other well].")
+@damping_option()
 @common_options
 @out_option("basin")
-def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, fourier, well, no_plot, quiet, verbose,
-          allow_expensive, out):
+def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, damping, fourier, well, no_plot, quiet,
+          verbose, allow_expensive, out):
     """Analytic safe basin of the slow flow, on the resonance manifold and on the IC plane.
 
     PREFIX.nc has the layout of the pipeline's Figs 5-9: boundary curves (`gamma`, `xi`,
     `q0_vertex`, `p0_vertex`, `kind`), `escapes(q0, p0)`, `C` and `escapes_rm` on
-    (gamma_rm, xi_rm); PREFIX.png is the two-panel figure.
+    (gamma_rm, xi_rm); PREFIX.png is the two-panel figure.  With --damping beta > 0 the first
+    integral C is not conserved: only the IC plane applies (the damped slow flow's `escapes(q0, p0)`
+    and the outline of its safe mask as the boundary curves, docs/damping.md); the
+    resonance-manifold options are refused there.
 
     Example: safebasins basin --F 0.0876 --Omega 0.92 --xi-max 0.24
     """
+    from safebasins.pipeline.values import damping_param
+
     ctx = click.get_current_context()
+    if damping > 0:
+        given = [OPTION_OF.get(k, f"--{k.replace('_', '-')}") for k in ("n_gamma", "n_xi", "xi_top")
+                 if ctx.get_parameter_source(k) is not click.core.ParameterSource.DEFAULT]
+        if given:
+            raise click.BadParameter(f"{', '.join(given)} set the resonance-manifold panel, which does not apply "
+                                     f"with --damping {fmt(damping)} > 0 (C is not conserved; only the IC plane "
+                                     "is drawn)", param_hint="'--damping'")
     if xi_top is None:
         w = current_well(ctx)
         xi_top = (from_schema("basin_rm", "manifold", "xi_top")() if w.name == "quartic"
@@ -327,24 +348,32 @@ def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, fouri
     fourier = fourier_of(ctx, fourier)
     params = dict(command="basin", kind="basin_rm", experiment=name, fourier=fourier, well=well, F=F, Omega=Omega, Psi=Psi,
                   xi_max=xi_max, grid=grid_params(grid, n), n_points=n_points,
-                  manifold={"n_gamma": n_gamma, "n_xi": n_xi, "xi_top": xi_top})
-    params["title"] = (f"Analytic safe basin, {well_label(well)} well, F = {fmt(F)}, Omega = {fmt(Omega)}, "
-                       f"Psi = {fmt(Psi, angle=True)}, xi_max = {fmt(xi_max)} (safebasins basin {name})")
+                  manifold={"n_gamma": n_gamma, "n_xi": n_xi, "xi_top": xi_top}, **damping_param(damping))
+    params["title"] = (f"Analytic {'damped ' if damping > 0 else ''}safe basin, {well_label(well)} well, "
+                       f"F = {fmt(F)}, Omega = {fmt(Omega)}, Psi = {fmt(Psi, angle=True)}, xi_max = {fmt(xi_max)}"
+                       + (f", beta = {fmt(damping)}" if damping > 0 else "") + f" (safebasins basin {name})")
+    if damping > 0:  # no resonance-manifold panel: C is not conserved
+        params["manifold"] = {"n_gamma": 0, "n_xi": 0, "xi_top": xi_top}
     cost_guard("basin_rm", params, allow_expensive, numeric=False)
     from safebasins.analysis.ic_basins import add_resonance_manifold, analytic_basin
 
     with library_errors(), chatter(verbose):
         w = well_of(params)
         q0, p0 = grid_axes(params["grid"])
-        ds = analytic_basin(F, Omega, Psi, xi_max, q0, p0, well=w, n_points=n_points, label=name)
-        ds = add_resonance_manifold(ds, F, Omega, xi_max, n_gamma=n_gamma, n_xi=n_xi, xi_top=xi_top, well=w)
+        if damping > 0:
+            ds = analytic_basin(F, Omega, Psi, xi_max, q0, p0, well=w, n_points=n_points, label=name,
+                                damping=damping)
+        else:
+            ds = analytic_basin(F, Omega, Psi, xi_max, q0, p0, well=w, n_points=n_points, label=name)
+            ds = add_resonance_manifold(ds, F, Omega, xi_max, n_gamma=n_gamma, n_xi=n_xi, xi_top=xi_top, well=w)
         ds.attrs.update(F=F, Omega=Omega, Psi=Psi, xi_max=xi_max, fourier=fourier)
         ds = finish(ds, title=params["title"], params=params)
         fig = None
         if not no_plot:
+            from safebasins.plotting.api import plot_basin
             from safebasins.plotting.basins import figure_rm_basin
 
-            fig = draw(figure_rm_basin, ds)
+            fig = draw(plot_basin, ds) if damping > 0 else draw(figure_rm_basin, ds)
     write_outputs([(f"{out}.nc", ds)], fig, f"{out}.png")
     safe = ~ds["escapes"].astype(bool)
     kinds = sorted({str(k) for k in ds["kind"].values if str(k)})

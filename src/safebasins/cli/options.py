@@ -25,7 +25,7 @@ OPTION_OF = {"F": "--F", "Omega": "--Omega", "Psi": "--Psi", "xi_max": "--xi-max
              "cycles": "--cycles", "steps_per_cycle": "--steps-per-cycle", "threads": "--threads",
              "xi_ini": "--xi-ini", "gamma_ini": "--gamma-ini", "tol": "--tol", "n_scan": "--n-scan",
              "F_bracket": "--F-bracket", "n_points": "--n-points", "q0": "--grid", "p0": "--grid",
-             "xi_top": "--xi-top", "t_eval": "--t-eval", "backend": "--backend"}
+             "xi_top": "--xi-top", "t_eval": "--t-eval", "backend": "--backend", "damping": "--damping"}
 
 _ANGLE = re.compile(r"^([+-]?)(\d+(?:\.\d*)?|\.\d+)?\*?pi(?:/(\d+(?:\.\d*)?))?$", re.IGNORECASE)
 
@@ -394,6 +394,19 @@ def grid_options(f):
     return click.option("--grid", "grid", type=Fields("grid"), default=None,
                         help="IC window q0min,q0max,p0min,p0max (endpoints included) [default: the whole well, "
                              "Well.ic_window(): -1,1,-0.75,0.75 for the quartic].")(f)
+
+
+def damping_option(multiple=False):
+    """``--damping`` beta >= 0 of q'' + beta q' + V'(q) = F sin(Omega t + Psi) (0: the paper's
+    undamped equation); ``multiple``: a comma list or repeated, one F_cr curve each."""
+    text = ("Linear damping beta >= 0 of q'' + beta q' + V'(q) = F sin(Omega t + Psi) (0: the undamped "
+            "equation; beta > 0: the damped slow flow and numerics, docs/damping.md)")
+    if multiple:
+        return click.option("--damping", "damping", type=NumberList("damping", NONNEG), multiple=True,
+                            callback=joined(unique=False),
+                            help=text + ". A list makes one curve per value, each > 0 [default: 0].")
+    return click.option("--damping", "damping", type=Number("damping", NONNEG), default="0", show_default=True,
+                        help=text + ".")
 
 
 def well_option(f):
