@@ -287,3 +287,16 @@ def test_unwritable_output_is_refused_before_computing(tmp_path):
     (tmp_path / "run.nc").mkdir()
     res = run([*CHART[:9], "-o", "run"], tmp_path)
     assert res.returncode == 2 and "run.nc is a folder" in res.stderr, res.stderr
+
+
+def test_fcr_damping_one_curve_per_beta_recorded(tmp_path):
+    res = run(["fcr", "--xi-max", "0.15", "--Omega-range", "0.9,0.95,2", "--damping", "0.01,0.02", "--numeric",
+               "--numeric-Omega", "0.9,0.95,2", "--cycles", "100", "--n-scan", "0", "--tol", "1e-3", "--no-plot",
+               "-o", "d"], tmp_path)
+    assert res.returncode == 0, res.stderr
+    with xr.open_dataset(tmp_path / "d.nc") as a, xr.open_dataset(tmp_path / "d_numeric.nc") as n:
+        assert a["damping"].values.tolist() == n["damping"].values.tolist() == [0.01, 0.02]
+        assert "F_cr_undamped" in a and (a["F_cr"] >= a["F_cr_undamped"] - 1e-3).all()
+        assert json.loads(a.attrs["parameters"])["damping"] == [0.01, 0.02]
+    bad = run(["fcr", "--xi-max", "0.15", "--damping", "0,0.02", "-o", "x"], tmp_path)
+    assert bad.returncode == 2 and "'--damping'" in bad.stderr and "every value must be > 0" in bad.stderr

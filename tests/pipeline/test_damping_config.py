@@ -22,7 +22,7 @@ def test_every_kind_has_the_damping_key_with_default_zero(base):
     run = plan(base)
     for name, exp in run.experiments.items():
         if exp.key.startswith("damped."):
-            assert exp.params["damping"] > 0
+            assert min(exp.params["damping"] if isinstance(exp.params["damping"], list) else [exp.params["damping"]]) > 0
         else:
             assert "damping" not in exp.params, name          # beta = 0: no parameter, files unchanged
 
@@ -68,3 +68,34 @@ def test_damped_chart_tiles_integrate_the_damped_equation(base):
                        well=base_well(p), damping=0.1)
     assert tile.attrs["damping"] == 0.1
     np.testing.assert_array_equal(tile["escape_cycle_energy"].values, ref["escape_cycle_energy"].values)
+
+
+def test_fcr_damping_list_makes_one_curve_per_beta(base):
+    run = plan(base)
+    p = run.experiments["damped_quartic_fcr"].params
+    assert [c["damping"] for c in p["curves"]] == p["damping"] == [0.005, 0.01, 0.02]
+    assert [c["label"] for c in p["curves"]] == ["damping = 0.005", "damping = 0.01", "damping = 0.02"]
+    msg = refused(merged(base, {"damped": {"quartic_fcr": {"damping": [0.0, 0.01]}}}), "damped.quartic_fcr.damping")
+    assert "every value must be > 0" in msg
+    refused(merged(base, {"damped": {"quartic_fcr": {"damping": [0.01, 0.02], "xi_max": [0.1, 0.12, 0.15]}}}),
+            "damped.quartic_fcr.damping")                          # 2 values against 3 curves
+
+
+def test_damped_analytic_fcr_curves_are_the_theory_per_curve():
+    """analysis.fcr_curves stacks theory.critical_forcing(..., damping=beta) per curve, with the
+    coordinate damping; undamped curves keep their old coordinates."""
+    import numpy as np
+
+    from safebasins.analysis.fcr_curves import analytic_fcr_curves
+    from safebasins.theory import critical_forcing
+
+    Om = np.array([0.9, 0.95])
+    curves = [{"label": f"damping = {b}", "xi_max": 0.15, "xi_ini": 0.0, "gamma_ini": 0.0, "damping": b}
+              for b in (0.01, 0.02)]
+    out = analytic_fcr_curves(Om, curves)
+    assert out["damping"].values.tolist() == [0.01, 0.02]
+    for i, b in enumerate((0.01, 0.02)):
+        ref = critical_forcing(Om, 0.15, damping=b)
+        np.testing.assert_array_equal(out["F_cr"].isel(curve=i).values, ref["F_cr"].values)
+    und = analytic_fcr_curves(Om, [{k: v for k, v in curves[0].items() if k != "damping"}])
+    assert "damping" not in und.coords and "mechanism" in und

@@ -1,7 +1,7 @@
 """Critical-forcing curves F_cr(Omega), analytic and numeric, stacked over ``curve`` (Figs 1-4, 10-12).
 
-A curve is a dict with ``label``, ``xi_max``, ``xi_ini``, ``gamma_ini`` and, for the numerics,
-``Psi`` (safebasins.pipeline.values.curves makes them from a config block); the pipeline's
+A curve is a dict with ``label``, ``xi_max``, ``xi_ini``, ``gamma_ini``, optionally ``damping``
+(beta > 0: the damped theory and numerics) and, for the numerics, ``Psi`` (safebasins.pipeline.values.curves makes them from a config block); the pipeline's
 ``fcr_theory`` / ``fcr_compare`` kinds and ``safebasins fcr`` call these functions.
 """
 from __future__ import annotations
@@ -24,11 +24,17 @@ def analytic_fcr_curves(Omega, curves, *, well=None, label=""):
     parts = []
     for c in curves:
         print(f"{label}: critical_forcing for {c['label']}")
-        parts.append(critical_forcing(Omega, c["xi_max"], xi_ini=c["xi_ini"], gamma_ini=c["gamma_ini"], well=well))
-    coords = {k: [c[k] for c in curves] for k in ("xi_max", "xi_ini", "gamma_ini", "label")}
-    if all("Psi" in c for c in curves):
-        coords["Psi"] = [c["Psi"] for c in curves]
-    return stack(parts, "curve", coords=coords)
+        parts.append(critical_forcing(Omega, c["xi_max"], xi_ini=c["xi_ini"], gamma_ini=c["gamma_ini"], well=well,
+                                      damping=c.get("damping", 0.0)))
+    return stack(parts, "curve", coords=_curve_coords(curves, ("xi_max", "xi_ini", "gamma_ini", "label"),
+                                                      ("Psi", "damping")))
+
+
+def _curve_coords(curves, keys, optional):
+    """Per-curve coordinates: ``keys`` and each of ``optional`` that every curve has (a curve
+    without ``damping`` is undamped, and undamped stacks keep their old coordinates)."""
+    have = [*keys, *(k for k in optional if all(k in c for c in curves))]
+    return {k: [c[k] for c in curves] for k in have}
 
 
 @api_provenance
@@ -51,7 +57,7 @@ def numeric_fcr_curves(Omega, curves, *, well=None, cycles, tol, F_bracket, crit
         parts.append(critical_forcing_numeric(
             Omega, c["xi_max"], q0=q0, p0=p0, Psi=c["Psi"], cycles=cycles, tol=tol, F_bracket=tuple(F_bracket),
             criterion=criterion, n_scan=n_scan, steps_per_cycle=steps_per_cycle, threads=threads, backend=backend,
-            well=well))
-    coords = {k: [c[k] for c in curves] for k in ("xi_max", "xi_ini", "gamma_ini", "Psi", "label")}
+            well=well, damping=c.get("damping", 0.0)))
+    coords = _curve_coords(curves, ("xi_max", "xi_ini", "gamma_ini", "Psi", "label"), ("damping",))
     coords.update(q0=q0s, p0=p0s)
     return stack(parts, "curve", coords=coords)

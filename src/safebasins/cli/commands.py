@@ -187,14 +187,15 @@ def n_scan_check(n):
               help="Bisection bracket lo,hi of F.")
 @click.option("--criterion", type=click.Choice(["energy", "displacement"]), default="energy", show_default=True,
               help="Numeric escape: H0 > xi_max, or |q| > q_max(xi_max).")
+@damping_option(multiple=True)
 @common_options
 @out_option("fcr")
 def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cycles, steps_per_cycle,
-        threads, backend, tol, n_scan, F_bracket, criterion, fourier, well, no_plot, quiet, verbose, allow_expensive,
-        out):
+        threads, backend, tol, n_scan, F_bracket, criterion, damping, fourier, well, no_plot, quiet, verbose,
+        allow_expensive, out):
     """Critical forcing F_cr(Omega): analytic curves, optionally with the numeric bisection.
 
-    Curves come from --xi-max / --xi-ini / --gamma-ini (equal lengths or length 1).  Writes
+    Curves come from --xi-max / --xi-ini / --gamma-ini / --damping (equal lengths or length 1).  Writes
     PREFIX.nc (analytic, layout of the pipeline's fcr datasets: `F_cr(curve, Omega)`,
     `mechanism`, branches) and with --numeric also PREFIX_numeric.nc (`F_cr`, brackets,
     `non_monotone`); PREFIX.png shows the curves (and the numeric dots).
@@ -203,8 +204,13 @@ def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cyc
     """
     from safebasins.pipeline import values
 
-    block = {"xi_max": xi_max, "xi_ini": xi_ini or [0.0], "gamma_ini": gamma_ini or [0.0], "Psi": Psi}
-    lens = {k: len(block[k]) for k in ("xi_max", "xi_ini", "gamma_ini")}
+    damping = damping or [0.0]
+    if len(damping) > 1 and not all(b > 0 for b in damping):
+        raise click.BadParameter(f"a list makes one damped curve per value: every value must be > 0, got {damping}",
+                                 param_hint="'--damping'")
+    block = {"xi_max": xi_max, "xi_ini": xi_ini or [0.0], "gamma_ini": gamma_ini or [0.0], "Psi": Psi,
+             "damping": damping if len(damping) > 1 else damping[0]}
+    lens = {k: len(v) for k, v in values.curve_lists(block).items()}
     ncurve = max(lens.values())
     for k, m in lens.items():
         if m not in (1, ncurve):
@@ -222,7 +228,8 @@ def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cyc
         w0 = float(current_well(ctx).omega(0.0))
         Omega_range = {"start": round(0.5 * w0, 12), "stop": round(1.2 * w0, 12), "num": 351}
     params = dict(command="fcr", kind="fcr_compare" if numeric else "fcr_theory", experiment=name, fourier=fourier,
-                  well=well, Omega=values.range_values(Omega_range), curves=curves)
+                  well=well, **values.damping_param(block["damping"]), Omega=values.range_values(Omega_range),
+                  curves=curves)
     if numeric:
         params["numeric"] = {"Omega": values.range_values(numeric_Omega or Omega_range), "cycles": cycles,
                              "tol": tol, "F_bracket": F_bracket, "n_scan": n_scan, "criterion": criterion,

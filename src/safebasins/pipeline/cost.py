@@ -59,9 +59,17 @@ def _n(v):
     return len(v) if isinstance(v, (list, tuple)) else 1
 
 
+#: slow-flow evaluations one damped F_cr point costs (an F scan and bisection of damped slow
+#: trajectories: about 0.35 s per Omega on one core of the machine of ANALYTIC_RATE, quartic)
+DAMPED_FCR_EVALUATIONS = 400_000
+
+
 def _fcr(p):
-    # critical_forcing solves each (Omega, curve) on an xi grid of n_grid nodes
-    return len(p["Omega"]) * len(p["curves"]) * _default("safebasins.theory:critical_forcing", "n_grid")
+    # critical_forcing solves each (Omega, curve) on an xi grid of n_grid nodes; a damped curve
+    # integrates slow trajectories instead
+    per = [DAMPED_FCR_EVALUATIONS if c.get("damping", 0.0) > 0 else _default("safebasins.theory:critical_forcing",
+                                                                              "n_grid") for c in p["curves"]]
+    return len(p["Omega"]) * sum(per)
 
 
 #: slow-flow evaluations one IC of a damped analytic basin costs (its slow trajectory is integrated

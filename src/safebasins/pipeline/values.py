@@ -76,9 +76,17 @@ def box(b) -> list[list[float]]:
     return [[float(lo), float(hi)] for lo, hi in b]
 
 
+def curve_lists(blk) -> dict:
+    """The list-valued keys that make F_cr curves: xi_max, xi_ini, gamma_ini and, for a damped
+    block (:func:`damping_param`), damping."""
+    keys = ("xi_max", "xi_ini", "gamma_ini") + (("damping",) if damping_param(blk.get("damping", 0.0)) else ())
+    return {k: as_list(blk[k]) for k in keys}
+
+
 def curves(blk, with_psi) -> list[dict]:
-    """F_cr curves from list-valued xi_max / xi_ini / gamma_ini (equal lengths or length 1)."""
-    lists = {k: as_list(blk[k]) for k in ("xi_max", "xi_ini", "gamma_ini")}
+    """F_cr curves from list-valued xi_max / xi_ini / gamma_ini (and damping; equal lengths or
+    length 1)."""
+    lists = curve_lists(blk)
     n = max(len(v) for v in lists.values())
     varying = [k for k, v in lists.items() if len(v) > 1]
     out = []
@@ -87,6 +95,8 @@ def curves(blk, with_psi) -> list[dict]:
         xi_max, xi_ini, gamma_ini = float(c["xi_max"]), float(c["xi_ini"]), angle(c["gamma_ini"])
         label = ", ".join(f"{k} = {fmt(c[k])}" for k in varying) if varying else f"xi_max = {fmt(xi_max)}"
         cur = {"label": label, "xi_max": xi_max, "xi_ini": xi_ini, "gamma_ini": gamma_ini}
+        if "damping" in c:
+            cur["damping"] = float(c["damping"])
         if with_psi:
             cur["Psi"] = angle(blk["Psi"])
         out.append(cur)

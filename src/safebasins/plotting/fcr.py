@@ -25,7 +25,7 @@ MECHANISMS = {
 }
 # branch variables of the critical_forcing dataset, in the mechanism order above
 BRANCHES = {1: "F_MM_0", 2: "F_MM_pi", 3: "F_SM", 4: "F_SMM"}
-CURVE_COORDS = ("xi_max", "xi_ini", "gamma_ini", "Psi")
+CURVE_COORDS = ("xi_max", "xi_ini", "gamma_ini", "Psi", "damping")
 
 
 def curve_labels(ds, dim="curve"):
@@ -52,7 +52,7 @@ def curve_labels(ds, dim="curve"):
 
 def _symbols(label):
     """"xi_ini = 0.05" (a stored curve label) -> "$\\xi_{ini}$ = 0.05"."""
-    for name in ("xi_ini", "gamma_ini", "xi_max", "Psi"):
+    for name in ("xi_ini", "gamma_ini", "xi_max", "Psi", "damping"):
         label = label.replace(f"{name} =", f"{SYMBOLS[name]} =")
     return label
 
@@ -401,6 +401,7 @@ def figure_fcr_comparison(analytic, numeric, *, layout="overlay", F_max=None, ti
         if layout == "panels":
             _fcr_ylim(ax, arrays, F_max)
             ax.set_title(labels[i])
+    undamped = _draw_undamped(axes, ana, layout)
     if layout == "overlay":
         _fcr_ylim(axes[0], [ana["F_cr"], num["F_cr"]], F_max)
     bracket_label = r"non-monotone in $F$: $F_{escape,low}$ .. $F_{escape,all}$"
@@ -416,6 +417,9 @@ def figure_fcr_comparison(analytic, numeric, *, layout="overlay", F_max=None, ti
         else:
             h, l_ = ax.get_legend_handles_labels()
             hs, ls_ = [x for x, lab in zip(h, l_) if lab], [lab for lab in l_ if lab]
+        if undamped:
+            hs.append(Line2D([], [], **UNDAMPED_STYLE))
+            ls_.append(r"undamped theory ($\beta$ = 0)")
         if ax_brackets.get(id(ax)) and bracket:
             hs.append(bracket_handle())
             ls_.append(bracket_label)
@@ -430,7 +434,52 @@ def figure_fcr_comparison(analytic, numeric, *, layout="overlay", F_max=None, ti
                            (f", {head}" if head else "") + (f"  [{', '.join(sub)}]" if sub else "")),
                  fontsize=10)
     _comparison_notes(fig, pairs, cycles, tol)
+    if undamped:
+        _damping_notes(fig, ana, labels)
     return fig
+
+
+def _damping_notes(fig, ana, labels):
+    """The damped theory's minimum F_cr against the undamped one's, per curve, from the data."""
+    parts = []
+    for i in range(ana.sizes["curve"]):
+        a = ana.isel(curve=i)
+        Om = np.asarray(a["Omega"], float)
+        F, F0 = np.asarray(a["F_cr"], float), np.asarray(a["F_cr_undamped"], float)
+        if not (np.isfinite(F).any() and np.isfinite(F0).any()):
+            continue
+        k, k0 = np.nanargmin(F), np.nanargmin(F0)
+        parts.append(f"{plain_text(labels[i])}: {F[k]:.4g} at Ω = {Om[k]:.3g} (undamped {F0[k0]:.4g} at "
+                     f"Ω = {Om[k0]:.3g}, x{F[k] / F0[k0]:.2f})")
+    if parts:
+        add_note(fig, "Damping raises the threshold most at the resonance: minimum theoretical F_cr " + "; ".join(parts)
+                      + ".")
+    if "undecided" in ana.variables:
+        n_und = int(np.asarray(ana["undecided"]).astype(bool).sum())
+        add_note(fig, f"Damped theory: {count(n_und, 'Ω point')} left undecided (a slow trajectory neither "
+                      "escaped nor was certified settled within its time limit; F_cr is NaN there, never guessed)."
+                 if n_und else "Damped theory: every slow trajectory was decided (escaped or certified settled).")
+
+
+#: the undamped theory beside damped curves (theory.critical_forcing's F_cr_undamped)
+UNDAMPED_STYLE = dict(color="0.45", lw=1.0, ls="--")
+
+
+def _draw_undamped(axes, ana, layout):
+    """The undamped theory of damped curves, once per distinct curve without its damping (one line
+    where every curve has the same xi_max and IC); False when the curves are undamped."""
+    if "F_cr_undamped" not in ana.variables:
+        return False
+    seen = set()
+    for i in range(ana.sizes["curve"]):
+        a = ana.isel(curve=i)
+        key = (id(axes[i]), *(float(a[c]) for c in ("xi_max", "xi_ini", "gamma_ini") if c in a.coords))
+        if key in seen:
+            continue
+        seen.add(key)
+        axes[i].plot(np.asarray(a["Omega"], float), np.asarray(a["F_cr_undamped"], float), zorder=2,
+                     **UNDAMPED_STYLE)
+    return True
 
 
 #: the two sides of an F_cr curve by the mechanism of the theory there (MECHANISMS codes)
@@ -458,6 +507,8 @@ def _side_notes(fig, sides):
     """The error on the SM side (left of each minimum, large F) versus the MM side, read from the data."""
     txt = []
     for lab, e in sides:
+        if not e:                  # no mechanism (damped theory): no sides
+            continue
         txt.append(f"{lab}: " + ", ".join(f"{side} side median {100 * e[side][0]:.0f}%, max {100 * e[side][1]:.0f}% "
                                           f"(Ω = {e[side][2]:.3g}, numeric F_cr = {e[side][3]:.3g})" for side in SIDES if side in e))
     if not txt:

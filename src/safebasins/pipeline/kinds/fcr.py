@@ -24,24 +24,30 @@ CURVES_SCHEMA = {
     "xi_max": {"$ref": "#/$defs/threshold_list"},
     "xi_ini": {"$ref": "#/$defs/energy_list", "default": 0.0},
     "gamma_ini": {"$ref": "#/$defs/angle_list", "default": 0.0},
+    # one value, or one per curve (F_cr(Omega) for several beta); every value > 0 in a list
+    "damping": {"$ref": "#/$defs/damping_list", "default": 0.0},
 }
 
 
 def _check_curves(block, key, ctx):
     ctx.check_range(f"{key}.Omega", block["Omega"], positive=True)
-    lens = {k: len(values.as_list(block[k])) for k in ("xi_max", "xi_ini", "gamma_ini")}
+    lists = values.curve_lists(block)
+    lens = {k: len(v) for k, v in lists.items()}
     n = max(lens.values())
+    beta = values.as_list(block["damping"])
+    if len(beta) > 1 and not all(b > 0 for b in beta):
+        ctx.fail(f"{key}.damping", f"a list of damping values makes one damped curve each: every value must be > 0 "
+                                   f"(the undamped theory has other outputs, the mechanism branches), got {beta}")
     for k, m in lens.items():
         if m not in (1, n):
             ctx.fail(f"{key}.{k}", f"has {m} values but another curve list has {n}: lists must have equal length")
     ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "analytic F_cr", ctx.well_at(key))
-    xm = values.as_list(block["xi_max"]) * (n // lens["xi_max"])
-    xi = values.as_list(block["xi_ini"]) * (n // lens["xi_ini"])
-    ga = values.as_list(block["gamma_ini"]) * (n // lens["gamma_ini"])
+    full = {k: v * (n // len(v)) for k, v in lists.items()}
+    xm, xi = full["xi_max"], full["xi_ini"]
     seen = set()
-    for i, curve in enumerate(zip(xm, xi, ga)):
+    for i, curve in enumerate(zip(*full.values())):
         if curve in seen:
-            ctx.fail(key, f"curve {i} (xi_max, xi_ini, gamma_ini) = {curve} repeats an earlier curve")
+            ctx.fail(key, f"curve {i} ({', '.join(full)}) = {curve} repeats an earlier curve")
         seen.add(curve)
     for i, (a, b) in enumerate(zip(xm, xi)):
         if b >= a:
@@ -72,6 +78,7 @@ def build_fcr_numeric(params, data, job):
 @register
 class FcrTheory(Kind):
     name = "fcr_theory"
+    damped = True
     description = "analytic F_cr(Omega) curves; list-valued xi_max / xi_ini / gamma_ini give the curves"
     builder = "safebasins.plotting.fcr:figure_fcr"
     schema = {
@@ -99,6 +106,7 @@ class FcrTheory(Kind):
 @register
 class FcrCompare(Kind):
     name = "fcr_compare"
+    damped = True
     description = "analytic F_cr curves (fine Omega) and their numeric counterparts (coarse Omega)"
     builder = "safebasins.plotting.fcr:figure_fcr_comparison"
     schema = {
