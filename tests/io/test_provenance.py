@@ -30,3 +30,32 @@ def test_stack_drops_the_parts_provenance():
     parts = [escape_chart(q, q, F, 0.9, np.pi, xi_max=(0.1,), cycles=3) for F in (0.01, 0.02)]
     out = stack(parts, "F", [0.01, 0.02], pad=())
     assert not set(PROVENANCE_ATTRS) & set(out.coords) and not set(PROVENANCE_ATTRS) & set(out.attrs)
+
+
+def test_every_public_function_returning_a_dataset_is_wrapped():
+    """The public functions of theory, numerics and analysis whose result is a Dataset carry the
+    provenance decorator (io.provenance.api_provenance): one list, checked against the modules."""
+    import importlib
+    import inspect
+
+    modules = ["safebasins.numerics", "safebasins.analysis.melnikov", "safebasins.analysis.erosion",
+               "safebasins.analysis.phase_invariant", "safebasins.analysis.period_map",
+               "safebasins.analysis.fourier_compare", "safebasins.analysis.ic_basins",
+               "safebasins.analysis.fcr_curves", "safebasins.analysis.tangency", "safebasins.analysis.fractality"]
+    missing = []
+    for name in modules:
+        mod = importlib.import_module(name)
+        for fn_name in mod.__all__:
+            fn = getattr(mod, fn_name)
+            if inspect.isfunction(fn) and "xr.Dataset" in inspect.getsource(inspect.unwrap(fn)) \
+                    and not hasattr(fn, "__wrapped__"):
+                missing.append(f"{name}.{fn_name}")
+    assert missing == [], missing
+
+
+def test_analysis_datasets_carry_provenance():
+    from safebasins.analysis.melnikov import melnikov_curve
+
+    ds = melnikov_curve([0.8, 0.9], 0.1, well="cubic")
+    assert ds.attrs["safebasins_version"] == __version__ and ds.attrs["well"] == "cubic"
+    assert json.loads(ds.attrs["parameters"])["damping"] == 0.1

@@ -33,6 +33,7 @@ from safebasins.io.cf import annotate
 from safebasins.numerics import escape_chart
 from safebasins.theory import slow_flow_escapes
 from safebasins.wells import resolve_well, well_attrs
+from safebasins.io.provenance import api_provenance
 
 __all__ = [
     "analytic_safe_masks",
@@ -74,6 +75,7 @@ def analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier=None, well
     return da.isel(fourier=0) if scalar else da
 
 
+@api_provenance
 def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier=None, *, keep_masks=False, well=None):
     """Analytic erosion profile: GIM/LIM/IF versus F from the slow flow on the (q0, p0) grid.
 
@@ -109,6 +111,7 @@ def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier=None,
 
 
 # --------------------------------------------------------------------------- numeric
+@api_provenance
 def profile_from_charts(charts, t_eval=None, *, criterion="energy", stack_dim="F"):
     """Integrity profile from existing escape charts (no integration).
 
@@ -146,6 +149,7 @@ def profile_from_charts(charts, t_eval=None, *, criterion="energy", stack_dim="F
     return annotate(ds)
 
 
+@api_provenance
 def erosion_profile_numeric(F_values, Omega, Psi, xi_max, q0, p0, t_eval=None, cycles=3000, *,
                             q_max=(), keep_charts=False, well=None, **chart_kwargs):
     """Numeric erosion profile: ONE escape chart per F, all thresholds and t_eval read from it.
@@ -182,6 +186,7 @@ def erosion_profile_numeric(F_values, Omega, Psi, xi_max, q0, p0, t_eval=None, c
 
 
 # --------------------------------------------------------------------------- summaries
+@api_provenance
 def level_crossing(profile, level=0.5, dim="F"):
     """First value of ``dim`` at which a profile falls below ``level`` (linear interpolation).
 
@@ -225,6 +230,7 @@ def level_crossing(profile, level=0.5, dim="F"):
                             long_name=f"first {dim} at which {profile.name or 'the measure'} < {level}")
 
 
+@api_provenance
 def compare_profiles(analytic, numeric, level=0.5):
     """Side-by-side Dataset: ``<measure>_analytic``, ``<measure>_numeric`` and the F at which
     each falls below ``level`` (``F_<measure>_analytic``, ``F_<measure>_numeric``).

@@ -30,6 +30,7 @@ from safebasins.io.cf import annotate
 from safebasins.numerics import critical_forcing_numeric
 from safebasins.theory import angle_energy, critical_forcing, initial_condition, slow_flow_escapes
 from safebasins.wells.quartic import FOURIER_VARIANTS, QUARTIC, QuarticWell
+from safebasins.io.provenance import api_provenance
 
 __all__ = ["fcr_fourier_comparison", "fcr_fourier_comparison_from_numeric", "iou_fourier_comparison"]
 
@@ -87,6 +88,7 @@ def _fcr_dataset(Omega, F_num, F_an, extra=None, attrs=None):
     return ds
 
 
+@api_provenance
 def fcr_fourier_comparison(Omega, xi_max, *, xi_ini=0.0, gamma_ini=0.0, Psi=0.0, cycles=3000, tol=5e-5,
                            well=None, **numeric_kwargs):
     """F_cr(Omega): paper vs exact first harmonic against the numeric bisection.
@@ -129,6 +131,7 @@ def _curve_param(ds, name, default=None):
     raise ValueError(f"numeric F_cr dataset has no {name!r} (coordinate, variable or attribute)")
 
 
+@api_provenance
 def fcr_fourier_comparison_from_numeric(numeric, *, xi_ini=None, gamma_ini=None):
     """Paper vs exact F_cr against an existing ``critical_forcing_numeric`` Dataset.
 
@@ -169,6 +172,7 @@ def fcr_fourier_comparison_from_numeric(numeric, *, xi_ini=None, gamma_ini=None)
     return _fcr_dataset(Om, F_num, F_an, extra, attrs)
 
 
+@api_provenance
 def iou_fourier_comparison(chart, t_eval=None, *, criterion="energy"):
     """Safe basins: analytic masks with both first-harmonic variants vs a numeric chart.
 

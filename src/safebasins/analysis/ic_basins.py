@@ -29,6 +29,7 @@ __all__ = ["analytic_basin", "analytic_basin_stack", "add_resonance_manifold", "
 MASK_OUTLINE = "mask_outline"
 
 
+@api_provenance
 def mask_outline(safe, q0, p0, Psi, *, well=None):
     """The outline of a safe mask on the IC grid as boundary curves in the layout of
     :func:`safebasins.theory.safe_basin_boundaries` (dims ``curve``, ``vertex``).

@@ -69,6 +69,7 @@ from numpy.polynomial import legendre as _leg
 from safebasins import checks
 from safebasins.wells import resolve_well, well_attrs
 from safebasins.wells.orbit_quadrature import clenshaw_curtis
+from safebasins.io.provenance import api_provenance
 
 __all__ = ["melnikov_threshold", "melnikov_curve", "melnikov_function", "separatrix_integrals", "separatrix_orbit",
            "SeparatrixOrbit", "manifold_splitting", "CLOSED_FORMS"]
@@ -336,6 +337,7 @@ def melnikov_function(t0, F, Omega, damping, well=None, Psi=0.0):
     return float(M) if np.ndim(M) == 0 else M
 
 
+@api_provenance
 def melnikov_curve(Omega, damping, well=None) -> xr.Dataset:
     """:func:`melnikov_threshold` over the 1-D ``Omega`` as a Dataset: ``F_M(Omega)``, the separatrix
     integrals ``I1`` and ``I2_abs(Omega)``, attributes naming the well (:func:`well_attrs`), the
@@ -494,6 +496,7 @@ def _manifold_section(well, F, Omega, damping, Psi, q_b, direction, unstable, se
     return t_c, states
 
 
+@api_provenance
 def manifold_splitting(F, Omega, damping, well=None, Psi=0.0, n_phase=48, offset=1e-6, rtol=1e-11):
     """Numeric splitting of the forced saddle's manifolds: the energy gap ``H0(W^u) - H0(W^s)``
     where the unstable and stable manifolds first cross the normal section of the separatrix orbit

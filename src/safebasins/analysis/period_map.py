@@ -39,6 +39,7 @@ from __future__ import annotations
 import numpy as np
 
 from safebasins import checks
+from safebasins.io.provenance import api_provenance
 
 __all__ = ["birkhoff_weights", "weighted_birkhoff", "rotation_numbers", "island_chains", "classify_orbits",
            "portrait_with_criteria",
@@ -336,6 +337,7 @@ def chain_orbits(step, q, p, period, *, max_period=40, same_tol=1e-6):
     return member, chains
 
 
+@api_provenance
 def period_map_portrait(q0, p0, F, Omega, Psi, *, n_keep, n_iter=3000, xi_max=None, q_max=None,
                         steps_per_cycle=None, threads=None, min_digits=5.0, max_period=40, confine=0.5,
                         rational_tol=1e-6, well=None):

@@ -50,6 +50,7 @@ from safebasins.io.cf import annotate
 from safebasins.numerics import escape_chart
 from safebasins.theory import angle_energy, escapes_on_manifold
 from safebasins.wells import resolve_well, well_attrs
+from safebasins.io.provenance import api_provenance
 
 __all__ = [
     "default_phases",
@@ -173,6 +174,7 @@ def _assemble(safe, q, p, Psi, lead_dims, lead_coords, xi_norm, well):
     return ds
 
 
+@api_provenance
 def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fourier=None, n_psi=16,
                              n_gamma=512, well=None):
     """Analytic phase-invariant safe basin and its integrity.
@@ -250,6 +252,7 @@ def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fouri
     return annotate(ds)
 
 
+@api_provenance
 def true_safe_basin_from_charts(charts, t_eval=None, *, criterion="energy"):
     """Numeric phase-invariant basin from escape charts stacked over ``Psi`` (or a list of charts).
 
@@ -275,6 +278,7 @@ def true_safe_basin_from_charts(charts, t_eval=None, *, criterion="energy"):
     return annotate(ds)
 
 
+@api_provenance
 def true_safe_basin_numeric(F, Omega, xi_max, q0, p0, Psi_values=None, t_eval=None, cycles=3000, *,
                             n_psi=16, keep_charts=False, well=None, **chart_kwargs):
     """Numeric phase-invariant safe basin: one ``numerics.escape_chart`` per phase.
@@ -297,6 +301,7 @@ def true_safe_basin_numeric(F, Omega, xi_max, q0, p0, Psi_values=None, t_eval=No
     return (ds, stacked) if keep_charts else ds
 
 
+@api_provenance
 def phase_boundaries(F, Omega, xi_max, Psi_values, *, fourier=None, n_points=400, well=None):
     """Boundary curves of the analytic per-phase basins on the IC plane, from the slow flow
     itself (:func:`safebasins.theory.safe_basin_boundaries` for every phase), not from a grid.
