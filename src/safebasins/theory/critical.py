@@ -163,8 +163,10 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
         raise ValueError("n_grid must be an integer >= 16")
     beta = check_damping(damping)
     if beta > 0:
+        from safebasins.theory.damped import slow_tables
         from safebasins.theory.damped_escape import damped_critical_forcing
-        F0 = critical_forcing(Om, xm, x0, g0, n_grid=n_grid, well=w)["F_cr"].values
+        # the undamped F_cr seeds the scan; the damped flow's tables end just below the barrier
+        F0 = critical_forcing(Om, min(xm, slow_tables(w).xi_top), x0, g0, n_grid=n_grid, well=w)["F_cr"].values
         return damped_critical_forcing(Om, xm, x0, g0, beta, w, F_undamped=F0)
 
     nO = Om.size

@@ -116,6 +116,9 @@ def damped_critical_forcing(Omega, xi_max, xi_ini, gamma_ini, damping, well, n_s
     value escapes and up, doubling, at most 8 times while none does), then bisection between the
     largest settling F below the first escaping one and that one, to a relative width ``rtol``.
     An escape window narrower than the scan's spacing below the first escaping scan value is missed.
+    Cost: about 0.2 s per Omega at xi_max = 0.2 of the quartic; xi_max at the barrier energy is
+    slow (cubic, xi_max = 1/6: 400 s for two Omega): near the separatrix omega ~ 1/log and dA/dxi
+    diverge, and the trajectories that graze it need tens of thousands of steps.
     """
     w, beta = well, damping
     tab = slow_tables(w)
