@@ -40,6 +40,7 @@ from scipy import optimize
 from safebasins.checks import check_finite, check_nonnegative, check_positive, check_positive_int
 from safebasins.theory.slow_flow import SlowFlowProfile, _scalar, unshear
 from safebasins.wells import resolve_well
+from safebasins.io.provenance import api_provenance
 
 __all__ = ["safe_basin_boundaries"]
 
@@ -138,6 +139,7 @@ def _side_curves(prof, side, n_points):
     return curves
 
 
+@api_provenance
 def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier=None, n_points=400, well=None):
     """Boundaries of the analytic safe basin (paper Sec. 2.3, eqs 27-28).
 

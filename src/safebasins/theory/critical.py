@@ -46,6 +46,7 @@ from safebasins.checks import check_finite, check_positive
 from safebasins.theory.damped import check_damping
 from safebasins.theory.slow_flow import _scalar, _xi_grid, unshear
 from safebasins.wells import resolve_well
+from safebasins.io.provenance import api_provenance
 
 __all__ = ["critical_forcing", "MECHANISMS"]
 
@@ -99,6 +100,7 @@ def _interior_max(L, valid, xi, refine_fun, n_iter=60):
     return x_out, v_out, exists
 
 
+@api_provenance
 def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_grid=2001, well=None,
                      damping=0.0):
     """Critical forcing amplitude F_cr(Omega) of the slow flow (eqs 22-26).

@@ -23,6 +23,7 @@ from safebasins.checks import check_1d, check_nonnegative, check_positive, check
 from safebasins.theory.damped import TOP_GAP, check_damping, coefficients, slow_tables
 from safebasins.theory.slow_flow import unshear
 from safebasins.wells import resolve_well
+from safebasins.io.provenance import api_provenance
 
 __all__ = ["steady_responses", "fixed_points", "FixedPoints", "KINDS"]
 
@@ -272,6 +273,7 @@ def _folds(well, c, grid, F, beta):
     return sorted(out)
 
 
+@api_provenance
 def steady_responses(Omega, F, damping, well=None, xi_max=None, fourier=None, n_grid=4000):
     """Steady responses of ``q'' + beta q' + V'(q) = F sin(Omega tau + Psi)`` in the damped slow flow.
 

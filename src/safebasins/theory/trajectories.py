@@ -15,6 +15,7 @@ from safebasins.checks import check_finite, check_nonnegative, check_positive, c
 from safebasins.theory.damped import check_damping, from_tilde, rhs_exact, slow_tables, to_tilde
 from safebasins.theory.damped_flow import default_t_max, pivots
 from safebasins.wells import resolve_well
+from safebasins.io.provenance import api_provenance
 
 __all__ = ["slow_trajectory"]
 
@@ -47,6 +48,7 @@ def _transversal(pv, k, rho0, rho1, d, f):
     return True
 
 
+@api_provenance
 def slow_trajectory(xi_ini, gamma_ini, F, Omega, xi_max, damping=0.0, well=None, fourier=None,
                     t_max=None, rtol=1e-10, atol=1e-12):
     """Integrate the damped slow flow (docs/damping.md) from ``(gamma_ini, xi_ini)`` until it reaches
