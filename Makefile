@@ -18,6 +18,10 @@ $(STAMP): environment.lock pyproject.toml
 	$(BIN)/pip install --quiet --require-hashes --no-deps -r environment.lock
 	$(BIN)/pip install --quiet --no-deps --no-build-isolation -e .
 	$(BIN)/python -m ipykernel install --sys-prefix --name python3 >/dev/null
+	@# numba cache (the package's __pycache__): one tiny quartic chart compiles the CPU engine once
+	@# here, so the first escape_chart of a later process loads it (benchmarks/bench_cold_start.py)
+	$(BIN)/python -c "import numpy as np, safebasins.numerics as nu; q = np.linspace(-0.5, 0.5, 2); \
+	nu.escape_chart(q, q, F=0.01, Omega=0.9, Psi=np.pi, xi_max=(0.18,), cycles=2)"
 	touch $(STAMP)
 
 ## Full reproduction at paper resolution: every dataset, figure, the archive and the HTML report.
@@ -56,6 +60,12 @@ lock:
 .PHONY: test-cluster
 test-cluster: $(STAMP)
 	tests/cluster/run_cluster_check.sh
+
+## Speed benchmarks (not run by CI): rerun them and rewrite the README's benchmarks table
+## (quick variants, ~2 min on 2 cores; BENCH_FLAGS=--full for the paper-size ones).
+.PHONY: benchmarks
+benchmarks: $(STAMP)
+	$(BIN)/python scripts/update_benchmarks.py $(BENCH_FLAGS)
 
 ## The documentation site (docs/_build/html): Sphinx + MyST-NB, tutorials executed on every
 ## build, every warning an error. Open docs/_build/html/index.html (docs/index.md says more).

@@ -46,6 +46,8 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 from numba import literally, njit, typeof, types
+from numba.core import errors
+from numba.extending import overload
 
 from safebasins.numerics.steps import (  # noqa: F401  (re-exported: the step API of the engine)
     BM6_DRIFT, BM6_KICK, BM6_KICK_TIMES, DRIFT1, DRIFT2, DRIFT3, INTEGRATOR, INTEGRATORS, KICK1, KICK2, KICK3,
@@ -144,19 +146,21 @@ def _replay(scheme, well, wpar, i, q, p, period, s0, s1, sintab, c, F, thrE2, th
 
 
 @njit(cache=True, nogil=True)
-def _run_task(well, scheme, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrLo, thrHi,
-              cycles, stop_any, outE, outQ, store, do_store):
+def _run_task(well, scheme, shared, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrLo,
+              thrHi, cycles, stop_any, outE, outQ, store, do_store):
     """Trajectories task, task + n_tasks, ... (one thread): the lane machinery of the module
-    docstring.  `well` is the kernel key of a compiled well and `scheme` the scheme flag
-    (numba literals: one specialised, cached kernel per pair, compiled on first use)."""
+    docstring.  `well` is the kernel key of a compiled well, `scheme` the scheme flag and
+    `shared` whether all trajectories share one parameter set (``coef.shape[0] == 1``: the
+    shared loop, else the per-lane loop); numba literals: one specialised, cached kernel per
+    triple, compiled on first use, with only the period loop it runs."""
     literally(well)
     literally(scheme)
+    literally(shared)
     damped = scheme == SRKN6B_DAMPED or scheme == RK4_DAMPED
     N = q0.shape[0]
     S = sintab.shape[0]
     nE = thrE2.shape[0]
     nQ = thrHi.shape[0]
-    shared = coef.shape[0] == 1
     L = np.int64(lanes)
     Lmem = max(L, 4 * MIN_SEGMENT) + 32       # room for the padded segments
     Q = np.zeros(Lmem)
@@ -259,11 +263,8 @@ def _run_task(well, scheme, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar
                 SQ[g, l] = Q[l]
                 SP[g, l] = P[l]
             # segment maxima go straight into the rows SME[g], SMQ[g] (, SMN[g])
-            if shared:
-                _period_shared(scheme, well, wpar, M, Q, P, SME[g], SMQ[g], SMN[g], coef[0], FS, seg[g], seg[g + 1])
-            else:
-                _period_lanes(scheme, well, wpar, M, Q, P, SME[g], SMQ[g], SMN[g], HL, CL, FL, sintab, seg[g],
-                              seg[g + 1])
+            _period(shared, scheme, well, wpar, M, Q, P, SME[g], SMQ[g], SMN[g], coef, FS, HL, CL, FL, sintab,
+                    seg[g], seg[g + 1])
         # ---------------------------------------------------- period boundary
         # vectorised test first: only lanes whose maxima crossed a threshold (or, for the
         # map, every lane) need the scalar bookkeeping below
@@ -315,10 +316,29 @@ def _run_task(well, scheme, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar
             done[l] = d
 
 
+def _period(shared, scheme, well, wpar, M, Q, P, ME, MQ, MN, coef, FS, HL, CL, FL, sintab, s0, s1):
+    """Steps [s0, s1) of the period: ``_period_shared`` (one parameter set, coef[0] and the
+    scaled table FS) when the literal ``shared`` is True, else ``_period_lanes`` (per lane)."""
+    raise NotImplementedError("compiled code (numba)")
+
+
+@overload(_period)
+def _ol_period(shared, scheme, well, wpar, M, Q, P, ME, MQ, MN, coef, FS, HL, CL, FL, sintab, s0, s1):
+    if not isinstance(shared, types.BooleanLiteral):
+        raise errors.TypingError(f"shared must be a compile-time constant (bool literal), got {shared}")
+    if shared.literal_value:
+        def impl(shared, scheme, well, wpar, M, Q, P, ME, MQ, MN, coef, FS, HL, CL, FL, sintab, s0, s1):
+            _period_shared(scheme, well, wpar, M, Q, P, ME, MQ, MN, coef[0], FS, s0, s1)
+    else:
+        def impl(shared, scheme, well, wpar, M, Q, P, ME, MQ, MN, coef, FS, HL, CL, FL, sintab, s0, s1):
+            _period_lanes(scheme, well, wpar, M, Q, P, ME, MQ, MN, HL, CL, FL, sintab, s0, s1)
+    return impl
+
+
 def specialised(dispatcher, args, n_literal=2):
     """The compiled entry point of ``dispatcher`` for ``args``, whose first ``n_literal`` arguments
-    (the kernel key, the scheme flag) are taken as numba literals (compiled, or loaded from the
-    on-disk cache, on first use).  Calling it skips numba's dispatch, which would first try the
+    (the kernel key, the scheme flag; for _run_task also the shared flag) are taken as numba
+    literals (compiled, or loaded from the on-disk cache, on first use).  Calling it skips numba's dispatch, which would first try the
     non-literal signature at every call."""
     sig = tuple(types.literal(a) for a in args[:n_literal]) + tuple(typeof(a) for a in args[n_literal:])
     entry = _ENTRIES.get((dispatcher, sig))
@@ -375,10 +395,10 @@ def ensemble(q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQ, cycles, stop_a
     thrQ = np.ascontiguousarray(thrQ, dtype=float)
     thrQlo = -thrQ if thrQlo is None else np.ascontiguousarray(thrQlo, dtype=float)
     scheme = _scheme(scheme, sintab, coef)
-    args = [code.key, scheme, code.wpar, 0, int(n_tasks), int(lanes), q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2,
-            thrQlo, thrQ, int(cycles), bool(stop_any), outE, outQ, store, bool(do_store)]
-    entry = specialised(_run_task, args)
-    run_tasks(lambda task: entry(*args[:3], task, *args[4:]), n_tasks)
+    args = [code.key, scheme, bool(coef.shape[0] == 1), code.wpar, 0, int(n_tasks), int(lanes), q0, p0, pidx, coef,
+            hpar, Fpar, sintab, thrE2, thrQlo, thrQ, int(cycles), bool(stop_any), outE, outQ, store, bool(do_store)]
+    entry = specialised(_run_task, args, n_literal=3)
+    run_tasks(lambda task: entry(*args[:4], task, *args[5:]), n_tasks)
 
 
 def _scheme(scheme, sintab, coef):
