@@ -19,6 +19,17 @@ NUMERIC_CONTRACT = {**{v: _CO for v in ("F_cr", "F_cr_low", "F_cr_high", "F_esca
                                          "non_monotone")},
                     **{c: ("curve",) for c in ("xi_max", "xi_ini", "gamma_ini", "Psi", "label", "q0", "p0")}}
 
+#: the damped theory's variables (theory.critical_forcing with damping > 0: no mechanism branches)
+DAMPED_ANALYTIC_CONTRACT = {**{v: _CO for v in ("F_cr", "F_settle", "F_cr_undamped", "F_min", "xi_attractor",
+                                                 "t_escape", "undecided")},
+                            **{c: ("curve",) for c in ("xi_max", "xi_ini", "gamma_ini", "label", "damping")}}
+
+
+def analytic_contract(params):
+    """The analytic dataset's contract: the damped theory's when the experiment is damped."""
+    return DAMPED_ANALYTIC_CONTRACT if "damping" in params else ANALYTIC_CONTRACT
+
+
 CURVES_SCHEMA = {
     "Omega": {"$ref": "#/$defs/omega_range"},
     "xi_max": {"$ref": "#/$defs/threshold_list"},
@@ -96,7 +107,7 @@ class FcrTheory(Kind):
 
     def products(self, experiment, params):
         return [Product(dataset_path("analytic", f"fcr_{experiment}"), "analytic", build_fcr_analytic,
-                        title=params["title"], contract=ANALYTIC_CONTRACT,
+                        title=params["title"], contract=analytic_contract(params),
                         history=f"safebasins.theory.critical_forcing per curve ({experiment})")]
 
     def figure_inputs(self, experiment, params):
@@ -149,9 +160,10 @@ class FcrCompare(Kind):
     def products(self, experiment, params):
         return [
             Product(dataset_path("analytic", f"fcr_{experiment}"), "analytic", build_fcr_analytic,
-                    title=params["title"], contract={**ANALYTIC_CONTRACT, "Psi": ("curve",)}, history=f"safebasins.theory.critical_forcing per curve ({experiment})"),
+                    title=params["title"], contract={**analytic_contract(params), "Psi": ("curve",)}, history=f"safebasins.theory.critical_forcing per curve ({experiment})"),
             Product(dataset_path("numeric", f"fcr_{experiment}"), "numeric", build_fcr_numeric, heavy=True,
-                    title=params["title"], contract=NUMERIC_CONTRACT,
+                    title=params["title"],
+                    contract={**NUMERIC_CONTRACT, **({"damping": ("curve",)} if "damping" in params else {})},
                     history=f"safebasins.numerics.critical_forcing_numeric per curve ({experiment})"),
         ]
 
