@@ -28,6 +28,7 @@ from safebasins.analysis._grid_slow_flow import GridSlowFlow
 from safebasins.analysis.integrity import integrity_measures, unforced_radii2, unforced_safe_mask
 from safebasins.analysis.safe import chart_well, safe_stack
 from safebasins.io.cf import annotate
+from safebasins.io.provenance import api_provenance
 from safebasins.numerics import escape_chart_batch
 from safebasins.wells import well_attrs
 
@@ -42,6 +43,7 @@ def _control(Omega, F):
     return Om, Fv
 
 
+@api_provenance
 def integrity_map_analytic(Omega, F, Psi, xi_max, q0, p0, *, fourier=None, n_gamma=128, n_xi=64, well=None):
     """Analytic integrity map over (Omega, F): GIM, LIM, IF of the slow-flow basin for phase Psi,
     and ``xi_true``, ``GIM_true``, ``LIM_true``, ``IF_true`` of the basin safe for every phase.
@@ -102,6 +104,7 @@ def _closed_measures(xis, xi_max, well):
     return out
 
 
+@api_provenance
 def integrity_from_batch(charts, t_eval=None):
     """GIM, LIM, IF per control point and t_eval from an ``escape_chart_batch`` Dataset (one
     energy threshold), over (control, t_eval)."""
@@ -112,6 +115,7 @@ def integrity_from_batch(charts, t_eval=None):
     return m[list(MEASURES)].transpose("control", "t_eval")
 
 
+@api_provenance
 def integrity_map_numeric(Omega, F, Psi, xi_max, q0, p0, *, cycles=1000, t_eval=None, well=None, **chart_kwargs):
     """Numeric integrity map over (Omega, F, t_eval): one escape chart per control point (all
     control points in one ensemble), safe = escape_cycle > t_eval."""
@@ -132,6 +136,7 @@ def integrity_map_numeric(Omega, F, Psi, xi_max, q0, p0, *, cycles=1000, t_eval=
     return annotate(ds)
 
 
+@api_provenance
 def erosion_front(ds, level=0.5, measures=MEASURES):
     """The F at which each measure first falls below ``level``, per Omega (and t_eval): variables
     ``F_<measure>`` (NaN where it never does)."""
