@@ -405,18 +405,17 @@ DECLARATIONS += tuple(
 
 # ---------------------------------------------------------------- damping (issue 17)
 # q'' + beta q' + V'(q) = F sin(Omega t + Psi) (config block `damped`): Thompson's escape equation
-# at beta = 0.1, Omega = 0.85 across the Melnikov tangency of its hilltop saddle.
+# across the Melnikov tangency of its hilltop saddle, and the paper's quartic with small damping.
 _DAMPED = "Damping: the escape equation across the Melnikov tangency and the damped quartic"
 DECLARATIONS += (
     Declaration(
         name="damped_tangency", kind="tangency", key=("damped", "escape_equation"), stem="damped_tangency",
         label="Damped escape equation: erosion across the Melnikov tangency", category=_DAMPED, options={},
         seed_offset=31000,
-        title="Damped escape equation (beta = 0.1, Omega = 0.85): integrity, boundary fractality and basins "
-              "across the Melnikov tangency",
-        caption=("Thompson's escape equation with damping, q'' + 0.1 q' + q - q² = F sin(0.85 t), the classic "
-                 "benchmark of basin erosion: the safe basin (energy criterion H0 > 1/6, the hilltop) of the "
-                 "long-time response versus the forcing amplitude F. The Melnikov threshold F_M (first order in "
+        title="Damped escape equation: integrity, boundary fractality and basins across the Melnikov tangency",
+        caption=("Thompson's escape equation with damping, q'' + β q' + q - q² = F sin(Ωt + Ψ) (β, Ω, Ψ in the "
+                 "title), the classic benchmark of basin erosion: the safe basin (energy criterion, H0 above the "
+                 "hilltop's energy) of the long-time response versus the forcing amplitude F. The Melnikov threshold F_M (first order in "
                  "F and β, docs/melnikov.md) is where the hilltop saddle's stable and unstable manifolds first "
                  "touch; past it the basin boundary becomes fractal and the basin erodes."),
         look=("(a) GIM, LIM and IF versus F (faint: the early evaluation time, solid: the long-time basin) with "
@@ -428,10 +427,9 @@ DECLARATIONS += (
         name="damped_quartic_fcr", kind="fcr_compare", key=("damped", "quartic_fcr"), stem="damped_quartic_fcr",
         label="Damped quartic: F_cr(Ω) for several β", category=_DAMPED,
         options={'layout': 'overlay', 'bracket': True, 'F_max': None},
-        title="Paper's quartic with small damping: analytic versus numeric F_cr(Omega), zero IC, xi_max = 0.15",
-        caption=("The paper's benchmark with linear damping, q'' + β q' + q - q³ = F sin(Ωt), zero initial "
-                 "condition, truncation level ξ_max = 0.15 (Fig. 10's lowest), for three small damping "
-                 "coefficients. Theory: F_cr is the smallest F for which the damped slow flow "
+        title="Paper's quartic with small damping: analytic versus numeric F_cr(Omega) for several beta",
+        caption=("The paper's benchmark with linear damping, q'' + β q' + q - q³ = F sin(Ωt + Ψ), one initial "
+                 "condition and truncation level (in the title), one curve per small damping coefficient β. Theory: F_cr is the smallest F for which the damped slow flow "
                  "J' = -∂C/∂γ - βJ, γ' = ∂C/∂J (docs/damping.md) carries the zero IC to ξ_max before it settles "
                  "on an attractor."),
         look=("Lines: damped slow-flow theory, one colour per β; markers: numeric bisection of the damped "
