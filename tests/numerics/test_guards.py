@@ -8,10 +8,14 @@ from safebasins import wells
 from safebasins.numerics import critical_forcing_numeric, engine, escape_chart, stroboscopic_map
 
 
-@pytest.mark.parametrize("Omega,S", [(1e-4, 32), (0.02, 32), (1e-300, 32), (1.0, 4)])
-def test_too_large_a_step_is_refused(Omega, S):
+@pytest.mark.parametrize("Omega,S,why", [(1e-4, 32, r"use steps_per_cycle >= \d+"),
+                                         (0.02, 32, r"use steps_per_cycle >= 297"),
+                                         (1e-300, 32, r"Omega = 1e-300 is too small to integrate: .* use a larger "
+                                                      r"Omega"),
+                                         (1.0, 4, r"use steps_per_cycle >= \d+")])
+def test_too_large_a_step_is_refused(Omega, S, why):
     q = np.linspace(-0.5, 0.5, 3)
-    with pytest.raises(ValueError, match=r"steps_per_cycle: .* use steps_per_cycle >= \d+"):
+    with pytest.raises(ValueError, match=r"^steps_per_cycle: .*" + why):
         escape_chart(q, q, 0.01, Omega, 0.0, cycles=2, steps_per_cycle=S)
     with pytest.raises(ValueError, match="steps_per_cycle"):
         stroboscopic_map(q, q, 0.01, Omega, 0.0, n_iter=2, steps_per_cycle=S)

@@ -52,6 +52,9 @@ def check_steps_per_cycle(steps_per_cycle):
 #: largest h * omega_max accepted (numerics docs): half of SRKN6b's stability limit 3.16 for
 #: the harmonic oscillator and below RK4's 2.83 (|R(i x)| <= 1); phase error 1.2e-4 per step there
 STEP_LIMIT = 1.5
+#: above this many steps per forcing cycle the forcing is quasi-static for the well: a smaller
+#: Omega is refused as such rather than answered with an astronomical steps_per_cycle
+MAX_STEPS_PER_CYCLE = 10 ** 7
 
 
 def check_step(Omega, steps_per_cycle, well=None):
@@ -67,7 +70,13 @@ def check_step(Omega, steps_per_cycle, well=None):
     fastest = max(w.omega_max, om_min)
     x = h * fastest
     if x > STEP_LIMIT:
-        need = math.ceil(2.0 * math.pi * fastest / (om_min * STEP_LIMIT))
+        need = 2.0 * math.pi * fastest / (om_min * STEP_LIMIT)
+        if need > MAX_STEPS_PER_CYCLE:
+            raise ValueError(
+                f"steps_per_cycle: Omega = {om_min:.6g} is too small to integrate: the step limit h * {fastest:.4g} <= "
+                f"{STEP_LIMIT} of the {w.name} well would need {need:.3g} steps per forcing cycle (more than "
+                f"{MAX_STEPS_PER_CYCLE:.0e}); use a larger Omega")
+        need = math.ceil(need)
         raise ValueError(
             f"steps_per_cycle: {steps_per_cycle} steps per forcing cycle at Omega = {om_min:.6g} give a step "
             f"h = {h:.4g}, and h * {fastest:.4g} = {x:.4g} exceeds {STEP_LIMIT} ({fastest:.4g} = the larger of Omega "
