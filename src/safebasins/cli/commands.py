@@ -38,6 +38,11 @@ def grid_axes(grid):
     return axes(grid)
 
 
+def damping_text(damping):
+    """("damped ", ", beta = B") of a damped run's title; ("", "") undamped."""
+    return ("damped ", f", beta = {fmt(damping)}") if damping > 0 else ("", "")
+
+
 def well_label(spec):
     """How titles name the well of a run."""
     return spec.get("expression", spec["name"]) if spec["name"] == "expression" else spec["name"]
@@ -107,9 +112,9 @@ def chart(F, Omega, Psi, xi_max, q_max, grid, n, cycles, steps_per_cycle, thread
                   xi_max=xi_max, q_max=q_max, Omega=Omega, Psi=Psi, grid=grid_params(grid, n), cycles=cycles,
                   t_eval=[t_eval], n_points=n_points, steps_per_cycle=steps_per_cycle,
                   tasks=[{"F": F, "xi_max": xi_max, "q_max": q_max}], **damping_param(damping))
-    params["title"] = (f"Escape chart and {'damped ' if damping > 0 else ''}slow-flow safe basins, "
-                       f"{well_label(well)} well, F = {fmt(F)}, Omega = {fmt(Omega)}, Psi = {fmt(Psi, angle=True)}"
-                       + (f", beta = {fmt(damping)}" if damping > 0 else "") + f" (safebasins chart {name})")
+    damped, beta = damping_text(damping)
+    params["title"] = (f"Escape chart and {damped}slow-flow safe basins, {well_label(well)} well, F = {fmt(F)}, "
+                       f"Omega = {fmt(Omega)}, Psi = {fmt(Psi, angle=True)}{beta} (safebasins chart {name})")
     check_step(Omega, steps_per_cycle)
     cost_guard("basin_chart", params, allow_expensive)
     with library_errors(), chatter(verbose):
@@ -356,9 +361,9 @@ def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, dampi
     params = dict(command="basin", kind="basin_rm", experiment=name, fourier=fourier, well=well, F=F, Omega=Omega, Psi=Psi,
                   xi_max=xi_max, grid=grid_params(grid, n), n_points=n_points,
                   manifold={"n_gamma": n_gamma, "n_xi": n_xi, "xi_top": xi_top}, **damping_param(damping))
-    params["title"] = (f"Analytic {'damped ' if damping > 0 else ''}safe basin, {well_label(well)} well, "
-                       f"F = {fmt(F)}, Omega = {fmt(Omega)}, Psi = {fmt(Psi, angle=True)}, xi_max = {fmt(xi_max)}"
-                       + (f", beta = {fmt(damping)}" if damping > 0 else "") + f" (safebasins basin {name})")
+    damped, beta = damping_text(damping)
+    params["title"] = (f"Analytic {damped}safe basin, {well_label(well)} well, F = {fmt(F)}, Omega = {fmt(Omega)}, "
+                       f"Psi = {fmt(Psi, angle=True)}, xi_max = {fmt(xi_max)}{beta} (safebasins basin {name})")
     if damping > 0:  # no resonance-manifold panel: C is not conserved
         params["manifold"] = {"n_gamma": 0, "n_xi": 0, "xi_top": xi_top}
     cost_guard("basin_rm", params, allow_expensive, numeric=False)
@@ -367,11 +372,8 @@ def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, dampi
     with library_errors(), chatter(verbose):
         w = well_of(params)
         q0, p0 = grid_axes(params["grid"])
-        if damping > 0:
-            ds = analytic_basin(F, Omega, Psi, xi_max, q0, p0, well=w, n_points=n_points, label=name,
-                                damping=damping)
-        else:
-            ds = analytic_basin(F, Omega, Psi, xi_max, q0, p0, well=w, n_points=n_points, label=name)
+        ds = analytic_basin(F, Omega, Psi, xi_max, q0, p0, well=w, n_points=n_points, label=name, damping=damping)
+        if damping == 0:  # the resonance-manifold panel: level curves of the conserved C
             ds = add_resonance_manifold(ds, F, Omega, xi_max, n_gamma=n_gamma, n_xi=n_xi, xi_top=xi_top, well=w)
         ds.attrs.update(F=F, Omega=Omega, Psi=Psi, xi_max=xi_max, fourier=fourier)
         ds = finish(ds, title=params["title"], params=params)

@@ -38,7 +38,7 @@ import weakref
 
 import numpy as np
 
-from safebasins.checks import check_nonnegative, check_scalar
+from safebasins.checks import check_nonnegative, check_positive, check_scalar
 from safebasins.theory.slow_flow import unshear
 from safebasins.wells.quartic import QuarticWell
 
@@ -191,6 +191,17 @@ def slow_tables(well):
     if tab is None:
         tab = _TABLES[well] = SlowTables(well)
     return tab
+
+
+def forcing_and_level(well, F, Omega, xi_max):
+    """``(F, Omega, xi_max, tables)`` of a damped slow-flow call, checked (ValueError naming the
+    argument); xi_max is clipped to the top of the well's :class:`SlowTables` (just below the
+    separatrix, where the tables end)."""
+    F = check_scalar("F", F, check_nonnegative)
+    Om = check_scalar("Omega", Omega, check_positive)
+    xm = check_scalar("xi_max", xi_max, well.check_threshold)
+    tab = slow_tables(well)
+    return F, Om, min(xm, tab.xi_top), tab
 
 
 def xi_of_J(well, Jv):

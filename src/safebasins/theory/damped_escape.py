@@ -23,8 +23,8 @@ import warnings
 import numpy as np
 import xarray as xr
 
-from safebasins.checks import check_finite, check_nonnegative, check_positive, check_scalar
-from safebasins.theory.damped import check_damping, slow_tables, to_tilde
+from safebasins.checks import check_finite, check_scalar
+from safebasins.theory.damped import check_damping, forcing_and_level, slow_tables, to_tilde
 from safebasins.theory.damped_flow import ESCAPED, SETTLED, STATUS, UNDECIDED, default_t_max, integrate_batch, pivots
 from safebasins.wells import resolve_well
 
@@ -73,12 +73,8 @@ def slow_flow_outcomes(q0, p0, F, Omega, Psi, xi_max, damping, fourier=None, wel
                          "slow_flow_escapes)")
     q0 = check_finite("q0", q0)
     p0 = check_finite("p0", p0)
-    F = check_scalar("F", F, check_nonnegative)
-    Om = check_scalar("Omega", Omega, check_positive)
     Psi = check_scalar("Psi", Psi, check_finite)
-    xm = check_scalar("xi_max", xi_max, w.check_threshold)
-    tab = slow_tables(w)
-    xm = min(xm, tab.xi_top)
+    F, Om, xm, tab = forcing_and_level(w, F, Omega, xi_max)
     q0, p0 = np.broadcast_arrays(q0, p0)
     out = np.full(q0.shape, ESCAPED, np.int8)
     inside = w.in_well(q0) & (w.H0(q0, p0) < xm)

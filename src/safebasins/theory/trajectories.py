@@ -11,8 +11,8 @@ import numpy as np
 import xarray as xr
 from scipy import integrate
 
-from safebasins.checks import check_finite, check_nonnegative, check_positive, check_scalar
-from safebasins.theory.damped import check_damping, from_tilde, rhs_exact, slow_tables, to_tilde
+from safebasins.checks import check_finite, check_positive, check_scalar
+from safebasins.theory.damped import check_damping, forcing_and_level, from_tilde, rhs_exact, to_tilde
 from safebasins.theory.damped_flow import default_t_max, pivots
 from safebasins.wells import resolve_well
 from safebasins.io.provenance import api_provenance
@@ -80,11 +80,7 @@ def slow_trajectory(xi_ini, gamma_ini, F, Omega, xi_max, damping=0.0, well=None,
     beta = check_damping(damping)
     x0 = check_scalar("xi_ini", xi_ini, lambda n, v: w.check_energy(n, v))
     g0 = check_scalar("gamma_ini", gamma_ini, check_finite)
-    F = check_scalar("F", F, check_nonnegative)
-    Om = check_scalar("Omega", Omega, check_positive)
-    xm = check_scalar("xi_max", xi_max, w.check_threshold)
-    tab = slow_tables(w)
-    xm = min(xm, tab.xi_top)
+    F, Om, xm, tab = forcing_and_level(w, F, Omega, xi_max)
     pv = pivots(tab, np.array([F]), np.array([Om]), beta, xm)
     T = float(default_t_max(pv, max(beta, 1e-300))[0]) if t_max is None else \
         check_scalar("t_max", t_max, check_positive)
