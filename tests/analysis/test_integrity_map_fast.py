@@ -58,3 +58,24 @@ def test_closed_measures_cached_equal():
     got = _closed_measures(xs, 0.18, w)
     for x in xs:
         assert _bits(got[x]) == _bits(closed_measures(x, 0.18, w))
+
+
+@pytest.mark.parametrize("well, fourier, xi, Psi, Omega", [(None, ["paper", "exact"], [0.15, 0.2], 0.0, 0.9),
+                                                            ("cubic", None, [0.1], 1.0, 0.95)])
+def test_erosion_masks_equal_slow_flow_escapes_per_F(well, fourier, xi, Psi, Omega):
+    """analytic_safe_masks (shared grid, issue 20) = ~slow_flow_escapes & S0 per F, xi_max, variant."""
+    from safebasins.analysis.common import well_variants
+    from safebasins.analysis.erosion import analytic_safe_masks
+    from safebasins.analysis.integrity import unforced_safe_mask
+
+    F = [0.0, 0.01, 0.03, 0.06]
+    q, p, Q, P = mesh(np.linspace(-1.0, 1.0, 25), np.linspace(-0.72, 0.72, 21))
+    masks = analytic_safe_masks(F, Omega, Psi, xi, q, p, fourier=fourier, well=well)
+    names, wl, scalar = well_variants(resolve_well(well) if well else None, fourier)
+    got = masks.values[None] if scalar else masks.values
+    assert got.any() and not got.all()
+    for a, w in enumerate(wl):
+        for i, f in enumerate(F):
+            for j, x in enumerate(xi):
+                S0 = unforced_safe_mask(q, p, np.array([x]), wl[0])[0]
+                assert np.array_equal(got[a, i, j], ~np.asarray(slow_flow_escapes(Q, P, f, Omega, Psi, x, well=w)) & S0)

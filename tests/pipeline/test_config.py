@@ -63,7 +63,7 @@ def test_defaults_filled_from_the_schema(base):
     del cfg["numerics"], cfg["fourier"]
     del cfg["figures"]["fig13"]["cycles"]
     validate_config(cfg)
-    assert cfg["fourier"] == "paper" and cfg["numerics"] == {"steps_per_cycle": 32, "threads": 1, "tiles": 1,
+    assert cfg["fourier"] == "paper" and cfg["numerics"] == {"steps_per_cycle": 32, "threads": 1, "tiles": 0,
                                                             "budget_core_hours": 1.0, "allow_expensive": False,
                                                             "budget_analytic_evaluations": 2e9, "backend": "cpu"}
     assert cfg["figures"]["fig13"]["cycles"] == 3000
@@ -136,7 +136,7 @@ BAD = [
     ({"figures": {"fig99": {"F": 0.1}}}, "figures.fig99", "unknown figure name"),
     ({"figures": {"figure13": {}}}, "figures.figure13", "unknown figure name"),
     ({"figures": {"fig13": {"Fmax": 0.1}}}, "figures.fig13.Fmax", "unknown key"),
-    ({"numerics": {"tiles": 0}}, "numerics.tiles", "minimum"),
+    ({"numerics": {"tiles": -1}}, "numerics.tiles", "minimum"),
     ({"numerics": {"threads": "two"}}, "numerics.threads", "type"),
     ({"numerics": {"steps_per_cycle": 16.5}}, "numerics.steps_per_cycle", "type"),
     ({"numerics": {"tiles": 500}}, "numerics.tiles", "q0 rows"),

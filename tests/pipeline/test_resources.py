@@ -26,16 +26,19 @@ def _plan(*overrides):
     return plan(cfg)
 
 
+TILES = {"numerics": {"tiles": 2}}
+
+
 def _jobs(run):
     """(rule, job_cost keyword) of every heavy job of a plan."""
-    jobs = [("chart_tile", {"tile_of": e}) for e in run.chart_experiments()]
+    jobs = [("chart_tile", {"tile_of": e}) for e in run.chart_experiments()] if run.tiles else []
     jobs += [(f"{run.product(d).stage}_dataset", {"dataset": d}) for d in run.datasets()]
     return jobs
 
 
-@pytest.mark.parametrize("quick", [True, False])
-def test_resources_positive_for_every_job(quick):
-    run = _plan() if quick else plan(REPO_ROOT / "config" / "config.yaml")
+@pytest.mark.parametrize("quick,tiles", [(True, False), (True, True), (False, False)])
+def test_resources_positive_for_every_job(quick, tiles):
+    run = _plan(*[TILES] * tiles) if quick else plan(REPO_ROOT / "config" / "config.yaml")
     for _, job in _jobs(run):
         steps, points = job_cost(run, **job)
         assert steps >= 0 and points >= 0, job
@@ -44,13 +47,22 @@ def test_resources_positive_for_every_job(quick):
         assert all(isinstance(v, int) for v in res.values())
 
 
-def test_job_costs_add_up_to_the_estimate():
-    """Tiles and integrating datasets share each experiment's cost; gathering datasets cost 0."""
-    run = _plan()
+@pytest.mark.parametrize("tiles", [0, 2])
+def test_job_costs_add_up_to_the_estimate(tiles):
+    """Tiles (or, with numerics.tiles = 0, the dataset reading the charts) and integrating datasets
+    share each experiment's cost; gathering datasets cost 0."""
+    run = _plan({"numerics": {"tiles": tiles}})
+    assert run.tiles == tiles
     for name, exp in run.experiments.items():
-        if exp.tasks:
+        charts = [p for p in exp.products if p.tiles]
+        if exp.tasks and tiles:
             total = job_cost(run, tile_of=name)[0] * len(exp.tasks) * run.tiles
-            assert job_cost(run, dataset=exp.products[-1].path)[0] == 0
+            assert job_cost(run, dataset=charts[0].path)[0] == 0
+        elif exp.tasks:
+            total = job_cost(run, dataset=charts[0].path)[0]
+            assert run.integrates(charts[0].path) and not run.product_inputs(charts[0].path).get("tiles")
+            with pytest.raises(ValueError, match="no chart_tile jobs"):
+                job_cost(run, tile_of=name)
         else:
             total = sum(job_cost(run, dataset=p.path)[0] for p in exp.products if p.heavy) \
                 or sum(job_cost(run, dataset=p.path)[0] for p in exp.products)
@@ -67,10 +79,10 @@ def test_resources_scale_with_cost():
     assert resources(10 * steps, 0)["runtime"] > one["runtime"]
     assert resources(0, 10**7)["mem_mb"] > resources(0, 10**5)["mem_mb"] > MEM_BASE_MB
     # more cycles -> longer tiles; more tiles -> shorter tiles with fewer trajectories each
-    cheap, dear = _plan(), _plan(EXPENSIVE)
+    cheap, dear = _plan(TILES), _plan(EXPENSIVE)
     s1, p1 = job_cost(cheap, tile_of="fig13")
     s2, p2 = job_cost(dear, tile_of="fig13")
-    assert s2 > 1e5 * s1 and p2 == -(-p1 // 2)
+    assert s2 > 1e5 * s1 and p2 == p1
     assert resources(s2, p2)["runtime"] > RUNTIME_FLOOR_MIN
 
 

@@ -7,13 +7,17 @@ from tests.pipeline.sandbox import BIN, run_snakemake, snakemake_env
 
 
 def test_dry_run_quick_and_full(sandbox):
-    for cfg in (("config/quick.yaml",), ()):
+    tiles = sandbox / "tiles.yaml"
+    tiles.write_text("numerics:\n  tiles: 2\n")
+    for cfg in (("config/quick.yaml",), (), ("config/quick.yaml", tiles)):
         r = run_snakemake(sandbox, "-n", "all", "archive", configfiles=cfg)
         assert r.returncode == 0, r.stderr[-3000:]
         out = r.stdout + r.stderr
-        for rule in ("parameters", "analytic_dataset", "numeric_dataset", "extras_dataset", "chart_tile",
+        for rule in ("parameters", "analytic_dataset", "numeric_dataset", "extras_dataset",
                      "fig01", "extra_fourier", "archive"):
             assert re.search(rf"^{rule}\s+\d+", out, re.M), rule
+        # numerics.tiles = 0 (the default): the datasets integrate their chart tasks, no tile jobs
+        assert bool(re.search(r"^chart_tile\s+\d+", out, re.M)) == (tiles in cfg), cfg
     assert not (sandbox / "results").exists()
 
 
@@ -55,7 +59,7 @@ def test_config_found_beside_the_snakefile_from_another_directory(sandbox, tmp_p
     r = subprocess.run([str(BIN / "snakemake"), "-n", "-s", str(sandbox / "Snakefile"), "-d", str(sandbox), "datasets"],
                        capture_output=True, text=True, cwd=elsewhere, env=snakemake_env(), timeout=600)
     assert r.returncode == 0, r.stderr[-3000:]
-    assert "cost estimate" in r.stderr and "chart_tile" in r.stdout + r.stderr
+    assert "cost estimate" in r.stderr and "numeric_dataset" in r.stdout + r.stderr
 
 
 def test_cost_guard_stops_before_any_job(sandbox):

@@ -16,6 +16,7 @@ rule analytic_dataset:
     params:
         extensions=EXTENSIONS,
         backend=BACKEND,
+        tiles=RUN.tiles,
     threads: dataset_threads("analytic")
     resources:
         **job_resources("analytic"),

@@ -83,7 +83,7 @@ def dataset_inputs(stage):
 
 
 def dataset_threads(stage):
-    return lambda wildcards: NUM_THREADS if RUN.product(dataset_path(stage, wildcards)).heavy else 1
+    return lambda wildcards: NUM_THREADS if RUN.integrates(dataset_path(stage, wildcards)) else 1
 
 
 def job_resources(stage=None):

@@ -17,6 +17,7 @@ rule extras_dataset:
     params:
         extensions=EXTENSIONS,
         backend=BACKEND,
+        tiles=RUN.tiles,
     threads: dataset_threads("extras")
     resources:
         **job_resources("extras"),

@@ -43,6 +43,7 @@ rule numeric_dataset:
     params:
         extensions=EXTENSIONS,
         backend=BACKEND,
+        tiles=RUN.tiles,
     threads: dataset_threads("numeric")
     resources:
         **job_resources("numeric"),

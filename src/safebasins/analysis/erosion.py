@@ -26,12 +26,12 @@ import xarray as xr
 
 from safebasins import checks
 from safebasins.io import cf
+from safebasins.analysis._grid_slow_flow import GridSlowFlow
 from safebasins.analysis.common import as_1d, mesh, stack_charts, well_variants
 from safebasins.analysis.integrity import integrity_measures, unforced_safe_mask
 from safebasins.analysis.safe import chart_well, safe_stack
 from safebasins.io.cf import annotate
 from safebasins.numerics import escape_chart
-from safebasins.theory import slow_flow_escapes
 from safebasins.wells import resolve_well, well_attrs
 from safebasins.io.provenance import api_provenance
 
@@ -64,11 +64,12 @@ def analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier=None, well
     q, p, Q, P = mesh(q0, p0)
     S0 = unforced_safe_mask(q, p, xi, wl[0])
     out = np.zeros((len(fl), F.size, xi.size, q.size, p.size), dtype=bool)
-    for a, f in enumerate(fl):
-        for i, Fi in enumerate(F):
-            for j, x in enumerate(xi):
-                e = np.asarray(slow_flow_escapes(Q, P, float(Fi), Omega, Psi, float(x), well=wl[a]), dtype=bool)
-                out[a, i, j] = ~e & S0[j]
+    for a in range(len(fl)):
+        for j, x in enumerate(xi):
+            # = slow_flow_escapes per F, bit for bit, the grid's and threshold's parts once (issue 20)
+            grid = GridSlowFlow(Q, P, Psi, float(x), wl[a])
+            for i, Fi in enumerate(F):
+                out[a, i, j] = ~grid.escapes(grid.profile(float(Fi), Omega)) & S0[j]
     da = xr.DataArray(out, dims=("fourier", "F", "xi_max", "q0", "p0"),
                       coords={"fourier": fl, "F": F, "xi_max": xi, "q0": q, "p0": p},
                       attrs={"long_name": "analytic safe basin (isolated 1:1 resonance)", "units": "1"})

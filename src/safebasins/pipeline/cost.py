@@ -229,12 +229,15 @@ def job_cost(run, *, tile_of: str | None = None, dataset: str | None = None) -> 
     tasks x ``numerics.tiles`` tiles; it holds its trajectories (chart tasks integrate
     ``params["cycles"]`` cycles of ``params["steps_per_cycle"]`` steps).  ``dataset=path``: one
     dataset job, holding its experiment's grid once per chart task.  A chart experiment
-    integrates in its tiles, so its datasets only gather (0 steps); an experiment without chart
-    tasks integrates in its heavy products (in each product if none is heavy).
+    integrates in its tiles, so its datasets only gather (0 steps), or with ``numerics.tiles`` = 0
+    in the one dataset that reads its charts (the whole cost); an experiment without chart tasks
+    integrates in its heavy products (in each product if none is heavy).
     """
     if (tile_of is None) == (dataset is None):
         raise ValueError("job_cost: give exactly one of tile_of= and dataset=")
     if tile_of is not None:
+        if not run.tiles:
+            raise ValueError("job_cost: numerics.tiles is 0, there are no chart_tile jobs")
         exp = run.experiments[tile_of]
         n_jobs = len(exp.tasks) * run.tiles
         steps = exp_cost(exp) / n_jobs
@@ -242,6 +245,8 @@ def job_cost(run, *, tile_of: str | None = None, dataset: str | None = None) -> 
     exp, prod = run.experiment_of(dataset), run.product(dataset)
     points = _grid_points(exp.params) * max(len(exp.tasks), 1)
     heavy = [p for p in exp.products if p.heavy]
+    if run.integrates_tasks(dataset):
+        return float(exp_cost(exp)), points
     if exp.tasks or (heavy and not prod.heavy):
         return 0.0, points
     return exp_cost(exp) / max(len(heavy), 1), points

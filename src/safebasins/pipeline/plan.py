@@ -75,6 +75,8 @@ class Plan:
         self.config = config
         num = config["numerics"]
         self.threads = int(num["threads"])
+        #: tile jobs per chart task (rule chart_tile); 0: none, the dataset that reads an experiment's
+        #: charts integrates its tasks in its own job (no per-task process start-up)
         self.tiles = int(num["tiles"])
         self.experiments: dict[str, Experiment] = {}
         self._products: dict[str, tuple[Experiment, Product]] = {}
@@ -91,6 +93,9 @@ class Plan:
                              products=tuple(kind.products(name, params)), tasks=tuple(kind.tasks(params)))
             self.experiments[name] = exp
             _check_compiled(exp, well)
+            if len([p for p in exp.products if p.tiles]) > 1:
+                # (with numerics.tiles = 0 each would integrate the charts again)
+                raise ValueError(f"experiment {name!r}: more than one product reads its chart tiles")
             for prod in exp.products:
                 if prod.path in self._products:
                     other = self._products[prod.path][0].name
@@ -114,19 +119,30 @@ class Plan:
         return [params_path(n) for n in self.experiments]
 
     def tile_files(self, experiment: str) -> list[str]:
-        """Tile files of every task of a chart experiment (tasks x tiles, task-major)."""
+        """Tile files of every task of a chart experiment (tasks x tiles, task-major); none when
+        ``numerics.tiles`` is 0."""
         exp = self.experiments[experiment]
         return [tile_path(experiment, k, t, self.tiles) for k in range(len(exp.tasks)) for t in range(self.tiles)]
 
     def chart_experiments(self) -> list[str]:
         return [n for n, e in self.experiments.items() if e.tasks]
 
+    def integrates_tasks(self, path) -> bool:
+        """The dataset ``path`` integrates its experiment's chart tasks in its own job: it reads
+        the charts and ``numerics.tiles`` is 0 (no chart_tile jobs)."""
+        return self.tiles == 0 and self.product(path).tiles
+
+    def integrates(self, path) -> bool:
+        """The dataset's job integrates trajectories or the slow flow (runs with numerics.threads):
+        a heavy product, or one integrating its chart tasks."""
+        return self.product(path).heavy or self.integrates_tasks(path)
+
     def product_inputs(self, path) -> dict:
         """Snakemake inputs of a dataset: its experiment's parameter file, its tiles (chart kinds
         whose product gathers them) and the files the product names."""
         exp, prod = self._products[str(path)]
         inputs = {"params": exp.params_file, **prod.inputs}
-        if prod.tiles:
+        if prod.tiles and self.tiles:
             inputs["tiles"] = self.tile_files(exp.name)
         return inputs
 

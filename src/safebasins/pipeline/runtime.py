@@ -2,7 +2,8 @@
 
 * :func:`write_params` -- rule ``parameters``: ``results/params/<experiment>.yaml``;
 * :func:`make_dataset` -- rules ``analytic``, ``numeric``, ``extras``: the product of the
-  registry that the output path names is built from its inputs, given CF/provenance
+  registry that the output path names is built from its inputs (with ``numerics.tiles`` = 0 a
+  product reading charts integrates its experiment's chart tasks itself), given CF/provenance
   attributes and written atomically;
 * :func:`make_tile` -- rule ``chart_tile``: one tile (a contiguous block of q0 rows or of
   samples) of one escape-chart task.
@@ -96,14 +97,20 @@ def load_inputs(inputs, ntasks) -> dict:
 
 
 def make_dataset(smk):
-    """Rules ``analytic`` / ``numeric`` / ``extras``: build, finalize and write one product."""
+    """Rules ``analytic`` / ``numeric`` / ``extras``: build, finalize and write one product.
+    A product reading the chart tiles gets them from the ``chart_tile`` jobs, or with
+    ``numerics.tiles`` = 0 integrates every task here (one tile per task, the same values)."""
     from safebasins.io.datasets import finalize, params_hash, write_netcdf
+    from safebasins.pipeline.tiles import task_tiles
 
     params, kind = _job(smk)
     out = str(smk.output[0])
     product = next(p for p in kind.products(params["experiment"], params) if p.path == out)
-    ds = product.build(params, load_inputs(smk.input, len(kind.tasks(params))),
-                       Job(threads=smk.threads, backend=smk.params.backend))
+    job = Job(threads=smk.threads, backend=smk.params.backend)
+    inputs = load_inputs(smk.input, len(kind.tasks(params)))
+    if product.tiles and int(smk.params.tiles) == 0:
+        inputs["tiles"] = task_tiles(kind, params, job)
+    ds = product.build(params, inputs, job)
     finalize(ds, title=product.title, params=params, config_hash=params_hash(params),
              history=f"{product.history} (rule {smk.rule})")
     write_netcdf(ds, out)
@@ -118,6 +125,6 @@ def make_tile(smk):
     params, kind = _job(smk)
     k, tile, tiles = int(smk.wildcards.task), int(smk.wildcards.tile), int(smk.wildcards.tiles)
     ds = kind.compute_tile(params, k, tile, tiles, Job(threads=smk.threads, backend=smk.params.backend))
-    ds.attrs.update(task=k, tile=tile, tiles=tiles)
+    ds.attrs.update(task=k, tile=tile, tiles=tiles)  # (dropped when gathered)
     write_netcdf(ds, smk.output[0])
     print(ds)

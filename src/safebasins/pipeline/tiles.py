@@ -1,4 +1,5 @@
-"""The default tile job of escape-chart tasks (rule ``chart_tile``, ``Kind.compute_tile``).
+"""The default tile job of escape-chart tasks (rule ``chart_tile``, ``Kind.compute_tile``), and
+every task of an experiment integrated in one job (``numerics.tiles`` = 0, :func:`task_tiles`).
 
 Grid tasks: a contiguous block of q0 rows x all p0 (dims q0, p0).  Paired ICs: a contiguous
 block of the samples (dim ``sample``, global index).  A task may carry its own forcing phase
@@ -32,3 +33,10 @@ def chart_tile(kind, params, k, tile, tiles, job):
     if not grid:
         ds = ds.assign_coords(sample=np.arange(sl.start, sl.stop))
     return ds
+
+
+def task_tiles(kind, params, job) -> list[list]:
+    """Every chart task of an experiment integrated here, one whole-task tile each (the
+    ``inputs["tiles"]`` of the product that reads them: tasks x 1, task-major) -- what the
+    ``chart_tile`` jobs would have written with one tile per task."""
+    return [[kind.compute_tile(params, k, 0, 1, job)] for k in range(len(kind.tasks(params)))]

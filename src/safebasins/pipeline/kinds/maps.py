@@ -36,6 +36,7 @@ def build_numeric(params, data, job):
     import xarray as xr
 
     from safebasins.analysis.integrity_map import erosion_front
+    from safebasins.io.gather import TILE_ATTRS
 
     rows = [xr.concat(block, dim="F") for block in data["tiles"]]
     ds = xr.concat(rows, dim="Omega").transpose("Omega", "F", "t_eval")
@@ -45,6 +46,8 @@ def build_numeric(params, data, job):
         ds[f"{k}_diff"] = (ds[k] - analytic[k]).assign_attrs(
             units="1", long_name=f"{k} numeric - analytic (slow flow)")
     ds.update(erosion_front(ds, params["level"]))
+    for k in TILE_ATTRS:  # one tile's bookkeeping, not the map's (as gather_tiles drops it)
+        ds.attrs.pop(k, None)
     ds.attrs.update(level=params["level"], Psi=params["Psi"], xi_max=params["xi_max"], cycles=params["cycles"],
                     steps_per_cycle=params["steps_per_cycle"])
     return ds
