@@ -1,7 +1,7 @@
 """Run the benchmarks that feed the README table and rewrite its section (``make benchmarks``).
 
-    .venv/bin/python scripts/update_benchmarks.py            # quick variants (~2 min on 2 cores)
-    .venv/bin/python scripts/update_benchmarks.py --full     # the paper-size variants (~4 min)
+    .venv/bin/python scripts/update_benchmarks.py            # quick variants (~6 min on 2 cores)
+    .venv/bin/python scripts/update_benchmarks.py --full     # the paper-size variants (~16 min)
     .venv/bin/python scripts/update_benchmarks.py --dry-run  # print the table, leave README.md
 
 Each benchmark prints ``BENCH {json}`` lines (benchmarks/_report.py); the table between
@@ -29,6 +29,7 @@ def commands(full):
         [py, "benchmarks/bench_integrity_map.py", "--analytic"] + ([] if full else ["--quick"]),
         [py, "benchmarks/bench_cold_start.py"],
         [py, "benchmarks/bench_peak.py"] + ([] if full else ["--quick"]),
+        [py, "benchmarks/bench_reproduce.py"] + (["--full"] if full else []),
     ]
 
 
