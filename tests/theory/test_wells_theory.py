@@ -128,3 +128,18 @@ def test_bad_input_names_the_reason():
         wells.polynomial([0, 0.1, 0.5, 0, -0.25])   # minimum not at q = 0
     with pytest.raises(ValueError, match="no barrier"):
         wells.polynomial([0, 0, 0.5, 0, 0.25])      # nothing can escape
+
+
+def test_cubic_fcr_with_xi_max_one_ulp_below_the_rounded_barrier():
+    """xi_max = 1/6 (the float) lies one ulp below the cubic's rounded barrier energy: the SMM
+    search above xi_max has no energy left (it used to evaluate the well on the barrier and raise);
+    F_cr is finite and equals the eq (24) endpoint branch, with no saddle above xi_max."""
+    from safebasins.theory import critical_forcing
+    from safebasins.wells import resolve_well
+
+    w = resolve_well("cubic")
+    assert 1 / 6 < w.barrier_energy and np.nextafter(1 / 6, 1.0) == w.barrier_energy
+    ds = critical_forcing(np.array([0.6, 0.9, 1.05]), 1 / 6, well="cubic")
+    assert np.isfinite(ds["F_cr"]).all() and np.isnan(ds["F_SMM"]).all()
+    assert np.isnan(ds["xi_saddle_smm"]).all()
+    assert np.array_equal(ds["F_cr"].values, np.fmax(ds["F_MM_0"], np.fmax(ds["F_MM_pi"], ds["F_SM"])).values)

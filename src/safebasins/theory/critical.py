@@ -253,8 +253,11 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
     xi_smm = np.full(nO, np.nan)
     has_smm = np.zeros(nO, bool)
     rows = np.nonzero(np.isfinite(FA_end))[0]
-    if rows.size and xm < E_b:
-        up = _xi_grid(xm, E_b, 600)[:-1]
+    # energies strictly below the barrier (xi_max = 1/6 of the cubic lies one ulp below its rounded
+    # barrier energy: grid points there round onto it, and no interval is left for an SMM)
+    up = _xi_grid(xm, E_b, 600)[:-1] if xm < E_b else np.empty(0)
+    up = up[up < E_b]
+    if rows.size and up.size >= 2:
         dG_up = w.harmonic_amplitude_derivative(up)
         w_up = w.omega(up)
         ap = (1.0 - Om[rows, None] / w_up[None, :]) - FA_end[rows, None] * dG_up[None, :]
