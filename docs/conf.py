@@ -25,6 +25,7 @@ extensions = [
     "sphinx.ext.autosummary",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
+    "sphinx-mathjax-offline",   # MathJax 3 copied into _static/mathjax: equations render offline
     "sphinx.ext.viewcode",
     "apipages",          # docs/_ext: writes api/<package>.md from the packages (every public module)
 ]

@@ -1,6 +1,6 @@
 """The built documentation site (make docs) in headless Debian Chromium: the index, the API
 reference and an executed tutorial render with their headings and images, without console
-errors; every page's images load.  Screenshots go to $SB_SCREENSHOTS or the test's tmp dir.
+errors; every page's images load; the equations are typeset by the bundled MathJax, offline.  Screenshots go to $SB_SCREENSHOTS or the test's tmp dir.
 
 The site must be built first (`make docs`); without it the tests skip, unless SB_REQUIRE_DOCS=1
 (.ci/run runs them after `make docs` that way).  Without Debian's chromium they skip, except in CI.
@@ -35,9 +35,9 @@ API = {"api/theory.html": ["safebasins.theory.critical.critical_forcing",
        "api/numerics.html": ["safebasins.numerics.charts.escape_chart"],
        "api/wells.html": ["safebasins.wells.resolve_well"],
        "api/analysis.html": ["safebasins.analysis.agreement.iou"]}
-#: the only hosts the site may load from (math is rendered by MathJax from its CDN); the tests
-#: answer them with an empty script, so they run offline
-EXTERNAL_HOSTS = {"cdn.jsdelivr.net"}
+#: the hosts the site may load from: none (MathJax is bundled into _static/mathjax by
+#: sphinx-mathjax-offline); any other request is answered with an empty script and recorded
+EXTERNAL_HOSTS: set[str] = set()
 IMAGES_LOADED = "() => [...document.images].filter(i => !(i.complete && i.naturalWidth > 0)).map(i => i.src)"
 
 
@@ -143,3 +143,21 @@ def test_every_page_loads_its_images(site_url, tmp_path):
             assert page.evaluate(IMAGES_LOADED) == [], path
         assert errors == [], errors
         assert hosts <= EXTERNAL_HOSTS, hosts
+
+
+def test_equations_typeset_offline(site_url, tmp_path):
+    """Every display and inline equation of the damping derivation is typeset (MathJax's CHTML
+    output, mjx-container) from the site's own files, with every other host unreachable."""
+    shots = screenshot_dir(tmp_path)
+    with chromium_page(tmp_path, width=1300, height=1000) as (page, errors):
+        hosts = offline(page)
+        page.goto(site_url + "damping.html")
+        page.wait_for_load_state("load")
+        n_math = page.locator("article .math").count()
+        assert n_math >= 10
+        page.wait_for_function(f"() => document.querySelectorAll('article mjx-container').length >= {n_math}",
+                               timeout=30_000)
+        # typeset, not raw TeX: no TeX control sequence left in the visible text
+        assert "\\frac" not in page.locator("article").inner_text()
+        page.screenshot(path=str(shots / "damping_equations.png"), full_page=False)
+        assert errors == [] and hosts == set(), (errors, hosts)
