@@ -18,8 +18,9 @@ import math
 
 from safebasins.pipeline.validation import fail
 
-#: trajectory-steps per second and core of the CPU engine on an escape chart (benchmarks/
-#: bench_escape.py: 1.0e9 on 2 cores of an AMD EPYC Zen 4 with AVX-512 at 2.6 GHz; 1.35e9 dense)
+#: trajectory-steps per second and core of the CPU engine on an escape chart of the quartic
+#: (benchmarks/bench_escape.py: 1.0e9 on 2 cores of an AMD EPYC Zen 4 with AVX-512 at 2.6 GHz;
+#: 1.35e9 dense); other wells count their steps times their step_cost (exp_cost)
 RATE_PER_CORE = 5.0e8
 #: slow-flow evaluations per second and core, to the order of magnitude (same machine:
 #: 2e6 per IC of the quartic, 4e5 of a numeric well, 1e6 per resonance-manifold point, 2e7 per
@@ -28,9 +29,17 @@ ANALYTIC_RATE = 1.0e6
 
 
 def exp_cost(exp) -> int:
-    """Upper-bound trajectory-steps of one experiment's numerics (its kind's ``cost``; 0 for
-    analytic-only kinds)."""
-    return int(exp.kind.cost(exp.params))
+    """Upper-bound trajectory-steps of one experiment's numerics, in steps of the quartic (its
+    kind's ``cost`` times its well's ``step_cost``, safebasins.wells.base: a transcendental well's
+    scalar lanes cost up to 150 quartic steps each); 0 for analytic-only kinds."""
+    steps = exp.kind.cost(exp.params)
+    return int(steps * _step_cost(exp.params)) if steps else 0
+
+
+def _step_cost(params) -> float:
+    from safebasins import wells
+
+    return wells.from_spec(params["well"]).step_cost
 
 
 def costs(run, experiments=None) -> dict[str, int]:

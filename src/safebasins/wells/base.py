@@ -41,6 +41,18 @@ import numpy as np
 __all__ = ["Well"]
 
 
+#: Step costs of the compiled forms relative to the quartic's closed form, rounded up from
+#: benchmarks/bench_wells.py (SRKN6b, 1 thread, AMD EPYC AVX-512; docs/numerics.md "Wells"):
+#: polynomial codes of degree class 4 measured 1.29, of class 8 2.5-3.07; an arithmetic
+#: expression 1.1-1.19; a code calling libm functions (sin, exp, tanh, ...) runs its lanes
+#: scalar: pendulum 45-68, Morse 42, sech^2 130 -- the upper bound covers any such well, and a
+#: user's Python functions (what they call is unknown).
+STEP_COST_POLY4 = 1.5
+STEP_COST_POLY8 = 3.5
+STEP_COST_ARITHMETIC = 1.5
+STEP_COST_TRANSCENDENTAL = 150.0
+
+
 class Well(abc.ABC):
     """Abstract potential well; subclasses give V, dV, the barriers and the action-angle data.
 
@@ -54,6 +66,10 @@ class Well(abc.ABC):
     #: which first harmonic the slow flow uses: the exact one (the quartic can also use the
     #: paper's truncated eq (20): "paper")
     fourier: str = "exact"
+    #: upper bound of the time of one integration step of the well's compiled form, in steps of
+    #: the quartic's closed form (the cost estimate's unit, safebasins.pipeline.cost); subclasses
+    #: set it from their code (STEP_COST_*)
+    step_cost: float = 1.0
 
     # ------------------------------------------------------------------ the potential
     @abc.abstractmethod

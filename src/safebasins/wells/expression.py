@@ -24,6 +24,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from safebasins.wells.base import STEP_COST_ARITHMETIC, STEP_COST_TRANSCENDENTAL
 from safebasins.wells.numeric import NumericWell
 
 __all__ = ["ExpressionWell", "expression", "FUNCTIONS"]
@@ -210,6 +211,13 @@ def generate_source(V, q):
     return f"def V(q):\n    return {pr(V)}\n\n\ndef dV(q):\n    return {pr(dV)}\n", dV
 
 
+def step_cost(V, dV) -> float:
+    """Step cost of the generated code (safebasins.wells.base): arithmetic (+, -, *, /, powers:
+    vectorised lanes) or calling a libm function (sin, exp, tanh, ...: scalar lanes)."""
+    sp = _sympy()
+    return STEP_COST_TRANSCENDENTAL if V.atoms(sp.Function) | dV.atoms(sp.Function) else STEP_COST_ARITHMETIC
+
+
 def _functions(source, namespace):
     ns = dict(namespace)
     exec(compile(source, "<safebasins expression well>", "exec"), ns)   # our own generated text
@@ -244,6 +252,7 @@ class ExpressionWell(NumericWell):
         self.formula = str(V)
         self.source, dV = generate_source(V, q)
         self.derivative = str(dV)
+        self.step_cost = step_cost(V, dV)
         self._V_scalar, self._dV_scalar = _functions(self.source, {"math": math, "mul": _mul_stub()})
         Vn, dVn = _functions(self.source, _NAMESPACE_NUMPY)
         kwargs.setdefault("asymptotes", (_limit(V, q, -1), _limit(V, q, 1)))

@@ -58,7 +58,7 @@ from functools import partial
 import numpy as np
 
 from safebasins.checks import as_array, value_repr
-from safebasins.wells.base import Well
+from safebasins.wells.base import STEP_COST_TRANSCENDENTAL, Well
 from safebasins.wells.bottom import cancellation_fix
 from safebasins.wells.interpolation import BOTTOM, EnergyInterpolant
 from safebasins.wells.orbit_quadrature import EPS, OrbitQuadrature, solve_increasing
@@ -411,6 +411,9 @@ class NumericWell(WellShape, Well):
         return q.reshape(shape), p.reshape(shape)
 
     # ------------------------------------------------------------------ the numerics
+    #: a user's Python V, dV may call anything: the bound of a code calling libm functions
+    step_cost = STEP_COST_TRANSCENDENTAL
+
     def _compiled_form(self):
         from safebasins.numerics.wellcode import user_code
 

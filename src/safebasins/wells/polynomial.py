@@ -24,6 +24,7 @@ import numpy as np
 from numpy.polynomial import polynomial as P
 
 from safebasins.checks import as_array
+from safebasins.wells.base import STEP_COST_POLY4, STEP_COST_POLY8
 from safebasins.wells.numeric import NumericWell, check_options
 
 __all__ = ["PolynomialWell", "polynomial", "cubic", "quartic_polynomial"]
@@ -157,6 +158,13 @@ class PolynomialWell(NumericWell):
 
 
     # ------------------------------------------------------------------ the numerics
+    @property
+    def step_cost(self) -> float:
+        """Step cost of its degree class (safebasins.wells.base.STEP_COST_POLY*)."""
+        from safebasins.numerics.wellcode import POLY_DEGREES
+
+        return STEP_COST_POLY4 if self.coefficients.size - 1 <= POLY_DEGREES[0] else STEP_COST_POLY8
+
     def _compiled_form(self):
         from safebasins.numerics.wellcode import polynomial_code
 
