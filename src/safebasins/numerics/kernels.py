@@ -195,6 +195,7 @@ def _run_task(well, scheme, shared, wpar, task, n_tasks, lanes, q0, p0, pidx, co
     FL = np.zeros(Lmem)
     CL = np.zeros((N_COEF, Lmem if damped else 1))     # per-lane coefficient columns (damped schemes)
 
+    zero = np.int64(0)
     nxt = np.int64(task)
     nact = np.int64(0)
     ndone = np.int64(0)        # lanes finished at the last period boundary
@@ -211,7 +212,8 @@ def _run_task(well, scheme, shared, wpar, task, n_tasks, lanes, q0, p0, pidx, co
             while nxt < N:
                 i = nxt
                 nxt += n_tasks
-                iE, iQ = _check_state(well, wpar, i, q0[i], p0[i], 0, thrE2, thrLo, thrHi, 0, 0, outE, outQ)
+                # int64 zeros, not literals: the same _check_state as the replay's (one compile)
+                iE, iQ = _check_state(well, wpar, i, q0[i], p0[i], zero, thrE2, thrLo, thrHi, zero, zero, outE, outQ)
                 if do_store and iE == 0 and iQ == 0:
                     store[i, 0, 0] = q0[i]
                     store[i, 0, 1] = p0[i]

@@ -41,7 +41,8 @@ from numba import njit, types
 from numba.core import errors
 from numba.extending import overload
 
-from safebasins.numerics.wellcode import _literal_code, cpu_functions, fma, mul, quartic_code, well_energy2, well_force
+from safebasins.numerics.wellcode import (_literal_code, cpu_functions, cpu_jit, fma, mul, quartic_code,
+                                           well_energy2, well_force)
 
 # --- Blanes & Moan 2002, SRKN_6^b (Table 3), order 4 -------------------------------------
 _A1 = 0.245298957184271
@@ -219,8 +220,7 @@ def scheme_steps(force):
 @functools.cache
 def cpu_steps(key):
     """The four steps of the code with kernel key ``key``, compiled for the CPU lanes (inlined)."""
-    jit = njit(inline="always")
-    return tuple(jit(s) for s in scheme_steps(cpu_functions(key)[0]))
+    return tuple(cpu_jit(s) for s in scheme_steps(cpu_functions(key)[0]))
 
 
 def _literal_scheme(scheme):

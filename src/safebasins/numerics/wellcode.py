@@ -8,7 +8,8 @@ A well reaches the engines as a :class:`WellCode` (``Well.compiled``, built once
   coefficients), ``wpar = [q_left, q_right, w_0 .. w_13]`` with the barriers (+-inf on a side
   without one).
 * ``make(jit) -> (force, energy2)`` compiles them with a target's decorator: the CPU lanes use
-  ``numba.njit(inline="always")`` (kernels.py, through :func:`well_force` / :func:`well_energy2`),
+  :func:`cpu_jit`, ``numba.njit(inline="always")`` with the primitives bound to their CPU
+  intrinsics (kernels.py, through :func:`well_force` / :func:`well_energy2`),
   the CUDA kernels ``numba.cuda.jit(device=True)`` (cuda_kernels.py).  The SAME Python source
   serves both; only the two primitives below differ by target.
 * ``key``: a 61-bit hash of the source text of the arithmetic (and of the engine's own source),
@@ -39,6 +40,8 @@ from __future__ import annotations
 import functools
 import hashlib
 import inspect
+import operator
+import types as types_module
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable
@@ -286,10 +289,37 @@ def _literal_code(well):
     return code_of(well.literal_value)
 
 
+@intrinsic
+def mul_cpu(typingctx, a, b):
+    """``a * b`` exactly as numba compiles it (the CPU's mul)."""
+    sig = typingctx.resolve_function_type(operator.mul, (a, b), {})
+
+    def codegen(context, builder, signature, args):
+        return context.get_function(operator.mul, signature)(builder, args)
+
+    return sig, codegen
+
+
+_CPU_PRIMITIVES = {"fma": (fma, fma_cpu), "mul": (mul, mul_cpu)}
+
+
+def cpu_jit(fn):
+    """``njit(inline="always")`` of a function of the wells' one source (a force, an energy, a
+    scheme's step) for the CPU lanes, with its globals ``fma`` and ``mul`` (when they are this
+    module's) bound to the CPU primitives: the same operations, typed once per signature; through
+    the generic functions' inline overloads numba reruns its front end at every call site and
+    type-inference round (~2.5 ms each, ~2 s of a kernel's first compile)."""
+    g = fn.__globals__
+    cpu = {k: c for k, (generic, c) in _CPU_PRIMITIVES.items() if g.get(k) is generic}
+    if cpu:
+        fn = types_module.FunctionType(fn.__code__, {**g, **cpu}, fn.__name__, fn.__defaults__, fn.__closure__)
+    return njit(inline="always")(fn)
+
+
 @functools.cache
 def cpu_functions(key):
     """(force, energy2) of a code compiled for the CPU lanes (inlined into the kernels)."""
-    return code_of(key).make(njit(inline="always"))
+    return code_of(key).make(cpu_jit)
 
 
 def well_force(well, w, q, f):
