@@ -54,7 +54,7 @@ from safebasins.numerics.steps import (  # noqa: F401  (re-exported: the step AP
     KICK4, N_COEF, N_KICKS, RK4, RK4_C1, RK4_C2, RK4_C3, RK4_COEF, RK4_DAMPED, RK4_TIMES, SRKN6B, SRKN6B_DAMPED,
     bm6_step, check_integrator, energy, energy2, force, lane_coefficients, lane_coefs, rk4_step, row, scheme_of,
     sine_table, step, step_sizes, wtuple)
-from safebasins.numerics.periods import _period_lanes, _period_shared
+from safebasins.numerics.periods import _period_lanes_body, _period_shared_body
 from safebasins.numerics.wellcode import WellCode, abs_tracking, quartic_code, well_energy2
 
 # smallest lane segment of the 4-chain vector loop (lanes run: 4 * segment)
@@ -162,6 +162,7 @@ def _run_task(well, scheme, shared, wpar, task, n_tasks, lanes, q0, p0, pidx, co
     nE = thrE2.shape[0]
     nQ = thrHi.shape[0]
     L = np.int64(lanes)
+    # every array np.zeros: np.empty would be one more numba overload to compile (the cost is nil)
     Lmem = max(L, 4 * MIN_SEGMENT) + 32       # room for the padded segments
     Q = np.zeros(Lmem)
     P = np.zeros(Lmem)
@@ -171,25 +172,25 @@ def _run_task(well, scheme, shared, wpar, task, n_tasks, lanes, q0, p0, pidx, co
     # after one without any crossing runs as ONE segment (a crossing there is replayed over
     # the whole period; the recorded steps are the same either way)
     Gmax = SEGMENTS if S >= 4 * SEGMENTS else 1
-    segs = np.empty((2, Gmax + 1), np.int64)
+    segs = np.zeros((2, Gmax + 1), np.int64)
     for g in range(Gmax + 1):
         segs[0, g] = g * S // Gmax
         segs[1, g] = S if g > 0 else 0
     SQ = np.zeros((Gmax, Lmem))
     SP = np.zeros((Gmax, Lmem))
-    SME = np.empty((Gmax, Lmem))
-    SMQ = np.empty((Gmax, Lmem))
-    SMN = np.empty((Gmax, 1 if abs_tracking(well) else Lmem))    # max -q (signed tracking only)
+    SME = np.zeros((Gmax, Lmem))
+    SMQ = np.zeros((Gmax, Lmem))
+    SMN = np.zeros((Gmax, 1 if abs_tracking(well) else Lmem))    # max -q (signed tracking only)
     nhit = np.int64(1)         # crossings at the last period boundary (first period: segmented)
-    traj = np.empty(L, np.int64)
-    per = np.empty(L, np.int64)
-    lE = np.empty(L, np.int64)
-    lQ = np.empty(L, np.int64)
+    traj = np.zeros(L, np.int64)
+    per = np.zeros(L, np.int64)
+    lE = np.zeros(L, np.int64)
+    lQ = np.zeros(L, np.int64)
     done = np.zeros(L, np.bool_)
     hit = np.zeros(L, np.bool_)
-    tE = np.empty(L)      # next uncrossed 2*xi threshold of the lane (inf: none)
-    tQ = np.empty(L)      # next uncrossed |q| (|q| tracking) or upper bound, or the barrier
-    tN = np.empty(L)      # signed tracking: next uncrossed -lower bound, or -q_left
+    tE = np.zeros(L)      # next uncrossed 2*xi threshold of the lane (inf: none)
+    tQ = np.zeros(L)      # next uncrossed |q| (|q| tracking) or upper bound, or the barrier
+    tN = np.zeros(L)      # signed tracking: next uncrossed -lower bound, or -q_left
     FS = Fpar[0] * sintab        # (S, 7) or (S, 3), shared path
     HL = np.zeros(Lmem)          # per-lane path
     FL = np.zeros(Lmem)
@@ -320,7 +321,9 @@ def _run_task(well, scheme, shared, wpar, task, n_tasks, lanes, q0, p0, pidx, co
 
 def _period(shared, scheme, well, wpar, M, Q, P, ME, MQ, MN, coef, FS, HL, CL, FL, sintab, s0, s1):
     """Steps [s0, s1) of the period: ``_period_shared`` (one parameter set, coef[0] and the
-    scaled table FS) when the literal ``shared`` is True, else ``_period_lanes`` (per lane)."""
+    scaled table FS) when the literal ``shared`` is True, else ``_period_lanes`` (per lane).
+    Their bodies are called directly: each compiled function between the task and the loop is
+    one more O3 pass over the linked loop (~0.2 s at the first compile)."""
     raise NotImplementedError("compiled code (numba)")
 
 
@@ -330,10 +333,10 @@ def _ol_period(shared, scheme, well, wpar, M, Q, P, ME, MQ, MN, coef, FS, HL, CL
         raise errors.TypingError(f"shared must be a compile-time constant (bool literal), got {shared}")
     if shared.literal_value:
         def impl(shared, scheme, well, wpar, M, Q, P, ME, MQ, MN, coef, FS, HL, CL, FL, sintab, s0, s1):
-            _period_shared(scheme, well, wpar, M, Q, P, ME, MQ, MN, coef[0], FS, s0, s1)
+            _period_shared_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, coef[0], FS, s0, s1)
     else:
         def impl(shared, scheme, well, wpar, M, Q, P, ME, MQ, MN, coef, FS, HL, CL, FL, sintab, s0, s1):
-            _period_lanes(scheme, well, wpar, M, Q, P, ME, MQ, MN, HL, CL, FL, sintab, s0, s1)
+            _period_lanes_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, HL, CL, FL, sintab, s0, s1)
     return impl
 
 
