@@ -68,7 +68,7 @@ class Well(abc.ABC):
     fourier: str = "exact"
     #: upper bound of the time of one integration step of the well's compiled form, in steps of
     #: the quartic's closed form (the cost estimate's unit, safebasins.pipeline.cost); subclasses
-    #: set it from their code (STEP_COST_*)
+    #: set it from their code (the ``STEP_COST_`` constants of this module)
     step_cost: float = 1.0
 
     # ------------------------------------------------------------------ the potential

@@ -211,9 +211,10 @@ def generate_source(V, q):
     return f"def V(q):\n    return {pr(V)}\n\n\ndef dV(q):\n    return {pr(dV)}\n", dV
 
 
-def step_cost(V, dV) -> float:
-    """Step cost of the generated code (safebasins.wells.base): arithmetic (+, -, *, /, powers:
-    vectorised lanes) or calling a libm function (sin, exp, tanh, ...: scalar lanes)."""
+def _step_cost(V, dV) -> float:
+    """Step cost of the generated code (safebasins.wells.base): arithmetic (sums, products,
+    quotients, powers: vectorised lanes) or calling a libm function (sin, exp, tanh, ...: scalar
+    lanes)."""
     sp = _sympy()
     return STEP_COST_TRANSCENDENTAL if V.atoms(sp.Function) | dV.atoms(sp.Function) else STEP_COST_ARITHMETIC
 
@@ -252,7 +253,7 @@ class ExpressionWell(NumericWell):
         self.formula = str(V)
         self.source, dV = generate_source(V, q)
         self.derivative = str(dV)
-        self.step_cost = step_cost(V, dV)
+        self.step_cost = _step_cost(V, dV)
         self._V_scalar, self._dV_scalar = _functions(self.source, {"math": math, "mul": _mul_stub()})
         Vn, dVn = _functions(self.source, _NAMESPACE_NUMPY)
         kwargs.setdefault("asymptotes", (_limit(V, q, -1), _limit(V, q, 1)))

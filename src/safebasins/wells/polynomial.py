@@ -160,7 +160,8 @@ class PolynomialWell(NumericWell):
     # ------------------------------------------------------------------ the numerics
     @property
     def step_cost(self) -> float:
-        """Step cost of its degree class (safebasins.wells.base.STEP_COST_POLY*)."""
+        """Step cost of its degree class (``STEP_COST_POLY4`` / ``STEP_COST_POLY8`` of
+        safebasins.wells.base)."""
         from safebasins.numerics.wellcode import POLY_DEGREES
 
         return STEP_COST_POLY4 if self.coefficients.size - 1 <= POLY_DEGREES[0] else STEP_COST_POLY8
