@@ -25,6 +25,18 @@ def cpu_info():
     return model, simd, os.cpu_count(), ghz
 
 
+def cpu_family():
+    """(CPU family number, vendor id) from /proc/cpuinfo; (0, "?") where unreadable."""
+    try:
+        with open("/proc/cpuinfo") as fh:
+            lines = fh.read().splitlines()
+        family = int(next(ln.split(":", 1)[1] for ln in lines if ln.startswith("cpu family")))
+        vendor = next(ln.split(":", 1)[1].strip() for ln in lines if ln.startswith("vendor_id"))
+        return family, vendor
+    except (OSError, StopIteration, ValueError):
+        return 0, "?"
+
+
 def machine():
     model, simd, n, _ = cpu_info()
     return f"{model} ({simd}), {n} logical cores"

@@ -319,7 +319,8 @@ def integrators_section(args):
     ceil_boost = ncores * 3.65e9 * 16 / 46
     # instruction-level: 20 zmm FMA-pipe ops (mul/FMA) per 8 lane-steps (asm of the RK4 loop:
     # 14 FMA + 6 MUL per chain; the 11 add/sub/cmp go to the FADD pipes), 1 zmm FMA-pipe op per
-    # cycle per core (Zen 4 double-pumps 512-bit ops over its two 256-bit FMA pipes)
+    # cycle per core (Zen 4 double-pumps 512-bit ops over its two 256-bit FMA pipes; a Zen 5 has
+    # two 512-bit pipes and this machine runs at ~4.4 GHz: benchmarks/bench_peak.py measures both)
     ceil_isa = ncores * 2.6e9 * 8 / 20
     print(f"\nRK4 ceilings ({ncores} cores): brief's 2.8e9; 46 flops/step x 16 flops/cycle/core: "
           f"{ceil_nom:.3g} at 2.6 GHz nominal, {ceil_boost:.3g} at 3.65 GHz boost; "

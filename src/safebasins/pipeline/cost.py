@@ -19,8 +19,8 @@ import math
 from safebasins.pipeline.validation import fail
 
 #: trajectory-steps per second and core of the CPU engine on an escape chart of the quartic
-#: (benchmarks/bench_escape.py: 1.0e9 on 2 cores of an AMD EPYC Zen 4 with AVX-512 at 2.6 GHz;
-#: 1.35e9 dense); other wells count their steps times their step_cost (exp_cost)
+#: (benchmarks/bench_escape.py: 1.0e9 on 2 cores of an AMD EPYC Zen 5 with AVX-512, ~4.4 GHz;
+#: 2.2e9 dense); other wells count their steps times their step_cost (exp_cost)
 RATE_PER_CORE = 5.0e8
 #: slow-flow evaluations per second and core, to the order of magnitude (same machine:
 #: 2e6 per IC of the quartic, 4e5 of a numeric well, 1e6 per resonance-manifold point, 2e7 per
