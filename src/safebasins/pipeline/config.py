@@ -1,6 +1,7 @@
 """Configuration: loading, the schema assembled from the registry, validation naming the key.
 
-The schema is ``workflow/schemas/config.schema.yaml`` (global knobs and shared building blocks
+The schema is ``schemas/config.schema.yaml`` beside this module (package data: the pipeline, the
+command line and an installed wheel read the same file; global knobs and shared building blocks
 under ``$defs``) plus one ``$defs`` entry per registered kind (its ``schema``): the paper's
 figures (block ``figures``) and the beyond-the-paper products (block ``extras``) refer to
 their kind's definition, and blocks under ``experiments`` name theirs with ``kind:``.  Every
@@ -25,8 +26,11 @@ from safebasins.pipeline import catalog
 from safebasins.pipeline.registry import KINDS
 from safebasins.pipeline.validation import CheckContext, ConfigError, fail, indexed, key_path
 
+#: the package's config schema (shipped inside the package: an installed wheel reads it too)
+SCHEMA_PATH = Path(__file__).resolve().parent / "schemas" / "config.schema.yaml"
+#: the source checkout holding this package (config/config.yaml, the Snakefile): scripts and tests
+#: of a checkout use it; the library reads nothing there
 REPO_ROOT = Path(__file__).resolve().parents[3]
-SCHEMA_PATH = REPO_ROOT / "workflow" / "schemas" / "config.schema.yaml"
 #: the kind modules of the package (importing them registers the kinds)
 KIND_MODULES = ("safebasins.pipeline.kinds.fcr", "safebasins.pipeline.kinds.basins",
                 "safebasins.pipeline.kinds.charts", "safebasins.pipeline.kinds.extras", "safebasins.pipeline.kinds.maps",
@@ -195,7 +199,8 @@ def _format_schema_error(err, prefix=()) -> str:
         sub = subs[0]
         if list(sub.absolute_path) != list(err.absolute_path) or sub.validator not in ("type",):
             return _format_schema_error(sub, prefix)
-        msg = f"{err.instance!r} is not valid here: {err.schema.get('description', 'see workflow/schemas/config.schema.yaml')}"
+        what = err.schema.get("description", "see the config schema, safebasins/pipeline/schemas/config.schema.yaml")
+        msg = f"{err.instance!r} is not valid here: {what}"
     if err.validator == "pattern" and err.validator_value == "^-?pi$":
         msg = f"{err.instance!r} is not an angle: give a number (radians) or 'pi'"
     return f"config key {key}: {msg}"
