@@ -137,6 +137,7 @@ def benchmark(args):
     import numba
     from safebasins.numerics import escape_chart
     from safebasins.numerics import engine
+    from safebasins.numerics.problem import ensemble_problem
     S = args.steps_per_cycle or engine.DEFAULT_STEPS_PER_CYCLE
     print("machine:", machine_state())
     print(f"numba {numba.__version__}, threads {numba.get_num_threads()}, threading layer "
@@ -170,8 +171,8 @@ def benchmark(args):
     rows.append((f"engine, 100x100 chart ({100 * np.mean(np.isfinite(eE)):.1f}% escape, "
                  f"{100 * frac_early:.1f}% within 10 cycles)", steps_chart, tchart))
     # the same chart, kernel only (no argument checks / meshgrid / xarray)
-    tker, _ = best_time(lambda: engine.run_ensemble(Q, P, np.zeros(Q.size, np.int64), [c["Omega"]], [c["F"]], c["Psi"],
-                                               xi_max=(c["xi_max"],), cycles=c["cycles"], steps_per_cycle=S),
+    tker, _ = best_time(lambda: engine.run_cpu(ensemble_problem(Q, P, np.zeros(Q.size, np.int64), [c["Omega"]], [c["F"]], c["Psi"],
+                                               xi_max=(c["xi_max"],), cycles=c["cycles"], steps_per_cycle=S)),
                         args.repeat, "kernel")
     rows.append(("  same chart, engine kernel only (run_ensemble)", steps_chart, tker))
     # 300x300 chart of Fig 21 at 3000 cycles (the paper-scale job)
@@ -239,14 +240,15 @@ E_LEVELS = np.array([0.01, 0.1, 0.2, 0.24, 0.249])   # H0 of the ICs at rest (F 
 def energy_error(integrator, S, cycles):
     """Max relative |H0(t) - H0(0)| / H0(0) over the steps of cycle `cycles` + 1 (F = 0,
     Omega = 1), ICs at rest at H0 = E_LEVELS, with the engine's own step (kernels.final_states)."""
-    from safebasins.numerics import kernels
+    from safebasins.numerics import kernels, schemes, steps
+    from safebasins.numerics.scheme_code import scheme_code
     q0 = np.sqrt(1 - np.sqrt(1 - 4 * E_LEVELS))
     q, p = kernels.final_states(q0, np.zeros_like(q0), np.zeros(q0.size, np.int64),
-                          kernels.lane_coefficients(1.0, S, integrator), np.array([0.0]),
-                          kernels.sine_table(S, 0.0, integrator), cycles)
+                                schemes.lane_coefficients(1.0, S, integrator), np.array([0.0]),
+                                schemes.sine_table(S, 0.0, integrator), cycles, scheme=scheme_code(integrator))
     # then one more cycle step by step: the max over the steps of that cycle (a symplectic
     # scheme's error oscillates within the period; the period-end value can be far smaller)
-    c = kernels.lane_coefficients(1.0, S, integrator)[0]
+    c = schemes.lane_coefficients(1.0, S, integrator)[0]
     worst = np.zeros(q0.size)
     for s in range(S + 1):
         H = 0.5 * p * p + 0.5 * q * q - 0.25 * q ** 4
@@ -254,10 +256,8 @@ def energy_error(integrator, S, cycles):
         worst = np.where(np.abs(rel) > np.abs(worst), rel, worst)
         if s < S:
             for j in range(q0.size):
-                if integrator == "rk4":
-                    q[j], p[j] = kernels.rk4_step(q[j], p[j], c[0], c[1], c[2], 0.0, 0.0, 0.0)
-                else:
-                    q[j], p[j] = kernels.bm6_step(q[j], p[j], *c[:7], *np.zeros(7))
+                q[j], p[j] = steps.scalar_step(integrator)(steps.W0, q[j], p[j], tuple(c),
+                                                           (0.0,) * scheme_code(integrator).width)
     return float(np.abs(worst).max()), float(worst[np.argmax(np.abs(worst))])
 
 
@@ -272,10 +272,11 @@ def kernel_rate(integrator, Q, P, F, Omega, Psi, cycles, S, repeat, reps=1):
     """Best wall time of `reps` back-to-back engine.run_ensemble calls (kernel only);
     returns (time, useful trajectory-steps, CPU time of the best run)."""
     from safebasins.numerics import engine
+    from safebasins.numerics.problem import ensemble_problem
     def job():
         for _ in range(reps):
-            sE, _, _ = engine.run_ensemble(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=(0.25,),
-                                      cycles=cycles, steps_per_cycle=S, integrator=integrator)
+            sE, _, _ = engine.run_cpu(ensemble_problem(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=(0.25,),
+                                      cycles=cycles, steps_per_cycle=S, integrator=integrator))
         return sE
     key = f"{integrator}-{S}-{cycles}-{reps}"
     t, sE = best_time(job, repeat, key)
@@ -289,14 +290,15 @@ def integrators_section(args):
     steps/cycle each needs for the 11,000-cycle energy bound)."""
     import numba
     from safebasins.numerics import engine
+    from safebasins.numerics.problem import ensemble_problem
     nthr = numba.get_num_threads()
     c = CHART
     S0 = engine.DEFAULT_STEPS_PER_CYCLE
     qd, pd = dense_ics(args.dense_n)
     _, Q, P = chart_ics()
     for integ in ("srkn6b", "rk4"):     # compile / cache load outside the timings
-        engine.run_ensemble([0.1], [0.0], [0], [1.0], [0.0], 0.0, xi_max=(0.25,), cycles=1, steps_per_cycle=S0,
-                       integrator=integ)
+        engine.run_cpu(ensemble_problem([0.1], [0.0], [0], [1.0], [0.0], 0.0, xi_max=(0.25,), cycles=1, steps_per_cycle=S0,
+                       integrator=integ))
     print(f"\n=== SRKN6b vs RK4 in the same compiled engine ({nthr} threads, kernel only, best of {args.repeat}) ===")
     print(f"dense: {args.dense_n} ICs inside the well, F = 0, {args.dense_cycles_long} cycles (no escapes); "
           f"chart: 100x100, {c['cycles']} cycles, the whole chart job repeated {args.chart_reps}x back to back "
@@ -399,6 +401,7 @@ def study(args):
               f"{np.quantile(d, 0.99):9.2g} {100 * one_step:10.2f} {(d > 1).sum():8d} {dt_run:6.2f}")
     # and the t_eval-resolved agreement at the default
     from safebasins.numerics import engine
+    from safebasins.numerics.problem import ensemble_problem
     S = engine.DEFAULT_STEPS_PER_CYCLE
     ch = escape_chart(q, q, c["F"], c["Omega"], c["Psi"], xi_max=c["xi_max"], cycles=c["cycles"], steps_per_cycle=S)
     e = ch["escape_cycle_energy"].values[0].ravel()

@@ -55,6 +55,7 @@ from numba import cuda
 
 from safebasins import wells
 from safebasins.numerics import cuda_engine, cuda_kernels, engine
+from safebasins.numerics.problem import ensemble_problem
 
 # wells of section (c), as the config names them (safebasins.wells.resolve_well)
 CUBIC = "cubic"
@@ -132,22 +133,22 @@ def dense(n, cycles, S=32, seed=1, run_cpu=True, integrator="srkn6b", blocks=())
     pidx = np.zeros(n, np.int64)
     kw = dict(xi_max=[0.25], q_max=[1.0], cycles=cycles, steps_per_cycle=S, integrator=integrator)
     steps = n * cycles * S
-    cuda_engine.run_ensemble_cuda(q[:256], p[:256], pidx[:256], [0.95], [0.0], np.pi, **dict(kw, cycles=2))
+    cuda_engine.run_cuda(ensemble_problem(q[:256], p[:256], pidx[:256], [0.95], [0.0], np.pi, **dict(kw, cycles=2)))
     tm = {}
-    gE, gQ = cuda_engine.run_ensemble_cuda(q, p, pidx, [0.95], [0.0], np.pi, timing=tm, **kw)
+    gE, gQ = cuda_engine.run_cuda(ensemble_problem(q, p, pidx, [0.95], [0.0], np.pi, **kw), timing=tm)
     out = dict(integrator=integrator, n=n, cycles=cycles, steps_per_cycle=S, trajectory_steps=steps, gpu=dict(tm),
                gpu_steps_per_s=steps / tm["kernel_s"], escaped=int((gE >= 0).sum() + (gQ >= 0).sum()), block_sweep={})
     for b in blocks:                         # GPU only: threads per block (results must not change)
-        cuda_engine.run_ensemble_cuda(q[:256], p[:256], pidx[:256], [0.95], [0.0], np.pi, block=b, **dict(kw, cycles=2))
+        cuda_engine.run_cuda(ensemble_problem(q[:256], p[:256], pidx[:256], [0.95], [0.0], np.pi, **dict(kw, cycles=2)), block=b)
         tb = {}
-        bE, bQ = cuda_engine.run_ensemble_cuda(q, p, pidx, [0.95], [0.0], np.pi, timing=tb, block=b, **kw)
+        bE, bQ = cuda_engine.run_cuda(ensemble_problem(q, p, pidx, [0.95], [0.0], np.pi, **kw), timing=tb, block=b)
         out["block_sweep"][b] = dict(kernel_s=tb["kernel_s"], steps_per_s=steps / tb["kernel_s"], grid=tb["grid"],
                                      regs=tb.get("regs_per_thread"),
                                      same_as_default=bool(np.array_equal(bE, gE) and np.array_equal(bQ, gQ)))
     if run_cpu:
-        engine.run_ensemble(q[:256], p[:256], pidx[:256], [0.95], [0.0], np.pi, **dict(kw, cycles=2))
+        engine.run_cpu(ensemble_problem(q[:256], p[:256], pidx[:256], [0.95], [0.0], np.pi, **dict(kw, cycles=2)))
         t = time.perf_counter()
-        cE, cQ, _ = engine.run_ensemble(q, p, pidx, [0.95], [0.0], np.pi, **kw)
+        cE, cQ, _ = engine.run_cpu(ensemble_problem(q, p, pidx, [0.95], [0.0], np.pi, **kw))
         dt = time.perf_counter() - t
         out.update(cpu_s=dt, cpu_steps_per_s=steps / dt, E=compare(cE, gE), Q=compare(cQ, gQ))
     return out
@@ -173,7 +174,7 @@ def fig21(n=300, cpu_sample=None, cpu_result=None, cycles=FIG21["cycles"], integ
     runs = []
     for _ in range(2):                      # the first run pays for nothing but the transfers
         tm = {}
-        gE, gQ = cuda_engine.run_ensemble_cuda(Q, P, pidx, *args, timing=tm, **kw)
+        gE, gQ = cuda_engine.run_cuda(ensemble_problem(Q, P, pidx, *args, **kw), timing=tm)
         runs.append(tm)
     S = FIG21["steps_per_cycle"]
     work = work_steps(gE, gQ, cycles, S)
@@ -197,9 +198,9 @@ def fig21(n=300, cpu_sample=None, cpu_result=None, cycles=FIG21["cycles"], integ
         cE, cQ, cpu_s = cached["steps_E"], cached["steps_Q"], float(cached["cpu_s"])
         out["cpu_from"] = cpu_result
     else:
-        engine.run_ensemble(Q[:64], P[:64], pidx[:64], *args, **dict(kw, cycles=2))
+        engine.run_cpu(ensemble_problem(Q[:64], P[:64], pidx[:64], *args, **dict(kw, cycles=2)))
         t = time.perf_counter()
-        cE, cQ, _ = engine.run_ensemble(Q[sel], P[sel], pidx[sel], *args, **kw)
+        cE, cQ, _ = engine.run_cpu(ensemble_problem(Q[sel], P[sel], pidx[sel], *args, **kw))
         cpu_s = time.perf_counter() - t
         if cpu_result:
             np.savez(cpu_result, steps_E=cE, steps_Q=cQ, rows=rows, n=n, cycles=cycles, cpu_s=cpu_s,
@@ -225,12 +226,12 @@ def wells_section(n_dense, cycles, chart_n, chart_cycles, cpu_rows, integrator="
     steps_n = n_dense * cycles * S
     for name, well, thr in jobs:
         kw = dict(cycles=cycles, steps_per_cycle=S, integrator=integrator, well=well, **thr)
-        cuda_engine.run_ensemble_cuda(q[:256], p[:256], pidx[:256], [0.95], [0.0], np.pi, **dict(kw, cycles=2))
+        cuda_engine.run_cuda(ensemble_problem(q[:256], p[:256], pidx[:256], [0.95], [0.0], np.pi, **dict(kw, cycles=2)))
         tm = {}
-        gE, gQ = cuda_engine.run_ensemble_cuda(q, p, pidx, [0.95], [0.0], np.pi, timing=tm, **kw)
-        engine.run_ensemble(q[:256], p[:256], pidx[:256], [0.95], [0.0], np.pi, **dict(kw, cycles=2))
+        gE, gQ = cuda_engine.run_cuda(ensemble_problem(q, p, pidx, [0.95], [0.0], np.pi, **kw), timing=tm)
+        engine.run_cpu(ensemble_problem(q[:256], p[:256], pidx[:256], [0.95], [0.0], np.pi, **dict(kw, cycles=2)))
         t = time.perf_counter()
-        cE, cQ, _ = engine.run_ensemble(q, p, pidx, [0.95], [0.0], np.pi, **kw)
+        cE, cQ, _ = engine.run_cpu(ensemble_problem(q, p, pidx, [0.95], [0.0], np.pi, **kw))
         cpu_s = time.perf_counter() - t
         out["dense"][name] = dict(kernel_s=tm["kernel_s"], gpu_steps_per_s=steps_n / tm["kernel_s"],
                                   regs=tm.get("regs_per_thread"), cpu_s=cpu_s, cpu_steps_per_s=steps_n / cpu_s,
@@ -247,12 +248,12 @@ def wells_section(n_dense, cycles, chart_n, chart_cycles, cpu_rows, integrator="
     runs = []
     for _ in range(2):
         tm = {}
-        gE, gQ = cuda_engine.run_ensemble_cuda(Q, P, np.zeros(Q.size, np.int64), *args, timing=tm, **kw)
+        gE, gQ = cuda_engine.run_cuda(ensemble_problem(Q, P, np.zeros(Q.size, np.int64), *args, **kw), timing=tm)
         runs.append(tm["kernel_s"])
     rows = np.unique(np.linspace(0, chart_n - 1, min(cpu_rows, chart_n)).round().astype(int))
     sel = (rows[:, None] * chart_n + np.arange(chart_n)[None, :]).ravel()
     t = time.perf_counter()
-    cE, cQ, _ = engine.run_ensemble(Q[sel], P[sel], np.zeros(sel.size, np.int64), *args, **kw)
+    cE, cQ, _ = engine.run_cpu(ensemble_problem(Q[sel], P[sel], np.zeros(sel.size, np.int64), *args, **kw))
     cpu_s = time.perf_counter() - t
     out["cubic_chart"] = dict(n=chart_n, cycles=chart_cycles, kernel_s=min(runs), cpu_rows=int(rows.size), cpu_s=cpu_s,
                               escaped_fraction=float((gE[:, 1] >= 0).mean()), E=compare(cE, gE[sel]),

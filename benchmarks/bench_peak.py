@@ -98,6 +98,7 @@ def main():
     import numba
 
     from safebasins.numerics import engine
+    from safebasins.numerics.problem import ensemble_problem
 
     _, simd, ncores, nominal = cpu_info()
     family, vendor = cpu_family()
@@ -111,8 +112,8 @@ def main():
     pidx = np.zeros(args.n, np.int64)
 
     def job():
-        return engine.run_ensemble(Q, P, pidx, [1.0], [0.0], 0.0, xi_max=(0.25,), cycles=args.cycles,
-                                   steps_per_cycle=S)[0]
+        return engine.run_cpu(ensemble_problem(Q, P, pidx, [1.0], [0.0], 0.0, xi_max=(0.25,), cycles=args.cycles,
+                                   steps_per_cycle=S))[0]
 
     sE = job()                                   # compile / cache load, and the check
     assert (sE < 0).all(), "a dense IC escaped"

@@ -120,15 +120,18 @@ class Job:
     """One kernels.ensemble call with fixed arrays; run() returns the escape steps."""
 
     def __init__(self, name, mod, Q, P, F, Omega, Psi, xi_max, cycles, S, integrator, threads, code=None):
-        from safebasins.numerics import engine, kernels
+        from safebasins.numerics import engine, kernels, schemes
+        from safebasins.numerics.scheme_code import scheme_code
         self.name, self.mod, self.cycles, self.S = name, mod, cycles, S
         self.Q, self.P = Q, P
         N = Q.size
-        self.args = (Q, P, np.zeros(N, np.int64), kernels.lane_coefficients([Omega], S, integrator),
-                     kernels.step_sizes([Omega], S), np.array([F]), kernels.sine_table(S, Psi, integrator),
+        self.args = (Q, P, np.zeros(N, np.int64), schemes.lane_coefficients([Omega], S, integrator),
+                     schemes.step_sizes([Omega], S), np.array([F]), schemes.sine_table(S, Psi, integrator),
                      np.array([2.0 * xi_max]), np.zeros(0), cycles, False,
                      max(1, min(-(-N // engine.LANES), threads)), engine.LANES)
         self.kw = {} if code is None else dict(well=code, thrQlo=np.zeros(0))
+        if mod is kernels:          # today's engine takes the scheme's compiled form
+            self.kw["scheme"] = scheme_code(integrator)
         self.out = None
 
     def run(self):

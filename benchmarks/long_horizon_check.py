@@ -236,8 +236,8 @@ def main(argv=None):
             qq, pp = qq + 0.5 * h * (pp + pe), pp + 0.5 * h * (a0 + qe ** 3 - qe)
         print(f"  Heun RK2 {S} steps/cycle: {(H0(qq, pp) - 0.2) / 0.2:+.2e}")
     for S in (32, 256):
-        q, p = kernels.final_states(np.array([q0]), np.zeros(1), np.zeros(1, np.int64), kernels.lane_coefficients(1.0, S, "rk4"),
-                              np.array([0.0]), kernels.sine_table(S, 0.0, "rk4"), 2000)
+        q, p = kernels.final_states(np.array([q0]), np.zeros(1), np.zeros(1, np.int64), schemes.lane_coefficients(1.0, S, "rk4"),
+                              np.array([0.0]), schemes.sine_table(S, 0.0, "rk4"), 2000)
         print(f"  engine RK4 {S} steps/cycle: {(H0(q[0], p[0]) - 0.2) / 0.2:+.2e}")
 
 

@@ -5,6 +5,7 @@ import pytest
 from safebasins.numerics import (critical_forcing_numeric, escape_chart, random_initial_conditions,
                                  stroboscopic_map)
 from safebasins.numerics import kernels
+from safebasins.numerics import schemes
 
 
 @pytest.fixture(scope="module")
@@ -96,8 +97,8 @@ def test_stroboscopic_map():
     safe = np.flatnonzero(~esc)[:3]
     S = m.attrs["steps_per_cycle"]
     for n in (1, 37, 200):
-        q, p = kernels.final_states(q0[safe], p0[safe], np.zeros(safe.size, np.int64), kernels.lane_coefficients(0.99, S),
-                              np.array([0.0876]), kernels.sine_table(S, np.pi), n)
+        q, p = kernels.final_states(q0[safe], p0[safe], np.zeros(safe.size, np.int64), schemes.lane_coefficients(0.99, S),
+                              np.array([0.0876]), schemes.sine_table(S, np.pi), n)
         np.testing.assert_array_equal(q, m["q"].values[safe, n])
         np.testing.assert_array_equal(p, m["p"].values[safe, n])
     # escape times agree with escape_chart on the same ICs

@@ -1,5 +1,5 @@
-"""The CUDA backend (cuda_engine.run_ensemble_cuda) under numba's CUDA simulator: escape steps
-bitwise equal to the CPU engine (engine.run_ensemble).
+"""The CUDA backend (engine.integrate(problem, "cuda"): cuda_engine.run_cuda) under numba's CUDA
+simulator: escape steps bitwise equal to the CPU backend (engine.integrate(problem, "cpu")).
 
 The simulator must be switched on before numba.cuda is first imported, so the GPU side runs in a
 SUBPROCESS with NUMBA_ENABLE_CUDASIM=1 (this file run as a script, cases as JSON on stdin) and
@@ -26,6 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
+from safebasins.numerics import schemes
+
 SRC = Path(__file__).resolve().parents[2] / "src"
 # wells travel to the subprocess as specs (safebasins.wells.resolve_well): the cubic
 # V = q^2/2 - q^3/3 (a polynomial code, Horner from run-time coefficients) and a well written as
@@ -47,19 +49,16 @@ def _knife_edges(integrator, ics, Omega, F, Psi, S, n_steps, per_ic=2):
     thresholds 2 xi = e* and nextafter(e*, -inf); the lower one is crossed exactly at that step,
     and a state one ulp off there moves the step of one of the two.  Returns (xi_max, expected):
     expected[j] = (IC, step) at which the CPU must cross xi_max[2 j + 1]."""
-    from safebasins.numerics import kernels
-    c = kernels.lane_coefficients(Omega, S, integrator)[0]
-    tab = F * kernels.sine_table(S, Psi, integrator)
+    from safebasins.numerics import kernels, steps
+    c = schemes.lane_coefficients(Omega, S, integrator)[0]
+    tab = F * schemes.sine_table(S, Psi, integrator)
     xi, expected = [], []
     for ic, (q, p) in enumerate(ics):
-        emax, records = kernels.energy2(q, p), []
+        emax, records = steps.energy2(q, p), []
         for n in range(n_steps):
             row = tab[n % S]
-            if integrator == "rk4":
-                q, p = kernels.rk4_step(q, p, c[0], c[1], c[2], row[0], row[1], row[2])
-            else:
-                q, p = kernels.bm6_step(q, p, *c[:7], *row)
-            e = kernels.energy2(q, p)
+            q, p = steps.scalar_step(integrator)(steps.W0, q, p, tuple(c), tuple(row))
+            e = steps.energy2(q, p)
             if e > emax and abs(q) <= 1.0:
                 emax = e
                 records.append((n + 1, e))
@@ -75,7 +74,7 @@ def _cases():
     (Python's float repr round-trips every double exactly)."""
     Q, P = _grid_ics()
     zero = [0] * Q.size
-    for integrator in ("srkn6b", "rk4"):
+    for integrator in schemes.SCHEMES:
         yield f"{integrator}/grid", dict(
             args=[Q.tolist(), P.tolist(), zero, [0.95], [0.0876], np.pi],
             kw=dict(xi_max=[0.2, 0.12], q_max=[0.8], cycles=20, steps_per_cycle=16, integrator=integrator))
@@ -121,8 +120,9 @@ API_CHART = dict(q0=np.linspace(-0.8, 0.8, 5).tolist(), p0=np.linspace(-0.4, 0.6
 
 def child():
     """In the subprocess (NUMBA_ENABLE_CUDASIM=1): run every case (JSON on stdin) with
-    run_ensemble_cuda under the simulator, and one escape_chart(backend="cuda"); print as JSON."""
-    from safebasins.numerics import cuda_engine, cuda_kernels, escape_chart
+    the CUDA backend under the simulator, and one escape_chart(backend="cuda"); print as JSON."""
+    from safebasins.numerics import cuda_engine, cuda_kernels, engine, escape_chart
+    from safebasins.numerics.problem import ensemble_problem
     assert cuda_kernels.SIMULATOR and cuda_engine.cuda_available()
     a = dict(API_CHART)
     ch = escape_chart(a.pop("q0"), a.pop("p0"), a.pop("F"), a.pop("Omega"), a.pop("Psi"), backend="cuda", **a)
@@ -131,14 +131,14 @@ def child():
     for name, c in json.load(sys.stdin).items():
         cuda_kernels.SHARED_TABLE_BYTES = 0 if c.get("global_table") else 16 * 1024
         t = time.perf_counter()
-        E, Q = cuda_engine.run_ensemble_cuda(*c["args"], **c["kw"], **c.get("cuda", {}), well=c.get("well"))
+        E, Q = engine.integrate(ensemble_problem(*c["args"], **c["kw"], well=c.get("well")), "cuda", **c.get("cuda", {}))
         out[name] = dict(E=E.tolist(), Q=Q.tolist(), dtype=[str(E.dtype), str(Q.dtype)],
                          seconds=round(time.perf_counter() - t, 2))
     print(json.dumps(out))
 
 
 def test_cuda_simulator_matches_cpu_engine_bitwise():
-    from safebasins.numerics import engine
+    from tests.numerics.ensemble import run_ensemble
     cases = dict(_cases())
     env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1",
                PYTHONPATH=os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")]))
@@ -157,7 +157,7 @@ def test_cuda_simulator_matches_cpu_engine_bitwise():
     assert np.array_equal(np.array(api["Q"]), ch["escape_cycle_displacement"].values)
     assert sorted(gpu) == sorted(cases)
     for name, c in cases.items():
-        cpu_E, cpu_Q, _ = engine.run_ensemble(*c["args"], threads=1, **c["kw"], well=c.get("well"))
+        cpu_E, cpu_Q = run_ensemble(*c["args"], threads=1, **c["kw"], well=c.get("well"))
         for j, (ic, step) in enumerate(c.get("expect", ())):   # the knife edges really are ones
             assert cpu_E[ic, 2 * j + 1] == step and cpu_E[ic, 2 * j] != step, (name, cpu_E, c["expect"])
         g = gpu[name]
@@ -171,14 +171,15 @@ def test_cuda_simulator_matches_cpu_engine_bitwise():
 
 
 def test_missing_gpu_is_an_explicit_error():
-    """Without a GPU and without the simulator, run_ensemble_cuda refuses to run."""
+    """Without a GPU and without the simulator, the CUDA backend refuses to run."""
     from safebasins.numerics import cuda_engine, cuda_kernels
+    from safebasins.numerics.problem import ensemble_problem
     if cuda_kernels.SIMULATOR or cuda_engine.cuda_available():
         return          # a GPU (or the simulator) is there: nothing to refuse
     import pytest
     with pytest.raises(RuntimeError, match="CUDA GPU"):
-        cuda_engine.run_ensemble_cuda([0.0], [0.0], [0], [1.0], [0.0], 0.0, xi_max=[0.2], cycles=1,
-                                      steps_per_cycle=8)
+        cuda_engine.run_cuda(ensemble_problem([0.0], [0.0], [0], [1.0], [0.0], 0.0, xi_max=[0.2], cycles=1,
+                                              steps_per_cycle=8))
 
 
 if __name__ == "__main__":

@@ -10,6 +10,8 @@ from scipy.integrate import solve_ivp
 
 from safebasins import wells
 from safebasins.numerics import critical_forcing_numeric, escape_chart, kernels, stroboscopic_map
+from safebasins.numerics import schemes
+from safebasins.numerics.scheme_code import scheme_code
 
 
 def test_zero_damping_is_the_undamped_code():
@@ -42,9 +44,9 @@ def test_damped_schemes_have_order_four(integrator):
     ref = np.array([_reference(a, b, F, Omega, beta, n * 2 * np.pi / Omega, w) for a, b in zip(q0, p0)])
     err = []
     for S in (16, 32, 64):
-        q, p = kernels.final_states(q0, p0, np.zeros(2, np.int64), kernels.lane_coefficients(Omega, S, integrator, beta),
-                                    np.array([F]), kernels.sine_table(S, 0.0, integrator), n, well=code,
-                                    scheme=kernels.scheme_of(integrator, beta))
+        q, p = kernels.final_states(q0, p0, np.zeros(2, np.int64), schemes.lane_coefficients(Omega, S, integrator, beta),
+                                    np.array([F]), schemes.sine_table(S, 0.0, integrator), n, well=code,
+                                    scheme=scheme_code(integrator, beta > 0))
         err.append(np.max(np.abs(np.stack([q, p], 1) - ref)))
     rates = np.log2(np.array(err[:-1]) / np.array(err[1:]))
     assert (rates > 3.6).all() and (rates < 4.6).all(), (err, rates)

@@ -6,6 +6,7 @@ import pytest
 
 from safebasins import wells
 from safebasins.numerics import critical_forcing_numeric, engine, escape_chart, stroboscopic_map
+from tests.numerics.ensemble import run_ensemble
 
 
 @pytest.mark.parametrize("Omega,S,why", [(1e-4, 32, r"use steps_per_cycle >= \d+"),
@@ -42,17 +43,17 @@ def test_nan_state_counts_as_escape():
     q = np.linspace(-0.3, 0.3, 7)
     Q, P = (a.ravel() for a in np.meshgrid(q, q, indexing="ij"))
     for kw in (dict(xi_max=(0.2, 0.25), q_max=(0.9,)), dict(xi_max=(0.2,), q_bounds=((-0.9, 0.95),))):
-        sE, sQ, _ = engine.run_ensemble(Q, P, np.zeros(Q.size, np.int64), [1e-4], [0.01], 0.0, cycles=3,
+        sE, sQ = run_ensemble(Q, P, np.zeros(Q.size, np.int64), [1e-4], [0.01], 0.0, cycles=3,
                                         steps_per_cycle=32, **kw)
         assert (sE >= 0).all() and (sQ >= 0).all()
     # a NaN state, given directly (the engine does not check its arrays): escaped at step 0, for
     # both lane machineries (|q| tracking, signed tracking) and every threshold kind
     for kw in (dict(xi_max=(0.2,), q_max=(0.5,)), dict(xi_max=(0.2,), q_bounds=((-0.5, 0.6),)),
                dict(xi_max=(0.2,), well="cubic")):
-        sE, sQ, _ = engine.run_ensemble([np.nan, 0.1], [0.0, np.inf], [0, 0], [0.9], [0.01], 0.0, cycles=3,
+        sE, sQ = run_ensemble([np.nan, 0.1], [0.0, np.inf], [0, 0], [0.9], [0.01], 0.0, cycles=3,
                                         steps_per_cycle=32, **kw)
         assert (sE == 0).all() and (sQ[0] == 0).all() and (sQ >= 0).all()   # (0.1, inf): q is finite at step 0
     # the well bottom at rest with F = 0 stays put (a fixed point): not a NaN, correctly safe
-    sE, _, _ = engine.run_ensemble([0.0], [0.0], [0], [1e-4], [0.0], 0.0, xi_max=(0.2,), cycles=3,
+    sE, _ = run_ensemble([0.0], [0.0], [0], [1e-4], [0.0], 0.0, xi_max=(0.2,), cycles=3,
                                    steps_per_cycle=32)
     assert (sE == -1).all()

@@ -6,6 +6,9 @@ from scipy.integrate import solve_ivp
 
 from safebasins.numerics import engine
 from safebasins.numerics import kernels
+from safebasins.numerics import schemes
+from safebasins.numerics import steps
+from tests.numerics.ensemble import run_ensemble
 
 
 def H0(q, p):
@@ -15,8 +18,8 @@ def H0(q, p):
 def run_final(q0, p0, F, Om, Psi, S, periods):
     q0 = np.atleast_1d(np.asarray(q0, float))
     p0 = np.atleast_1d(np.asarray(p0, float))
-    return kernels.final_states(q0, p0, np.zeros(q0.size, np.int64), kernels.lane_coefficients(Om, S),
-                          np.array([float(F)]), kernels.sine_table(S, Psi), periods)
+    return kernels.final_states(q0, p0, np.zeros(q0.size, np.int64), schemes.lane_coefficients(Om, S),
+                          np.array([float(F)]), schemes.sine_table(S, Psi), periods)
 
 
 def dop853(q0, p0, F, Om, Psi, t_end, **kw):
@@ -59,13 +62,13 @@ def test_single_trajectories_agree_with_dop853(q0, p0, F, Om, Psi):
 
 def _steps_one_by_one(q, p, F, Om, Psi, S, n_steps):
     """Python loop over the same compiled step: the state after every step."""
-    c = kernels.lane_coefficients(Om, S)[0]
-    tab = F * kernels.sine_table(S, Psi)
+    c = schemes.lane_coefficients(Om, S)[0]
+    tab = F * schemes.sine_table(S, Psi)
     out = np.empty((n_steps + 1, 2))
     out[0] = q, p
     for n in range(n_steps):
         f = tab[n % S]
-        q, p = kernels.bm6_step(q, p, *c[:7], *f)
+        q, p = steps.scalar_step("srkn6b")(steps.W0, q, p, tuple(c), tuple(f))
         out[n + 1] = q, p
     return out
 
@@ -77,11 +80,11 @@ def test_escape_step_exact_constructed_case():
     F, Om, Psi, S = 0.05, 0.95, 0.0, 32
     xi = np.array([0.05, 0.12, 0.2])
     qm = np.array([0.3, 0.5, 0.7])
-    sE, sQ, _ = engine.run_ensemble([0.0], [0.0], [0], [Om], [F], Psi, xi_max=xi, q_max=qm, cycles=200,
+    sE, sQ = run_ensemble([0.0], [0.0], [0], [Om], [F], Psi, xi_max=xi, q_max=qm, cycles=200,
                                steps_per_cycle=S)
     assert (sE > 0).all() and (sQ > 0).all()
     traj = _steps_one_by_one(0.0, 0.0, F, Om, Psi, S, int(max(sE.max(), sQ.max())) + 2)
-    e2 = np.array([kernels.energy2(a, b) for a, b in traj])
+    e2 = np.array([steps.energy2(a, b) for a, b in traj])
     for j, x in enumerate(xi):
         first = int(np.argmax(e2 > 2 * x))
         assert sE[0, j] == first
@@ -101,7 +104,7 @@ def test_escape_step_exact_constructed_case():
 
 
 def test_initial_condition_beyond_threshold_is_zero():
-    sE, sQ, _ = engine.run_ensemble([0.9, 0.0, 1.2], [0.0, 0.0, 0.0], [0, 0, 0], [1.0], [0.01], 0.0,
+    sE, sQ = run_ensemble([0.9, 0.0, 1.2], [0.0, 0.0, 0.0], [0, 0, 0], [1.0], [0.01], 0.0,
                                xi_max=[0.2, 0.25], q_max=[0.5, 1.0], cycles=5, steps_per_cycle=16)
     # H0(0.9, 0) = 0.2410: beyond 0.2, not beyond 0.25; |q| = 0.9 beyond 0.5, not beyond 1
     assert sE[0, 0] == 0 and sE[0, 1] != 0
@@ -118,7 +121,7 @@ def test_bitwise_independent_of_threads_tasks_and_lanes(integrator):
     kw = dict(xi_max=(0.2, 0.25), q_max=(0.8, 1.0), cycles=60, integrator=integrator)
     a = escape_chart(q, q, 0.0876, 0.95, np.pi, threads=1, **kw)
     b = escape_chart(q, q, 0.0876, 0.95, np.pi, threads=min(2, numba.config.NUMBA_NUM_THREADS), **kw)
-    assert a.attrs["integrator"] == kernels.INTEGRATORS[integrator]
+    assert a.attrs["integrator"] == schemes.SCHEMES[integrator].title
     assert ("RK4" in a.attrs["integrator"]) == (integrator == "rk4")
     for v in ("escape_cycle_energy", "escape_cycle_displacement"):
         np.testing.assert_array_equal(a[v].values, b[v].values)
@@ -129,11 +132,11 @@ def test_bitwise_independent_of_threads_tasks_and_lanes(integrator):
     S = 32
     res = []
     for n_tasks, lanes, npar in ((1, 128, 1), (7, 64, 1), (3, 128, 2)):   # npar 2: per-lane path
-        coef = np.repeat(kernels.lane_coefficients(0.95, S, integrator), npar, 0)
+        coef = np.repeat(schemes.lane_coefficients(0.95, S, integrator), npar, 0)
         oE = np.full((N, 2), -1, np.int64)
         oQ = np.full((N, 2), -1, np.int64)
-        kernels.ensemble(Q, P, np.arange(N) % npar, coef, np.repeat(kernels.step_sizes(0.95, S), npar),
-                   np.full(npar, 0.0876), kernels.sine_table(S, np.pi, integrator),
+        kernels.ensemble(Q, P, np.arange(N) % npar, coef, np.repeat(schemes.step_sizes(0.95, S), npar),
+                   np.full(npar, 0.0876), schemes.sine_table(S, np.pi, integrator),
                    2 * np.array([0.2, 0.25]), np.array([0.8, 1.0]), 60, False, n_tasks, lanes, oE, oQ,
                    np.empty((0, 0, 2)), False)
         res.append((oE, oQ))

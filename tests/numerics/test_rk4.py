@@ -7,6 +7,9 @@ from scipy.integrate import solve_ivp
 from safebasins.numerics import engine
 from safebasins.numerics import escape_chart
 from safebasins.numerics import kernels
+from safebasins.numerics import schemes
+from safebasins.numerics import steps
+from tests.numerics.ensemble import run_ensemble
 
 
 def H0(q, p):
@@ -16,14 +19,14 @@ def H0(q, p):
 def run_rk4(q0, p0, F, Om, Psi, S, periods):
     q0 = np.atleast_1d(np.asarray(q0, float))
     p0 = np.atleast_1d(np.asarray(p0, float))
-    return kernels.final_states(q0, p0, np.zeros(q0.size, np.int64), kernels.lane_coefficients(Om, S, "rk4"),
-                          np.array([float(F)]), kernels.sine_table(S, Psi, "rk4"), periods)
+    return kernels.final_states(q0, p0, np.zeros(q0.size, np.int64), schemes.lane_coefficients(Om, S, "rk4"),
+                          np.array([float(F)]), schemes.sine_table(S, Psi, "rk4"), periods)
 
 
 def test_tables_select_the_scheme():
-    assert kernels.sine_table(16, 0.3, "rk4").shape == (16, 3)
-    assert kernels.sine_table(16, 0.3).shape == (16, 7)
-    c = kernels.lane_coefficients(0.95, 16, "rk4")[0]
+    assert schemes.sine_table(16, 0.3, "rk4").shape == (16, 3)
+    assert schemes.sine_table(16, 0.3).shape == (16, 7)
+    c = schemes.lane_coefficients(0.95, 16, "rk4")[0]
     h = 2 * np.pi / (0.95 * 16)
     assert c[0] == h * 0.5 and c[1] == h and c[2] == h * (1.0 / 6.0) and not c[3:].any()
     with pytest.raises(ValueError, match="integrator"):
@@ -69,15 +72,15 @@ def test_rk4_escape_step_is_first_step_beyond_threshold():
     """The engine's recorded step is the first RK4 step whose state is beyond the threshold
     (replay of the same arithmetic as the vector loop)."""
     F, Om, Psi, S = 0.05, 0.95, 0.0, 32
-    sE, _, _ = engine.run_ensemble([0.0], [0.0], [0], [Om], [F], Psi, xi_max=[0.05, 0.2], cycles=200,
+    sE, _ = run_ensemble([0.0], [0.0], [0], [Om], [F], Psi, xi_max=[0.05, 0.2], cycles=200,
                               steps_per_cycle=S, integrator="rk4")
-    c = kernels.lane_coefficients(Om, S, "rk4")[0]
-    tab = F * kernels.sine_table(S, Psi, "rk4")
+    c = schemes.lane_coefficients(Om, S, "rk4")[0]
+    tab = F * schemes.sine_table(S, Psi, "rk4")
     q = p = 0.0
     e2 = [0.0]
     for n in range(int(sE.max()) + 2):
-        q, p = kernels.rk4_step(q, p, c[0], c[1], c[2], *tab[n % S])
-        e2.append(kernels.energy2(q, p))
+        q, p = steps.scalar_step("rk4")(steps.W0, q, p, tuple(c), tuple(tab[n % S]))
+        e2.append(steps.energy2(q, p))
     e2 = np.array(e2)
     for j, x in enumerate((0.05, 0.2)):
         assert sE[0, j] == int(np.argmax(e2 > 2 * x))

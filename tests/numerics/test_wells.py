@@ -21,6 +21,8 @@ from scipy.integrate import solve_ivp
 from safebasins.numerics import (critical_forcing_numeric, displacement_bounds, engine, escape_chart,
                                  escape_chart_batch, kernels, steps, stroboscopic_map, wellcode)
 from safebasins.wells.polynomial import PolynomialWell, cubic
+from safebasins.numerics import schemes
+from tests.numerics.ensemble import run_ensemble
 
 # ---------------------------------------------------------------------------------------------
 # the quartic, bitwise: references computed with the engine BEFORE the well flag (commit f85d441)
@@ -130,8 +132,8 @@ def test_signed_tracking_equals_abs_tracking_bitwise(npar):
         oE = np.full((N, 2), -1, np.int64)
         oQ = np.full((N, 2), -1, np.int64)
         hi = np.array([0.8, 1.0])
-        kernels.ensemble(Q, P, np.arange(N) % npar, np.repeat(kernels.lane_coefficients(0.95, S), npar, 0),
-                         np.repeat(kernels.step_sizes(0.95, S), npar), np.full(npar, 0.0876), kernels.sine_table(S, np.pi),
+        kernels.ensemble(Q, P, np.arange(N) % npar, np.repeat(schemes.lane_coefficients(0.95, S), npar, 0),
+                         np.repeat(schemes.step_sizes(0.95, S), npar), np.full(npar, 0.0876), schemes.sine_table(S, np.pi),
                          2 * np.array([0.12, 0.2]), hi, 40, False, 2, 64, oE, oQ, np.empty((0, 0, 2)), False,
                          well=flag, thrQlo=-hi)
         out.append((oE, oQ))
@@ -213,8 +215,8 @@ def test_cubic_map_and_bisection(wells):
     safe = np.flatnonzero(~m["escaped"].values)
     assert safe.size
     S = m.attrs["steps_per_cycle"]
-    q, p = kernels.final_states(q0[safe], p0[safe], np.zeros(safe.size, np.int64), kernels.lane_coefficients(0.85, S),
-                                np.array([0.02]), kernels.sine_table(S, 0.3), 30, well=w.compiled)
+    q, p = kernels.final_states(q0[safe], p0[safe], np.zeros(safe.size, np.int64), schemes.lane_coefficients(0.85, S),
+                                np.array([0.02]), schemes.sine_table(S, 0.3), 30, well=w.compiled)
     np.testing.assert_array_equal(q, m["q"].values[safe, 30])
     np.testing.assert_array_equal(p, m["p"].values[safe, 30])
     f = critical_forcing_numeric([0.8, 0.9], 0.12, cycles=60, n_scan=0, F_bracket=(0.0, 0.1), tol=2e-3,
@@ -257,8 +259,8 @@ def test_horner_classes():
     for q, p in ((0.3, -0.2), (-0.7, 0.4)):
         assert h4(code3.wpar, q, p) == h8(code3.wpar, q, p)
     S = 16
-    args = (np.array([0.2, -0.3]), np.array([0.1, 0.2]), np.zeros(2, np.int64), kernels.lane_coefficients(0.9, S),
-            np.array([0.02]), kernels.sine_table(S, 0.0), 5)
+    args = (np.array([0.2, -0.3]), np.array([0.1, 0.2]), np.zeros(2, np.int64), schemes.lane_coefficients(0.9, S),
+            np.array([0.02]), schemes.sine_table(S, 0.0), 5)
     a = kernels.final_states(*args, well=code3)
     b = kernels.final_states(*args, well=as8)
     np.testing.assert_array_equal(a, b)
@@ -308,5 +310,5 @@ def test_bad_wells_and_quartic_limits(wells):
         stroboscopic_map([0.1], [0.0], 0.01, 0.9, 0.0, q_bounds=((-0.5, 0.5), (-0.6, 0.6)), well=wells.cubic,
                          xi_max=None)
     with pytest.raises(ValueError, match="nested"):     # the engine itself refuses pairs it cannot watch
-        engine.run_ensemble([0.0], [0.0], [0], [1.0], [0.0], 0.0, q_max=(0.5,), q_bounds=((-0.6, 0.4),), cycles=1,
+        run_ensemble([0.0], [0.0], [0], [1.0], [0.0], 0.0, q_max=(0.5,), q_bounds=((-0.6, 0.4),), cycles=1,
                             steps_per_cycle=8)

@@ -8,7 +8,8 @@ import xarray as xr
 
 from safebasins import checks
 from safebasins.io.provenance import api_provenance
-from safebasins.numerics import criteria, engine, kernels
+from safebasins.numerics import criteria, engine, schemes
+from safebasins.numerics.problem import check_cycles, check_damping, ensemble_problem
 from safebasins.wells import QuarticWell, resolve_well
 
 DEFAULT_N_SCAN = 301
@@ -44,9 +45,10 @@ def _list(values, most=6):
 def _escapes(q0, p0, Omega, F, Psi, thr_kw, cycles, spc, threads, integrator, backend, w, damping):
     """One compiled ensemble: trajectory k with (Omega[k], F[k]); True where it escapes."""
     n = Omega.size
-    sE, sQ = engine.integrate(np.full(n, q0), np.full(n, p0), np.arange(n), Omega, F, Psi, cycles=cycles,
-                              steps_per_cycle=spc, threads=threads, stop_any=True, integrator=integrator,
-                              backend=backend, well=w, damping=damping, **thr_kw)
+    problem = ensemble_problem(np.full(n, q0), np.full(n, p0), np.arange(n), Omega, F, Psi, cycles=cycles,
+                               steps_per_cycle=spc, stop_any=True, integrator=integrator, well=w, damping=damping,
+                               **thr_kw)
+    sE, sQ = engine.integrate(problem, backend, threads=threads)
     return ((sE >= 0).any(axis=1)) | ((sQ >= 0).any(axis=1))
 
 
@@ -87,8 +89,8 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     q0 = checks.check_scalar("q0", q0, checks.check_finite)
     p0 = checks.check_scalar("p0", p0, checks.check_finite)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
-    damping = engine.check_damping(damping)
-    cycles = engine.check_cycles("cycles", cycles)
+    damping = check_damping(damping)
+    cycles = check_cycles("cycles", cycles)
     tol = checks.check_scalar("tol", tol, checks.check_positive)
     br = checks.check_nonnegative("F_bracket", F_bracket)
     if br.shape != (2,) or not np.isfinite(br).all() or not br[1] > br[0]:
@@ -97,9 +99,9 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
         raise ValueError(f"criterion must be 'energy' or 'displacement', got {criterion!r}")
     if isinstance(n_scan, bool) or not isinstance(n_scan, (int, np.integer)) or n_scan < 0 or n_scan == 1:
         raise ValueError(f"n_scan must be 0 (no scan) or an integer >= 2, got {n_scan!r}")
-    spc = engine.check_step(Om, engine.check_steps_per_cycle(steps_per_cycle), w)
+    schemes.check_integrator(integrator)
+    spc = engine.check_step(Om, engine.check_steps_per_cycle(steps_per_cycle), w, integrator)
     threads = engine.check_threads(threads)
-    kernels.check_integrator(integrator)
     bounds = {}
     if criterion == "energy":
         thr_kw = {"xi_max": (xi,), "q_max": ()}

@@ -7,7 +7,8 @@ import xarray as xr
 from safebasins import checks
 from safebasins.io import cf
 from safebasins.io.provenance import api_provenance
-from safebasins.numerics import criteria, engine, kernels
+from safebasins.numerics import criteria, engine, schemes
+from safebasins.numerics.problem import check_cycles, check_damping, displacement_pairs, ensemble_problem
 from safebasins.wells import resolve_well
 
 def _monotone(a):
@@ -40,7 +41,7 @@ def _thresholds(w, xi_max, q_max, q_bounds):
     qb = w.check_bounds("q_bounds", q_bounds)
     if xi.size == 0 and qm.size == 0 and qb.shape[0] == 0:
         raise ValueError("xi_max, q_max and q_bounds: at least one threshold is required")
-    engine.displacement_pairs(qm, qb)          # nested (ValueError naming q_max / q_bounds)
+    displacement_pairs(qm, qb)          # nested (ValueError naming q_max / q_bounds)
     return xi, qm, qb
 
 
@@ -100,17 +101,18 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=()
     F = checks.check_scalar("F", F, checks.check_nonnegative)
     Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
-    damping = engine.check_damping(damping)
+    damping = check_damping(damping)
     w = resolve_well(well)
     xi, qm, qb = _thresholds(w, xi_max, q_max, q_bounds)
-    cycles = engine.check_cycles("cycles", cycles)
-    spc = engine.check_step(Omega, engine.check_steps_per_cycle(steps_per_cycle), w)
+    cycles = check_cycles("cycles", cycles)
+    schemes.check_integrator(integrator)
+    spc = engine.check_step(Omega, engine.check_steps_per_cycle(steps_per_cycle), w, integrator)
     threads = engine.check_threads(threads)
-    kernels.check_integrator(integrator)
 
-    sE, sQ = engine.integrate(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
-                              q_bounds=qb, cycles=cycles, steps_per_cycle=spc, threads=threads, integrator=integrator,
-                              backend=backend, well=w, damping=damping)
+    problem = ensemble_problem(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
+                               q_bounds=qb, cycles=cycles, steps_per_cycle=spc, integrator=integrator, well=w,
+                               damping=damping)
+    sE, sQ = engine.integrate(problem, backend, threads=threads)
     tE = engine.steps_to_cycles(sE, spc).T   # (nE, N)
     tQ = engine.steps_to_cycles(sQ, spc).T   # (nQ + nB, N)
     if is_grid:
@@ -166,17 +168,18 @@ def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bou
     if F.size != Omega.size or F.size == 0:
         raise ValueError(f"F and Omega must be 1-D of the same non-zero length, got {F.size} and {Omega.size}")
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
-    damping = engine.check_damping(damping)
+    damping = check_damping(damping)
     w = resolve_well(well)
     xi, qm, qb = _thresholds(w, xi_max, q_max, q_bounds)
-    cycles = engine.check_cycles("cycles", cycles)
-    spc = engine.check_step(Omega, engine.check_steps_per_cycle(steps_per_cycle), w)
+    cycles = check_cycles("cycles", cycles)
+    schemes.check_integrator(integrator)
+    spc = engine.check_step(Omega, engine.check_steps_per_cycle(steps_per_cycle), w, integrator)
     threads = engine.check_threads(threads)
-    kernels.check_integrator(integrator)
     K, n = F.size, Q.size
-    sE, sQ = engine.integrate(np.tile(Q, K), np.tile(P, K), np.repeat(np.arange(K), n), Omega, F, Psi,
-                              xi_max=xi, q_max=qm, q_bounds=qb, cycles=cycles, steps_per_cycle=spc, threads=threads,
-                              integrator=integrator, backend=backend, well=w, damping=damping)
+    problem = ensemble_problem(np.tile(Q, K), np.tile(P, K), np.repeat(np.arange(K), n), Omega, F, Psi,
+                               xi_max=xi, q_max=qm, q_bounds=qb, cycles=cycles, steps_per_cycle=spc,
+                               integrator=integrator, well=w, damping=damping)
+    sE, sQ = engine.integrate(problem, backend, threads=threads)
     shape = (K, qa.size, pa.size)
     nQ, nB = qm.size, qb.shape[0]
     tE = np.moveaxis(engine.steps_to_cycles(sE, spc).reshape(shape + (xi.size,)), -1, 1)

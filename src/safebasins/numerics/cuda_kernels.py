@@ -1,6 +1,7 @@
 """CUDA kernels (numba-cuda) for the escape ensembles of q'' + V'(q) = F sin(Omega t + Psi).
 
-The GPU twin of kernels.py: same schemes (Blanes-Moan SRKN6b by default, classic RK4), same
+The GPU twin of kernels.py: same schemes (schemes.py: each a constant, its step generated once by
+scheme_code.py and compiled here as a device function), same
 wells (the one compiled form of a well, wellcode.WellCode: the SAME Python source of its force
 and energy, compiled here as device functions), same forcing tables, same escape
 criteria, and the SAME SEQUENCE OF IEEE OPERATIONS per trajectory, so the recorded
@@ -19,7 +20,7 @@ operand is the result of a multiply; this module leaves no such pair:
   exactly the CPU's form: the forcing values F * sin(Omega t_k + Psi) are the table
   FS[k, s, j] = F[k] * sine_table[s, j] (the CPU's shared path precomputes the same products,
   its replay and per-lane paths form the same IEEE products in the loop), and the step
-  coefficients h * a_k, h * b_k are kernels.lane_coefficients (the CPU's replay uses the same
+  coefficients h * a_k, h * b_k are schemes.lane_coefficients (the CPU's replay uses the same
   array);
 * the products that remain in the kernel, q*q in the force and q*q, p*p in the energy, feed
   only explicit fma instructions (as a multiplicand or as the addend), never an add: an fma
@@ -81,18 +82,16 @@ import numpy as np
 from numba import cuda, float64, int32, int64, uint64
 from numba.cuda.core import config as cuda_config
 
-from safebasins.numerics import kernels
-from safebasins.numerics import steps, wellcode
+from safebasins.numerics import schemes, wellcode
+from safebasins.numerics.scheme_code import scheme_code
 
 SIMULATOR = bool(cuda_config.ENABLE_CUDASIM)
-WIDTHS = {"srkn6b": 7, "rk4": 3}     # forcing values per step (the scheme of a table)
 BLOCK = 128                          # threads per block on a GPU
 WARP = 32
-# forcing-table offsets are unsigned: numba wraps negative signed indices around (a compare,
-# select and add per load, five 64-bit integer instructions on each of the 7 loads of a step,
-# which made the step issue-bound); unsigned + unsigned stays unsigned (unsigned + signed would
-# be float64 in numba's typing)
-U1, U2, U3, U4, U5, U6, U7, U8, U9 = (np.uint64(j) for j in range(1, 10))
+# forcing-table and coefficient offsets are unsigned (scheme_code's flat_row / flat_coefs): numba
+# wraps negative signed indices around (a compare, select and add per load, five 64-bit integer
+# instructions on each of the 7 loads of a step, which made the step issue-bound); unsigned +
+# unsigned stays unsigned (unsigned + signed would be float64 in numba's typing)
 # forcing tables up to this size go to shared memory (48 KiB needs no opt-in; leave room for
 # the compaction buffers and for several blocks per SM)
 SHARED_TABLE_BYTES = 16 * 1024
@@ -121,34 +120,29 @@ fma = wellcode.fma
 
 
 # ------------------------------------------------------------------------------- the well and the scheme
-def make_step(code, scheme):
-    """(step, energy2) device functions of a compiled well (wellcode.WellCode) and a scheme flag
-    (steps.SRKN6B, RK4, SRKN6B_DAMPED, RK4_DAMPED): the well's one source and the schemes' one
-    source (steps.scheme_steps), compiled for the GPU.
+def make_step(code, sc):
+    """(step, energy2, flat_coefs) device functions of a compiled well (wellcode.WellCode) and a
+    scheme code (scheme_code.SchemeCode): the well's one source and the scheme's one generated
+    source, compiled for the GPU.
 
-    step(q, p, c1, ..., c10, tab, o, w) -> (q, p) reads the forcing values tab[o], tab[o+1], ...
-    (already multiplied by F; o unsigned) and calls the scheme's step with them; c1..c10 as
-    kernels.lane_coefficients, w the well's 14 coefficients (steps.wtuple).
-    energy2(q, p, w) = 2 H0 of the well."""
+    step(q, p, c, tab, o, w) -> (q, p) reads the forcing values tab[o], tab[o+1], ... (already
+    multiplied by F; o unsigned) and calls the scheme's step with them; c the coefficient tuple
+    (flat_coefs(coef, o): schemes.lane_coefficients of one parameter set), w the well's 14
+    coefficients (steps.wtuple).  energy2(q, p, w) = 2 H0 of the well."""
     force, energy_w = code.make(_device)
-    inner = _device(steps.scheme_steps(force)[scheme])
+    inner = sc.make(_device, force)
+    H = sc.helpers(_device)
+    flat_row = H["flat_row"]
 
-    if scheme in (steps.SRKN6B, steps.SRKN6B_DAMPED):
-        @_device
-        def step(q, p, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, tab, o, w):
-            return inner(w, q, p, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, tab[o], tab[o + U1], tab[o + U2],
-                         tab[o + U3], tab[o + U4], tab[o + U5], tab[o + U6])
-    else:
-        @_device
-        def step(q, p, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, tab, o, w):
-            return inner(w, q, p, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, tab[o], tab[o + U1], tab[o + U2],
-                         0.0, 0.0, 0.0, 0.0)
+    @_device
+    def step(q, p, c, tab, o, w):
+        return inner(w, q, p, c, flat_row(tab, o))
 
     @_device
     def energy2w(q, p, w):
         return energy_w(w, q, p)
 
-    return step, energy2w
+    return step, energy2w, H["flat_coefs"]
 
 
 # ------------------------------------------------------------------------------- escape bookkeeping
@@ -235,31 +229,30 @@ def finished(iE, iQ, nE, nQ, stop_any):
 def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WARP, well=None, damped=False):
     """The compiled ensemble kernel for one scheme and well (cached per argument set).
 
-    integrator: "srkn6b" | "rk4"; shared_table: copy the forcing table into dynamic shared
+    integrator: a name of schemes.SCHEMES; shared_table: copy the forcing table into dynamic shared
     memory (launch with its size in bytes); block: threads per block (static shared buffers);
     warp: compaction granularity (32 on a GPU; smaller values exercise compaction in the
     simulator); well: the compiled well (wellcode.WellCode; None: the quartic); damped: the
-    scheme's damped variant (steps.DAMPED_INTEGRATORS; coefficients from lane_coefficients with
-    the damping).
+    scheme's damped variant (coefficients from schemes.lane_coefficients with the damping).
 
     Launch: kernel[grid, block, 0, table_bytes if shared_table else 0](
         q0, p0, pidx, coef, FS, thrE2, nE, thrLo, thrHi, nQ, N, S, cycles, stop_any, A, counter,
         outE, outQ, wpar)
-    q0, p0 (N,) float64; pidx (N,) int64; coef (P*N_COEF,) lane_coefficients; FS (P*S*W,) the
-    forcing products F[k] * sine_table (W = 7 or 3); thrE2 (>= max(nE, 1),) sorted 2*xi_max;
+    q0, p0 (N,) float64; pidx (N,) int64; coef (P*NC,) lane_coefficients (NC per parameter set);
+    FS (P*S*W,) the forcing products F[k] * sine_table (W the scheme's width); thrE2 (>= max(nE, 1),) sorted 2*xi_max;
     thrLo, thrHi (>= max(nQ, 1),) the nested displacement bounds, inside out (|q| tracking: thrHi
     = sorted q_max, thrLo unused); A: scrambling multiplier (coprime to N); counter (1,) int64
     = 0; outE (N*nE,), outQ (N*nQ,) int64 pre-filled with -1; wpar (steps.N_WPAR,) the well's
     barriers and coefficients (wellcode.WellCode.wpar).
     """
-    W = WIDTHS[kernels.check_integrator(integrator)]
+    W = WIDTHS[schemes.check_integrator(integrator)]
     UW = np.uint64(W)
     code = wellcode.quartic_code() if well is None else well
     if not isinstance(code, wellcode.WellCode):
         raise ValueError(f"well must be a compiled well (wellcode.WellCode), got {well!r}")
-    step, energy2w = make_step(code, steps.SCHEMES[(integrator, bool(damped))])
+    step, energy2w, flat_coefs = make_step(code, sc)
     crossed, check_state, next_filters = make_criteria(code.abs_tracking)
-    NC = np.uint64(steps.N_COEF)
+    NC = np.uint64(sc.n_coef)
     SHARED = bool(shared_table)
     BLK = int(block)
     WRP = int(warp)
@@ -306,7 +299,7 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
         tE = math.inf
         tQ = math.inf
         tN = math.inf
-        c1 = c2 = c3 = c4 = c5 = c6 = c7 = c8 = c9 = c10 = 0.0
+        cf = flat_coefs(coef, uint64(0))
         reload = False
         while True:
             # ---------------------------------------------- take the next trajectory
@@ -362,24 +355,14 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
                 # of idle lanes issues no arithmetic and only waits at the barriers
                 continue
             if reload:
-                o = uint64(k) * NC
-                c1 = coef[o]
-                c2 = coef[o + U1]
-                c3 = coef[o + U2]
-                c4 = coef[o + U3]
-                c5 = coef[o + U4]
-                c6 = coef[o + U5]
-                c7 = coef[o + U6]
-                c8 = coef[o + U7]
-                c9 = coef[o + U8]
-                c10 = coef[o + U9]
+                cf = flat_coefs(coef, uint64(k) * NC)
                 tE, tQ, tN = next_filters(iE, iQ, thrE2, nE, thrLo, thrHi, nQ, qL, qR)
                 reload = False
             # ---------------------------------------------- one forcing period
             o = uint64(k) * uSW
             base = per * S
             for s in range(S):
-                q, p = step(q, p, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, tab, o, w)
+                q, p = step(q, p, cf, tab, o, w)
                 o += UW
                 e = energy2w(q, p, w)
                 if crossed(e, q, tE, tQ, tN):

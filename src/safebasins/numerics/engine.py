@@ -1,18 +1,26 @@
-"""Python driver of the compiled ensemble kernel (argument checks, thread control, tasks)."""
+"""The CPU backend of the ensemble engine and the one entry point of both backends.
+
+:func:`integrate` takes an :class:`~safebasins.numerics.problem.EnsembleProblem` (built and
+checked once by problem.ensemble_problem) and runs it on the CPU lanes (:func:`run_cpu`, the
+reference) or the CUDA kernels (cuda_engine.run_cuda, bitwise equal); this module also holds the
+engine's checks that depend on the scheme and the machine (steps per cycle, threads).
+"""
 from __future__ import annotations
 
 import contextlib
+import importlib
 import math
 
 import numba
 import numpy as np
 
 from safebasins import checks
-from safebasins.numerics import kernels, steps
+from safebasins.numerics import kernels, schemes
+from safebasins.numerics.problem import EnsembleProblem
 from safebasins.wells import resolve_well
 
 DEFAULT_STEPS_PER_CYCLE = 32
-DEFAULT_INTEGRATOR = "srkn6b"
+DEFAULT_INTEGRATOR = schemes.DEFAULT_SCHEME
 #: where ensembles run: the CPU lanes (the reference), a CUDA GPU (cuda_engine: bitwise equal
 #: escape steps) or "auto" (the GPU when one is visible, else the CPU)
 BACKENDS = ("cpu", "cuda", "auto")
@@ -49,22 +57,22 @@ def check_steps_per_cycle(steps_per_cycle):
     return n
 
 
-#: largest h * omega_max accepted (numerics docs): half of SRKN6b's stability limit 3.16 for
-#: the harmonic oscillator and below RK4's 2.83 (|R(i x)| <= 1); phase error 1.2e-4 per step there
-STEP_LIMIT = 1.5
 #: above this many steps per forcing cycle the forcing is quasi-static for the well: a smaller
 #: Omega is refused as such rather than answered with an astronomical steps_per_cycle
 MAX_STEPS_PER_CYCLE = 10 ** 7
 
 
-def check_step(Omega, steps_per_cycle, well=None):
-    """Refuse a step ``h = 2 pi / (Omega steps_per_cycle)`` the schemes cannot integrate: ValueError
-    (naming steps_per_cycle) when ``h * max(omega_max, Omega) > STEP_LIMIT`` for the smallest
-    Omega, omega_max being the well's largest local frequency sqrt(max |V''|) (Well.omega_max).
-    Beyond it the schemes lose their accuracy and, past ~3, blow up to NaN (which the kernels
-    count as escape, never as safe: a chart would be all escape, not an answer)."""
+def check_step(Omega, steps_per_cycle, well=None, integrator=DEFAULT_INTEGRATOR):
+    """Refuse a step ``h = 2 pi / (Omega steps_per_cycle)`` the scheme cannot integrate: ValueError
+    (naming steps_per_cycle) when ``h * max(omega_max, Omega)`` exceeds the scheme's step limit
+    (schemes.step_limit: half its stability limit on the harmonic oscillator; SRKN6b 1.58, RK4
+    1.41) for the smallest Omega, omega_max being the well's largest local frequency
+    sqrt(max |V''|) (Well.omega_max).  Beyond it the scheme loses its accuracy and, past its
+    stability limit, blows up to NaN (which the kernels count as escape, never as safe: a chart
+    would be all escape, not an answer)."""
     Om = np.atleast_1d(np.asarray(Omega, dtype=float))
     w = resolve_well(well)
+    STEP_LIMIT = schemes.step_limit(integrator)
     om_min = float(Om.min())
     h = 2.0 * math.pi / (om_min * steps_per_cycle)
     fastest = max(w.omega_max, om_min)
@@ -85,26 +93,13 @@ def check_step(Omega, steps_per_cycle, well=None):
     return steps_per_cycle
 
 
-def check_damping(damping):
-    """The damping beta of q'' + beta q' + V'(q) = F sin(Omega t + Psi): a finite scalar >= 0."""
-    return checks.check_scalar("damping", damping, checks.check_nonnegative)
-
-
 def damping_attrs(damping):
     """``{"damping": beta}`` for a damped run; nothing for the undamped equation (datasets of the
     paper's equation keep their attributes: no damping attribute means beta = 0)."""
     return {"damping": damping} if damping > 0 else {}
 
 
-def integrator_text(integrator, damping):
-    """The integrator of a dataset in words (its damped variant for damping > 0)."""
-    return steps.DAMPED_INTEGRATORS[integrator] if damping > 0 else steps.INTEGRATORS[integrator]
-
-
-def check_cycles(name, cycles):
-    if isinstance(cycles, (float, np.floating)) and float(cycles).is_integer() and cycles >= 1:
-        cycles = int(cycles)
-    return checks.check_positive_int(name, cycles)
+integrator_text = schemes.integrator_text
 
 
 def thresholds(name, values, check):
@@ -114,78 +109,26 @@ def thresholds(name, values, check):
     return a
 
 
-def displacement_pairs(q_max=(), q_bounds=()):
-    """The displacement thresholds as bound pairs (lo, hi): q_max -> (-q_max, q_max), then the
-    q_bounds pairs; returns (lo, hi, order, signed): `order` sorts them nested from the inside
-    out (hi ascending, lo descending; stable), `signed` = some pair is not symmetric.
-    ValueError naming q_max / q_bounds when two pairs are not nested (neither contains the
-    other: the engine watches only the next uncrossed bound of each trajectory)."""
-    qm = np.asarray(q_max, dtype=float).ravel()
-    qb = np.asarray(q_bounds, dtype=float).reshape(-1, 2) if np.size(q_bounds) else np.zeros((0, 2))
-    lo = np.concatenate([-qm, qb[:, 0]])
-    hi = np.concatenate([qm, qb[:, 1]])
-    order = np.lexsort((-lo, hi))
-    if lo.size and not (np.diff(lo[order]) <= 0).all():
-        name = "q_bounds" if qb.shape[0] else "q_max"
-        pairs = [(float(a), float(b)) for a, b in zip(lo[order], hi[order])]
-        raise ValueError(f"{name}: the displacement bounds (q_max as (-q_max, q_max) and q_bounds) must be nested, "
-                         f"each pair inside the next; got {pairs}")
-    return lo, hi, order, bool((lo != -hi).any())
-
-
-def engine_code(well, q_max=(), q_bounds=()):
-    """The compiled form the engines integrate ``well`` in: its |q|-tracking form only when every
-    displacement bound is symmetric (displacement_pairs)."""
-    code = resolve_well(well).compiled
-    return code.signed() if displacement_pairs(q_max, q_bounds)[3] else code
-
-
-def run_ensemble(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bounds=(), cycles, steps_per_cycle,
-                 threads=None, stop_any=False, store=False, integrator=DEFAULT_INTEGRATOR, well=None, damping=0.0):
-    """Integrate trajectories i from (q0[i], p0[i]) with Omega[pidx[i]], F[pidx[i]] in `well`.
+def run_cpu(problem: EnsembleProblem, *, threads=None, store: bool = False):
+    """Integrate a problem on the CPU lanes (kernels.ensemble).
 
     Returns (steps_E (N, nE), steps_Q (N, nQ), store or None): int64 first-crossing steps in the
-    order of the given thresholds (-1: not within `cycles`), and period-map iterates.  The
-    displacement columns are the q_max thresholds (|q| > q_max) followed by the q_bounds pairs
-    (q < lo or q > hi); all of them must be nested (displacement_pairs).
-    integrator: "srkn6b" (default) or "rk4" (kernels.INTEGRATORS), with ``damping`` beta > 0 of
-    q'' + beta q' + V'(q) = F sin(...) their damped variants (steps.DAMPED_INTEGRATORS; 0: the
-    undamped schemes, bitwise as before damping existed); well: any form
-    safebasins.wells.resolve_well reads (None: the quartic), integrated in its compiled form.
-    Thresholds are not checked against the well here (the public functions do that).
-    """
-    kernels.check_integrator(integrator)
-    code = engine_code(well, q_max, q_bounds)
-    q0 = np.ascontiguousarray(q0, dtype=float).ravel()
-    p0 = np.ascontiguousarray(p0, dtype=float).ravel()
-    pidx = np.ascontiguousarray(pidx, dtype=np.int64).ravel()
-    Omega = np.atleast_1d(np.asarray(Omega, dtype=float))
-    F = np.atleast_1d(np.asarray(F, dtype=float))
-    xi = np.asarray(xi_max, dtype=float).ravel()
-    lo, hi, oQ_sorted, _ = displacement_pairs(q_max, q_bounds)
-    N = q0.size
-    oE_sorted = np.argsort(xi, kind="stable")
-    outE = np.full((N, xi.size), -1, dtype=np.int64)
-    outQ = np.full((N, hi.size), -1, dtype=np.int64)
-    st = np.full((N, cycles + 1, 2), np.nan) if store else np.empty((0, 0, 2))
+    problem's sorted threshold order (-1: not within `cycles`), and with ``store`` the period-map
+    iterates (N, cycles + 1, 2) (NaN after escape)."""
+    pb = problem
+    N = pb.n
+    outE = np.full((N, pb.thrE2.size), -1, dtype=np.int64)
+    outQ = np.full((N, pb.hi.size), -1, dtype=np.int64)
+    st = np.full((N, pb.cycles + 1, 2), np.nan) if store else np.empty((0, 0, 2))
     if N:
-        coef = np.ascontiguousarray(kernels.lane_coefficients(Omega, steps_per_cycle, integrator, damping))
-        sintab = kernels.sine_table(steps_per_cycle, Psi, integrator)
         with thread_count(threads) as nthreads:
             # one task per thread: trajectories are interleaved over tasks (i % n_tasks), so each
             # task gets a statistically equal share of long-lived ones and its lanes stay full
             n_tasks = max(1, min(math.ceil(N / LANES), nthreads))
-            kernels.ensemble(q0, p0, pidx, coef, kernels.step_sizes(Omega, steps_per_cycle), np.ascontiguousarray(F), sintab,
-                       np.ascontiguousarray(2.0 * xi[oE_sorted]), np.ascontiguousarray(hi[oQ_sorted]),
-                       int(cycles), bool(stop_any), int(n_tasks), LANES, outE, outQ, st, bool(store),
-                       scheme=kernels.scheme_of(integrator, damping),
-                       well=code, thrQlo=np.ascontiguousarray(lo[oQ_sorted]))
-    # back to the caller's threshold order
-    steps_E = np.empty_like(outE)
-    steps_E[:, oE_sorted] = outE
-    steps_Q = np.empty_like(outQ)
-    steps_Q[:, oQ_sorted] = outQ
-    return steps_E, steps_Q, (st if store else None)
+            kernels.ensemble(pb.q0, pb.p0, pb.pidx, pb.coefficients(), pb.step_sizes(), pb.F, pb.sine_table(),
+                             pb.thrE2, pb.hi, pb.cycles, pb.stop_any, int(n_tasks), LANES, outE, outQ, st,
+                             bool(store), scheme=pb.scheme, well=pb.code, thrQlo=pb.lo)
+    return outE, outQ, (st if store else None)
 
 
 def steps_to_cycles(steps, steps_per_cycle):
@@ -200,18 +143,24 @@ def resolve_backend(backend):
     if backend not in BACKENDS:
         raise ValueError(f"backend must be one of {BACKENDS}, got {backend!r}")
     if backend == "auto":
-        from safebasins.numerics.cuda_engine import cuda_available
-
-        return "cuda" if cuda_available() else "cpu"
+        return "cuda" if _cuda().cuda_available() else "cpu"
     return backend
 
 
-def integrate(q0, p0, pidx, Omega, F, Psi, *, backend="cpu", threads=None, **kwargs):
-    """:func:`run_ensemble` on the chosen backend; returns (steps_E, steps_Q), bitwise the same
-    on either (the CUDA kernels repeat the CPU lanes' operations; tests/numerics/test_cuda_simulator.py)."""
-    if resolve_backend(backend) == "cuda":
-        from safebasins.numerics.cuda_engine import run_ensemble_cuda
+def _cuda():
+    """The CUDA backend's module, imported on first use: importing numba.cuda costs ~1 s and the
+    simulator must be chosen (NUMBA_ENABLE_CUDASIM) before it."""
+    return importlib.import_module("safebasins.numerics.cuda_engine")
 
-        return run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, **kwargs)
-    steps_E, steps_Q, _ = run_ensemble(q0, p0, pidx, Omega, F, Psi, threads=threads, **kwargs)
-    return steps_E, steps_Q
+
+def integrate(problem: EnsembleProblem, backend: str = "cpu", *, threads=None, **options):
+    """Integrate an ensemble problem (problem.ensemble_problem) on a backend: "cpu" (the CPU lanes,
+    the reference; ``threads``), "cuda" (cuda_engine.run_cuda; ``block``, ``grid``, ``timing``) or
+    "auto" (the GPU when one is visible).  Returns (steps_E, steps_Q) in the caller's threshold
+    order, bitwise the same on either backend (the CUDA kernels repeat the CPU lanes' operations;
+    tests/numerics/test_cuda_simulator.py)."""
+    if resolve_backend(backend) == "cuda":
+        steps_E, steps_Q = _cuda().run_cuda(problem, **options)
+    else:
+        steps_E, steps_Q, _ = run_cpu(problem, threads=threads, **options)
+    return problem.caller_order(steps_E, steps_Q)

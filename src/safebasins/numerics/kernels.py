@@ -1,15 +1,17 @@
 """Compiled ensemble integrator for eq (1) in any supported well: q'' + V'(q) = F sin(Omega t + Psi).
 
-The step (schemes, forcing tables) lives in steps.py, the vectorised period loops over the
-lanes in periods.py, the well's force and energy in its compiled form (wellcode.py); this module
-holds the lane machinery: escape detection, replay, refill, compaction, and the entry points.
+The schemes are constants (schemes.py) whose steps are generated once (scheme_code.py) and
+compiled for the CPU in steps.py, the vectorised period loops over the lanes live in periods.py,
+the well's force and energy in its compiled form (wellcode.py); this module holds the lane
+machinery: escape detection, replay, refill, compaction, and the entry points.
 
-Schemes and wells are compile-time constants of the inline period bodies: `scheme` (steps.SRKN6B,
-RK4 and their damped variants; the forcing table's width 7 or 3 matches it) and `well`, the kernel key of a compiled well
-(wellcode.WellCode.key), which _run_task forces to a numba literal (`literally`): every key is
-its own compiled kernel, cached on disk and compiled on first use, and holds only its own
-well's code (numba @overload on the literal, resolved at typing time).  Keys hash the
-arithmetic and the engine's source, so a cached kernel is never reused after an edit.
+Schemes and wells are compile-time constants of the inline period bodies: `scheme`, the key of a
+scheme's compiled form (scheme_code.SchemeCode.key; the forcing table's width and the coefficient
+table match it) and `well`, the kernel key of a compiled well (wellcode.WellCode.key), which
+_run_task forces to numba literals (`literally`): every pair of keys is its own compiled kernel,
+cached on disk and compiled on first use, and holds only its own scheme's and well's code (numba
+@overload on the literal, resolved at typing time).  Keys hash the arithmetic and the engine's
+source, so a cached kernel is never reused after an edit.
 Parallelism: one task per thread (Python threads; the task function releases the GIL).
 
 Every lane's arithmetic is written with explicit fused multiply-adds (llvm.fma), no
@@ -49,12 +51,9 @@ from numba import literally, njit, typeof, types
 from numba.core import errors
 from numba.extending import overload
 
-from safebasins.numerics.steps import (  # noqa: F401  (re-exported: the step API of the engine)
-    BM6_DRIFT, BM6_KICK, BM6_KICK_TIMES, DRIFT1, DRIFT2, DRIFT3, INTEGRATOR, INTEGRATORS, KICK1, KICK2, KICK3,
-    KICK4, N_COEF, N_KICKS, RK4, RK4_C1, RK4_C2, RK4_C3, RK4_COEF, RK4_DAMPED, RK4_TIMES, SRKN6B, SRKN6B_DAMPED,
-    bm6_step, check_integrator, energy, energy2, force, lane_coefficients, lane_coefs, rk4_step, row, scheme_of,
-    sine_table, step, step_sizes, wtuple)
 from safebasins.numerics.periods import _period_lanes_body, _period_shared_body
+from safebasins.numerics.scheme_code import SchemeCode, scheme_code
+from safebasins.numerics.steps import coefs, is_damped, scaled_row, step, wtuple
 from safebasins.numerics.wellcode import WellCode, abs_tracking, quartic_code, well_energy2
 
 # smallest lane segment of the 4-chain vector loop (lanes run: 4 * segment)
@@ -117,13 +116,6 @@ def _filters(well, wpar, iE, iQ, thrE2, thrLo, thrHi):
     return tE, tQ, tN
 
 
-@njit(cache=True, inline="always")
-def _scaled_row(tab, s, scheme, F):
-    """F times row s of the forcing table (the products the vector loop forms)."""
-    t1, t2, t3, t4, t5, t6, t7 = row(tab, s, scheme)
-    return F * t1, F * t2, F * t3, F * t4, F * t5, F * t6, F * t7
-
-
 @njit(cache=True)
 def _replay(scheme, well, wpar, i, q, p, period, s0, s1, sintab, c, F, thrE2, thrLo, thrHi, iE, iQ, outE, outQ,
             stop_any):
@@ -135,10 +127,9 @@ def _replay(scheme, well, wpar, i, q, p, period, s0, s1, sintab, c, F, thrE2, th
     nQ = thrHi.shape[0]
     w = wtuple(wpar)
     base = period * S
-    c1, c2, c3, c4, c5, c6, c7, c8, c9, c10 = c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9]
+    cc = coefs(scheme, c)
     for s in range(s0, s1):
-        f1, f2, f3, f4, f5, f6, f7 = _scaled_row(sintab, s, scheme, F)
-        q, p = step(scheme, well, w, q, p, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, f1, f2, f3, f4, f5, f6, f7)
+        q, p = step(scheme, well, w, q, p, cc, scaled_row(scheme, sintab, s, F))
         iE, iQ = _check_state(well, wpar, i, q, p, base + s + 1, thrE2, thrLo, thrHi, iE, iQ, outE, outQ)
         if _finished(iE, iQ, nE, nQ, stop_any):
             break
@@ -149,14 +140,14 @@ def _replay(scheme, well, wpar, i, q, p, period, s0, s1, sintab, c, F, thrE2, th
 def _run_task(well, scheme, shared, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrLo,
               thrHi, cycles, stop_any, outE, outQ, store, do_store):
     """Trajectories task, task + n_tasks, ... (one thread): the lane machinery of the module
-    docstring.  `well` is the kernel key of a compiled well, `scheme` the scheme flag and
+    docstring.  `well` is the kernel key of a compiled well, `scheme` the key of a scheme code and
     `shared` whether all trajectories share one parameter set (``coef.shape[0] == 1``: the
     shared loop, else the per-lane loop); numba literals: one specialised, cached kernel per
     triple, compiled on first use, with only the period loop it runs."""
     literally(well)
     literally(scheme)
     literally(shared)
-    damped = scheme == SRKN6B_DAMPED or scheme == RK4_DAMPED
+    damped = is_damped(scheme)
     N = q0.shape[0]
     S = sintab.shape[0]
     nE = thrE2.shape[0]
@@ -191,10 +182,11 @@ def _run_task(well, scheme, shared, wpar, task, n_tasks, lanes, q0, p0, pidx, co
     tE = np.zeros(L)      # next uncrossed 2*xi threshold of the lane (inf: none)
     tQ = np.zeros(L)      # next uncrossed |q| (|q| tracking) or upper bound, or the barrier
     tN = np.zeros(L)      # signed tracking: next uncrossed -lower bound, or -q_left
-    FS = Fpar[0] * sintab        # (S, 7) or (S, 3), shared path
+    FS = Fpar[0] * sintab        # (S, width), shared path
     HL = np.zeros(Lmem)          # per-lane path
     FL = np.zeros(Lmem)
-    CL = np.zeros((N_COEF, Lmem if damped else 1))     # per-lane coefficient columns (damped schemes)
+    NC = coef.shape[1]
+    CL = np.zeros((NC, Lmem if damped else 1))     # per-lane coefficient columns (damped schemes)
 
     zero = np.int64(0)
     nxt = np.int64(task)
@@ -225,7 +217,7 @@ def _run_task(well, scheme, shared, wpar, task, n_tasks, lanes, q0, p0, pidx, co
                 HL[l] = hpar[k]
                 FL[l] = Fpar[k]
                 if damped:
-                    for j in range(N_COEF):
+                    for j in range(NC):
                         CL[j, l] = coef[k, j]
                 traj[l] = i; per[l] = 0; lE[l] = iE; lQ[l] = iQ
                 tE[l], tQ[l], tN[l] = _filters(well, wpar, iE, iQ, thrE2, thrLo, thrHi)
@@ -246,7 +238,7 @@ def _run_task(well, scheme, shared, wpar, task, n_tasks, lanes, q0, p0, pidx, co
                 HL[l] = HL[last]
                 FL[l] = FL[last]
                 if damped:
-                    for j in range(N_COEF):
+                    for j in range(NC):
                         CL[j, l] = CL[j, last]
                 traj[l] = traj[last]; per[l] = per[last]; lE[l] = lE[last]; lQ[l] = lQ[last]
                 tE[l] = tE[last]; tQ[l] = tQ[last]; tN[l] = tN[last]; done[l] = done[last]
@@ -342,7 +334,7 @@ def _ol_period(shared, scheme, well, wpar, M, Q, P, ME, MQ, MN, coef, FS, HL, CL
 
 def specialised(dispatcher, args, n_literal=2):
     """The compiled entry point of ``dispatcher`` for ``args``, whose first ``n_literal`` arguments
-    (the kernel key, the scheme flag; for _run_task also the shared flag) are taken as numba
+    (the kernel key, the scheme key; for _run_task also the shared flag) are taken as numba
     literals (compiled, or loaded from the on-disk cache, on first use).  Calling it skips numba's dispatch, which would first try the
     non-literal signature at every call."""
     sig = tuple(types.literal(a) for a in args[:n_literal]) + tuple(typeof(a) for a in args[n_literal:])
@@ -377,8 +369,8 @@ def _check_code(well):
 def ensemble(q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQ, cycles, stop_any, n_tasks, lanes,
              outE, outQ, store, do_store, well=None, thrQlo=None, scheme=None):
     """Integrate every trajectory i from (q0[i], p0[i]) with parameter set pidx[i]
-    (coef[pidx[i]] = step coefficients from lane_coefficients, hpar[pidx[i]] = the step h
-    from step_sizes, Fpar[pidx[i]] = F) for at most
+    (coef[pidx[i]] = step coefficients from schemes.lane_coefficients, hpar[pidx[i]] = the step h
+    from schemes.step_sizes, Fpar[pidx[i]] = F) for at most
     `cycles` forcing periods of S = sintab.shape[0] steps.
 
     thrE2: sorted ascending 2*xi_max thresholds; thrQ: the upper displacement bounds, sorted
@@ -389,33 +381,33 @@ def ensemble(q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQ, cycles, stop_a
     A trajectory stops when every threshold is crossed (stop_any: when any is crossed); a NaN
     or inf state is beyond every threshold.
     store (N, cycles+1, 2): period-map iterates when do_store (pre-filled with NaN).
-    scheme: the scheme flag (steps.SRKN6B, RK4, SRKN6B_DAMPED, RK4_DAMPED; None: the undamped
-    scheme of the table's width, 7 SRKN6b, 3 RK4), with sine_table / lane_coefficients of the same
-    integrator and damping; the well is its compiled form `well` (wellcode.WellCode; None: the
-    quartic).
+    scheme: the scheme's compiled form (scheme_code.scheme_code(integrator, damped); None: SRKN6b
+    undamped), with schemes.sine_table / lane_coefficients of the same scheme and damping; the
+    well is its compiled form `well` (wellcode.WellCode; None: the quartic).
     Trajectory i is run by task i % n_tasks (one thread each); the results do not depend on
     n_tasks, lanes or the thread count (each trajectory is the same sequence of IEEE operations).
     """
     code = quartic_code() if well is None else _check_code(well)
     thrQ = np.ascontiguousarray(thrQ, dtype=float)
     thrQlo = -thrQ if thrQlo is None else np.ascontiguousarray(thrQlo, dtype=float)
-    scheme = _scheme(scheme, sintab, coef)
-    args = [code.key, scheme, bool(coef.shape[0] == 1), code.wpar, 0, int(n_tasks), int(lanes), q0, p0, pidx, coef,
+    sc = _scheme(scheme, sintab, coef)
+    args = [code.key, sc.key, bool(coef.shape[0] == 1), code.wpar, 0, int(n_tasks), int(lanes), q0, p0, pidx, coef,
             hpar, Fpar, sintab, thrE2, thrQlo, thrQ, int(cycles), bool(stop_any), outE, outQ, store, bool(do_store)]
     entry = specialised(_run_task, args, n_literal=3)
     run_tasks(lambda task: entry(*args[:4], task, *args[5:]), n_tasks)
 
 
-def _scheme(scheme, sintab, coef):
-    """The scheme flag, checked against the forcing table's width and the coefficient table."""
-    width = {SRKN6B: 7, RK4: 3, SRKN6B_DAMPED: 7, RK4_DAMPED: 3}
-    if scheme is None:
-        scheme = RK4 if sintab.shape[1] == 3 else SRKN6B
-    if scheme not in width or sintab.shape[1] != width[scheme]:
-        raise ValueError(f"scheme {scheme!r} does not match a forcing table of width {sintab.shape[1]}")
-    if coef.ndim != 2 or coef.shape[1] != N_COEF:
-        raise ValueError(f"coef must be lane_coefficients, shape (n, {N_COEF}), got {coef.shape}")
-    return int(scheme)
+def _scheme(scheme, sintab, coef) -> SchemeCode:
+    """The scheme code (None: SRKN6b), checked against the forcing table and the coefficient table."""
+    sc = scheme_code("srkn6b") if scheme is None else scheme
+    if not isinstance(sc, SchemeCode):
+        raise ValueError(f"scheme must be a scheme code (scheme_code.scheme_code), got {scheme!r}")
+    if sintab.ndim != 2 or sintab.shape[1] != sc.width:
+        raise ValueError(f"the forcing table of {sc.name} has {sc.width} columns (schemes.sine_table), "
+                         f"got shape {sintab.shape}")
+    if coef.ndim != 2 or coef.shape[1] != sc.n_coef:
+        raise ValueError(f"coef must be lane_coefficients of {sc.name}, shape (n, {sc.n_coef}), got {coef.shape}")
+    return sc
 
 
 @njit(cache=True, nogil=True)
@@ -428,15 +420,12 @@ def _final_states(well, scheme, wpar, q0, p0, pidx, coef, Fpar, sintab, n_period
     for i in range(task, N, n_tasks):
         k = pidx[i]
         F = Fpar[k]
-        c = coef[k]
-        c1, c2, c3, c4, c5, c6, c7, c8, c9, c10 = c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9]
+        cc = coefs(scheme, coef[k])
         q = q0[i]
         p = p0[i]
         for n in range(n_periods):
             for s in range(S):
-                f1, f2, f3, f4, f5, f6, f7 = _scaled_row(sintab, s, scheme, F)
-                q, p = step(scheme, well, w, q, p, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, f1, f2, f3, f4, f5, f6,
-                            f7)
+                q, p = step(scheme, well, w, q, p, cc, scaled_row(scheme, sintab, s, F))
         qo[i] = q
         po[i] = p
 
@@ -449,8 +438,8 @@ def final_states(q0, p0, pidx, coef, Fpar, sintab, n_periods, well=None, n_tasks
     q0 = np.ascontiguousarray(q0, dtype=float)
     qo, po = np.empty(q0.shape), np.empty(q0.shape)
     n_tasks = max(1, min(int(n_tasks), q0.size))
-    scheme = _scheme(scheme, sintab, coef)
-    args = [code.key, scheme, code.wpar, q0, np.ascontiguousarray(p0, dtype=float), pidx, coef, Fpar, sintab,
+    sc = _scheme(scheme, sintab, coef)
+    args = [code.key, sc.key, code.wpar, q0, np.ascontiguousarray(p0, dtype=float), pidx, coef, Fpar, sintab,
             int(n_periods), 0, n_tasks, qo, po]
     entry = specialised(_final_states, args)
     run_tasks(lambda t: entry(*args[:10], t, *args[11:]), n_tasks)

@@ -7,7 +7,8 @@ import xarray as xr
 from safebasins import checks
 from safebasins.io import cf
 from safebasins.io.provenance import api_provenance
-from safebasins.numerics import criteria, engine, kernels
+from safebasins.numerics import criteria, engine, schemes
+from safebasins.numerics.problem import check_cycles, check_damping, displacement_pairs, ensemble_problem
 from safebasins.wells import resolve_well
 
 
@@ -49,8 +50,8 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
     F = checks.check_scalar("F", F, checks.check_nonnegative)
     Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
-    n_iter = engine.check_cycles("n_iter", n_iter)
-    damping = engine.check_damping(damping)
+    n_iter = check_cycles("n_iter", n_iter)
+    damping = check_damping(damping)
     w = resolve_well(well)
     xi = () if xi_max is None else (checks.check_scalar("xi_max", xi_max, w.check_threshold),)
     qm = () if q_max is None else (checks.check_scalar("q_max", q_max, w.check_displacement),)
@@ -59,14 +60,15 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
         raise ValueError(f"q_bounds must be one pair (lo, hi) for the map, got {qb.tolist()}")
     if not xi and not qm and not qb.shape[0]:
         raise ValueError("xi_max, q_max and q_bounds: at least one escape threshold is required")
-    engine.displacement_pairs(qm, qb)
-    spc = engine.check_step(Omega, engine.check_steps_per_cycle(steps_per_cycle), w)
+    displacement_pairs(qm, qb)
+    schemes.check_integrator(integrator)
+    spc = engine.check_step(Omega, engine.check_steps_per_cycle(steps_per_cycle), w, integrator)
     threads = engine.check_threads(threads)
-    kernels.check_integrator(integrator)
 
-    sE, sQ, st = engine.run_ensemble(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm,
-                                     q_bounds=qb, cycles=n_iter, steps_per_cycle=spc, threads=threads, stop_any=True,
-                                     store=True, integrator=integrator, well=w, damping=damping)
+    problem = ensemble_problem(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, q_max=qm, q_bounds=qb,
+                               cycles=n_iter, steps_per_cycle=spc, stop_any=True, integrator=integrator, well=w,
+                               damping=damping)
+    sE, sQ, st = engine.run_cpu(problem, threads=threads, store=True)
     steps = np.concatenate([sE, sQ], axis=1).astype(float)
     steps[steps < 0] = np.inf
     first = steps.min(axis=1)

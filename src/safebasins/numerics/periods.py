@@ -1,8 +1,8 @@
 """The vectorised period loops of the compiled engine: steps [s0, s1) of the forcing period
 for every lane of a task, with the per-lane maxima the escape detection of kernels.py reads.
 
-Two loops, each specialised at compile time on the scheme flag (steps.SRKN6B, RK4 and their
-damped variants) and the kernel key (steps.py): _period_shared_body (every lane with the same
+Two loops, each specialised at compile time on the scheme key (scheme_code.SchemeCode.key: a
+scheme and damped or not) and the well's kernel key (steps.py): _period_shared_body (every lane with the same
 Omega and F: 4 dependency chains per iteration) and _period_lanes_body (per-lane Omega and F:
 one chain), numba overloads whose body is picked at typing time on the literal kernel key: a
 code with |q| tracking (the quartic's closed form, wellcode.WellCode.abs_tracking) tracks
@@ -17,7 +17,7 @@ import numpy as np
 from numba import njit
 from numba.extending import overload
 
-from safebasins.numerics.steps import RK4_DAMPED, SRKN6B_DAMPED, _literal_scheme, cpu_steps, lane_coefs, row, wtuple
+from safebasins.numerics.steps import cpu_helpers, cpu_lane, cpu_step, literal_scheme, wtuple
 from safebasins.numerics.wellcode import _literal_code, cpu_functions
 
 
@@ -56,31 +56,18 @@ def _reset(n, ME, MQ, MN, signed):
             MN[l] = -np.inf
 
 
-@njit(cache=True, inline="always")
-def _coefs(c):
-    """The 10 step coefficients of a parameter set (steps.N_COEF) as scalars."""
-    return c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9]
-
-
-@njit(cache=True, inline="always")
-def _lane(scheme, l, HL, CL):
-    """Lane l's step coefficients: formed from its step h = HL[l] for the undamped schemes (the
-    IEEE products lane_coefficients precomputes), read from its column of CL (lane_coefficients
-    of its parameter set, copied at load) for the damped ones."""
-    if scheme == SRKN6B_DAMPED or scheme == RK4_DAMPED:
-        return (CL[0, l], CL[1, l], CL[2, l], CL[3, l], CL[4, l], CL[5, l], CL[6, l], CL[7, l], CL[8, l],
-                CL[9, l])
-    return lane_coefs(scheme, HL[l])
-
-
 def _arithmetic(scheme, well):
-    """(scheme flag, abs_tracking, STEP, ENERGY2) of the literal scheme and kernel key: the code's
-    step and energy compiled for the CPU lanes (njit inline="always").  The loop bodies below call
-    them directly (inlined into the untyped IR, typed once with the body), not through the
-    generic inline overloads steps.step / wellcode.well_energy2, which numba types anew at every
-    call site and type-inference round (~30 ms each, ~0.8 s of a kernel's first compile)."""
-    SCHEME, code = _literal_scheme(scheme), _literal_code(well)
-    return SCHEME, code.abs_tracking, cpu_steps(code.key)[SCHEME], cpu_functions(code.key)[1]
+    """(helpers, abs_tracking, STEP, ENERGY2, LANE) of the literal scheme and kernel key: the
+    scheme's tuple helpers, the code's step and energy compiled for the CPU lanes (njit
+    inline="always") and the lane's coefficients (``LANE(l, HL, CL)``: formed from its step h =
+    HL[l] for an undamped scheme, the IEEE products lane_coefficients precomputes; read from its
+    column of CL, copied at load, for a damped one).  The loop bodies below call them directly
+    (inlined into the untyped IR, typed once with the body), not through the generic inline
+    overloads of steps.py / wellcode.py, which numba types anew at every call site and
+    type-inference round (~30 ms each, ~0.8 s of a kernel's first compile)."""
+    sc, code = literal_scheme(scheme), _literal_code(well)
+    return (cpu_helpers(sc.key), code.abs_tracking, cpu_step(sc.key, code.key), cpu_functions(code.key)[1],
+            cpu_lane(sc.key))
 
 
 def _period_shared_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
@@ -101,44 +88,45 @@ def _period_shared_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
 
 @overload(_period_shared_body)
 def _ol_period_shared_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
-    SCHEME, ABS, STEP, ENERGY2 = _arithmetic(scheme, well)
+    H, ABS, STEP, ENERGY2, _ = _arithmetic(scheme, well)
+    COEFS, ROW = H["coefs"], H["row"]
     if ABS:
         def impl(scheme, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
-            c1, c2, c3, c4, c5, c6, c7, c8, c9, c10 = _coefs(c)
+            cc = COEFS(c)
             w = wtuple(wpar)
             _reset(4 * M, ME, MQ, MN, False)
             for s in range(s0, s1):
-                f1, f2, f3, f4, f5, f6, f7 = row(FS, s, SCHEME)
+                f = ROW(FS, s)
                 for j in range(M):
                     l0 = 0 * M + j
                     l1 = 1 * M + j
                     l2 = 2 * M + j
                     l3 = 3 * M + j
-                    q0, p0 = STEP(w, Q[l0], P[l0], c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, f1, f2, f3, f4, f5, f6, f7)
-                    q1, p1 = STEP(w, Q[l1], P[l1], c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, f1, f2, f3, f4, f5, f6, f7)
-                    q2, p2 = STEP(w, Q[l2], P[l2], c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, f1, f2, f3, f4, f5, f6, f7)
-                    q3, p3 = STEP(w, Q[l3], P[l3], c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, f1, f2, f3, f4, f5, f6, f7)
+                    q0, p0 = STEP(w, Q[l0], P[l0], cc, f)
+                    q1, p1 = STEP(w, Q[l1], P[l1], cc, f)
+                    q2, p2 = STEP(w, Q[l2], P[l2], cc, f)
+                    q3, p3 = STEP(w, Q[l3], P[l3], cc, f)
                     _keep_abs(l0, q0, p0, ENERGY2(w, q0, p0), Q, P, ME, MQ)
                     _keep_abs(l1, q1, p1, ENERGY2(w, q1, p1), Q, P, ME, MQ)
                     _keep_abs(l2, q2, p2, ENERGY2(w, q2, p2), Q, P, ME, MQ)
                     _keep_abs(l3, q3, p3, ENERGY2(w, q3, p3), Q, P, ME, MQ)
     else:
         def impl(scheme, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
-            c1, c2, c3, c4, c5, c6, c7, c8, c9, c10 = _coefs(c)
+            cc = COEFS(c)
             w = wtuple(wpar)
             n = 4 * M
             _reset(n, ME, MQ, MN, True)
             for s in range(s0, s1):
-                f1, f2, f3, f4, f5, f6, f7 = row(FS, s, SCHEME)
+                f = ROW(FS, s)
                 for j in range(M):
                     l0 = 0 * M + j
                     l1 = 1 * M + j
                     l2 = 2 * M + j
                     l3 = 3 * M + j
-                    q0, p0 = STEP(w, Q[l0], P[l0], c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, f1, f2, f3, f4, f5, f6, f7)
-                    q1, p1 = STEP(w, Q[l1], P[l1], c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, f1, f2, f3, f4, f5, f6, f7)
-                    q2, p2 = STEP(w, Q[l2], P[l2], c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, f1, f2, f3, f4, f5, f6, f7)
-                    q3, p3 = STEP(w, Q[l3], P[l3], c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, f1, f2, f3, f4, f5, f6, f7)
+                    q0, p0 = STEP(w, Q[l0], P[l0], cc, f)
+                    q1, p1 = STEP(w, Q[l1], P[l1], cc, f)
+                    q2, p2 = STEP(w, Q[l2], P[l2], cc, f)
+                    q3, p3 = STEP(w, Q[l3], P[l3], cc, f)
                     Q[l0] = q0
                     P[l0] = p0
                     Q[l1] = q1
@@ -165,7 +153,8 @@ def _period_lanes_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, HL, CL, FL, sint
 
 @overload(_period_lanes_body)
 def _ol_period_lanes_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, HL, CL, FL, sintab, s0, s1):
-    SCHEME, ABS, STEP, ENERGY2 = _arithmetic(scheme, well)
+    H, ABS, STEP, ENERGY2, LANE = _arithmetic(scheme, well)
+    ROW, SCALED = H["row"], H["scaled"]
     SIGNED = not ABS
 
     def impl(scheme, well, wpar, M, Q, P, ME, MQ, MN, HL, CL, FL, sintab, s0, s1):
@@ -173,12 +162,9 @@ def _ol_period_lanes_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, HL, CL, FL, s
         w = wtuple(wpar)
         _reset(n, ME, MQ, MN, SIGNED)
         for s in range(s0, s1):
-            t1, t2, t3, t4, t5, t6, t7 = row(sintab, s, SCHEME)
+            t = ROW(sintab, s)
             for l in range(n):
-                F = FL[l]
-                c1, c2, c3, c4, c5, c6, c7, c8, c9, c10 = _lane(SCHEME, l, HL, CL)
-                q, p = STEP(w, Q[l], P[l], c1, c2, c3, c4, c5, c6, c7, c8, c9, c10,
-                            F * t1, F * t2, F * t3, F * t4, F * t5, F * t6, F * t7)
+                q, p = STEP(w, Q[l], P[l], LANE(l, HL, CL), SCALED(FL[l], t))
                 e = ENERGY2(w, q, p)
                 if SIGNED:
                     Q[l] = q

@@ -100,11 +100,11 @@ def _ol_mul(a, b):
 # ------------------------------------------------------------------------------- the compiled form
 @functools.cache
 def engine_fingerprint() -> str:
-    """Hash of the engine's source (steps, periods, kernels and this module): part of every key,
-    so an edit of the engine never reuses a kernel cached before it."""
+    """Hash of the engine's source (schemes, steps, periods, kernels and this module): part of every
+    key, so an edit of the engine never reuses a kernel cached before it."""
     h = hashlib.blake2b(digest_size=16)
     here = Path(__file__).parent
-    for name in ("wellcode.py", "steps.py", "periods.py", "kernels.py"):
+    for name in ("wellcode.py", "schemes.py", "scheme_code.py", "steps.py", "periods.py", "kernels.py"):
         h.update((here / name).read_bytes())
     return h.hexdigest()
 

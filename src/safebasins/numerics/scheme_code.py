@@ -1,0 +1,202 @@
+"""The compiled form of a scheme: its step generated once from the constant, compiled for every target.
+
+:func:`scheme_code` turns a scheme of schemes.py (and whether the equation is damped) into a
+:class:`SchemeCode`: the Python source of
+
+* ``step(w, q, p, c, f) -> (q, p)``: one step with the coefficient tuple ``c``
+  (schemes.lane_coefficients of one parameter set) and the forcing values ``f`` (F sin(Omega t + Psi)
+  at the scheme's distinct force sub-times), calling ``force(w, q, f_k) = -V'(q) + f_k`` of a well's
+  compiled form (wellcode.py) and the primitives ``fma`` / ``mul`` (every product that meets an
+  add is an explicit fma; the damped p *= e is a mul: never contracted on the GPU);
+* the tuple helpers of its arity: ``row(tab, s)`` (a forcing-table row), ``scaled(F, t)`` (F times
+  it: the products the shared path precomputes), ``coefs(c)`` (a coefficient row as a tuple),
+  ``column(CL, l)`` (a lane's coefficient column), ``from_h(h)`` (undamped: the coefficients formed
+  from the step h, the same IEEE products as lane_coefficients), ``flat_row(tab, o)`` and
+  ``flat_coefs(coef, o)`` (CUDA: flat arrays at an unsigned offset).
+
+``make(jit, force)`` compiles the step for a target (the CPU lanes: wellcode.cpu_jit; CUDA:
+``cuda.jit(device=True)``), ``helpers(jit)`` the tuple helpers.  ``key`` hashes the generated
+source and the engine's: the numba literal on which the CPU kernels are specialised and cached,
+as a well's key (wellcode.WellCode.key).
+"""
+from __future__ import annotations
+
+import functools
+import hashlib
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from safebasins.numerics import wellcode
+from safebasins.numerics.schemes import RungeKutta, Scheme, Splitting, scheme_of
+
+__all__ = ["SchemeCode", "scheme_code", "code_of_scheme"]
+
+
+def _splitting_step(s: Splitting, damped: bool) -> list[str]:
+    nd, nk = len(s.drift_values), len(s.kick_values)
+    lines = []
+    for k, b in enumerate(s.kick):
+        ck = nd + s.kick_values.index(b)
+        lines.append(f"p = fma(c[{ck}], force(w, q, f[{s.times.index(s.kick_times[k])}]), p)")
+        if k < len(s.drift):
+            j = s.drift_values.index(s.drift[k])
+            lines.append(f"q = fma(c[{j}], p, q)")
+            if damped:
+                lines.append(f"p = mul(p, c[{nd + nk + j}])")
+    return lines
+
+
+def _sum(names: list[str]) -> str:
+    text = names[0]
+    for n in names[1:]:
+        text = f"({text} + {n})" if len(names) > 2 else f"{text} + {n}"
+    return text
+
+
+def _rk_step(s: RungeKutta, damped: bool) -> list[str]:
+    lines = []
+    P, Q = ["p"], ["q"]
+    if damped:
+        lines.append(f"nb = -c[{len(s.stage_values) + 1}]")
+    for i in range(len(s.weights)):
+        if i:
+            qi, pi = "q", "p"
+            for j, a in enumerate(s.a[i]):
+                if a != 0.0:
+                    ca = s.stage_values.index(a)
+                    qi = f"fma(c[{ca}], {P[j]}, {qi})"
+                    pi = f"fma(c[{ca}], k{j + 1}, {pi})"
+            lines += [f"q{i + 1} = {qi}", f"p{i + 1} = {pi}"]
+            Q.append(f"q{i + 1}")
+            P.append(f"p{i + 1}")
+        force = f"force(w, {Q[i]}, f[{s.times.index(s.c[i])}])"
+        lines.append(f"k{i + 1} = fma(nb, {P[i]}, {force})" if damped else f"k{i + 1} = {force}")
+    cw = len(s.stage_values)
+    for var, terms in (("q", P), ("p", [f"k{i + 1}" for i in range(len(s.weights))])):
+        ones = [t for t, w in zip(terms, s.weights) if w == 1]
+        twos = [t for t, w in zip(terms, s.weights) if w == 2]
+        parts = []
+        if ones:
+            parts.append(_sum(ones))
+        if twos:
+            lines.append(f"s{var} = {_sum(twos)}")
+            parts.append(f"(s{var} + s{var})")
+        total = " + ".join(f"({x})" if " + " in x and not x.startswith("(") else x for x in parts)
+        lines.append(f"{var}_new = fma(c[{cw}], {total}, {var})")
+    lines += ["q = q_new", "p = p_new"]
+    return lines
+
+
+def _tuple(items: list[str]) -> str:
+    return "(" + ", ".join(items) + ("," if len(items) == 1 else "") + ")"
+
+
+def _source(s: Scheme, damped: bool) -> str:
+    body = _splitting_step(s, damped) if isinstance(s, Splitting) else _rk_step(s, damped)
+    n, W = s.n_coef(damped), len(s.times)
+    from_h = (_splitting_from_h(s) if isinstance(s, Splitting) else
+              _tuple([f"h * C{j}" for j in range(len(s.stage_values) + 1)]))
+    return "\n".join([
+        "def step(w, q, p, c, f):",
+        *("    " + line for line in body),
+        "    return q, p",
+        "",
+        "def row(tab, s):",
+        f"    return {_tuple([f'tab[s, {j}]' for j in range(W)])}",
+        "",
+        "def scaled(F, t):",
+        f"    return {_tuple([f'F * t[{j}]' for j in range(W)])}",
+        "",
+        "def coefs(c):",
+        f"    return {_tuple([f'c[{j}]' for j in range(n)])}",
+        "",
+        "def column(CL, l):",
+        f"    return {_tuple([f'CL[{j}, l]' for j in range(n)])}",
+        "",
+        "def from_h(h):",
+        f"    return {from_h}",
+        "",
+        "def flat_row(tab, o):",
+        f"    return {_tuple(['tab[o]'] + [f'tab[o + U{j}]' for j in range(1, W)])}",
+        "",
+        "def flat_coefs(coef, o):",
+        f"    return {_tuple(['coef[o]'] + [f'coef[o + U{j}]' for j in range(1, n)])}",
+        "",
+    ])
+
+
+def _splitting_from_h(s: Splitting) -> str:
+    nd = len(s.drift_values)
+    return _tuple([f"h * C{j}" for j in range(nd + len(s.kick_values))])
+
+
+def _constants(s: Scheme) -> dict[str, Any]:
+    """The products' constants of from_h (the same floats lane_coefficients multiplies by) and the
+    unsigned offsets of the flat loads."""
+    vals = (s.drift_values + s.kick_values) if isinstance(s, Splitting) else (s.stage_values + (s.weight_scale,))
+    consts: dict[str, Any] = {f"C{j}": float(v) for j, v in enumerate(vals)}
+    consts.update({f"U{j}": np.uint64(j) for j in range(1, 64)})
+    return consts
+
+
+@dataclass(frozen=True, eq=False)
+class SchemeCode:
+    """A scheme (and damping or not) as the compiled engines see it (module docstring)."""
+
+    scheme: Scheme
+    damped: bool
+    source: str = field(repr=False)
+    key: int = field(init=False)
+
+    def __post_init__(self) -> None:
+        text = f"{wellcode.engine_fingerprint()}\0scheme\0{self.source}"
+        key = int.from_bytes(hashlib.blake2b(text.encode(), digest_size=8).digest(), "little") >> 3
+        object.__setattr__(self, "key", key)
+        _CODES.setdefault(key, self)
+
+    @property
+    def name(self) -> str:
+        return self.scheme.name
+
+    @property
+    def n_coef(self) -> int:
+        return self.scheme.n_coef(self.damped)
+
+    @property
+    def width(self) -> int:
+        """Forcing values per step (the forcing table's width)."""
+        return len(self.scheme.times)
+
+    def _namespace(self, force: Callable | None, primitives: dict[str, Any]) -> dict[str, Any]:
+        ns: dict[str, Any] = {"force": force, **primitives, **_constants(self.scheme)}
+        exec(compile(self.source, f"<scheme {self.name}{' damped' if self.damped else ''}>", "exec"), ns)
+        return ns
+
+    def make(self, jit: Callable, force: Callable) -> Callable:
+        """The step compiled with ``jit`` around ``force`` (already compiled for the target)."""
+        return jit(self._namespace(force, {"fma": wellcode.fma, "mul": wellcode.mul})["step"])
+
+    def helpers(self, jit: Callable) -> dict[str, Callable]:
+        """The tuple helpers (row, scaled, coefs, column, from_h, flat_row, flat_coefs) compiled with jit."""
+        ns = self._namespace(None, {})
+        return {k: jit(ns[k]) for k in ("row", "scaled", "coefs", "column", "from_h", "flat_row", "flat_coefs")}
+
+
+_CODES: dict[int, SchemeCode] = {}
+
+
+@functools.cache
+def scheme_code(integrator: str, damped: bool = False) -> SchemeCode:
+    """The compiled form of the scheme ``integrator`` (a name of schemes.SCHEMES), damped or not."""
+    s = scheme_of(integrator)
+    return SchemeCode(s, bool(damped), _source(s, bool(damped)))
+
+
+def code_of_scheme(key: int) -> SchemeCode:
+    """The registered scheme code of a kernel key."""
+    try:
+        return _CODES[key]
+    except KeyError:
+        raise ValueError(f"no compiled scheme with key {key!r} (build it with scheme_code)") from None
