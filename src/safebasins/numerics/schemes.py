@@ -262,7 +262,7 @@ def _stable(s: Scheme, x: float) -> bool:
 @functools.cache
 def stability_limit(integrator: str | Scheme) -> float:
     """The largest h omega for which the scheme is stable on the harmonic oscillator q'' = -omega^2 q
-    (from 0 up: the first loss of stability), to 1e-12: SRKN6b 3.155, RK4 2 sqrt 2, Forest-Ruth
+    (from 0 up: the first loss of stability), to 1e-12: SRKN6b 3.163, RK4 2 sqrt 2, Forest-Ruth
     1.573."""
     s = scheme_of(integrator)
     x, dx = 0.0, 1e-3
