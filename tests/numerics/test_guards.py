@@ -10,7 +10,7 @@ from tests.numerics.ensemble import run_ensemble
 
 
 @pytest.mark.parametrize("Omega,S,why", [(1e-4, 32, r"use steps_per_cycle >= \d+"),
-                                         (0.02, 32, r"use steps_per_cycle >= 297"),
+                                         (0.02, 32, r"use steps_per_cycle >= 281"),   # 2 pi sqrt 2 / (0.02 * 1.5817)
                                          (1e-300, 32, r"Omega = 1e-300 is too small to integrate: .* use a larger "
                                                       r"Omega"),
                                          (1.0, 4, r"use steps_per_cycle >= \d+")])

@@ -8,6 +8,7 @@ from safebasins.numerics import engine
 from safebasins.numerics import kernels
 from safebasins.numerics import schemes
 from safebasins.numerics import steps
+from safebasins.numerics.scheme_code import scheme_code
 from tests.numerics.ensemble import run_ensemble
 
 
@@ -136,9 +137,9 @@ def test_bitwise_independent_of_threads_tasks_and_lanes(integrator):
         oE = np.full((N, 2), -1, np.int64)
         oQ = np.full((N, 2), -1, np.int64)
         kernels.ensemble(Q, P, np.arange(N) % npar, coef, np.repeat(schemes.step_sizes(0.95, S), npar),
-                   np.full(npar, 0.0876), schemes.sine_table(S, np.pi, integrator),
-                   2 * np.array([0.2, 0.25]), np.array([0.8, 1.0]), 60, False, n_tasks, lanes, oE, oQ,
-                   np.empty((0, 0, 2)), False)
+                         np.full(npar, 0.0876), schemes.sine_table(S, np.pi, integrator),
+                         2 * np.array([0.2, 0.25]), np.array([0.8, 1.0]), 60, False, n_tasks, lanes, oE, oQ,
+                         np.empty((0, 0, 2)), False, scheme=scheme_code(integrator))
         res.append((oE, oQ))
     for oE, oQ in res[1:]:
         np.testing.assert_array_equal(oE, res[0][0])

@@ -9,6 +9,7 @@ from safebasins.numerics import escape_chart
 from safebasins.numerics import kernels
 from safebasins.numerics import schemes
 from safebasins.numerics import steps
+from safebasins.numerics.scheme_code import scheme_code
 from tests.numerics.ensemble import run_ensemble
 
 
@@ -20,7 +21,8 @@ def run_rk4(q0, p0, F, Om, Psi, S, periods):
     q0 = np.atleast_1d(np.asarray(q0, float))
     p0 = np.atleast_1d(np.asarray(p0, float))
     return kernels.final_states(q0, p0, np.zeros(q0.size, np.int64), schemes.lane_coefficients(Om, S, "rk4"),
-                          np.array([float(F)]), schemes.sine_table(S, Psi, "rk4"), periods)
+                                np.array([float(F)]), schemes.sine_table(S, Psi, "rk4"), periods,
+                                scheme=scheme_code("rk4"))
 
 
 def test_tables_select_the_scheme():

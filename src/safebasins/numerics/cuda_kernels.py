@@ -245,8 +245,8 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
     = 0; outE (N*nE,), outQ (N*nQ,) int64 pre-filled with -1; wpar (steps.N_WPAR,) the well's
     barriers and coefficients (wellcode.WellCode.wpar).
     """
-    W = WIDTHS[schemes.check_integrator(integrator)]
-    UW = np.uint64(W)
+    sc = scheme_code(schemes.check_integrator(integrator), bool(damped))
+    UW = np.uint64(sc.width)
     code = wellcode.quartic_code() if well is None else well
     if not isinstance(code, wellcode.WellCode):
         raise ValueError(f"well must be a compiled well (wellcode.WellCode), got {well!r}")
