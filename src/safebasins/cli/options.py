@@ -451,10 +451,10 @@ def numerics_options(func, what):
 def backend_check(ctx, param, value):
     """--backend cuda without a usable GPU is a usage error found before anything is computed."""
     if value == "cuda":
-        from safebasins.numerics.cuda_engine import require_cuda
+        from safebasins.numerics.engine import cuda_engine
 
         try:
-            require_cuda()
+            cuda_engine().require_cuda()
         except (RuntimeError, ImportError) as exc:
             raise click.BadParameter(str(exc), ctx, param) from None
     return value

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import math
 
 import numba
@@ -200,18 +201,25 @@ def resolve_backend(backend):
     if backend not in BACKENDS:
         raise ValueError(f"backend must be one of {BACKENDS}, got {backend!r}")
     if backend == "auto":
-        from safebasins.numerics.cuda_engine import cuda_available
-
-        return "cuda" if cuda_available() else "cpu"
+        return "cuda" if importlib.util.find_spec("numba_cuda") and cuda_engine().cuda_available() else "cpu"
     return backend
+
+
+def cuda_engine():
+    """The CUDA engine module (safebasins.numerics.cuda_engine); ImportError naming the extra to
+    install when numba-cuda, the numba CUDA target it is written for, is missing."""
+    if importlib.util.find_spec("numba_cuda") is None:
+        raise ImportError("the CUDA backend needs numba-cuda (numba's CUDA target), which is not installed: "
+                          "pip install 'safebasins[cuda]'", name="numba_cuda")
+    from safebasins.numerics import cuda_engine as module
+
+    return module
 
 
 def integrate(q0, p0, pidx, Omega, F, Psi, *, backend="cpu", threads=None, **kwargs):
     """:func:`run_ensemble` on the chosen backend; returns (steps_E, steps_Q), bitwise the same
     on either (the CUDA kernels repeat the CPU lanes' operations; tests/numerics/test_cuda_simulator.py)."""
     if resolve_backend(backend) == "cuda":
-        from safebasins.numerics.cuda_engine import run_ensemble_cuda
-
-        return run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, **kwargs)
+        return cuda_engine().run_ensemble_cuda(q0, p0, pidx, Omega, F, Psi, **kwargs)
     steps_E, steps_Q, _ = run_ensemble(q0, p0, pidx, Omega, F, Psi, threads=threads, **kwargs)
     return steps_E, steps_Q
