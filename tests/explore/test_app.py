@@ -236,3 +236,14 @@ def test_link_to_this_view_follows_the_sliders(explorer):
     well, values = from_query({k: [v] for k, v in (kv.split("=") for kv in query.split("&amp;" if "&amp;" in query
                                                                                        else "&"))})
     assert well == "quartic" and values["F"] == 0.0375 and values["xi_max"] == 0.18
+
+
+def test_page_can_start_damped():
+    doc = Document()
+    e = Explorer(doc, "quartic", {"damping": 0.01})
+    doc.add_next_tick_callback = lambda callback: callback()
+    assert not e.figures.levels.visible and "beta = 0.01" in e.figures.ic.title.text
+    assert "C is not conserved" in e.key.text
+    e.controls.sliders["damping"].value = 0.0               # undamped again: the level curves come back
+    e.redraw()
+    assert e.figures.levels.visible and len(e.figures.levels.line_renderer.data_source.data["xs"]) > 1

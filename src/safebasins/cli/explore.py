@@ -83,10 +83,11 @@ def explore(port, host, no_browser, well, Omega, F, Psi, xi_max, damping, export
             except ValueError as exc:
                 raise click.BadParameter(str(exc), param_hint="'--browser'" if browser else "'--snapshot'") from None
         try:
-            if export:
-                click.echo(f"wrote {static.write_html(export, r, f)}")
-            if snapshot:
-                click.echo(f"wrote {static.write_png(snapshot, r, f, browser)}")
+            with library_errors():
+                if export:
+                    click.echo(f"wrote {static.write_html(export, r, f)}")
+                if snapshot:
+                    click.echo(f"wrote {static.write_png(snapshot, r, f, browser)}")
         except (OSError, RuntimeError) as exc:
             raise click.ClickException(str(exc)) from None
         return

@@ -106,7 +106,8 @@ class Figures:
                          x_range=Range1d(-np.pi, np.pi), y_range=Range1d(0.0, r.xi_top))
         self.rm_source = ColumnDataSource(name="manifold_source", data=self._rm_image(rm))
         self.rm.image(source=self.rm_source, color_mapper=_mapper(SAFE_COLOR), name="manifold_safe")
-        self.levels = self.rm.contour(rm["gamma"], rm["xi"], rm["C"], rm["levels"], line_color=LEVEL_COLOR,
+        levels = rm["levels"] if len(rm["levels"]) else [0.0]     # (damped: none; a placeholder, hidden)
+        self.levels = self.rm.contour(rm["gamma"], rm["xi"], rm["C"], levels, line_color=LEVEL_COLOR,
                                       line_width=1, fill_color=None)
         self.lpt = self.rm.contour(rm["gamma"], rm["xi"], rm["C"], [0.0], line_color="black", line_width=2,
                                    fill_color=None)
