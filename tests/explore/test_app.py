@@ -247,3 +247,9 @@ def test_page_can_start_damped():
     e.controls.sliders["damping"].value = 0.0               # undamped again: the level curves come back
     e.redraw()
     assert e.figures.levels.visible and len(e.figures.levels.line_renderer.data_source.data["xs"]) > 1
+
+
+def test_cli_without_bokeh_names_the_extra(monkeypatch):
+    monkeypatch.setitem(__import__("sys").modules, "bokeh", None)     # import bokeh -> ImportError
+    result = CliRunner().invoke(main, ["explore", "--no-browser"])
+    assert result.exit_code == 1 and "pip install 'safebasins[explore]'" in result.output, result.output

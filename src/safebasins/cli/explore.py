@@ -65,6 +65,8 @@ def explore(port, host, no_browser, well, Omega, F, Psi, xi_max, damping, export
       safebasins explore --well "expression:q**2/2 - q**3/3" --snapshot cubic.png
     """
     try:
+        import bokeh  # noqa: F401 - the explorer's one optional dependency, named before anything runs
+
         from safebasins.explore import server
         from safebasins.explore.state import view
     except ImportError as exc:
