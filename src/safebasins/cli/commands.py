@@ -188,8 +188,9 @@ def n_scan_check(n):
 @click.option("--n-scan", "n_scan", type=int, callback=checked(None, n_scan_check),
               cls=Deferred, default=from_library("safebasins.numerics:critical_forcing_numeric", "n_scan"),
               help="F values of the non-monotonicity scan (0: none).")
-@click.option("--F-bracket", "F_bracket", type=Fields("bracket"), default="0,0.3", show_default=True,
-              help="Bisection bracket lo,hi of F.")
+@click.option("--F-bracket", "F_bracket", type=Fields("bracket"), default=None,
+              help="Bisection bracket lo,hi of F; its top is doubled (up to 3 times) where it does not escape "
+                   "[default: 0 to the well's static escape force, rounded up: 0,0.39 for the quartic].")
 @click.option("--criterion", type=click.Choice(["energy", "displacement"]), default="energy", show_default=True,
               help="Numeric escape: H0 > xi_max, or |q| > q_max(xi_max).")
 @damping_option(multiple=True)
@@ -236,6 +237,10 @@ def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cyc
                   well=well, **values.damping_param(block["damping"]), Omega=values.range_values(Omega_range),
                   curves=curves)
     if numeric:
+        if F_bracket is None:
+            from safebasins.numerics.bisection import default_bracket
+
+            F_bracket = list(default_bracket(current_well(ctx)))
         params["numeric"] = {"Omega": values.range_values(numeric_Omega or Omega_range), "cycles": cycles,
                              "tol": tol, "F_bracket": F_bracket, "n_scan": n_scan, "criterion": criterion,
                              "steps_per_cycle": steps_per_cycle}

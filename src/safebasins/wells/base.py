@@ -267,6 +267,40 @@ class Well(abc.ABC):
         return (lo, hi), (-pm, pm)
 
     @property
+    def static_escape_force(self) -> float:
+        """``F_static``: the largest ``|V'|`` between the well bottom and the turning point of the escape
+        energy E_b (a barrier, the closing point of a closed side; on a side open at infinity all of
+        it), on the side where that is smaller (the quartic: ``2 / (3 sqrt 3) = 0.385``, at its
+        inflection point; the cubic 1/4; the pendulum 1).  A constant force above it has no
+        equilibrium on the way: it pushes the particle from rest at the bottom past that turning
+        point with ``H0 > E_b >= xi_max`` -- the escape threshold of a forcing slow against the well
+        (``Omega -> 0``); resonance lowers it (numerics.bisection's default F bracket)."""
+        f = self.__dict__.get("_static_escape_force")
+        if f is None:
+            f = min(self._largest_force(side) for side in (-1.0, 1.0))
+            self.__dict__["_static_escape_force"] = f
+        return f
+
+    def _largest_force(self, side) -> float:
+        """``max |V'|`` between 0 and the turning point of E_b on one side (``side`` -1 or +1): on 2001
+        uniform and 2001 geometric points (a long open tail), the largest polished by a bounded scalar
+        search between its neighbours."""
+        from scipy import optimize
+
+        E = float(self.barrier_energy)
+        k = 0 if side < 0 else 1
+        q_t = float(self.turning_points(E)[k])
+        if not np.isfinite(q_t):              # open at infinity: V' decays along the tail
+            q_t = float(self.turning_points((1.0 - 1e-9) * E)[k])
+        q = np.unique(np.concatenate([np.linspace(0.0, q_t, 2001), q_t * np.geomspace(1e-7, 1.0, 2001)]))
+        f = np.abs(np.asarray(self.dV(q), dtype=float))
+        i = int(np.argmax(f))
+        lo, hi = sorted((q[max(i - 1, 0)], q[min(i + 1, q.size - 1)]))
+        res = optimize.minimize_scalar(lambda x: -abs(float(self.dV(np.array([x]))[0])), bounds=(lo, hi),
+                                       method="bounded", options={"xatol": 1e-12 * max(abs(q_t), 1.0)})
+        return max(float(f[i]), -float(res.fun))
+
+    @property
     def omega_max(self) -> float:
         """The well's largest local frequency ``sqrt(max |V''(q)|)`` over the IC window's q range
         (:meth:`ic_window`), from central differences of V' on 4001 points: the frequency an
