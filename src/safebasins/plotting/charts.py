@@ -241,7 +241,7 @@ def figure_nested_basins(analytic, numeric, *, title=None, t_eval=None, figsize=
     curves that border the analytic safe mask; ``analytic`` may be None (numerics only).
     Boundaries of several parameter values that coincide (e.g. a saddle-type curve below every
     threshold) are drawn as one line of alternating colours, each colour still visible.  Damped
-    data (attribute ``damping``, issue 17): beta in the title and a note, the analytic boundary
+    data (attribute ``damping``): beta in the title and a note, the analytic boundary
     is the outline of the damped slow flow's safe mask (the numeric and analytic damping must be
     equal)."""
     chart = open_dataset(numeric)
