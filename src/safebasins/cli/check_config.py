@@ -64,16 +64,16 @@ def key_location(key: str, files) -> tuple[str, int, bool] | None:
 @click.command("check-config")
 @click.argument("files", nargs=-1, required=True, metavar="FILE...", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--base", "base", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
-              help=f"Configuration the FILES are merged over, as snakemake merges --configfile over the "
+              help=f"Configuration the files are merged over, as snakemake merges --configfile over the "
                    f"Snakefile's  [default: {BASE} when the current directory has one (a checkout)]")
 @click.option("--no-base", "no_base", is_flag=True,
-              help="Check the FILES merged on their own (a complete configuration).")
+              help="Check the files merged on their own (a complete configuration).")
 def check_config(files, base, no_base):
-    """Check pipeline configuration FILES without running anything.
+    """Check pipeline configuration files without running anything.
 
     Reads each file strictly (YAML syntax errors and keys given twice with file, line and
     column), merges them over the checkout's config/config.yaml as `snakemake --configfile
-    FILES` does, and applies every check the pipeline applies before its first job: the schema,
+    FILE...` does, and applies every check the pipeline applies before its first job: the schema,
     the experiment kinds' checks, the wells, the cost guard.  Exit status 0 when the pipeline
     would accept the configuration, 1 (with the reason) when not.
 
