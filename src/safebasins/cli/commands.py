@@ -6,8 +6,9 @@ from pathlib import Path
 
 import click
 
-from safebasins.cli.options import (DISPLACEMENT, ENERGY, FINITE, OPTION_OF, POSITIVE, Deferred, Fields, Number,
-                                    NumberList, analytic_threshold, checked, common_options, cost_guard, current_well,
+from safebasins.cli.options import (DISPLACEMENT, ENERGY, FINITE, OPTION_OF, POSITIVE, THRESHOLD, Deferred, Fields,
+                                    Number, NumberList, analytic_thresholds, checked, common_options, cost_guard,
+                                    current_well,
                                     damping_option,
                                     forcing_options, fourier_of, from_library, from_schema, grid_options, grid_params,
                                     joined, lib_check, library_errors, numerics_options, out_option)
@@ -64,10 +65,10 @@ def main():
 
 @main.command()
 @forcing_options
-@click.option("--xi-max", "xi_max", type=NumberList("xi_max", analytic_threshold), multiple=True, required=True,
+@click.option("--xi-max", "xi_max", type=NumberList("xi_max", THRESHOLD), multiple=True, required=True,
               callback=joined(unique=True),
-              help="Energy thresholds in (0, E_b) (E_b: the well's barrier energy, 1/4 for the quartic): comma "
-                   "list or repeated (one basin each).")
+              help="Energy thresholds in (0, E_b) (E_b: the well's barrier energy, 1/4 for the quartic; with "
+                   "--damping > 0 also E_b itself): comma list or repeated (one basin each).")
 @click.option("--q-max", "q_max", type=NumberList("q_max", DISPLACEMENT), multiple=True,
               callback=joined(unique=True), help="Displacement thresholds |q| > q_max up to the nearest barrier, "
                                                  "stored beside the energy ones.")
@@ -99,6 +100,7 @@ def chart(F, Omega, Psi, xi_max, q_max, grid, n, cycles, steps_per_cycle, thread
     """
     from safebasins.pipeline.values import damping_param
 
+    analytic_thresholds(click.get_current_context(), [(x, damping) for x in xi_max])
     t_eval = float(cycles) if t_eval is None else t_eval
     if t_eval > cycles:
         raise click.BadParameter(f"evaluation time {t_eval} beyond the horizon --cycles {cycles}",
@@ -168,9 +170,10 @@ def n_scan_check(n):
 @click.option("--Omega-range", "Omega_range", type=Fields("range"), default=None,
               help="Analytic Omega values start,stop,num (endpoints included) [default: 0.5 w0,1.2 w0,351 with w0 "
                    "the well's small-amplitude frequency: 0.5,1.2,351 for the quartic].")
-@click.option("--xi-max", "xi_max", type=NumberList("xi_max", analytic_threshold), multiple=True, required=True,
+@click.option("--xi-max", "xi_max", type=NumberList("xi_max", THRESHOLD), multiple=True, required=True,
               callback=joined(unique=False),
-              help="Truncation levels in (0, E_b): one curve each (comma list or repeated).")
+              help="Truncation levels in (0, E_b) (a damped curve also E_b itself): one curve each (comma list or "
+                   "repeated).")
 @click.option("--xi-ini", "xi_ini", type=NumberList("xi_ini", ENERGY), multiple=True,
               callback=joined(unique=False), help="Initial energies (< xi_max) [default: 0, the zero IC].")
 @click.option("--gamma-ini", "gamma_ini", type=NumberList("gamma_ini", FINITE, angle=True), multiple=True,
@@ -223,6 +226,7 @@ def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cyc
             raise click.BadParameter(f"{m} values but another curve list has {ncurve}: give equal lengths or one",
                                      param_hint=f"'{OPTION_OF[k]}'")
     curves = values.curves(block, numeric)
+    analytic_thresholds(click.get_current_context(), [(c["xi_max"], c.get("damping", 0.0)) for c in curves])
     for c in curves:
         if not c["xi_ini"] < c["xi_max"]:
             raise click.BadParameter(f"initial energy {c['xi_ini']} must be below the truncation level xi_max = "
@@ -314,8 +318,8 @@ def fcr_numeric(params, job, quiet):
 
 @main.command()
 @forcing_options
-@click.option("--xi-max", "xi_max", type=Number("xi_max", analytic_threshold), required=True,
-              help="Energy truncation level in (0, E_b).")
+@click.option("--xi-max", "xi_max", type=Number("xi_max", THRESHOLD), required=True,
+              help="Energy truncation level in (0, E_b) (with --damping > 0 also E_b itself).")
 @grid_options
 @click.option("--n-points", "n_points", cls=Deferred, type=int, default=from_schema("basin_rm", "n_points"),
               callback=checked("n_points", lib_check("safebasins.checks:check_positive_int")),
@@ -348,6 +352,7 @@ def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, dampi
     from safebasins.pipeline.values import damping_param
 
     ctx = click.get_current_context()
+    analytic_thresholds(ctx, [(xi_max, damping)])
     if damping > 0:
         given = [OPTION_OF.get(k, f"--{k.replace('_', '-')}") for k in ("n_gamma", "n_xi", "xi_top")
                  if ctx.get_parameter_source(k) is not click.core.ParameterSource.DEFAULT]

@@ -176,7 +176,7 @@ def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier=None, n_points=400, wel
     F = _scalar("F", F, check_nonnegative)
     Om = _scalar("Omega", Omega, check_positive)
     Psi = _scalar("Psi", Psi, check_finite)
-    xm = _scalar("xi_max", xi_max, w.check_threshold)
+    xm = _scalar("xi_max", xi_max, w.check_analytic_threshold)
     n_points = check_positive_int("n_points", n_points)
     if n_points < 3:
         raise ValueError("n_points must be >= 3")

@@ -170,6 +170,7 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
         # the undamped F_cr seeds the scan; the damped flow's tables end just below the barrier
         F0 = critical_forcing(Om, min(xm, slow_tables(w).xi_top), x0, g0, n_grid=n_grid, well=w)["F_cr"].values
         return damped_critical_forcing(Om, xm, x0, g0, beta, w, F_undamped=F0)
+    w.check_analytic_threshold("xi_max", xm)     # the level curves of C need an orbit at xi_max
 
     nO = Om.size
     xi = _xi_grid(x0, xm, int(n_grid))

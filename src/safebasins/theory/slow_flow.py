@@ -205,7 +205,7 @@ def escapes_on_manifold(gamma, xi, F, Omega, xi_max, fourier=None, well=None):
     w = resolve_well(well, fourier)
     gamma = check_finite("gamma", gamma)
     xi = w.check_energy("xi", xi, allow_separatrix=True)
-    prof = slow_flow_profile(F, Omega, xi_max, well=w)
+    prof = slow_flow_profile(F, Omega, _scalar("xi_max", xi_max, w.check_analytic_threshold), well=w)
     return _escapes_rm(gamma, xi, prof)
 
 
@@ -226,6 +226,7 @@ def slow_flow_escapes(q0, p0, F, Omega, Psi, xi_max, fourier=None, well=None, da
     if check_scalar("damping", damping, check_nonnegative) > 0:
         from safebasins.theory.damped_escape import damped_escapes
         return damped_escapes(q0, p0, F, Omega, Psi, xi_max, damping, well=w)
+    xi_max = _scalar("xi_max", xi_max, w.check_analytic_threshold)
     q0 = check_finite("q0", q0)
     p0 = check_finite("p0", p0)
     _scalar("Psi", Psi, check_finite)

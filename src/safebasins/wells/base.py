@@ -174,8 +174,11 @@ class Well(abc.ABC):
         return (q > lo) & (q < hi)
 
     def check_threshold(self, name, xi_max):
-        """Energy truncation level in ``(0, barrier_energy]``; in ``(0, barrier_energy)`` when the
-        escape energy is a limit of V at infinity (the orbit at it is unbounded)."""
+        """Energy truncation level of an escape test in ``(0, barrier_energy]``: ``xi_max = E_b`` is
+        escape over the barrier, the numerics' and the damped slow flow's test (escape = H0, or the
+        slow energy, exceeding it); in ``(0, barrier_energy)`` when the escape energy is a limit of V
+        at infinity (the orbit at it is unbounded).  The undamped slow flow needs more:
+        :meth:`check_analytic_threshold`."""
         from safebasins.checks import as_array, value_repr
 
         a = as_array(name, xi_max)
@@ -189,6 +192,29 @@ class Well(abc.ABC):
             raise ValueError(f"{name} must lie in (0, {self.barrier_energy!r}] (the barrier energy of the "
                              f"{self.name} well), got {value_repr(a)}")
         return a
+
+    def check_analytic_threshold(self, name, xi_max):
+        """Truncation level of the undamped slow flow (the level curves of its first integral C):
+        :meth:`check_threshold`, and below the escape energy by more than a relative
+        ``checks.BARRIER_RTOL`` (closer counts as at it).  That theory needs an orbit at xi_max; at
+        the separatrix the period diverges, and F_cr grows like ``log(1 / (E_b - xi_max))`` without
+        a limit (the cubic's F_cr at Omega = 0.7: 0.13, 0.17, 0.21, 0.24 at E_b - xi_max = 1e-6,
+        1e-10, 1e-13 E_b and one ulp), so a value that close measures the float spacing, not the well."""
+        from safebasins.checks import BARRIER_RTOL, reaches, value_repr
+
+        a = self.check_threshold(name, xi_max)
+        if reaches(a, self.barrier_energy).any():
+            raise ValueError(f"{name} must lie below the barrier energy {self.barrier_energy_text} of the {self.name} "
+                             f"well (by more than a relative {BARRIER_RTOL:g}) for the undamped slow flow: it needs an "
+                             "orbit at xi_max, and on the separatrix its period diverges; got "
+                             f"{value_repr(a)}. Escape over the barrier, xi_max = E_b, is what the numerics (escape "
+                             "charts, numeric F_cr) and the damped slow flow test")
+        return a
+
+    @property
+    def barrier_energy_text(self) -> str:
+        """The escape energy as written in messages."""
+        return repr(float(self.barrier_energy))
 
     def unforced_safe(self, q, p, xi_max):
         """The unforced safe set of a threshold: ``H0 < xi_max`` inside the well."""

@@ -181,7 +181,8 @@ class BasinRM(Kind):
 
     def check(self, block, key, ctx):
         ctx.check_grid(f"{key}.grid", block["grid"])
-        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key))
+        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key),
+                                              block.get("damping", 0.0))
         if block["manifold"]["xi_top"] <= 0:
             ctx.fail(f"{key}.manifold.xi_top", "must be > 0")
 
@@ -232,7 +233,8 @@ class BasinChart(GridChartKind):
 
     def check(self, block, key, ctx):
         ctx.check_grid(f"{key}.grid", block["grid"])
-        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key))
+        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key),
+                                              block.get("damping", 0.0))
         if isinstance(block["F"], list) and isinstance(block["xi_max"], list):
             ctx.fail(f"{key}.F", "only one of F and xi_max may be a list (the scanned parameter)")
         ctx.check_unique(f"{key}.F", block["F"])
@@ -309,7 +311,8 @@ class Strobe(Kind):
 
     def check(self, block, key, ctx):
         ctx.check_grid(f"{key}.grid", block["grid"])
-        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key))
+        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key),
+                                              block.get("damping", 0.0))
         if "box" in block:
             ctx.check_interval(f"{key}.box[0]", block["box"][0])
             ctx.check_interval(f"{key}.box[1]", block["box"][1])

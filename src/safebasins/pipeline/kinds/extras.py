@@ -117,7 +117,8 @@ def build_fourier(params, data, job, *, what, source):
 
 def _check_grid_block(block, key, ctx):
     ctx.check_grid(f"{key}.grid", block["grid"])
-    ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "the analytic criterion", ctx.well_at(key))
+    ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "the analytic criterion", ctx.well_at(key),
+                                          block.get("damping", 0.0))
     ctx.check_t_eval_within(f"{key}.t_eval", block["t_eval"], block["cycles"])
     for k in ("xi_max", "t_eval"):
         ctx.check_unique(f"{key}.{k}", block[k])

@@ -52,7 +52,8 @@ def _check_curves(block, key, ctx):
     for k, m in lens.items():
         if m not in (1, n):
             ctx.fail(f"{key}.{k}", f"has {m} values but another curve list has {n}: lists must have equal length")
-    ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "analytic F_cr", ctx.well_at(key))
+    ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "analytic F_cr", ctx.well_at(key),
+                                          block["damping"])
     full = {k: v * (n // len(v)) for k, v in lists.items()}
     xm, xi = full["xi_max"], full["xi_ini"]
     seen = set()
