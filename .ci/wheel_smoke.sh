@@ -100,6 +100,19 @@ else
   log "read-only install: skipped (needs root and unshare -m for a read-only bind mount)"
 fi
 
+log "every module imports with the declared dependencies (the explorer and the CUDA engine: their extras)"
+run 0 "$V/python" -c "
+import importlib, pkgutil, safebasins
+EXTRAS = {'bokeh': 'explore', 'numba.cuda.core': 'cuda'}   # what an extra's absence may leave unimportable
+for m in pkgutil.walk_packages(safebasins.__path__, 'safebasins.'):
+    if m.name.endswith('.__main__'):
+        continue
+    try:
+        importlib.import_module(m.name)
+    except ModuleNotFoundError as exc:
+        if exc.name not in EXTRAS:
+            raise SystemExit(f'{m.name}: {exc} (not declared in pyproject.toml)')
+"
 run 0 safebasins --version
 expect "$(sed -n 's/^__version__ = "\(.*\)"/\1/p' "$ROOT/src/safebasins/__init__.py")"
 log "chart: quartic, pendulum, expression well"

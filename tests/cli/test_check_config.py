@@ -85,7 +85,8 @@ def test_plan_time_checks_of_the_pipeline_apply(in_checkout, tmp_path):
     failed(res, "config key figures.fig18.well: kind 'strobe' is written for the paper's quartic only")
     # the cost guard: the pipeline would refuse to start
     f, res = check(tmp_path, "numerics: {budget_core_hours: 0.001}\n")
-    failed(res, "config key numerics.budget_core_hours:", "above the budget of 0.001 core-hours", f"(set at {f}, line 1)")
+    failed(res, "config key numerics.budget_core_hours:", "above the budget of 0.001 core-hours",
+           f"(set at {f}, line 1)")
 
 
 def test_files_that_are_no_mapping_or_no_text_are_named(in_checkout, tmp_path):

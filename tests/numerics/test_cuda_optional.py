@@ -50,7 +50,8 @@ def test_cli_backend_cuda_without_numba_cuda_is_a_usage_error_naming_the_extra(w
     assert not list(tmp_path.iterdir())
 
 
-@pytest.mark.skipif(importlib.util.find_spec("numba_cuda") is None, reason="numba-cuda (safebasins[cuda]) not installed")
+@pytest.mark.skipif(importlib.util.find_spec("numba_cuda") is None,
+                    reason="numba-cuda (safebasins[cuda]) not installed")
 def test_with_numba_cuda_the_engine_module_is_the_cuda_engine():
     from safebasins.numerics import cuda_engine
 

@@ -28,7 +28,8 @@ def test_the_schema_is_package_data_and_has_one_copy():
     if (REPO_ROOT / ".git").exists():
         tracked = subprocess.run(["git", "-C", str(REPO_ROOT), "ls-files"], capture_output=True, text=True,
                                  check=True).stdout.split()
-        assert [f for f in tracked if f.endswith("config.schema.yaml")] == ["src/safebasins/pipeline/schemas/config.schema.yaml"]
+        schemas = [f for f in tracked if f.endswith("config.schema.yaml")]
+        assert schemas == ["src/safebasins/pipeline/schemas/config.schema.yaml"], schemas
 
 
 def test_a_config_file_must_hold_a_mapping(tmp_path):
@@ -44,7 +45,8 @@ def test_a_config_file_must_hold_a_mapping(tmp_path):
     e.write_text("# nothing yet\n")
     o.write_text("numerics: {tiles: 3}\n")
     cfg = load_config([BASE, e, o])
-    assert cfg["numerics"]["tiles"] == 3 and cfg["numerics"]["steps_per_cycle"] == load_yaml(BASE)["numerics"]["steps_per_cycle"]
+    assert cfg["numerics"]["tiles"] == 3
+    assert cfg["numerics"]["steps_per_cycle"] == load_yaml(BASE)["numerics"]["steps_per_cycle"]
 
 
 def test_a_config_file_must_be_utf8(tmp_path):
@@ -60,8 +62,8 @@ def test_make_reproduce_names_check_config_when_snakemake_cannot_parse_a_configf
     f = tmp_path / "bad.yaml"
     f.write_text("figures:\n  fig13: {cycles: [1, 2}\n")
     # -o: never reinstall the environment here; snakemake stops while reading its arguments
-    res = subprocess.run(["make", "-s", "-o", ".venv/.installed", "reproduce", "REPORT=", f"SNAKEMAKE_ARGS=--configfile {f}"],
-                         cwd=REPO_ROOT, capture_output=True, text=True, timeout=300)
+    cmd = ["make", "-s", "-o", ".venv/.installed", "reproduce", "REPORT=", f"SNAKEMAKE_ARGS=--configfile {f}"]
+    res = subprocess.run(cmd, cwd=REPO_ROOT, capture_output=True, text=True, timeout=300)
     out = res.stdout + res.stderr
     assert res.returncode != 0
     assert "Config file is not valid JSON or YAML" in out, out

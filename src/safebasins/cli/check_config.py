@@ -62,7 +62,8 @@ def key_location(key: str, files) -> tuple[str, int, bool] | None:
 
 
 @click.command("check-config")
-@click.argument("files", nargs=-1, required=True, metavar="FILE...", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.argument("files", nargs=-1, required=True, metavar="FILE...",
+                type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--base", "base", type=click.Path(exists=True, dir_okay=False, path_type=Path), default=None,
               help=f"Configuration the files are merged over, as snakemake merges --configfile over the "
                    f"Snakefile's  [default: {BASE} when the current directory has one (a checkout)]")
