@@ -85,6 +85,17 @@ def unshear(g, shift):
     return np.pi - np.mod(np.pi - (g - shift), 2.0 * np.pi)
 
 
+#: |delta| below this (rad) is noise of a well's tables (a symmetric well's delta is 0, its tables
+#: give a few 1e-16 of either sign, which would put a point of the ray gamma' = pi at +pi or -pi)
+SHIFT_RESOLUTION = 1e-12
+
+
+def resolved_shift(well, xi):
+    """``well.harmonic_shift(xi)`` with values below :data:`SHIFT_RESOLUTION` set to exactly 0."""
+    d = np.asarray(well.harmonic_shift(xi), dtype=float)
+    return np.where(np.abs(d) < SHIFT_RESOLUTION, 0.0, d)
+
+
 def _xi_grid(lo, hi, n):
     """Grid on [lo, hi] clustered at both ends (Chebyshev-Lobatto spacing)."""
     t = np.linspace(0.0, 1.0, n)
