@@ -85,8 +85,9 @@ def unshear(g, shift):
     return np.pi - np.mod(np.pi - (g - shift), 2.0 * np.pi)
 
 
-#: |delta| below this (rad) is noise of a well's tables (a symmetric well's delta is 0, its tables
-#: give a few 1e-16 of either sign, which would put a point of the ray gamma' = pi at +pi or -pi)
+#: a shift delta smaller than this in magnitude (rad) is noise of a well's tables (a symmetric
+#: well's delta is 0, its tables give a few 1e-16 of either sign, which would put a point of the
+#: ray gamma' = pi at +pi or -pi)
 SHIFT_RESOLUTION = 1e-12
 
 
