@@ -331,8 +331,8 @@ def fcr_numeric(params, job, quiet):
               cls=Deferred, default=from_schema("basin_rm", "manifold", "n_xi"),
               help="xi points of the resonance-manifold panel.")
 @click.option("--xi-top", "xi_top", type=Number("xi_top", ENERGY), default=None,
-              help="Top of the resonance-manifold panel (< E_b) [default: the basin_rm schema's 0.2499 for the "
-                   "quartic, 0.9996 E_b for any other well].")
+              help="Top of the resonance-manifold panel (< E_b) [default: the well's, Well.manifold_top = "
+                   "0.9996 E_b: 0.2499 for the quartic].")
 @damping_option()
 @common_options
 @out_option("basin")
@@ -361,9 +361,7 @@ def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, dampi
                                      f"with --damping {fmt(damping)} > 0 (C is not conserved; only the IC plane "
                                      "is drawn)", param_hint="'--damping'")
     if xi_top is None:
-        w = current_well(ctx)
-        xi_top = (from_schema("basin_rm", "manifold", "xi_top")() if w.name == "quartic"
-                  else 0.9996 * float(w.barrier_energy))
+        xi_top = current_well(ctx).manifold_top
     if not xi_top > 0:
         raise click.BadParameter(f"must be > 0, got {xi_top}", param_hint="'--xi-top'")
     name = Path(out).name

@@ -45,17 +45,10 @@ def well_description(name: str) -> str:
 
 
 def static_escape_force(well: wells.Well) -> float:
-    """The constant force that tilts the well until its bottom disappears: over each side through
-    which an orbit can escape (a barrier, or a finite limit of V at infinity), the largest |V'|
-    between the bottom and the edge of ``Well.ic_window`` on that side; the smaller of the sides
-    (the quartic: 2 / (3 sqrt 3) = 0.385, the pendulum: 1)."""
-    (lo, hi), _ = well.ic_window()
-    sides = []
-    for edge, barrier, limit in zip((lo, hi), well.barriers, well.asymptotes):
-        if np.isfinite(barrier) or limit is not None:
-            q = np.linspace(0.0, edge, 4001)
-            sides.append(float(np.nanmax(np.abs(well.dV(q)))))
-    return min(sides)
+    """The constant force that tilts the well until its bottom disappears (the well's own,
+    :attr:`safebasins.wells.base.Well.static_escape_force`: the quartic 2 / (3 sqrt 3) = 0.385, the
+    pendulum 1)."""
+    return float(well.static_escape_force)
 
 
 @dataclass(frozen=True)
@@ -133,4 +126,4 @@ def well_ranges(well="quartic") -> WellRanges:
         Psi=Slider(-np.pi, np.pi, np.pi / 180, np.pi),
         xi_max=Slider(0.02 * Eb, top, Eb / 1000, 0.18 if quartic else 0.72 * Eb),
         damping=Slider(0.0, DAMPING_MAX * omega0, 0.0005 * omega0, 0.0),
-        q_window=(q_lo, q_hi), p_window=(p_lo, p_hi), xi_top=top)
+        q_window=(q_lo, q_hi), p_window=(p_lo, p_hi), xi_top=w.manifold_top)

@@ -51,6 +51,8 @@ STEP_COST_POLY4 = 1.5
 STEP_COST_POLY8 = 3.5
 STEP_COST_ARITHMETIC = 1.5
 STEP_COST_TRANSCENDENTAL = 150.0
+#: top of a resonance-manifold panel as a fraction of the escape energy (:attr:`Well.manifold_top`)
+MANIFOLD_TOP = 0.9996
 
 
 class Well(abc.ABC):
@@ -291,6 +293,12 @@ class Well(abc.ABC):
             lo, hi = (float(x) for x in self.turning_points(0.99 * E))
         pm = 1.5 * float(np.sqrt(E))
         return (lo, hi), (-pm, pm)
+
+    @property
+    def manifold_top(self) -> float:
+        """Default top ``xi`` of a resonance-manifold panel ``(gamma, xi)``: ``MANIFOLD_TOP`` E_b, just
+        below the separatrix where the slow-flow tables end (the quartic: 0.2499, the paper's Figs 5-9)."""
+        return MANIFOLD_TOP * float(self.barrier_energy)
 
     @property
     def static_escape_force(self) -> float:
