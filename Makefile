@@ -29,6 +29,9 @@ reproduce: $(STAMP)
 	@$(BIN)/snakemake -j$(JOBS) --rerun-incomplete $(TARGETS) $(SNAKEMAKE_ARGS) || { \
 	  if [ -n "$$(ls -A .snakemake/locks 2>/dev/null; ls -A .snakemake/incomplete 2>/dev/null)" ]; then \
 	    echo "A killed run left Snakemake's lock or incomplete-file markers in .snakemake/. Run:  make recover"; fi; \
+	  case "$(SNAKEMAKE_ARGS)" in *configfile*) \
+	    echo "If Snakemake said 'Config file is not valid JSON or YAML' (no file, no line):" \
+	         "$(BIN)/safebasins check-config FILE names both and checks the file as the pipeline will.";; esac; \
 	  exit 1; }
 	$(if $(REPORT),$(BIN)/snakemake -j$(JOBS) --report $(REPORT) $(SNAKEMAKE_ARGS))
 

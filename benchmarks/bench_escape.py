@@ -174,7 +174,7 @@ def benchmark(args):
     tker, _ = best_time(lambda: engine.run_cpu(ensemble_problem(Q, P, np.zeros(Q.size, np.int64), [c["Omega"]], [c["F"]], c["Psi"],
                                                xi_max=(c["xi_max"],), cycles=c["cycles"], steps_per_cycle=S)),
                         args.repeat, "kernel")
-    rows.append(("  same chart, engine kernel only (run_ensemble)", steps_chart, tker))
+    rows.append(("  same chart, engine kernel only (run_cpu)", steps_chart, tker))
     # 300x300 chart of Fig 21 at 3000 cycles (the paper-scale job)
     if args.big:
         qb = np.linspace(-1, 1, 300)
@@ -269,7 +269,7 @@ def dense_ics(n, seed=0):
 
 
 def kernel_rate(integrator, Q, P, F, Omega, Psi, cycles, S, repeat, reps=1):
-    """Best wall time of `reps` back-to-back engine.run_ensemble calls (kernel only);
+    """Best wall time of `reps` back-to-back engine.run_cpu calls (kernel only);
     returns (time, useful trajectory-steps, CPU time of the best run)."""
     from safebasins.numerics import engine
     from safebasins.numerics.problem import ensemble_problem

@@ -2,7 +2,7 @@
 
     .venv/bin/python benchmarks/bench_peak.py [--quick]
 
-Job: ``engine.run_ensemble`` on N ICs inside the quartic well (radius <= 0.45 of the
+Job: ``engine.run_cpu`` on N ICs inside the quartic well (radius <= 0.45 of the
 (q0, p0) origin), F = 0, xi_max = 0.25: nothing escapes, so every lane takes every step (the
 per-step rate of the shared vector loop, all numba threads); best of ``--repeat`` runs after a
 warm-up.

@@ -11,7 +11,7 @@ jobs on the same arrays in this process, interleaved (job A, job B, job A, ... a
 time of each), and their escape steps are compared (must be equal: the quartic path is
 bitwise unchanged).
 
-Jobs (kernel only: kernels.ensemble with the arrays engine.run_ensemble would pass):
+Jobs (kernel only: kernels.ensemble with the arrays engine.run_cpu would pass):
   dense  ICs inside the well, F = 0: nothing escapes, every lane steps for --dense-cycles
          cycles (the per-step rate);
   chart  the 100x100 chart of bench_escape.py (quartic: F = 0.0876, Omega = 0.95, Psi = pi,

@@ -45,7 +45,8 @@ def _critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier="paper")
 
 
 def _escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), cycles=3000, steps_per_cycle=32,
-                  threads=None, well=None):
+                  threads=None, well=None, damping=0.0):
+    assert damping == 0.0, "the toy chart is undamped"
     Q, P = np.meshgrid(q0, p0, indexing="ij")
     th, h = _angle_energy(Q, P)
     xi = np.asarray(xi_max, float)[:, None, None]

@@ -1,8 +1,11 @@
 """`safebasins explore` in a real browser: the command serves the page, a dragged slider redraws
-the basin, the numeric run reports its IoU (headless Debian Chromium via playwright)."""
+the basin, the numeric run reports its IoU, the page fits the window, a well typed in is drawn,
+and the static picture of the current view is captured by a plain `chromium --screenshot`
+(headless Debian Chromium via playwright)."""
 from __future__ import annotations
 
 import io
+import json
 import socket
 import subprocess
 import sys
@@ -13,7 +16,8 @@ import pytest
 from PIL import Image
 
 from safebasins.explore.server import free_port
-from tests.docs.browser import chromium_page, require_chromium, screenshot_dir
+from safebasins.explore.snapshot import ink_fraction
+from tests.docs.browser import CHROMIUM, FLAGS, chromium_page, require_chromium, screenshot_dir
 
 pytestmark = pytest.mark.browser
 
@@ -112,7 +116,7 @@ def test_slider_redraws_and_numerics_report_iou(explorer_url, tmp_path):
 
 
 def test_damping_slider_changes_the_picture(explorer_url, tmp_path):
-    """beta > 0 (issue 17): the damped slow flow's basin (its mask outlined), titles and key say so."""
+    """beta > 0: the damped slow flow's basin (its mask outlined), titles and key say so."""
     shots = screenshot_dir(tmp_path)
     with chromium_page(tmp_path) as (page, errors):
         page.goto(explorer_url)
@@ -134,3 +138,94 @@ def test_damping_slider_changes_the_picture(explorer_url, tmp_path):
         assert changed > 0.01, f"only {changed:.2%} of the IC-plane pixels changed"
         page.screenshot(path=str(shots / "explore_damped.png"))
         assert errors == []
+
+
+#: every control and figure of the page, and the figures' toolbars (Bokeh's element classes)
+ELEMENTS = (".bk-Toolbar", ".bk-Figure", ".bk-Slider", ".bk-Select", ".bk-TextInput", ".bk-Button", ".bk-Div")
+
+
+def _outside(page):
+    """Boxes of the page's visible elements that leave the viewport, and the document's width."""
+    size = page.viewport_size
+    out = []
+    for selector in ELEMENTS:
+        loc = page.locator(selector)
+        for k in range(loc.count()):
+            box = loc.nth(k).bounding_box()
+            if box is None:                                  # hidden (the progress bar, an empty error line)
+                continue
+            if box["x"] < 0 or box["y"] < 0 or box["x"] + box["width"] > size["width"] + 0.5 \
+                    or box["y"] + box["height"] > size["height"] + 0.5:
+                out.append((selector, k, box))
+    return out, page.evaluate("() => document.documentElement.scrollWidth")
+
+
+def test_page_fits_the_window(explorer_url, tmp_path):
+    shots = screenshot_dir(tmp_path)
+    with chromium_page(tmp_path, width=1300, height=800) as (page, errors):
+        page.goto(explorer_url)
+        page.wait_for_function(READY, timeout=60_000)
+        page.wait_for_timeout(500)
+        widths = {}
+        for width, height in ((1300, 800), (1920, 1080)):
+            page.set_viewport_size({"width": width, "height": height})
+            page.wait_for_timeout(500)
+            page.screenshot(path=str(shots / f"explore_{width}x{height}.png"))
+            outside, scroll_width = _outside(page)
+            assert outside == [], f"{width}x{height}: outside the window: {outside}"
+            assert scroll_width <= width
+            assert page.locator(".bk-Toolbar").count() == 2
+            widths[width] = page.locator(".bk-Figure").first.bounding_box()["width"]
+        assert widths[1920] > widths[1300] + 200              # the figures take the room there is
+        assert errors == []
+
+
+def test_typed_well_is_drawn_and_a_bad_one_is_explained(explorer_url, tmp_path):
+    shots = screenshot_dir(tmp_path)
+    with chromium_page(tmp_path) as (page, errors):
+        page.goto(explorer_url)
+        page.wait_for_function(READY, timeout=60_000)
+        box = page.get_by_placeholder("e.g. 1 - cos(q)")
+        box.fill("q**2/2 - x")
+        box.press("Enter")
+        page.wait_for_function(f"() => {MODEL}('well_error').visible && {MODEL}('well_error').text.includes('unknown')")
+        assert page.get_by_text("unknown name(s) x").is_visible()
+        page.screenshot(path=str(shots / "explore_bad_expression.png"))
+        box.fill("1 - cos(q)")
+        box.press("Enter")
+        page.wait_for_function(f"() => {MODEL}('well_info').text.includes('E_b = 2')", timeout=60_000)
+        page.wait_for_function(f"() => {MODEL}('status').text.includes('redrawn')", timeout=60_000)
+        assert abs(page.evaluate(f"() => {MODEL}('ic_plane').x_range.end") - np.pi) < 1e-12
+        q_orbit = page.evaluate(f"() => Array.from({MODEL}('orbit_source').data.q)")
+        assert max(q_orbit) > 1.5                            # the pendulum's orbit at xi_max = 1.44: q = 2.0
+        assert not page.evaluate(f"() => {MODEL}('well_error').visible")
+        assert page.evaluate(f"() => {MODEL}('well').value") == "expression"
+        assert abs(page.evaluate(f"() => {MODEL}('xi_max').end") - 0.98 * 2) < 1e-12
+        page.wait_for_timeout(300)
+        page.screenshot(path=str(shots / "explore_expression_well.png"))
+        assert errors == []
+
+
+def test_static_picture_of_the_current_view(explorer_url, tmp_path):
+    """The page's link gives the static picture of the view after a slider moved; a plain
+    `chromium --screenshot` of it (no script, no waiting) is a picture, unlike one of the live page."""
+    shots = screenshot_dir(tmp_path)
+    with chromium_page(tmp_path) as (page, errors):
+        page.goto(explorer_url + "?well=pendulum&Omega=0.8")
+        page.wait_for_function(READY, timeout=60_000)
+        assert page.evaluate(f"() => {MODEL}('Omega').value") == 0.8
+        group = page.locator(".bk-input-group", has=page.locator(".bk-slider-title", has_text="Forcing amplitude F"))
+        group.locator(".noUi-handle").focus()
+        for _ in range(50):
+            page.keyboard.press("ArrowRight")
+        F = page.evaluate(f"() => {MODEL}('F').value")
+        page.wait_for_function(f"(F) => {MODEL}('snapshot').text.includes('F=' + F)", arg=repr(F))
+        href = page.get_by_role("link", name="Static picture of this view").get_attribute("href")
+        assert errors == []
+    url = explorer_url + href
+    html = __import__("urllib.request").request.urlopen(url, timeout=60).read().decode()
+    assert f"well pendulum; F = {F:.6g}, Omega = 0.8" in html
+    picture = shots / "explore_static_view_plain_screenshot.png"
+    subprocess.run([str(CHROMIUM), *FLAGS, f"--screenshot={picture}", "--window-size=1300,520", url],
+                   check=True, capture_output=True, timeout=120)
+    assert ink_fraction(picture) > 0.1

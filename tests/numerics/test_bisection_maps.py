@@ -58,8 +58,16 @@ def test_bracket_too_small_warns_naming_F_bracket():
     with pytest.warns(BracketWarning, match=r"F_bracket = \(0, 0.001\) did not contain the escape threshold.*"
                                             r"F_bracket\[1\] = 0.001 does not escape within 100 cycles at "
                                             r"Omega = 0.9, 1 \(2 of 2\).*F_bracket=\(0, 0.004\)"):
+        ds = critical_forcing_numeric([0.9, 1.0], 0.2, cycles=100, n_scan=0, F_bracket=(0.0, 0.001), max_widenings=0)
+    assert np.isnan(ds["F_cr"]).all()
+    # the widening is bounded: three doublings (0.008) still miss it, and the warning says so
+    with pytest.warns(BracketWarning, match=r"F_bracket = \(0, 0.001\) did not contain the escape threshold.*"
+                                            r"F_bracket\[1\] doubled 3 times, F = 0.008, does not escape within 100 "
+                                            r"cycles at Omega = 0.9, 1 \(2 of 2\).*F_bracket=\(0, 0.032\)"):
         ds = critical_forcing_numeric([0.9, 1.0], 0.2, cycles=100, n_scan=0, F_bracket=(0.0, 0.001))
     assert np.isnan(ds["F_cr"]).all()
+    assert ds["F_bracket_widenings"].values.tolist() == [3, 3]
+    np.testing.assert_array_equal(ds["F_bracket_used_high"], [0.008, 0.008])
     with pytest.warns(BracketWarning, match=r"F_bracket\[0\] = 0.5 already escapes at Omega = 0.9 .*"
                                             r"F_bracket=\(0, 0.6\)"):
         critical_forcing_numeric([0.9], 0.2, cycles=100, n_scan=0, F_bracket=(0.5, 0.6))

@@ -130,16 +130,20 @@ def test_bad_input_names_the_reason():
         wells.polynomial([0, 0, 0.5, 0, 0.25])      # nothing can escape
 
 
-def test_cubic_fcr_with_xi_max_one_ulp_below_the_rounded_barrier():
-    """xi_max = 1/6 (the float) lies one ulp below the cubic's rounded barrier energy: the SMM
-    search above xi_max has no energy left (it used to evaluate the well on the barrier and raise);
-    F_cr is finite and equals the eq (24) endpoint branch, with no saddle above xi_max."""
+def test_cubic_fcr_with_xi_max_at_the_rounded_barrier():
+    """xi_max = 1/6 (the float) lies one ulp below the cubic's rounded barrier energy: it counts as at
+    the barrier, where the undamped slow flow has no orbit (refused, naming xi_max, as by the config and
+    the command line).  Just below, the SMM search above xi_max has little energy left (it used to
+    evaluate the well on the barrier and raise): F_cr is finite and equals the eq (24) endpoint
+    branch, with no saddle above xi_max."""
     from safebasins.theory import critical_forcing
     from safebasins.wells import resolve_well
 
     w = resolve_well("cubic")
     assert 1 / 6 < w.barrier_energy and np.nextafter(1 / 6, 1.0) == w.barrier_energy
-    ds = critical_forcing(np.array([0.6, 0.9, 1.05]), 1 / 6, well="cubic")
+    with pytest.raises(ValueError, match="xi_max must lie below the barrier energy 0.16666666666666669 of the cubic"):
+        critical_forcing(np.array([0.9]), 1 / 6, well="cubic")
+    ds = critical_forcing(np.array([0.6, 0.9, 1.05]), (1 - 2e-12) / 6, well="cubic")
     assert np.isfinite(ds["F_cr"]).all() and np.isnan(ds["F_SMM"]).all()
     assert np.isnan(ds["xi_saddle_smm"]).all()
     assert np.array_equal(ds["F_cr"].values, np.fmax(ds["F_MM_0"], np.fmax(ds["F_MM_pi"], ds["F_SM"])).values)

@@ -16,7 +16,7 @@ rule analytic_dataset:
     params:
         extensions=EXTENSIONS,
         backend=BACKEND,
-        tiles=RUN.tiles,
+        integrate_tasks=dataset_integrates_tasks("analytic"),
     threads: dataset_threads("analytic")
     resources:
         **job_resources("analytic"),

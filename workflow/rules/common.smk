@@ -82,6 +82,11 @@ def dataset_inputs(stage):
     return lambda wildcards: RUN.product_inputs(dataset_path(stage, wildcards))
 
 
+def dataset_integrates_tasks(stage):
+    """The dataset integrates its experiment's chart tasks itself (numerics.tiles = 0; Plan.integrates_tasks)."""
+    return lambda wildcards: RUN.integrates_tasks(dataset_path(stage, wildcards))
+
+
 def dataset_threads(stage):
     return lambda wildcards: NUM_THREADS if RUN.integrates(dataset_path(stage, wildcards)) else 1
 

@@ -17,7 +17,7 @@ rule extras_dataset:
     params:
         extensions=EXTENSIONS,
         backend=BACKEND,
-        tiles=RUN.tiles,
+        integrate_tasks=dataset_integrates_tasks("extras"),
     threads: dataset_threads("extras")
     resources:
         **job_resources("extras"),

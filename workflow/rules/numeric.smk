@@ -43,7 +43,7 @@ rule numeric_dataset:
     params:
         extensions=EXTENSIONS,
         backend=BACKEND,
-        tiles=RUN.tiles,
+        integrate_tasks=dataset_integrates_tasks("numeric"),
     threads: dataset_threads("numeric")
     resources:
         **job_resources("numeric"),

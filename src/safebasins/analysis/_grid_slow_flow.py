@@ -1,4 +1,4 @@
-"""Slow-flow classification of one IC grid for many control points (issue 20: the analytic
+"""Slow-flow classification of one IC grid for many control points (the analytic
 integrity map).
 
 :func:`safebasins.theory.slow_flow_escapes` and

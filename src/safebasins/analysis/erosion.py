@@ -8,6 +8,11 @@ the numeric profile is a function of ``(F, xi_max, t_eval)`` at the cost of a
 function of F.  :func:`profile_from_charts` does the reading for charts that
 already exist (the pipeline's ``chart_fig16/17.nc``, or any stack over F).
 
+With damping (``damping`` = beta > 0, docs/damping.md) both sides take the damped equation
+``q'' + beta q' + V'(q) = F sin(Omega tau + Psi)``: the analytic profile follows each IC's damped
+slow trajectory until it escapes or settles below xi_max, the numeric one integrates the damped
+equation; the datasets carry the attribute ``damping``.
+
 All results are ``xarray.Dataset`` objects with the variables of
 :func:`safebasins.analysis.integrity.integrity_measures` (``GIM``, ``LIM``, ``IF`` plus raw
 radii/areas), ``units``/``long_name`` attributes, and the parameters as attributes.
@@ -17,9 +22,12 @@ grows, so GIM, LIM and IF are non-increasing in ``t_eval`` (LIM/IF because the
 distance to the unsafe set can only shrink when the unsafe set grows).  In F
 neither the analytic nor the numeric profile is monotone in general (secondary
 resonances, the non-monotone escape near the resonance minimum); the analytic
-profile starts at 1 at F = 0 where the slow flow is xi = const.
+profile starts at 1 at F = 0 where the slow flow is xi = const (with damping xi decays: every IC
+of S0 settles at the bottom).
 """
 from __future__ import annotations
+
+import warnings
 
 import numpy as np
 import xarray as xr
@@ -32,6 +40,10 @@ from safebasins.analysis.integrity import integrity_measures, unforced_safe_mask
 from safebasins.analysis.safe import chart_well, safe_stack
 from safebasins.io.cf import annotate
 from safebasins.numerics import escape_chart
+from safebasins.numerics.engine import damping_attrs
+from safebasins.theory.damped import check_damping
+from safebasins.theory.damped_escape import UndecidedWarning, slow_flow_outcomes
+from safebasins.theory.damped_flow import SETTLED, UNDECIDED
 from safebasins.wells import resolve_well, well_attrs
 from safebasins.io.provenance import api_provenance
 
@@ -46,7 +58,45 @@ __all__ = [
 
 
 # --------------------------------------------------------------------------- analytic
-def analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier=None, well=None):
+def _analytic_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier, well, damping):
+    """Safe masks (DataArray over fourier, F, xi_max, q0, p0), the count of undecided damped slow
+    trajectories (array over fourier, F, xi_max) and whether ``fourier`` was a scalar."""
+    F = as_1d("F_values", F_values, checks.check_nonnegative)
+    fl, wl, scalar = well_variants(well, fourier)
+    xi = as_1d("xi_max", xi_max, wl[0].check_threshold)
+    Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
+    Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
+    beta = check_damping(damping)
+    q, p, Q, P = mesh(q0, p0)
+    S0 = unforced_safe_mask(q, p, xi, wl[0])
+    out = np.zeros((len(fl), F.size, xi.size, q.size, p.size), dtype=bool)
+    undecided = np.zeros((len(fl), F.size, xi.size), dtype=np.int64)
+    for a in range(len(fl)):
+        for j, x in enumerate(xi):
+            if beta > 0:
+                # the damped slow flow: each IC's trajectory followed until it escapes or settles
+                for i, Fi in enumerate(F):
+                    status = slow_flow_outcomes(Q, P, float(Fi), Omega, Psi, float(x), beta, well=wl[a])
+                    out[a, i, j] = (status == SETTLED) & S0[j]
+                    undecided[a, i, j] = np.count_nonzero(status == UNDECIDED)
+                continue
+            # = slow_flow_escapes per F, bit for bit, the grid's and threshold's parts once
+            grid = GridSlowFlow(Q, P, Psi, float(x), wl[a])
+            for i, Fi in enumerate(F):
+                out[a, i, j] = ~grid.escapes(grid.profile(float(Fi), Omega)) & S0[j]
+    da = xr.DataArray(out, dims=("fourier", "F", "xi_max", "q0", "p0"),
+                      coords={"fourier": fl, "F": F, "xi_max": xi, "q0": q, "p0": p},
+                      attrs={"long_name": "analytic safe basin (isolated 1:1 resonance)", "units": "1",
+                             **damping_attrs(beta)})
+    n = int(undecided.sum())
+    if n:
+        warnings.warn(f"{n} damped slow trajectories undecided (neither settled nor escaped within the horizon): "
+                      "counted as escaping; the profile's variable n_undecided says where", UndecidedWarning,
+                      stacklevel=3)
+    return da, undecided, scalar
+
+
+def analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier=None, well=None, *, damping=0.0):
     """Analytic safe masks ``~slow_flow_escapes`` stacked as DataArray (fourier?, F, xi_max, q0, p0).
 
     ``fourier`` may be None (the well's own first harmonic: eq (20) as printed for the default
@@ -55,29 +105,18 @@ def analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier=None, well
     is "exact" (:func:`~safebasins.analysis.common.variant_well` states the rule).
     Points outside the unforced set S0 (eqs 4, 7; the well's ``unforced_safe``) are never safe
     (theory returns True there; the mask is intersected with S0 anyway so that GIM <= 1 exactly).
+    ``damping`` (beta >= 0; 0: the paper's conservative slow flow): for beta > 0 an IC is safe iff
+    its trajectory of the damped slow flow settles below xi_max
+    (:func:`safebasins.theory.damped_escape.slow_flow_outcomes`, docs/damping.md); undecided
+    trajectories count as escaping, with an ``UndecidedWarning``; attribute ``damping``.
     """
-    F = as_1d("F_values", F_values, checks.check_nonnegative)
-    fl, wl, scalar = well_variants(well, fourier)
-    xi = as_1d("xi_max", xi_max, wl[0].check_threshold)
-    Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
-    Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
-    q, p, Q, P = mesh(q0, p0)
-    S0 = unforced_safe_mask(q, p, xi, wl[0])
-    out = np.zeros((len(fl), F.size, xi.size, q.size, p.size), dtype=bool)
-    for a in range(len(fl)):
-        for j, x in enumerate(xi):
-            # = slow_flow_escapes per F, bit for bit, the grid's and threshold's parts once (issue 20)
-            grid = GridSlowFlow(Q, P, Psi, float(x), wl[a])
-            for i, Fi in enumerate(F):
-                out[a, i, j] = ~grid.escapes(grid.profile(float(Fi), Omega)) & S0[j]
-    da = xr.DataArray(out, dims=("fourier", "F", "xi_max", "q0", "p0"),
-                      coords={"fourier": fl, "F": F, "xi_max": xi, "q0": q, "p0": p},
-                      attrs={"long_name": "analytic safe basin (isolated 1:1 resonance)", "units": "1"})
+    da, _, scalar = _analytic_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier, well, damping)
     return da.isel(fourier=0) if scalar else da
 
 
 @api_provenance
-def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier=None, *, keep_masks=False, well=None):
+def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier=None, *, keep_masks=False, well=None,
+                             damping=0.0):
     """Analytic erosion profile: GIM/LIM/IF versus F from the slow flow on the (q0, p0) grid.
 
     Parameters
@@ -92,20 +131,35 @@ def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier=None,
         "exact" (:func:`~safebasins.analysis.common.variant_well`).
     well : the potential well (None: the paper's quartic).
     keep_masks : also return the masks as variable ``safe`` (..., q0, p0).
+    damping : beta >= 0 of ``q'' + beta q' + V'(q) = F sin(Omega tau + Psi)`` (0: the paper's
+        conservative slow flow); beta > 0 classifies every IC by its damped slow trajectory
+        (:func:`analytic_safe_masks`), hundreds of times the cost of the undamped level-curve test,
+        and adds the attribute ``damping`` and the variable ``n_undecided`` (fourier?, F, xi_max:
+        trajectories neither settled nor escaped within the horizon, counted as escaping).
 
     Returns
     -------
     xr.Dataset over (fourier?, F, xi_max) with ``GIM``, ``LIM``, ``IF`` and the raw
     measures (see :func:`safebasins.analysis.integrity.integrity_measures`).
     """
-    masks = analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier, well)
-    names, wl, scalar = well_variants(well, fourier)
+    masks, undecided, scalar = _analytic_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier, well, damping)
+    names, wl, _ = well_variants(well, fourier)
     w = wl[0]
+    beta = float(masks.attrs.get("damping", 0.0))
+    if scalar:
+        masks = masks.isel(fourier=0)
+        undecided = undecided[0]
     ds = integrity_measures(masks, well=w)
     if keep_masks:
         ds["safe"] = masks
-    ds.attrs.update({"kind": "analytic", "Omega": float(Omega), "Psi": float(Psi),
-                     "method": "safebasins.theory.slow_flow_escapes on the grid", **well_attrs(w)})
+    if beta > 0:
+        ds["n_undecided"] = (masks.dims[:-2], undecided,
+                             {"units": "1", "long_name": "damped slow trajectories neither settled nor escaped within "
+                                                         "the horizon (counted as escaping)"})
+    method = ("safebasins.theory.damped_escape.slow_flow_outcomes (damped slow flow) on the grid" if beta > 0
+              else "safebasins.theory.slow_flow_escapes on the grid")
+    ds.attrs.update({"kind": "analytic", "Omega": float(Omega), "Psi": float(Psi), "method": method,
+                     **damping_attrs(beta), **well_attrs(w)})
     if scalar:
         ds.attrs["fourier"] = names[0]
     return annotate(ds)
@@ -152,7 +206,7 @@ def profile_from_charts(charts, t_eval=None, *, criterion="energy", stack_dim="F
 
 @api_provenance
 def erosion_profile_numeric(F_values, Omega, Psi, xi_max, q0, p0, t_eval=None, cycles=3000, *,
-                            q_max=(), keep_charts=False, well=None, **chart_kwargs):
+                            q_max=(), keep_charts=False, well=None, damping=0.0, **chart_kwargs):
     """Numeric erosion profile: ONE escape chart per F, all thresholds and t_eval read from it.
 
     Parameters
@@ -164,6 +218,8 @@ def erosion_profile_numeric(F_values, Omega, Psi, xi_max, q0, p0, t_eval=None, c
         not returned here; use :func:`profile_from_charts` on the kept charts).
     keep_charts : return the stacked charts too: ``(profile, charts)``.
     well : the potential well (None: the paper's quartic; numerics: a polynomial well).
+    damping : beta >= 0: every chart integrates ``q'' + beta q' + V'(q) = F sin(Omega tau + Psi)``
+        (``numerics.escape_chart(damping=)``); the profile records ``damping`` for beta > 0.
     chart_kwargs : passed to ``numerics.escape_chart`` (``steps_per_cycle``, ``threads``).
 
     Returns
@@ -175,11 +231,13 @@ def erosion_profile_numeric(F_values, Omega, Psi, xi_max, q0, p0, t_eval=None, c
     checks.check_positive_int("cycles", cycles)
     checks.check_scalar("Omega", Omega, checks.check_positive)
     checks.check_scalar("Psi", Psi, checks.check_finite)
+    beta = check_damping(damping)
     q, p, _, _ = mesh(q0, p0)
     charts = []
     for Fi in F:
         c = escape_chart(q, p, float(Fi), float(Omega), float(Psi), xi_max=tuple(xi.tolist()),
-                         q_max=tuple(np.atleast_1d(q_max).tolist()), cycles=cycles, well=well, **chart_kwargs)
+                         q_max=tuple(np.atleast_1d(q_max).tolist()), cycles=cycles, well=well, damping=beta,
+                         **chart_kwargs)
         charts.append(c.assign_attrs(F=float(Fi)))
     stacked = stack_charts(charts, "F")
     prof = profile_from_charts(stacked, t_eval)

@@ -5,7 +5,7 @@ Library functions taking arrays and returning Datasets; the pipeline's experimen
 
 * :func:`analytic_basin` -- boundary curves of :func:`safebasins.theory.safe_basin_boundaries`
   (dims ``curve``, ``vertex``) plus the per-IC classification ``escapes(q0, p0)`` of
-  :func:`safebasins.theory.slow_flow_escapes` (eqs 18-28); with damping (beta > 0, issue 17) the
+  :func:`safebasins.theory.slow_flow_escapes` (eqs 18-28); with damping (beta > 0) the
   classification of the damped slow flow and, as its boundary, the outline of the safe mask
   (:func:`mask_outline`: the level curves of C are no trajectories there);
 * :func:`analytic_basin_stack` -- the same stacked over a scanned ``F`` or ``xi_max``;
@@ -13,6 +13,9 @@ Library functions taking arrays and returning Datasets; the pipeline's experimen
   ``(gamma_rm, xi_rm)`` grid of the resonance manifold;
 * :func:`numeric_check` -- integrate the analytic-safe ICs and store, per connected part of the
   analytic basin, the fraction the numerics keep (:func:`safebasins.analysis.confirm.confirm_regions`).
+
+They print nothing unless given a ``label`` (the pipeline's and the command line's log name): then
+one progress line each, for the job's log.
 """
 from __future__ import annotations
 
@@ -27,6 +30,12 @@ __all__ = ["analytic_basin", "analytic_basin_stack", "add_resonance_manifold", "
 #: ``kind`` of the boundary curves of a damped basin (:func:`mask_outline`) and the value of its
 #: attribute ``boundary``
 MASK_OUTLINE = "mask_outline"
+
+
+def _log(label, text):
+    """One progress line for a job's log, only when the caller names the job (``label``)."""
+    if label:
+        print(f"{label}: {text}", flush=True)
 
 
 @api_provenance
@@ -93,7 +102,7 @@ def analytic_basin(F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, l
     """Boundaries + per-IC analytic escape mask on the (q0, p0) grid of 1-D axes ``q0``, ``p0``.
 
     ``well``: any form :func:`safebasins.wells.resolve_well` reads (its first harmonic included);
-    ``label`` is printed in the log line.  ``damping`` (beta >= 0, default 0: the paper's
+    ``label``: the name of a progress line printed for a job's log (None: nothing printed).  ``damping`` (beta >= 0, default 0: the paper's
     conservative slow flow, output as before damping existed): for beta > 0 ``escapes`` is the
     classification of the damped slow flow (``slow_flow_escapes(..., damping=beta)``,
     docs/damping.md; undecided trajectories count as escaping) and the boundary curves are the
@@ -106,14 +115,14 @@ def analytic_basin(F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, l
     qa, pa = np.asarray(q0, float), np.asarray(p0, float)
     Q, P = np.meshgrid(qa, pa, indexing="ij")
     if beta > 0:
-        print(f"{label or 'basin'}: damped basin F={F} Omega={Omega} Psi={Psi} xi_max={xi_max} beta={beta}")
+        _log(label, f"damped basin F={F} Omega={Omega} Psi={Psi} xi_max={xi_max} beta={beta}")
         esc = np.asarray(slow_flow_escapes(Q, P, F, Omega, Psi, xi_max, well=well, damping=beta), dtype=bool)
         b = mask_outline(~esc, qa, pa, Psi, well=well)
         b.attrs.update(F=float(F), Omega=float(Omega), Psi=float(Psi), xi_max=float(xi_max), damping=beta,
                        saddle_gamma=np.nan, saddle_xi=np.nan)
         b["escapes"] = xr.DataArray(esc, dims=("q0", "p0"))
         return b.assign_coords(q0=("q0", qa), p0=("p0", pa))
-    print(f"{label or 'basin'}: basin F={F} Omega={Omega} Psi={Psi} xi_max={xi_max}")
+    _log(label, f"basin F={F} Omega={Omega} Psi={Psi} xi_max={xi_max}")
     b = safe_basin_boundaries(F, Omega, Psi, xi_max, well=well, n_points=n_points)
     esc = slow_flow_escapes(Q, P, F, Omega, Psi, xi_max, well=well)
     b["escapes"] = xr.DataArray(np.asarray(esc, dtype=bool), dims=("q0", "p0"))
@@ -160,16 +169,20 @@ def numeric_check(basin, F, Omega, Psi, xi_max, *, cycles, steps_per_cycle, well
     """Integrate the analytic-safe ICs of ``basin``'s grid for ``cycles`` forcing cycles (energy
     criterion) and store, per connected part of the analytic basin, the fraction the numerics
     keep: ``escape_cycle_numeric(q0, p0)``, ``region(q0, p0)``, ``region_size``,
-    ``region_numeric_safe`` (dim ``region_index``), attribute ``check_cycles``."""
+    ``region_numeric_safe`` (dim ``region_index``), attribute ``check_cycles``.  The numerics
+    integrate the equation of the basin: with its ``damping`` attribute (a damped basin of
+    :func:`analytic_basin`) the damped one.  ``label``: as :func:`analytic_basin`."""
     from safebasins.analysis.confirm import confirm_regions
     from safebasins.numerics import escape_chart
+    from safebasins.theory.damped import check_damping
 
+    beta = check_damping(basin.attrs.get("damping", 0.0))
     safe = ~np.asarray(basin["escapes"].transpose("q0", "p0").values, bool)
     Q, P = np.meshgrid(basin["q0"].values, basin["p0"].values, indexing="ij")
     ec = np.full(safe.shape, np.nan)
     if safe.any():
         ch = escape_chart(Q[safe], P[safe], F, Omega, Psi, xi_max=(xi_max,), cycles=cycles,
-                          steps_per_cycle=steps_per_cycle, threads=threads, grid=False, well=well)
+                          steps_per_cycle=steps_per_cycle, threads=threads, grid=False, well=well, damping=beta)
         ec[safe] = np.asarray(ch["escape_cycle_energy"].isel(xi_max=0).values, float)
     lab, size, frac = confirm_regions(safe, ec, cycles)
     out = basin.copy()
@@ -183,6 +196,6 @@ def numeric_check(basin, F, Omega, Psi, xi_max, *, cycles, steps_per_cycle, well
         "units": "1", "long_name": "fraction of the region's ICs that do not escape numerically within check_cycles"})
     out = out.assign_coords(region_index=("region_index", np.arange(1, size.size + 1)))
     out.attrs["check_cycles"] = int(cycles)
-    print(f"{label or 'basin'}: numeric check of {int(safe.sum())} analytic-safe ICs over "
-          f"{cycles} cycles: regions {size.tolist()}, kept {np.round(frac, 3).tolist()}")
+    _log(label, f"numeric check of {int(safe.sum())} analytic-safe ICs over {cycles} cycles: regions "
+                f"{size.tolist()}, kept {np.round(frac, 3).tolist()}")
     return out

@@ -132,6 +132,7 @@ def integrity_map_numeric(Omega, F, Psi, xi_max, q0, p0, *, cycles=1000, t_eval=
     ds.attrs.update(well_attrs(chart_well(charts)))
     ds.attrs.update(kind="numeric", Psi=float(Psi), xi_max=float(xi_max), cycles=int(cycles),
                     steps_per_cycle=charts.attrs["steps_per_cycle"], integrator=charts.attrs["integrator"],
+                    **{k: charts.attrs[k] for k in ("damping",) if k in charts.attrs},
                     method="escape_chart_batch per block of control points; safe = escape_cycle > t_eval")
     return annotate(ds)
 

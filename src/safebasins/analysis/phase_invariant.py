@@ -272,7 +272,7 @@ def true_safe_basin_from_charts(charts, t_eval=None, *, criterion="energy"):
                    lead_dims, lead_coords, xi_norm, well)
     ds.attrs.update(well_attrs(well))
     ds.attrs.update({k: v for k, v in chart.attrs.items() if k in ("F", "Omega", "cycles", "steps_per_cycle",
-                                                                       "integrator")})
+                                                                       "integrator", "damping")})
     ds.attrs.update({"kind": "numeric", "criterion": criterion,
                      "method": "intersection over Psi of escape_cycle > t_eval, one escape_chart per Psi"})
     return annotate(ds)

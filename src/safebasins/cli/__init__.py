@@ -11,10 +11,16 @@ output    provenance, progress bars, figures, atomic files, the `info` summary
 commands  the click group ``main`` (console script ``safebasins``) and its commands
 explore   the ``explore`` command: the interactive explorer (safebasins.explore) in a browser
 interrupt Ctrl-C (SIGINT) exits 130, never 0 (the group class of ``main``)
+check_config  the ``check-config`` command: a pipeline configuration checked as snakemake would
+reproduction  the ``verify-reproduction`` command: a new run checked against a results archive
 """
 from safebasins.cli.commands import main
 from safebasins.cli.explore import explore
+from safebasins.cli.check_config import check_config
+from safebasins.cli.reproduction import verify_reproduction
 
 main.add_command(explore)
+main.add_command(check_config)
+main.add_command(verify_reproduction)
 
 __all__ = ["main"]

@@ -6,8 +6,9 @@ from pathlib import Path
 
 import click
 
-from safebasins.cli.options import (DISPLACEMENT, ENERGY, FINITE, OPTION_OF, POSITIVE, Deferred, Fields, Number,
-                                    NumberList, analytic_threshold, checked, common_options, cost_guard, current_well,
+from safebasins.cli.options import (DISPLACEMENT, ENERGY, FINITE, OPTION_OF, POSITIVE, THRESHOLD, Deferred, Fields,
+                                    Number, NumberList, analytic_thresholds, checked, common_options, cost_guard,
+                                    current_well,
                                     damping_option,
                                     forcing_options, fourier_of, from_library, from_schema, grid_options, grid_params,
                                     joined, lib_check, library_errors, numerics_options, out_option)
@@ -64,10 +65,10 @@ def main():
 
 @main.command()
 @forcing_options
-@click.option("--xi-max", "xi_max", type=NumberList("xi_max", analytic_threshold), multiple=True, required=True,
+@click.option("--xi-max", "xi_max", type=NumberList("xi_max", THRESHOLD), multiple=True, required=True,
               callback=joined(unique=True),
-              help="Energy thresholds in (0, E_b) (E_b: the well's barrier energy, 1/4 for the quartic): comma "
-                   "list or repeated (one basin each).")
+              help="Energy thresholds in (0, E_b) (E_b: the well's barrier energy, 1/4 for the quartic; with "
+                   "--damping > 0 also E_b itself): comma list or repeated (one basin each).")
 @click.option("--q-max", "q_max", type=NumberList("q_max", DISPLACEMENT), multiple=True,
               callback=joined(unique=True), help="Displacement thresholds |q| > q_max up to the nearest barrier, "
                                                  "stored beside the energy ones.")
@@ -99,6 +100,7 @@ def chart(F, Omega, Psi, xi_max, q_max, grid, n, cycles, steps_per_cycle, thread
     """
     from safebasins.pipeline.values import damping_param
 
+    analytic_thresholds(click.get_current_context(), [(x, damping) for x in xi_max])
     t_eval = float(cycles) if t_eval is None else t_eval
     if t_eval > cycles:
         raise click.BadParameter(f"evaluation time {t_eval} beyond the horizon --cycles {cycles}",
@@ -168,9 +170,10 @@ def n_scan_check(n):
 @click.option("--Omega-range", "Omega_range", type=Fields("range"), default=None,
               help="Analytic Omega values start,stop,num (endpoints included) [default: 0.5 w0,1.2 w0,351 with w0 "
                    "the well's small-amplitude frequency: 0.5,1.2,351 for the quartic].")
-@click.option("--xi-max", "xi_max", type=NumberList("xi_max", analytic_threshold), multiple=True, required=True,
+@click.option("--xi-max", "xi_max", type=NumberList("xi_max", THRESHOLD), multiple=True, required=True,
               callback=joined(unique=False),
-              help="Truncation levels in (0, E_b): one curve each (comma list or repeated).")
+              help="Truncation levels in (0, E_b) (a damped curve also E_b itself): one curve each (comma list or "
+                   "repeated).")
 @click.option("--xi-ini", "xi_ini", type=NumberList("xi_ini", ENERGY), multiple=True,
               callback=joined(unique=False), help="Initial energies (< xi_max) [default: 0, the zero IC].")
 @click.option("--gamma-ini", "gamma_ini", type=NumberList("gamma_ini", FINITE, angle=True), multiple=True,
@@ -188,8 +191,9 @@ def n_scan_check(n):
 @click.option("--n-scan", "n_scan", type=int, callback=checked(None, n_scan_check),
               cls=Deferred, default=from_library("safebasins.numerics:critical_forcing_numeric", "n_scan"),
               help="F values of the non-monotonicity scan (0: none).")
-@click.option("--F-bracket", "F_bracket", type=Fields("bracket"), default="0,0.3", show_default=True,
-              help="Bisection bracket lo,hi of F.")
+@click.option("--F-bracket", "F_bracket", type=Fields("bracket"), default=None,
+              help="Bisection bracket lo,hi of F; its top is doubled (up to 3 times) where it does not escape "
+                   "[default: 0 to the well's static escape force, rounded up: 0,0.39 for the quartic].")
 @click.option("--criterion", type=click.Choice(["energy", "displacement"]), default="energy", show_default=True,
               help="Numeric escape: H0 > xi_max, or |q| > q_max(xi_max).")
 @damping_option(multiple=True)
@@ -222,6 +226,7 @@ def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cyc
             raise click.BadParameter(f"{m} values but another curve list has {ncurve}: give equal lengths or one",
                                      param_hint=f"'{OPTION_OF[k]}'")
     curves = values.curves(block, numeric)
+    analytic_thresholds(click.get_current_context(), [(c["xi_max"], c.get("damping", 0.0)) for c in curves])
     for c in curves:
         if not c["xi_ini"] < c["xi_max"]:
             raise click.BadParameter(f"initial energy {c['xi_ini']} must be below the truncation level xi_max = "
@@ -236,6 +241,10 @@ def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cyc
                   well=well, **values.damping_param(block["damping"]), Omega=values.range_values(Omega_range),
                   curves=curves)
     if numeric:
+        if F_bracket is None:
+            from safebasins.numerics.bisection import default_bracket
+
+            F_bracket = list(default_bracket(current_well(ctx)))
         params["numeric"] = {"Omega": values.range_values(numeric_Omega or Omega_range), "cycles": cycles,
                              "tol": tol, "F_bracket": F_bracket, "n_scan": n_scan, "criterion": criterion,
                              "steps_per_cycle": steps_per_cycle}
@@ -309,8 +318,8 @@ def fcr_numeric(params, job, quiet):
 
 @main.command()
 @forcing_options
-@click.option("--xi-max", "xi_max", type=Number("xi_max", analytic_threshold), required=True,
-              help="Energy truncation level in (0, E_b).")
+@click.option("--xi-max", "xi_max", type=Number("xi_max", THRESHOLD), required=True,
+              help="Energy truncation level in (0, E_b) (with --damping > 0 also E_b itself).")
 @grid_options
 @click.option("--n-points", "n_points", cls=Deferred, type=int, default=from_schema("basin_rm", "n_points"),
               callback=checked("n_points", lib_check("safebasins.checks:check_positive_int")),
@@ -322,8 +331,8 @@ def fcr_numeric(params, job, quiet):
               cls=Deferred, default=from_schema("basin_rm", "manifold", "n_xi"),
               help="xi points of the resonance-manifold panel.")
 @click.option("--xi-top", "xi_top", type=Number("xi_top", ENERGY), default=None,
-              help="Top of the resonance-manifold panel (< E_b) [default: the basin_rm schema's 0.2499 for the "
-                   "quartic, 0.9996 E_b for any other well].")
+              help="Top of the resonance-manifold panel (< E_b) [default: the well's, Well.manifold_top = "
+                   "0.9996 E_b: 0.2499 for the quartic].")
 @damping_option()
 @common_options
 @out_option("basin")
@@ -343,6 +352,7 @@ def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, dampi
     from safebasins.pipeline.values import damping_param
 
     ctx = click.get_current_context()
+    analytic_thresholds(ctx, [(xi_max, damping)])
     if damping > 0:
         given = [OPTION_OF.get(k, f"--{k.replace('_', '-')}") for k in ("n_gamma", "n_xi", "xi_top")
                  if ctx.get_parameter_source(k) is not click.core.ParameterSource.DEFAULT]
@@ -351,9 +361,7 @@ def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, dampi
                                      f"with --damping {fmt(damping)} > 0 (C is not conserved; only the IC plane "
                                      "is drawn)", param_hint="'--damping'")
     if xi_top is None:
-        w = current_well(ctx)
-        xi_top = (from_schema("basin_rm", "manifold", "xi_top")() if w.name == "quartic"
-                  else 0.9996 * float(w.barrier_energy))
+        xi_top = current_well(ctx).manifold_top
     if not xi_top > 0:
         raise click.BadParameter(f"must be > 0, got {xi_top}", param_hint="'--xi-top'")
     name = Path(out).name

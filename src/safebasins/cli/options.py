@@ -91,15 +91,22 @@ def well_check(method):
 ENERGY = well_check("check_energy")          # [0, E_b)
 THRESHOLD = well_check("check_threshold")    # (0, E_b] (below an asymptote: (0, E_b))
 DISPLACEMENT = well_check("check_displacement")
+#: the undamped slow flow's rule (0, E_b), the band just below E_b counting as at it
+analytic_threshold = well_check("check_analytic_threshold")
 
 
-def analytic_threshold(name, value, ctx):
-    """(0, E_b): the action-angle map of the slow flow is singular on the separatrix."""
-    THRESHOLD(name, value, ctx)
-    return ENERGY(name, value, ctx)
-
-
-analytic_threshold.needs_ctx = True
+def analytic_thresholds(ctx, pairs):
+    """``(xi_max, damping)`` pairs of a command checked by the one rule of the library: where the
+    slow flow is undamped, ``Well.check_analytic_threshold`` (below the barrier energy; its level
+    curves need an orbit at xi_max); the damped slow flow and the numerics take xi_max = E_b
+    (``Well.check_threshold``, already checked while parsing).  A usage error naming --xi-max."""
+    well = current_well(ctx)
+    for xi_max, damping in pairs:
+        if not damping > 0:
+            try:
+                well.check_analytic_threshold("xi_max", xi_max)
+            except ValueError as exc:
+                raise click.BadParameter(str(exc), ctx, param_hint="'--xi-max'") from None
 
 
 def parse_well(text):
@@ -451,10 +458,10 @@ def numerics_options(func, what):
 def backend_check(ctx, param, value):
     """--backend cuda without a usable GPU is a usage error found before anything is computed."""
     if value == "cuda":
-        from safebasins.numerics.cuda_engine import require_cuda
+        from safebasins.numerics.engine import cuda_engine
 
         try:
-            require_cuda()
+            cuda_engine().require_cuda()
         except (RuntimeError, ImportError) as exc:
             raise click.BadParameter(str(exc), ctx, param) from None
     return value

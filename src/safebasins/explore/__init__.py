@@ -7,13 +7,15 @@ redraw while the sliders move.  A button integrates the escape chart on the same
 the intersection over union of the analytic and numeric basins.  Every number on the page comes
 from a library call; this package only lays the page out.
 
-ranges    the wells offered and, per well, slider ranges, defaults and plot windows
+ranges    the wells offered (named, or V(q) typed in) and, per well, slider ranges, defaults and windows
 analytic  the slow-flow pictures (theory calls)
 numeric   the escape chart in blocks with progress, and its agreement with the slow flow
+state     one view (a well and a point of the sliders): checks, and the URL query of a page
 figures   the Bokeh figures and their data sources
 controls  the widgets
 app       the document: controls wired to redraws (coalesced) and the background numeric run
-server    the Bokeh server (free port, browser)
+snapshot  the static picture of a view: standalone HTML, and a PNG of it by a headless Chromium
+server    the Bokeh server (free port, browser) and the static pictures at /snapshot
 """
 from safebasins.explore.server import make_server, serve
 

@@ -8,7 +8,7 @@
   :func:`~safebasins.theory.slow_flow.first_integral`) with the escaping region
   (:func:`~safebasins.theory.slow_flow.escapes_on_manifold`).
 
-With damping (beta > 0, issue 17) C is not conserved and its level curves bound nothing: the IC
+With damping (beta > 0) C is not conserved and its level curves bound nothing: the IC
 plane shows the damped slow flow's classification
 (:func:`~safebasins.theory.slow_flow.slow_flow_escapes` with ``damping``) on a coarser grid
 (``DAMPED_IC_GRID``: each IC's slow trajectory is integrated) with the outline of its mask
@@ -25,9 +25,12 @@ import numpy as np
 from safebasins import theory
 from safebasins.explore.ranges import WellRanges
 
-__all__ = ["Forcing", "ic_grid", "ic_safe", "ic_plane", "manifold", "level_values", "DAMPED_IC_GRID",
-           "DAMPED_MANIFOLD_GRID"]
+__all__ = ["Forcing", "ic_grid", "ic_safe", "ic_plane", "manifold", "pictures", "level_values", "IC_GRID",
+           "MANIFOLD_GRID", "DAMPED_IC_GRID", "DAMPED_MANIFOLD_GRID"]
 
+#: grid of the IC-plane picture, and (gamma, xi) points of the manifold picture
+IC_GRID = 161
+MANIFOLD_GRID = (241, 161)
 #: vertices per branch of each analytic boundary curve
 BOUNDARY_POINTS = 200
 #: level curves of C drawn on the resonance manifold
@@ -127,3 +130,8 @@ def manifold(r: WellRanges, f: Forcing, n_gamma: int, n_xi: int) -> dict:
         return {"gamma": gamma, "xi": xi, "C": C, "escapes": escapes, "levels": np.array([])}
     escapes = theory.escapes_on_manifold(gamma[None, :], xi[:, None], f.F, f.Omega, f.xi_max, well=r.well)
     return {"gamma": gamma, "xi": xi, "C": C, "escapes": escapes, "levels": level_values(C)}
+
+
+def pictures(r: WellRanges, f: Forcing) -> tuple[dict, dict]:
+    """Both pictures of one point of the sliders, at the explorer's resolution: ``(ic_plane, manifold)``."""
+    return ic_plane(r, f, IC_GRID), manifold(r, f, *MANIFOLD_GRID)

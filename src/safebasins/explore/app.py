@@ -5,7 +5,13 @@ one is already pending, and that redraw reads the sliders' values when it runs, 
 slider redraws continuously at the rate the computation allows.  The numeric run integrates in
 a background thread, reports its blocks to the progress bar through the document's next-tick
 callbacks, and is abandoned (its result discarded) when a parameter changes meanwhile.
-Errors of the library (a ValueError naming the argument) are shown in the status line.
+Errors of the library (a ValueError naming the argument) are shown in the status line, those of
+a well typed in under the well menu.
+
+The page starts at the state of the command line (``safebasins explore --well ... --F ...``),
+which the page's URL query overrides (``/?well=pendulum&F=0.05``, :mod:`safebasins.explore.state`);
+its static-picture link (``/snapshot?...``) follows the sliders.  The layout follows the window:
+a fixed column of controls beside figures that stretch to the remaining width.
 """
 from __future__ import annotations
 
@@ -18,19 +24,17 @@ from bokeh.layouts import column, row
 from bokeh.models import Div
 
 from safebasins.explore import analytic, numeric
-from safebasins.explore.controls import forcing, make_controls, set_ranges
+from safebasins.explore.controls import WIDTH, forcing, make_controls, set_ranges
 from safebasins.explore.figures import Figures, key
-from safebasins.explore.ranges import well_ranges
+from safebasins.explore.ranges import EXPRESSION, well_names, well_ranges
+from safebasins.explore.state import to_query, view
 
-__all__ = ["Explorer", "make_document", "REDRAW_DELAY_MS", "IC_GRID", "MANIFOLD_GRID"]
+__all__ = ["Explorer", "make_document", "REDRAW_DELAY_MS", "HEADER"]
 
 log = logging.getLogger(__name__)
 
 #: delay of a scheduled redraw (ms)
 REDRAW_DELAY_MS = 40
-#: grid of the analytic IC-plane picture, and (gamma, xi) points of the manifold picture
-IC_GRID = 161
-MANIFOLD_GRID = (241, 161)
 
 HEADER = ("<b>safebasins explorer</b>: q'' + beta q' + V'(q) = F sin(Omega t + Psi). Left: initial conditions "
           "(q0, p0) that the slow flow keeps below xi_max (eq 21; with damping beta > 0: whose damped slow "
@@ -38,44 +42,103 @@ HEADER = ("<b>safebasins explorer</b>: q'' + beta q' + V'(q) = F sin(Omega t + P
           "(gamma, xi).")
 
 
-class Explorer:
-    """One browser session: its controls, figures and numeric run."""
+def error_text(exc: Exception) -> str:
+    """A library error for the page: a ValueError's message names the argument; anything else
+    also names its type."""
+    return str(exc) if isinstance(exc, ValueError) else f"{type(exc).__name__}: {exc}"
 
-    def __init__(self, doc, well="quartic"):
+
+def _query_arguments(doc) -> dict:
+    """The page request's query arguments (none outside a server session); Bokeh's own
+    (``bokeh-...``) left out."""
+    context = getattr(doc, "session_context", None)
+    request = getattr(context, "request", None)
+    arguments = getattr(request, "arguments", None) or {}
+    return {k: v for k, v in arguments.items() if not k.startswith("bokeh-")}
+
+
+class Explorer:
+    """One browser session: its controls, figures and numeric run, starting at the well ``well``
+    (any form of :func:`safebasins.explore.ranges.well_ranges`) and the point ``values``
+    (parameter -> value; missing: the well's defaults), both overridden by the page's query."""
+
+    def __init__(self, doc, well="quartic", values=None):
         self.doc = doc
-        self.ranges = well_ranges(well)
-        self.controls = make_controls(self.ranges)
-        f = forcing(self.controls)
-        self.figures = Figures(self.ranges, analytic.ic_plane(self.ranges, f, IC_GRID),
-                               analytic.manifold(self.ranges, f, *MANIFOLD_GRID))
-        self.figures.threshold.location = f.xi_max
-        self.key = Div(name="key", text=key(), width=1000)
+        problem = None
+        try:
+            self.ranges, f = view(well, values, _query_arguments(doc))
+        except Exception as exc:  # noqa: BLE001 - a bad query: the command line's state, the error shown
+            problem = f"URL query ignored: {error_text(exc)}"
+            self.ranges, f = view(well, values)
+        #: wells of the menu that are neither named nor typed in (a polynomial of the command line)
+        self.other_wells = ({} if self.ranges.name in (EXPRESSION, *well_names())
+                            else {self.ranges.name: self.ranges.spec})
+        self.controls = make_controls(self.ranges, f)
+        self.figures = Figures(self.ranges, *analytic.pictures(self.ranges, f), f.xi_max, f.damping)
+        self.key = Div(name="key", text=key(f.damping), sizing_mode="stretch_width")
         self.version = 0          # bumped by every parameter change: a numeric run checks it
         self.pending = None       # the scheduled redraw
         self.running = False
+        self.setting_well = False  # the menu is being set to match a well typed in
         c = self.controls
         c.well.on_change("value", self.on_well)
+        c.expression.on_change("value", self.on_expression)
         for slider in c.sliders.values():
             slider.on_change("value", self.on_parameter)
         c.grid.on_change("value", self.on_parameter)
         c.cycles.on_change("value", self.on_parameter)
         c.run.on_click(self.on_run)
+        self.link(f)
+        if problem:
+            self.status(problem)
         doc.title = "safebasins explorer"
-        doc.add_root(column(Div(text=HEADER, width=1340),
-                            row(column(*c.widgets()), column(row(self.figures.ic, self.figures.rm), self.key)),
-                            name="layout"))
+        figures = column(row(self.figures.ic, self.figures.rm, sizing_mode="stretch_width"), self.key,
+                         sizing_mode="stretch_width")
+        doc.add_root(column(Div(text=HEADER, sizing_mode="stretch_width"),
+                            row(column(*c.widgets(), width=WIDTH + 10), figures, sizing_mode="stretch_width"),
+                            sizing_mode="stretch_width", name="layout"))
+
+    # ------------------------------------------------------------------ wells
+    def on_well(self, attr, old, new):
+        if self.setting_well:
+            return
+        if new == EXPRESSION:
+            text = self.controls.expression.value.strip()
+            if not text:
+                self.well_error("type V(q) in the box below and press Enter")
+                return
+            self.set_well({"expression": text})
+        else:
+            self.set_well(self.other_wells.get(new, new))
+
+    def on_expression(self, attr, old, new):
+        if new.strip() and self.set_well({"expression": new.strip()}):
+            self.setting_well = True
+            try:
+                self.controls.well.value = EXPRESSION
+            finally:
+                self.setting_well = False
+
+    def set_well(self, well) -> bool:
+        """Show the well ``well`` at its defaults; False (the error shown under the well menu, the
+        page unchanged) when it does not resolve."""
+        try:
+            r = well_ranges(well)
+        except Exception as exc:  # noqa: BLE001 - a user's formula: shown on the page, which stays usable
+            self.well_error(error_text(exc))
+            return False
+        self.well_error("")
+        self.ranges = r
+        self.figures.set_windows(r)
+        set_ranges(self.controls, r)
+        self.changed()
+        return True
+
+    def well_error(self, text):
+        """The error of a well under the well menu (hidden when there is none)."""
+        self.controls.well_error.update(text=text, visible=bool(text))
 
     # ------------------------------------------------------------------ analytic pictures
-    def on_well(self, attr, old, new):
-        try:
-            self.ranges = well_ranges(new)
-        except Exception as exc:  # noqa: BLE001 - shown to the user, the page stays usable
-            self.status(f"{type(exc).__name__}: {exc}")
-            return
-        self.figures.set_windows(self.ranges)
-        set_ranges(self.controls, self.ranges)
-        self.changed()
-
     def on_parameter(self, attr, old, new):
         self.changed()
 
@@ -91,15 +154,21 @@ class Explorer:
         r, f = self.ranges, forcing(self.controls)
         t0 = time.perf_counter()
         try:
-            ic = analytic.ic_plane(r, f, IC_GRID)
-            rm = analytic.manifold(r, f, *MANIFOLD_GRID)
+            ic, rm = analytic.pictures(r, f)
         except Exception as exc:  # noqa: BLE001
-            self.status(f"{type(exc).__name__}: {exc}")
+            self.status(error_text(exc))
             return
         self.figures.show(r, f.xi_max, ic, rm, f.damping)
         self.key.text = key(f.damping)
+        self.link(f)
         self.status(f"{'damped ' if f.damping > 0 else ''}slow flow redrawn in "
                     f"{1e3 * (time.perf_counter() - t0):.0f} ms")
+
+    def link(self, f):
+        """The links to this view: its static picture and the live page at this state."""
+        query = to_query(self.ranges, f)
+        self.controls.snapshot.text = (f'<a href="snapshot?{query}" target="_blank">Static picture of this view</a>'
+                                       f' &middot; <a href="?{query}">link to this view</a>')
 
     def status(self, text):
         self.controls.status.text = text
@@ -126,7 +195,7 @@ class Explorer:
             value = None if safe is None else numeric.agreement(analytic.ic_safe(r, f, n), safe)
         except Exception as exc:  # noqa: BLE001
             log.exception("numeric run failed")
-            self.doc.add_next_tick_callback(partial(self.finished, None, None, f"{type(exc).__name__}: {exc}"))
+            self.doc.add_next_tick_callback(partial(self.finished, None, None, error_text(exc)))
             return
         text = None if safe is None else (f"{n} x {n} ICs, {cycles} cycles, {time.perf_counter() - t0:.1f} s")
         self.doc.add_next_tick_callback(partial(self.finished, (r, safe, n, cycles, token), value, text))
@@ -152,6 +221,7 @@ class Explorer:
         self.status(f"numerics: {text}")
 
 
-def make_document(doc):
-    """Bokeh application handler: one :class:`Explorer` per browser session."""
-    Explorer(doc)
+def make_document(doc, well="quartic", values=None):
+    """Bokeh application handler: one :class:`Explorer` per browser session (at the well and point
+    of the command line: bind them with ``functools.partial``)."""
+    Explorer(doc, well, values)

@@ -1,21 +1,25 @@
-"""The explorer's widgets: well, Omega, F, Psi, xi_max, damping beta; the numeric run's grid, horizon, button,
-progress bar; the IoU and status lines.  Every widget has a name (its Bokeh model name)."""
+"""The explorer's widgets: the well (a named well, or V(q) typed in), Omega, F, Psi, xi_max, damping
+beta; the numeric run's grid, horizon, button, progress bar; the IoU, status and static-picture
+lines.  Every widget has a name (its Bokeh model name)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from bokeh.models import Button, Div, Progress, Select, Slider
+from bokeh.models import Button, Div, Progress, Select, Slider, TextInput
 
 from safebasins.explore.analytic import Forcing
 from safebasins.explore.numeric import CYCLES, GRID_SIZES
-from safebasins.explore.ranges import WellRanges, well_description, well_names
+from safebasins.explore.ranges import EXPRESSION, WellRanges, well_names
 
-__all__ = ["Controls", "make_controls", "set_ranges", "forcing"]
+__all__ = ["Controls", "make_controls", "set_ranges", "forcing", "well_options", "WIDTH"]
 
+#: width of the column of controls (px)
+WIDTH = 300
 #: slider titles and number formats (numbro)
 SLIDERS = {"Omega": ("Forcing frequency Omega", "0.000"), "F": ("Forcing amplitude F", "0.0000"),
            "Psi": ("Forcing phase Psi", "0.000"), "xi_max": ("Escape threshold xi_max", "0.0000"),
            "damping": ("Damping beta (0: undamped)", "0.0000")}
+ERROR_STYLE = {"color": "#b00020"}
 
 
 @dataclass
@@ -23,6 +27,8 @@ class Controls:
     """The widgets."""
 
     well: Select
+    expression: TextInput
+    well_error: Div
     well_info: Div
     sliders: dict
     grid: Select
@@ -31,39 +37,55 @@ class Controls:
     progress: Progress
     iou: Div
     status: Div
+    snapshot: Div
 
     def widgets(self):
         """Every widget, top to bottom."""
-        return [self.well, self.well_info, *self.sliders.values(), self.grid, self.cycles, self.run, self.progress,
-                self.iou, self.status]
+        return [self.well, self.expression, self.well_error, self.well_info, *self.sliders.values(), self.grid,
+                self.cycles, self.run, self.progress, self.iou, self.status, self.snapshot]
 
 
-def _slider(name, s):
+def well_options(r: WellRanges) -> list[tuple[str, str]]:
+    """``(value, label)`` of the well menu: the named wells, a V(q) typed in, and the well ``r``
+    when it is a polynomial (given on the command line)."""
+    options = [(name, name) for name in well_names()] + [(EXPRESSION, "V(q) typed below")]
+    if r.name not in dict(options):
+        options.append((r.name, r.label))
+    return options
+
+
+def _slider(name, s, value):
     title, fmt = SLIDERS[name]
-    return Slider(name=name, title=title, start=s.start, end=s.end, step=s.step, value=s.value, format=fmt,
-                  width=300)
+    return Slider(name=name, title=title, start=min(s.start, value), end=max(s.end, value), step=s.step, value=value,
+                  format=fmt, width=WIDTH)
 
 
-def make_controls(r: WellRanges) -> Controls:
-    """Widgets for the well ``r`` (its ranges and defaults)."""
+def make_controls(r: WellRanges, f: Forcing) -> Controls:
+    """Widgets for the well ``r`` (its ranges, widened to hold the point ``f``) at the point ``f``."""
     return Controls(
-        well=Select(name="well", title="Potential well", value=r.name, options=well_names(), width=300),
-        well_info=Div(name="well_info", text=well_description(r.name), width=300),
-        sliders={name: _slider(name, getattr(r, name)) for name in SLIDERS},
+        well=Select(name="well", title="Potential well", value=r.name, options=well_options(r), width=WIDTH),
+        expression=TextInput(name="expression", title="or your own well: V(q) =  (Enter applies)",
+                             value=r.spec.get("expression", ""), placeholder="e.g. 1 - cos(q)  or  q**2/2 - q**3/3",
+                             width=WIDTH),
+        well_error=Div(name="well_error", text="", width=WIDTH, styles=ERROR_STYLE, visible=False),
+        well_info=Div(name="well_info", text=r.description(), width=WIDTH),
+        sliders={name: _slider(name, getattr(r, name), getattr(f, name)) for name in SLIDERS},
         grid=Select(name="grid", title="Numerics: grid points per axis", value=str(GRID_SIZES[1]),
-                    options=[str(n) for n in GRID_SIZES], width=300),
+                    options=[str(n) for n in GRID_SIZES], width=WIDTH),
         cycles=Select(name="cycles", title="Numerics: forcing cycles", value=str(CYCLES[1]),
-                      options=[str(n) for n in CYCLES], width=300),
-        run=Button(name="run", label="Run numerics", button_type="primary", width=300),
-        progress=Progress(name="progress", min=0, max=1, value=0, visible=False, width=300),
-        iou=Div(name="iou", text="", width=300),
-        status=Div(name="status", text="", width=300),
+                      options=[str(n) for n in CYCLES], width=WIDTH),
+        run=Button(name="run", label="Run numerics", button_type="primary", width=WIDTH),
+        progress=Progress(name="progress", min=0, max=1, value=0, visible=False, width=WIDTH),
+        iou=Div(name="iou", text="", width=WIDTH),
+        status=Div(name="status", text="", width=WIDTH),
+        snapshot=Div(name="snapshot", text="", width=WIDTH),
     )
 
 
 def set_ranges(c: Controls, r: WellRanges):
-    """Slider ranges and defaults of a new well."""
-    c.well_info.text = well_description(r.name)
+    """Description, slider ranges and defaults of a new well (the menu stays: it holds every well
+    the page can show)."""
+    c.well_info.text = r.description()
     for name, slider in c.sliders.items():
         s = getattr(r, name)
         slider.update(start=s.start, end=s.end, step=s.step, value=s.value)

@@ -30,6 +30,9 @@ NUMERIC_COLOR = "#404040"
 BOUNDARY_COLOR = "#d62728"
 LEVEL_COLOR = "#8c8c8c"
 TOOLS = "pan,wheel_zoom,box_zoom,reset,save"
+#: height of both figures (px); their width follows the window (``stretch_width``), at least MIN_WIDTH
+HEIGHT = 440
+MIN_WIDTH = 300
 
 
 def _swatch(color, alpha=1.0, dashed=False):
@@ -76,11 +79,13 @@ def _mapper(color):
 
 
 class Figures:
-    """Both figures, built for one well's windows and a first pair of pictures."""
+    """Both figures, built for one well's windows and a first pair of pictures (of threshold
+    ``xi_max`` and ``damping``); their width follows the window."""
 
-    def __init__(self, r: WellRanges, ic: dict, rm: dict):
-        self.ic = figure(name="ic_plane", title="Initial conditions: slow-flow safe basin",
-                         x_axis_label="q0", y_axis_label="p0", width=500, height=440, tools=TOOLS,
+    def __init__(self, r: WellRanges, ic: dict, rm: dict, xi_max: float, damping: float = 0.0):
+        size = {"sizing_mode": "stretch_width", "height": HEIGHT, "min_width": MIN_WIDTH}
+        ic_title, rm_title = titles(damping)
+        self.ic = figure(name="ic_plane", title=ic_title, x_axis_label="q0", y_axis_label="p0", tools=TOOLS, **size,
                          x_range=Range1d(*r.q_window), y_range=Range1d(*r.p_window))
         self.analytic_source = ColumnDataSource(name="analytic_source",
                                                 data=_mask_image(ic["safe"].T, r.q_window, r.p_window))
@@ -97,17 +102,18 @@ class Figures:
         self.orbit_source = ColumnDataSource(name="orbit_source", data={"q": q, "p": p})
         self.ic.line(x="q", y="p", source=self.orbit_source, line_color="black", line_dash="dashed", name="orbit")
 
-        self.rm = figure(name="manifold", title="Resonance manifold: level curves of C (eq 18)",
-                         x_axis_label="gamma", y_axis_label="xi", width=500, height=440, tools=TOOLS,
+        self.rm = figure(name="manifold", title=rm_title, x_axis_label="gamma", y_axis_label="xi", tools=TOOLS, **size,
                          x_range=Range1d(-np.pi, np.pi), y_range=Range1d(0.0, r.xi_top))
         self.rm_source = ColumnDataSource(name="manifold_source", data=self._rm_image(rm))
         self.rm.image(source=self.rm_source, color_mapper=_mapper(SAFE_COLOR), name="manifold_safe")
-        self.levels = self.rm.contour(rm["gamma"], rm["xi"], rm["C"], rm["levels"], line_color=LEVEL_COLOR,
+        levels = rm["levels"] if len(rm["levels"]) else [0.0]     # (damped: none; a placeholder, hidden)
+        self.levels = self.rm.contour(rm["gamma"], rm["xi"], rm["C"], levels, line_color=LEVEL_COLOR,
                                       line_width=1, fill_color=None)
         self.lpt = self.rm.contour(rm["gamma"], rm["xi"], rm["C"], [0.0], line_color="black", line_width=2,
                                    fill_color=None)
         self.levels.name, self.lpt.name = "levels", "lpt"
-        self.threshold = Span(location=0.0, dimension="width", line_color=BOUNDARY_COLOR, line_dash="dashed",
+        self.levels.visible = self.lpt.visible = not damping > 0
+        self.threshold = Span(location=xi_max, dimension="width", line_color=BOUNDARY_COLOR, line_dash="dashed",
                               line_width=2, name="threshold")
         self.rm.add_layout(self.threshold)
 

@@ -1,9 +1,15 @@
-"""The explorer's Bokeh server: one application at ``/`` on ``host:port`` (a free port by default)."""
+"""The explorer's Bokeh server on ``host:port`` (a free port by default): the application at ``/``
+and the static picture of a view at ``/snapshot?<query>`` (:mod:`safebasins.explore.snapshot`,
+the query of :mod:`safebasins.explore.state`), both starting from the command line's well and point."""
 from __future__ import annotations
 
 import socket
+from functools import partial
 
-__all__ = ["check_host", "free_port", "check_port", "make_server", "serve"]
+__all__ = ["check_host", "free_port", "check_port", "make_server", "serve", "SNAPSHOT_PATH"]
+
+#: URL path of the static picture of a view
+SNAPSHOT_PATH = "/snapshot"
 
 
 def check_host(host: str) -> str:
@@ -35,8 +41,43 @@ def check_port(host: str, port: int) -> int:
     return port
 
 
-def make_server(host: str = "127.0.0.1", port: int | None = None):
-    """A started-but-not-running :class:`bokeh.server.server.Server` serving the explorer at ``/``.
+def snapshot_handler():
+    """The tornado handler of ``/snapshot?<query>``: the static page of the query's view (the
+    command line's well and point where the query leaves them out); a bad query is answered 400
+    with the error in plain text."""
+    from tornado.ioloop import IOLoop
+    from tornado.web import RequestHandler
+
+    from safebasins.explore.app import error_text
+    from safebasins.explore.snapshot import static_html
+    from safebasins.explore.state import view
+
+    def page(well, values, arguments):
+        return static_html(*view(well, values, arguments))
+
+    class SnapshotHandler(RequestHandler):
+        def initialize(self, well, values):
+            self.well, self.values = well, values
+
+        async def get(self):
+            try:
+                html = await IOLoop.current().run_in_executor(None, page, self.well, self.values,
+                                                              dict(self.request.arguments))
+            except Exception as exc:  # noqa: BLE001 - a bad query or well: the error, not a traceback
+                self.set_status(400)
+                self.set_header("Content-Type", "text/plain; charset=utf-8")
+                self.write(f"safebasins explorer: {error_text(exc)}\n")
+                return
+            self.set_header("Content-Type", "text/html; charset=utf-8")
+            self.write(html)
+
+    return SnapshotHandler
+
+
+def make_server(host: str = "127.0.0.1", port: int | None = None, well="quartic", values=None):
+    """A started-but-not-running :class:`bokeh.server.server.Server` serving the explorer at ``/``
+    and its static pictures at ``/snapshot``, starting at the well ``well`` and the point
+    ``values`` (parameter -> value, :mod:`safebasins.explore.state`; missing: the well's defaults).
 
     Browsers may connect through ``host``, ``localhost`` or ``127.0.0.1`` on that port.
     """
@@ -47,16 +88,19 @@ def make_server(host: str = "127.0.0.1", port: int | None = None):
     check_host(host)
     port = free_port(host) if port is None else check_port(host, port)
     origins = sorted({f"{host}:{port}", f"localhost:{port}", f"127.0.0.1:{port}"})
-    server = Server({"/": make_document}, address=host, port=port, allow_websocket_origin=origins, num_procs=1)
+    server = Server({"/": partial(make_document, well=well, values=values)}, address=host, port=port,
+                    allow_websocket_origin=origins, num_procs=1,
+                    extra_patterns=[(SNAPSHOT_PATH, snapshot_handler(), {"well": well, "values": values})])
     server.start()
     return server
 
 
-def serve(host: str = "127.0.0.1", port: int | None = None, open_browser: bool = True, announce=print):
+def serve(host: str = "127.0.0.1", port: int | None = None, open_browser: bool = True, announce=print,
+          well="quartic", values=None):
     """Run the explorer until interrupted (Ctrl-C); ``announce`` receives the URL.  The interrupt
     (``KeyboardInterrupt``) is raised again once the server has stopped, so that a command that
     was interrupted does not exit as if it had completed (``safebasins explore`` exits 130)."""
-    server = make_server(host, port)
+    server = make_server(host, port, well, values)
     url = f"http://{host}:{server.port}/"
     announce(f"safebasins explorer at {url}  (Ctrl-C stops it)")
     if open_browser:

@@ -18,7 +18,8 @@ PROVENANCE_ATTRS = ("date_created", "git_commit", "safebasins_version", "config_
                     "history", "source", "seeds")
 
 
-def _same_array(a: np.ndarray, b: np.ndarray) -> bool:
+def same_array(a: np.ndarray, b: np.ndarray) -> bool:
+    """Equal shape, dtype and values (NaN == NaN; text by value, whatever its storage)."""
     if a.dtype.kind in "OUS" and b.dtype.kind in "OUS":  # text: object vs fixed-width is storage only
         return a.shape == b.shape and bool(np.array_equal(a.astype(str), b.astype(str)))
     if a.shape != b.shape or a.dtype != b.dtype:
@@ -28,7 +29,7 @@ def _same_array(a: np.ndarray, b: np.ndarray) -> bool:
     return bool(np.array_equal(a, b))
 
 
-def _same_attr(a, b) -> bool:
+def same_attr(a, b) -> bool:
     """Equal attribute values: numbers and arrays by value (NaN == NaN; a netCDF round trip turns
     Python scalars into numpy ones), everything else by equality."""
     numeric = (int, float, np.number, np.ndarray, list, tuple)
@@ -50,7 +51,7 @@ def _attr_diffs(where: str, a: dict, b: dict, ignore=()) -> list[str]:
             continue
         if k not in a or k not in b:
             out.append(f"{where}: attribute {k!r} only in {'new' if k in b else 'old'}")
-        elif not _same_attr(a[k], b[k]):
+        elif not same_attr(a[k], b[k]):
             out.append(f"{where}: attribute {k!r} differs: {a[k]!r} vs {b[k]!r}")
     return out
 
@@ -73,7 +74,7 @@ def dataset_differences(old: xr.Dataset, new: xr.Dataset, *, ignore_attrs=PROVEN
             out.append(f"{n}: dims {a.dims} vs {b.dims}")
             continue
         va, vb = np.asarray(a.values), np.asarray(b.values)
-        if not _same_array(va, vb):
+        if not same_array(va, vb):
             if va.shape != vb.shape or (va.dtype != vb.dtype and not (va.dtype.kind in "OUS" and vb.dtype.kind in "OUS")):
                 out.append(f"{n}: shape/dtype {va.shape} {va.dtype} vs {vb.shape} {vb.dtype}")
             else:
@@ -121,15 +122,17 @@ class TreeReport:
                + ("IDENTICAL" if self.identical else "DIFFERENT"))
 
 
-def _datasets(root: Path, parts: bool) -> set[str]:
-    return {str(p.relative_to(root)) for p in root.rglob("*.nc")
+def dataset_files(root, parts: bool = False) -> set[str]:
+    """The ``*.nc`` files below ``root`` (relative paths; tile parts under ``parts/`` only with ``parts``)."""
+    root = Path(root)
+    return {p.relative_to(root).as_posix() for p in root.rglob("*.nc")
             if parts or "parts" not in p.relative_to(root).parts}
 
 
 def compare_trees(old_root, new_root, *, parts=False) -> TreeReport:
     """Compare every dataset of two ``results/data`` trees (see the module docstring)."""
     old_root, new_root = Path(old_root), Path(new_root)
-    a, b = _datasets(old_root, parts), _datasets(new_root, parts)
+    a, b = dataset_files(old_root, parts), dataset_files(new_root, parts)
     rep = TreeReport(only_old=sorted(a - b), only_new=sorted(b - a))
     for f in sorted(a & b):
         rep.compared.append(f)
@@ -138,7 +141,7 @@ def compare_trees(old_root, new_root, *, parts=False) -> TreeReport:
         if diffs:
             rep.differences[f] = diffs
         prov = [k for k in PROVENANCE_ATTRS
-                if not _same_attr(old.attrs.get(k), new.attrs.get(k))]
+                if not same_attr(old.attrs.get(k), new.attrs.get(k))]
         if prov:
             rep.provenance[f] = prov
     return rep

@@ -33,9 +33,12 @@ from safebasins.io import netcdf
 
 @lru_cache(maxsize=1)
 def git_commit() -> str:
-    """Commit of the source tree the library was imported from ('unknown' outside git)."""
+    """Commit of the source tree the library was imported from ('unknown' outside git, and for an
+    installed copy inside another repository's work tree, e.g. a project's ignored .venv)."""
     here = Path(__file__).resolve().parent
     try:
+        subprocess.run(["git", "-C", str(here), "ls-files", "--error-unmatch", Path(__file__).name],
+                       capture_output=True, timeout=10, check=True)
         out = subprocess.run(["git", "-C", str(here), "rev-parse", "HEAD"], capture_output=True,
                              text=True, timeout=10, check=True).stdout.strip()
         dirty = subprocess.run(["git", "-C", str(here), "status", "--porcelain", "--untracked-files=no"],

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import importlib
+import importlib.util
 import math
 
 import numba
@@ -143,13 +144,18 @@ def resolve_backend(backend):
     if backend not in BACKENDS:
         raise ValueError(f"backend must be one of {BACKENDS}, got {backend!r}")
     if backend == "auto":
-        return "cuda" if _cuda().cuda_available() else "cpu"
+        return "cuda" if importlib.util.find_spec("numba_cuda") and cuda_engine().cuda_available() else "cpu"
     return backend
 
 
-def _cuda():
-    """The CUDA backend's module, imported on first use: importing numba.cuda costs ~1 s and the
-    simulator must be chosen (NUMBA_ENABLE_CUDASIM) before it."""
+def cuda_engine():
+    """The CUDA backend's module (safebasins.numerics.cuda_engine), imported on first use: importing
+    numba.cuda costs ~1 s and the simulator must be chosen (NUMBA_ENABLE_CUDASIM) before it;
+    ImportError naming the extra to install when numba-cuda, the numba CUDA target it is written
+    for, is missing."""
+    if importlib.util.find_spec("numba_cuda") is None:
+        raise ImportError("the CUDA backend needs numba-cuda (numba's CUDA target), which is not installed: "
+                          "pip install 'safebasins[cuda]'", name="numba_cuda")
     return importlib.import_module("safebasins.numerics.cuda_engine")
 
 
@@ -160,7 +166,7 @@ def integrate(problem: EnsembleProblem, backend: str = "cpu", *, threads=None, *
     order, bitwise the same on either backend (the CUDA kernels repeat the CPU lanes' operations;
     tests/numerics/test_cuda_simulator.py)."""
     if resolve_backend(backend) == "cuda":
-        steps_E, steps_Q = _cuda().run_cuda(problem, **options)
+        steps_E, steps_Q = cuda_engine().run_cuda(problem, **options)
     else:
         steps_E, steps_Q, _ = run_cpu(problem, threads=threads, **options)
     return problem.caller_order(steps_E, steps_Q)

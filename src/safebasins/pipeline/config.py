@@ -55,6 +55,8 @@ def load_yaml(path):
                 loader.dispose()
     except OSError as exc:
         raise ConfigError(f"config file {path}: cannot be read ({exc.strerror or exc})") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"config file {path}: not UTF-8 text (byte {exc.start}: {exc.reason})") from None
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         where = f", line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
@@ -103,18 +105,25 @@ def load_kinds(extensions=()):
 def well_schema() -> dict:
     """``$defs/well``: the forms of safebasins.wells (the named wells are read from its table)."""
     from safebasins.wells import NAMED_WELLS
+    from safebasins.wells.interpolation import DEFAULT_TOL, TOL_RANGE
+
+    # the tol key of a polynomial or expression well (safebasins.wells.numeric.NumericWell's tol)
+    tol = {"type": "number", "minimum": TOL_RANGE[0], "maximum": TOL_RANGE[1]}
 
     names = "; ".join(f"{k}: {d}" for k, (_, d) in NAMED_WELLS.items())
     return {
         "description": ("the potential well V(q) of q'' + V'(q) = F sin(Omega t + Psi) (safebasins.wells): a name "
                         f"({names}), {{polynomial: [c0, c1, c2, ...]}} for V = sum c_k q^k (c0 = c1 = 0, c2 > 0), or "
                         "{expression: '<formula in q>'} (sympy; e.g. '1 - cos(q)'); V(0) = V'(0) = 0, V''(0) > 0, "
-                        "escape over a barrier or to an asymptote on at least one side"),
+                        "escape over a barrier or to an asymptote on at least one side. A polynomial or expression "
+                        f"may add tol: the relative accuracy of its action-angle interpolants (default {DEFAULT_TOL:g}), "
+                        "for a formula whose own rounding does not reach it"),
         "oneOf": [{"enum": list(NAMED_WELLS)},
                   {"type": "object", "additionalProperties": False, "required": ["polynomial"],
-                   "properties": {"polynomial": {"type": "array", "minItems": 3, "items": {"type": "number"}}}},
+                   "properties": {"polynomial": {"type": "array", "minItems": 3, "items": {"type": "number"}},
+                                  "tol": tol}},
                   {"type": "object", "additionalProperties": False, "required": ["expression"],
-                   "properties": {"expression": {"type": "string", "minLength": 1}}}],
+                   "properties": {"expression": {"type": "string", "minLength": 1}, "tol": tol}}],
     }
 
 

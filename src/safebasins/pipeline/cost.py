@@ -106,7 +106,8 @@ ANALYTIC_COSTS = {
     "basin_rm": lambda p, run: _basin_ic(p) + p["manifold"]["n_gamma"] * p["manifold"]["n_xi"] + p["n_points"],
     "basin_chart": lambda p, run: (_basin_ic(p) + p["n_points"]) * _n(p[p["scan"]]),
     "strobe": lambda p, run: _grid(p) + p["n_points"],
-    "erosion": lambda p, run: _n(p["fourier"]) * _n(p["F"]) * _n(p["xi_max"]) * p["analytic_n"] ** 2,
+    "erosion": lambda p, run: _n(p["fourier"]) * _n(p["F"]) * _n(p["xi_max"]) * _basin_ic(
+        {**p, "grid": {"n": [p["analytic_n"]] * 2}} if p["analytic_n"] else p),
     "true_basin": lambda p, run: _n(p["fourier"]) * _n(p["xi_max"]) * (
         _n(p["Psi"]) * (_grid(p) + p["n_points"]) + _xi_true(p["n_gamma"])),
     "integrity_map": lambda p, run: _n(p["Omega"]) * _n(p["F"]) * (_grid(p) + _xi_true(p["n_gamma"], p["n_xi"])),

@@ -17,7 +17,7 @@ from pathlib import Path
 from safebasins import wells
 from safebasins.pipeline import values
 from safebasins.pipeline.config import experiment_blocks, load_yaml, merge_config, validate_config
-from safebasins.pipeline.validation import fail
+from safebasins.pipeline.validation import ConfigError, fail
 from safebasins.pipeline.registry import (KINDS, PARAMS_DIR, PARTS_DIR, Experiment, FigureSpec, Product,
                                           params_path)
 
@@ -190,11 +190,15 @@ def _relative(path) -> str:
 
 
 def load_config(paths) -> dict:
-    """Merge config files like ``snakemake --configfile`` (later files win, dicts merged)."""
-    paths = list(paths)
-    cfg = load_yaml(paths[0]) or {}
-    for extra in paths[1:]:
-        merge_config(cfg, load_yaml(extra) or {})
+    """Merge config files like ``snakemake --configfile`` (later files win, dicts merged); each
+    must hold a mapping (or nothing)."""
+    cfg = {}
+    for path in paths:
+        data = load_yaml(path)
+        if data is not None and not isinstance(data, dict):
+            raise ConfigError(f"config file {path}: must hold a mapping of keys (figures:, experiments:, ...), "
+                              f"got a {type(data).__name__}")
+        merge_config(cfg, data or {})
     return cfg
 
 

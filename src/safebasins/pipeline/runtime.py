@@ -99,7 +99,8 @@ def load_inputs(inputs, ntasks) -> dict:
 def make_dataset(smk):
     """Rules ``analytic`` / ``numeric`` / ``extras``: build, finalize and write one product.
     A product reading the chart tiles gets them from the ``chart_tile`` jobs, or with
-    ``numerics.tiles`` = 0 integrates every task here (one tile per task, the same values)."""
+    ``numerics.tiles`` = 0 integrates every task here (the rule's ``integrate_tasks``,
+    ``Plan.integrates_tasks``; one tile per task, the same values)."""
     from safebasins.io.datasets import finalize, params_hash, write_netcdf
     from safebasins.pipeline.tiles import task_tiles
 
@@ -108,7 +109,7 @@ def make_dataset(smk):
     product = next(p for p in kind.products(params["experiment"], params) if p.path == out)
     job = Job(threads=smk.threads, backend=smk.params.backend)
     inputs = load_inputs(smk.input, len(kind.tasks(params)))
-    if product.tiles and int(smk.params.tiles) == 0:
+    if smk.params.integrate_tasks:
         inputs["tiles"] = task_tiles(kind, params, job)
     ds = product.build(params, inputs, job)
     finalize(ds, title=product.title, params=params, config_hash=params_hash(params),

@@ -7,8 +7,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from safebasins.checks import reaches
-
 
 class ConfigError(ValueError):
     """A configuration error; the message starts with the offending key."""
@@ -116,15 +114,24 @@ class CheckContext:
         if self.tiles > nq:
             fail("numerics.tiles", f"{self.tiles} tiles but {key} has only {nq} q0 rows")
 
-    def check_thresholds_below_separatrix(self, key, values, what, well):
-        """Analytic products need xi_max strictly below the well's barrier energy."""
+    def check_thresholds_below_separatrix(self, key, values, what, well, damping=0.0):
+        """Analytic products of the undamped slow flow need xi_max below the well's barrier energy
+        (``Well.check_analytic_threshold``, the library's one rule); a damped one (``damping`` > 0: a
+        value, or one per curve like ``values``) takes xi_max = E_b, as the numerics do."""
         top = well.barrier_energy
-        for i, x in enumerate(values if isinstance(values, (list, tuple)) else [values]):
-            if reaches(x, top):
-                fail(indexed(key, values, i),
-                     f"{what} needs xi_max < {top:.6g}, the barrier energy of the {well.name} well (the "
-                     f"action-angle map is singular on the separatrix), got {x!r}"
-                     + (" (within a relative 1e-12 of it, which counts as at it)" if x < top else ""))
+        xs = values if isinstance(values, (list, tuple)) else [values]
+        betas = damping if isinstance(damping, (list, tuple)) else [damping]
+        for i in range(max(len(xs), len(betas))):
+            x, beta = xs[i if len(xs) > 1 else 0], betas[i if len(betas) > 1 else 0]
+            where = indexed(key, values, i if len(xs) > 1 else 0)
+            try:
+                (well.check_threshold if beta > 0 else well.check_analytic_threshold)("xi_max", x)
+            except ValueError as exc:
+                if beta > 0:
+                    fail(where, f"{what} (damping {beta:g}): {exc}")
+                fail(where, f"{what} needs xi_max < {top:.6g}, the barrier energy of the {well.name} well (the "
+                            f"action-angle map is singular on the separatrix), got {x!r}"
+                            + (" (within a relative 1e-12 of it, which counts as at it)" if x < top else ""))
 
     def check_t_eval_within(self, key, t_eval, cycles):
         t = t_eval if isinstance(t_eval, (list, tuple)) else [t_eval]

@@ -21,7 +21,8 @@ from safebasins.plotting.charts import CRITERIA, agreement_time, chart_scan, dra
 from safebasins.plotting.curves import IC_LINE, boundary_polylines, draw_well, plot_curve
 from safebasins.plotting.data import MissingData, open_dataset, param, source, var
 from safebasins.plotting.integrity_maps import plot_integrity_map
-from safebasins.plotting.style import LABELS, SB_EDGE, SB_FACE, SYMBOLS, fmt_value, new_axes, param_text
+from safebasins.plotting.style import (LABELS, SB_EDGE, SB_FACE, SYMBOLS, add_footnote, fmt_value, new_axes,
+                                       param_text)
 
 __all__ = ["plot_escape_chart", "plot_basin", "plot_fcr", "plot_integrity_map"]
 
@@ -259,7 +260,8 @@ def plot_fcr(analytic=None, numeric=None, *, ax=None):
     from matplotlib.legend_handler import HandlerTuple
 
     from safebasins.plotting.fcr import (CURVE_COLORS, CURVE_MARKERS, bracket_handle, curve_labels, draw_fcr,
-                                         draw_fcr_numeric, ic_text, mechanism_legend_handles, omega_margins)
+                                         draw_fcr_numeric, ic_text, mechanism_key, mechanism_legend_handles,
+                                         omega_margins)
 
     analytic, numeric = open_dataset(analytic), open_dataset(numeric)
     if analytic is None and numeric is None:
@@ -268,13 +270,14 @@ def plot_fcr(analytic=None, numeric=None, *, ax=None):
     for ds in (analytic, numeric):
         for name in ("F_cr", "Omega") if ds is not None else ():
             var(ds, name)
+    own = ax is None
     fig, ax = new_axes(ax, figsize=(6.6, 4.8))
     data.attach(fig, analytic, numeric)
     ref = analytic if analytic is not None else numeric
     labels, const = curve_labels(ref.expand_dims("curve") if "curve" not in ref.dims else ref)
     several = "curve" in ref.dims and ref.sizes["curve"] > 1
     colors = CURVE_COLORS if several else ["k"]
-    handles, texts = [], []
+    handles, texts, mechs = [], [], set()
     if analytic is not None:
         mechs, _ = draw_fcr(ax, analytic, color_by="curve" if several else "mechanism", colors=colors, legend=False)
         hs = mechanism_legend_handles(mechs, by_mechanism_color=not several)
@@ -309,4 +312,6 @@ def plot_fcr(analytic=None, numeric=None, *, ax=None):
     ax.set_ylabel(LABELS["F_cr"])
     head = ic_text(const)
     ax.set_title("Critical forcing" + (f", {head}" if head else ""), fontsize=10)
+    if own and mechs:   # the legend's abbreviations in words, under a figure of its own
+        add_footnote(fig, "Mechanisms: " + mechanism_key(mechs))
     return fig

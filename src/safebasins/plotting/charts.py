@@ -19,7 +19,7 @@ from safebasins.plotting.curves import (analytic_safe, boundary_polylines, draw_
 from safebasins.plotting.captions import add_note, count
 from safebasins.plotting import data
 from safebasins.plotting.data import load_params, open_dataset, param, source, var
-from safebasins.plotting.style import LABELS, SYMBOLS, fmt_value, grey_levels, param_text
+from safebasins.plotting.style import LABELS, LAYOUT, SYMBOLS, fmt_value, grey_levels, param_text
 
 LINE_STYLES = ["-", "--", "-.", ":", (0, (5, 1, 1, 1, 1, 1))]
 THEORY_COLORS = ["tab:red", "tab:blue", "tab:green", "tab:orange", "tab:purple", "tab:brown", "tab:pink"]
@@ -241,14 +241,14 @@ def figure_nested_basins(analytic, numeric, *, title=None, t_eval=None, figsize=
     curves that border the analytic safe mask; ``analytic`` may be None (numerics only).
     Boundaries of several parameter values that coincide (e.g. a saddle-type curve below every
     threshold) are drawn as one line of alternating colours, each colour still visible.  Damped
-    data (attribute ``damping``, issue 17): beta in the title and a note, the analytic boundary
+    data (attribute ``damping``): beta in the title and a note, the analytic boundary
     is the outline of the damped slow flow's safe mask (the numeric and analytic damping must be
     equal)."""
     chart = open_dataset(numeric)
     basins = open_dataset(analytic)
     scan = chart_scan(chart)
     t_ev = agreement_time(chart) if t_eval is None else float(t_eval)
-    fig, ax = plt.subplots(figsize=figsize, layout="constrained")
+    fig, ax = plt.subplots(figsize=figsize, layout=LAYOUT)
     data.attach(fig, basins, chart)
     # a stack over the scan must match it value for value; a single basin draws with its own value
     strict = basins is not None and scan in basins.dims
@@ -316,18 +316,26 @@ def figure_criteria(numeric, *, title=None, figsize=(6.4, 4.4)):
 # --------------------------------------------------------------------------------------------
 # Figs 20-22: DSB / ESB charts and area vs t_eval
 # --------------------------------------------------------------------------------------------
+def has_dsb(chart):
+    """Whether a chart has a displacement threshold (a DSB; the energy criterion alone for a well
+    other than the quartic, whose escape is over its own barriers)."""
+    return "escape_cycle_displacement" in chart.variables and chart.sizes.get("q_max", 0) > 0
+
+
 def chart_thresholds(chart):
-    """The (first) energy and displacement thresholds of a chart."""
-    return float(np.asarray(var(chart, "xi_max")).ravel()[0]), float(np.asarray(var(chart, "q_max")).ravel()[0])
+    """The (first) energy and displacement thresholds of a chart (displacement None without one)."""
+    qm = float(np.asarray(var(chart, "q_max")).ravel()[0]) if has_dsb(chart) else None
+    return float(np.asarray(var(chart, "xi_max")).ravel()[0]), qm
 
 
 def draw_dsb_esb(ax, chart, t_eval):
-    """DSB (displacement criterion) grey, ESB (energy criterion) black on top."""
+    """DSB (displacement criterion) grey, ESB (energy criterion) black on top (the ESB alone for a
+    chart without displacement threshold)."""
     esb = var(chart, "escape_cycle_energy").isel(xi_max=0)
-    dsb = var(chart, "escape_cycle_displacement").isel(q_max=0)
-    q, p, Zd = xy_grid(dsb)
-    _, _, Ze = xy_grid(esb)
-    safe_fill(ax, q, p, is_safe(Zd, t_eval), color="0.62", zorder=1)
+    q, p, Ze = xy_grid(esb)
+    if has_dsb(chart):
+        _, _, Zd = xy_grid(var(chart, "escape_cycle_displacement").isel(q_max=0))
+        safe_fill(ax, q, p, is_safe(Zd, t_eval), color="0.62", zorder=1)
     safe_fill(ax, q, p, is_safe(Ze, t_eval), color="k", zorder=2)
     ax.set_xlim(q.min(), q.max())
     ax.set_ylim(p.min(), p.max())
@@ -350,10 +358,12 @@ def ec(t):
 
 
 def _area_curves(chart, t):
-    """Safe pixels of the energy (ESB) and displacement (DSB) criteria at evaluation times t."""
+    """Safe pixels of the energy (ESB) and displacement (DSB; NaN without one) criteria at
+    evaluation times t."""
     area = safe_area(chart, np.asarray(t, float))
-    return (np.asarray(area["pixels_energy"].isel(xi_max=0), float),
-            np.asarray(area["pixels_displacement"].isel(q_max=0), float))
+    nE = np.asarray(area["pixels_energy"].isel(xi_max=0), float)
+    return nE, (np.asarray(area["pixels_displacement"].isel(q_max=0), float) if has_dsb(chart)
+                else np.full(nE.shape, np.nan))
 
 
 def _last_escape(chart, name, dim):
@@ -370,6 +380,18 @@ def settle_time(t, n, frac=0.01):
     return float(t[0]) if not off.size else float(t[min(off[-1] + 1, t.size - 1)])
 
 
+def _esb_notes(fig, chart, t_evals):
+    """Caption notes of a chart with the energy criterion only."""
+    nE, _ = _area_curves(chart, t_evals)
+    esc = np.asarray(var(chart, "escape_cycle_energy").isel(xi_max=0), float)
+    changed = int(((esc > t_evals[0]) != (esc > t_evals[-1])).sum())
+    add_note(fig, f"Safe pixels of {esc.size:,}: " + "; ".join(f"t_eval = {ec(t)}: ESB {int(e):,}"
+                                                              for t, e in zip(t_evals, nE)) + ".")
+    add_note(fig, f"No displacement threshold (q_max) in the chart: the ESB alone; between t_eval = {ec(t_evals[0])} "
+                  f"and {ec(t_evals[-1])} {count(changed, 'ESB pixel')} change, the last energy escape is at "
+                  f"{ec(_last_escape(chart, 'escape_cycle_energy', 'xi_max'))}.")
+
+
 def figure_dsb_esb(numeric, params, *, t_evals=None, title=None, figsize=None):
     """Figs 20-21: DSB grey / ESB black at the first (left) and last (right) t_eval."""
     chart = open_dataset(numeric)
@@ -378,19 +400,23 @@ def figure_dsb_esb(numeric, params, *, t_evals=None, title=None, figsize=None):
         aspect = np.ptp(np.asarray(chart["p0"], float)) / max(np.ptp(np.asarray(chart["q0"], float)), 1e-12)
         w = 5.6
         figsize = (w * len(t_evals) + 0.6, min(w * aspect, 7.5) + 1.5)
-    fig, axes = plt.subplots(1, len(t_evals), figsize=figsize, layout="constrained", squeeze=False)
+    fig, axes = plt.subplots(1, len(t_evals), figsize=figsize, layout=LAYOUT, squeeze=False)
     data.attach(fig, chart)
     for ax, t in zip(axes[0], t_evals):
         draw_dsb_esb(ax, chart, t)
     xi, qm = chart_thresholds(chart)
-    fig.legend(handles=[
-        Patch(facecolor="0.62", label=f"DSB: displacement criterion, $q_{{max}}$ = {fmt_value(qm)}"),
-        Patch(facecolor="k", label=rf"ESB: energy criterion, $\xi_{{max}}$ = {fmt_value(xi)}")],
-        loc="outside lower center", ncol=2, fontsize=9, frameon=False)
+    fig.legend(handles=([Patch(facecolor="0.62", label=f"DSB: displacement criterion, $q_{{max}}$ = {fmt_value(qm)}")]
+                        if qm is not None else [])
+               + [Patch(facecolor="k", label=rf"ESB: energy criterion, $\xi_{{max}}$ = {fmt_value(xi)}")],
+               loc="outside lower center", ncol=2, fontsize=9, frameon=False)
     shown = {k: param(chart, k) for k in ("F", "Omega", "Psi")}
     shown["xi_max"] = xi
-    fig.suptitle(title or ("Safe basins by the displacement (DSB, grey) and energy (ESB, black) "
-                           "criterion\n" + param_text(shown) + f", resolution {resolution(chart)}"), fontsize=10.5)
+    head = ("Safe basins by the displacement (DSB, grey) and energy (ESB, black) criterion" if qm is not None
+            else "Safe basins by the energy criterion (ESB, black; no displacement threshold)")
+    fig.suptitle(title or (head + "\n" + param_text(shown) + f", resolution {resolution(chart)}"), fontsize=10.5)
+    if qm is None:
+        _esb_notes(fig, chart, t_evals)
+        return fig
     # what the data show
     nE, nD = _area_curves(chart, t_evals)
     esc = np.asarray(var(chart, "escape_cycle_energy").isel(xi_max=0), float)
@@ -437,17 +463,19 @@ def figure_area_vs_time(numeric, params, *, t_evals=None, title=None, figsize=(1
     with np.errstate(divide="ignore"):
         lE, lD, pE, pD = (np.where(n > 0, np.log(n), np.nan) for n in (nE, nD, cE, cD))
     ms = 3.0 if t_cfg.size <= 100 else 1.6
-    a_lin.plot(t_cfg, pD, ls="--", color="k", lw=0.8, marker="o", ms=ms, mfc="w", mew=0.6,
-               label=f"DSB ($q_{{max}}$ = {fmt_value(qm)})")
+    if qm is not None:
+        a_lin.plot(t_cfg, pD, ls="--", color="k", lw=0.8, marker="o", ms=ms, mfc="w", mew=0.6,
+                   label=f"DSB ($q_{{max}}$ = {fmt_value(qm)})")
     a_lin.plot(t_cfg, pE, ls="-", color="k", lw=0.8, marker="o", ms=ms, mew=0.6,
                label=rf"ESB ($\xi_{{max}}$ = {fmt_value(xi)})")
     a_lin.set_xlim(0, horizon * 1.01)
     a_lin.set_xlabel(LABELS["t_eval"])
     a_lin.set_title(f"as in the paper: one point per $t_{{eval}}$ ({t_cfg.size} values)", fontsize=9)
-    a_log.plot(t, lD, ls="--", color="k", lw=1.4)
+    if qm is not None:
+        a_log.plot(t, lD, ls="--", color="k", lw=1.4)
     a_log.plot(t, lE, ls="-", color="k", lw=1.4)
     tE = _last_escape(chart, "escape_cycle_energy", "xi_max")
-    tD = settle_time(t, nD)
+    tD = settle_time(t, nD) if qm is not None else np.nan
     for ax in (a_lin, a_log):
         for x, txt, yf in ((tE, "last ESB escape", 0.62), (tD, "DSB within 1%\nof its final area", 0.78)):
             if np.isfinite(x):
@@ -469,6 +497,10 @@ def figure_area_vs_time(numeric, params, *, t_evals=None, title=None, figsize=(1
     add_note(fig, f"Read from the chart of {resolution(chart)} ICs over {ec(horizon)}, at the "
                   f"{t_cfg.size} configured t_eval ({ec(t_cfg.min())} ... {ec(t_cfg.max())}; left, one point each) and "
                   f"{n_log} log-spaced ones from {ec(1)} (right).")
+    if qm is None:
+        add_note(fig, f"No displacement threshold (q_max) in the chart: the ESB alone; it keeps {int(nE[-1]):,} pixels "
+                      f"at {ec(horizon)}, its last escape at {ec(tE)}.")
+        return fig
     reproduced = tE >= PAPER_SHRINK_EC / 2
     add_note(fig, f"Paper: the area shrinks rapidly for about {ec(PAPER_SHRINK_EC)} and then hardly changes. "
                   + ("Reproduced" if reproduced else "Not reproduced") + f" for the ESB: it loses its last pixel at "

@@ -67,7 +67,8 @@ def well(ds):
 
 
 #: dataset attributes written into saved figures (io.datasets.finalize: provenance; wells.spec_attrs)
-PROVENANCE = ("title", "safebasins_version", "git_commit", "config_hash", "well", "well_coefficients", "parameters")
+PROVENANCE = ("title", "safebasins_version", "git_commit", "config_hash", "well", "well_coefficients",
+              "well_expression", "parameters")
 _PROVENANCE_ATTR = "_safebasins_datasets"
 
 
@@ -97,11 +98,8 @@ def provenance(*datasets, fig=None) -> dict:
     items = list(_flat([*datasets, *(getattr(fig, _PROVENANCE_ATTR, None) or [])]))
     out, sources = {}, []
     for d in items:
-        if isinstance(d, (xr.Dataset, xr.DataArray)):
-            attrs, src = d.attrs, source(d) if isinstance(d, xr.Dataset) else "<data array>"
-        else:
-            with xr.open_dataset(d) as ds:
-                attrs, src = dict(ds.attrs), os.fspath(d)
+        attrs = _attrs_of(d)
+        src = source(d) if isinstance(d, xr.Dataset) else "<data array>" if isinstance(d, xr.DataArray) else os.fspath(d)
         if src not in sources:
             sources.append(src)
         for k in PROVENANCE:
@@ -114,6 +112,43 @@ def provenance(*datasets, fig=None) -> dict:
     meta = {"Source": "\n".join(sources)} if sources else {}
     meta.update({("Title" if k == "title" else k): "\n".join(v) for k, v in out.items()})
     return meta
+
+
+def _attrs_of(d):
+    if isinstance(d, (xr.Dataset, xr.DataArray)):
+        return d.attrs
+    with xr.open_dataset(d) as ds:
+        return dict(ds.attrs)
+
+
+def well_text(attrs) -> str | None:
+    """How a figure names the potential well of a dataset (its ``well`` attributes): a named well by
+    its description (``well: pendulum, the pendulum / ship roll V = 1 - cos q, ...``), an expression
+    well by its formula, a polynomial by V(q); None for the paper's quartic (every figure's default)
+    and a dataset that names no well."""
+    name = attrs.get("well")
+    if not isinstance(name, str) or name == "quartic":
+        return None
+    if name == "expression" and "well_expression" in attrs:      # the formula the dataset defines it by
+        return f"well: V(q) = {attrs['well_expression']}"
+    from safebasins.wells import NAMED_WELLS, from_attrs
+
+    if name in NAMED_WELLS:                                      # the named well's own description
+        return f"well: {name}, {NAMED_WELLS[name][1]}"
+    try:
+        return f"well: {name}, V(q) = {from_attrs(attrs).potential_text()}"
+    except ValueError:                                           # a well the attributes cannot rebuild
+        return f"well: {name}"
+
+
+def well_texts(*datasets, fig=None) -> list[str]:
+    """:func:`well_text` of every distinct well among the datasets (and those attached to ``fig``)."""
+    out = []
+    for d in _flat([*datasets, *(getattr(fig, _PROVENANCE_ATTR, None) or [])]):
+        t = well_text(_attrs_of(d))
+        if t and t not in out:
+            out.append(t)
+    return out
 
 
 def load_params(src):

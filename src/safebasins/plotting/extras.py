@@ -24,7 +24,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Patch
 
 from safebasins.plotting.curves import draw_well, plot_curve, separates_mask
-from safebasins.plotting.captions import add_note, fmt_range
+from safebasins.plotting.captions import add_note, count, fmt_range
 from safebasins.plotting import data
 from safebasins.plotting.data import open_dataset, param, var
 from safebasins.plotting.fcr import curve_labels, ic_text
@@ -123,7 +123,10 @@ def figure_erosion(analytic=None, numeric=None, *, measures=("GIM", "LIM", "IF")
     fig.legend(handles, labels, handler_map={tuple: HandlerTuple(ndivide=None, pad=0.1)}, loc="lower center",
                ncol=ncol, fontsize=7.5, frameon=False, bbox_to_anchor=(0.5, 0.0), columnspacing=1.5)
     par = {k: param(ref, k) for k in ("Omega", "Psi")}
-    fig.suptitle(title or "Erosion profiles: " + param_text(par), fontsize=10)
+    if "damping" in ref.attrs:          # a damped profile (both sides integrate the damped equation)
+        par["damping"] = param(ref, "damping")
+    fig.suptitle(title or ("Damped erosion profiles: " if "damping" in par else "Erosion profiles: ")
+                 + param_text(par), fontsize=10)
     fig.tight_layout(rect=(0, 0.04 + 0.045 * -(-len(handles) // ncol), 1, 1))
     _erosion_notes(fig, analytic, numeric, measures)
     return fig
@@ -134,6 +137,15 @@ def _erosion_notes(fig, analytic, numeric, measures):
     def crossings(ds, **sel):
         return ", ".join(f"F_{m} = {float(_sel(var(ds, f'F_{m}'), **sel)):.4g}" for m in measures)
 
+    ref = analytic if analytic is not None else numeric
+    if "damping" in ref.attrs:
+        und = int(np.asarray(analytic["n_undecided"]).sum()) if analytic is not None and "n_undecided" in analytic \
+            else 0
+        add_note(fig, f"Damped equation q'' + β q' + V'(q) = F sin(Ω t + Ψ), β = {fmt_value(param(ref, 'damping'))}: "
+                      "the numerics integrate it, the analytic profile follows each IC's damped slow trajectory until "
+                      "it escapes or settles below ξ_max (docs/damping.md)"
+                      + (f"; {count(und, 'slow trajectory', 'slow trajectories')} undecided, counted as escaping."
+                         if und else "."))
     if analytic is not None and "grid_n" in analytic.attrs:  # written by the pipeline's erosion kind
         n = np.atleast_1d(param(analytic, "grid_n"))
         add_note(fig, f"Analytic profiles from the slow flow on {' x '.join(str(int(v)) for v in n)} ICs of the "

@@ -14,7 +14,7 @@ from matplotlib.lines import Line2D
 from safebasins.plotting.captions import add_note, count, fmt_range
 
 from safebasins.plotting.data import open_dataset, param, var
-from safebasins.plotting.style import LABELS, SYMBOLS, fmt_value, param_text, plain_text
+from safebasins.plotting.style import LABELS, SYMBOLS, add_footnote, fmt_value, param_text, plain_text
 
 # mechanism flags of theory.critical_forcing: "none MM_0 MM_pi SM SMM"
 MECHANISMS = {
@@ -25,6 +25,19 @@ MECHANISMS = {
 }
 # branch variables of the critical_forcing dataset, in the mechanism order above
 BRANCHES = {1: "F_MM_0", 2: "F_MM_pi", 3: "F_SM", 4: "F_SMM"}
+#: the mechanisms in words (the paper, Sec. 3), keyed by the abbreviation of their legend labels
+MECHANISM_WORDS = {
+    "SM": "saddle mechanism (the level curve of C through the IC passes the saddle of C)",
+    "MM": "maximum mechanism (the level curve touches ξ = ξ_max at γ* = 0 or π)",
+    "SMM": "saddle maximum mechanism (the MM at γ* = 0 with the saddle above ξ_max)",
+}
+
+
+def mechanism_key(mechanisms) -> str:
+    """What the abbreviations of the mechanisms drawn (MECHANISMS codes) stand for: the key written
+    under every figure whose legend names them ("" for none)."""
+    abbr = dict.fromkeys(MECHANISMS[m]["label"].split()[0] for m in sorted(mechanisms) if m in MECHANISMS)
+    return "; ".join(f"{a}: {MECHANISM_WORDS[a]}" for a in abbr) + "." if abbr else ""
 CURVE_COORDS = ("xi_max", "xi_ini", "gamma_ini", "Psi", "damping")
 
 
@@ -142,6 +155,9 @@ def draw_fcr(ax, ds, *, color_by="curve", show_branches=False, colors=None, lw=1
         cmap = plt.get_cmap("viridis")
         colors = ["k"] if n == 1 else [cmap(v) for v in np.linspace(0.0, 0.9, n)]
     Omega = np.asarray(var(ds, "Omega"), float)
+    # the damped theory has neither mechanisms nor branches: one line style, no mechanism legend
+    show_branches = show_branches and all(v in ds.variables for v in BRANCHES.values())
+    has_mechanism = "mechanism" in ds.variables
     mechs_seen = set()
     curve_handles = []
     for i in range(n):
@@ -152,8 +168,9 @@ def draw_fcr(ax, ds, *, color_by="curve", show_branches=False, colors=None, lw=1
                 st = MECHANISMS[m]
                 ax.plot(Omega, np.asarray(var(d, v), float), ls=st["ls"], zorder=2,
                         color=st["color"] if color_by == "mechanism" else col, **THIN)
-        mechs_seen |= draw_fcr_curve(ax, Omega, var(d, "F_cr"), _mechanism_of(d), color=col,
-                                     by_mechanism_color=(color_by == "mechanism"), lw=lw)
+        drawn = draw_fcr_curve(ax, Omega, var(d, "F_cr"), _mechanism_of(d), color=col,
+                               by_mechanism_color=(color_by == "mechanism"), lw=lw)
+        mechs_seen |= drawn if has_mechanism else set()
         curve_handles.append(Line2D([], [], color=col, lw=lw, label=labels[i]))
     ax.set_xlabel(LABELS["Omega"])
     ax.set_ylabel(LABELS["F_cr"])
@@ -217,6 +234,9 @@ def figure_fcr(analytic, *, color_by="curve", show_branches=False, F_max=None, t
     seen, branches = draw_fcr(ax, ds, color_by=color_by, show_branches=show_branches)
     _fcr_ylim(ax, [ds["F_cr"]], F_max)
     _fcr_notes(fig, ds, seen, branches, color_by)
+    key = mechanism_key(seen | branches)
+    if key:
+        add_footnote(fig, "Mechanisms: " + key)
     _, const = curve_labels(ds)
     const.pop("Psi", None)  # F_cr on the RM does not depend on the forcing phase
     fourier = param(ds, "fourier")
@@ -237,8 +257,10 @@ def _mechanism_text(m, color_by):
 def _fcr_notes(fig, ds, seen, branches, color_by):
     """Caption notes of Figs 1-4: the line styles drawn and each curve's minimum (read from the data)."""
     labels, _ = curve_labels(ds)
-    add_note(fig, "Line styles drawn (mechanism setting F_cr): " + ", ".join(_mechanism_text(m, color_by) for m in
-                                                                            sorted(seen)) + ".")
+    if seen:
+        add_note(fig, "Line styles drawn (mechanism setting F_cr): " + ", ".join(_mechanism_text(m, color_by) for m in
+                                                                                sorted(seen)) + ". "
+                      + mechanism_key(seen))
     if branches:
         _branch_notes(fig, ds, seen, branches, color_by)
     Om = np.asarray(ds["Omega"], float)
@@ -250,9 +272,11 @@ def _fcr_notes(fig, ds, seen, branches, color_by):
             parts.append(f"{labels[i]}: no F_cr")
             continue
         k = int(np.nanargmin(F))
-        mech = sorted({int(m) for m in _mechanism_array(var(d, "mechanism")) if m})
-        parts.append(f"{plain_text(labels[i])}: minimum F_cr = {F[k]:.4g} at Ω = {Om[k]:.3g}, mechanisms "
-                     + ", ".join(_mechanism_text(m, None).rsplit(" ", 1)[0] for m in mech))
+        m_d = _mechanism_of(d)
+        mech = sorted({int(m) for m in _mechanism_array(m_d) if m}) if m_d is not None else []
+        parts.append(f"{plain_text(labels[i])}: minimum F_cr = {F[k]:.4g} at Ω = {Om[k]:.3g}"
+                     + (", mechanisms " + ", ".join(_mechanism_text(m, None).rsplit(" ", 1)[0] for m in mech)
+                        if mech else ""))
     add_note(fig, "; ".join(parts) + ".")
 
 

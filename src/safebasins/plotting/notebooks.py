@@ -5,7 +5,8 @@ repository root, output paths, style options; Snakemake overrides the paths with
 summary cell (:func:`safebasins.plotting.data.describe`) and one call of the figure's builder,
 which also writes the report caption with the numbers read from the datasets
 (:func:`safebasins.plotting.captions.write_caption`, ``results/captions/<name>.rst``); the saved
-PNG carries the datasets' provenance in its text chunks (:func:`safebasins.plotting.style.save_figure`).
+PNG carries the datasets' provenance in its text chunks (:func:`safebasins.plotting.style.save_figure`);
+the figure of an experiment declared in a config is headed by its ``title:``.
 """
 from __future__ import annotations
 
@@ -46,6 +47,8 @@ def build_notebook(fig) -> nbformat.NotebookNode:
     params = new_code_cell("\n".join(lines))
     params.metadata["tags"] = ["parameters"]
     inputs = ", ".join(f"{k}={k}" for k in fig.inputs)
+    # an experiment of the user's config (not in the catalog: not packaged): its title on the figure too
+    heading_arg = "" if fig.packaged else f", heading={fig.label!r}"
     opts = "".join(f", {k}={k}" for k in fig.options)
     setup = new_code_cell("from safebasins.plotting.captions import notes, write_caption\n"
                           "from safebasins.plotting.data import describe\n"
@@ -53,7 +56,7 @@ def build_notebook(fig) -> nbformat.NotebookNode:
                           f"from {module} import {function}\n\n"
                           f"apply_style()\ndescribe({inputs});")
     draw = new_code_cell(f"fig = {function}({inputs}{opts}, title=title)\n"
-                         f"save_figure(fig, png, pdf, dpi=dpi, datasets=[{', '.join(fig.inputs)}])\n"
+                         f"save_figure(fig, png, pdf, dpi=dpi, datasets=[{', '.join(fig.inputs)}]{heading_arg})\n"
                          f"write_caption(caption, fig, label={fig.label!r}, "
                          f"{'paper' if fig.category == 'Figures' else 'shows'}={fig.caption!r},\n"
                          f"              look={fig.look!r},\n"

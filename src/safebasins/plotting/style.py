@@ -70,26 +70,34 @@ def style(**overrides):
         yield
 
 
+#: layout engine of the figures: constrained layout that also fits fixed-aspect (equal) axes, so
+#: that the labels and the outside legend of an equal-aspect chart stay inside the figure whatever
+#: the window's proportions (plain constrained layout lets them spill over the edges)
+LAYOUT = "compressed"
+
+
 def new_axes(ax, figsize):
-    """(Figure, Axes): a new constrained-layout figure, or the figure of the given axes (``ax=``
-    of the public plotting functions)."""
+    """(Figure, Axes): a new figure (layout :data:`LAYOUT`), or the figure of the given axes
+    (``ax=`` of the public plotting functions)."""
     if ax is None:
-        fig, ax = plt.subplots(figsize=figsize, layout="constrained")
+        fig, ax = plt.subplots(figsize=figsize, layout=LAYOUT)
         return fig, ax
     return ax.figure, ax
 
 
-def save_figure(fig, png=None, pdf=None, *, dpi=DEFAULT_DPI, datasets=()):
+def save_figure(fig, png=None, pdf=None, *, dpi=DEFAULT_DPI, datasets=(), heading=None):
     """Write ``fig`` to PNG (``dpi``) and/or PDF, creating parent folders.
 
     The provenance of the datasets drawn (``datasets``: paths or Datasets, and those the
     builder attached, :func:`safebasins.plotting.data.attach`) goes into the files: PNG text
     chunks ``Source``, ``safebasins_version``, ``git_commit``, ``config_hash``, ``well``,
-    ``parameters``, ... (:func:`safebasins.plotting.data.provenance`); the PDF ``Subject``."""
-    from safebasins.plotting.data import provenance
+    ``parameters``, ... (:func:`safebasins.plotting.data.provenance`); the PDF ``Subject``.
+    ``heading`` (an experiment's title) and the potential of a well other than the paper's quartic
+    are written above everything drawn (:func:`add_heading`)."""
+    from safebasins.plotting.data import provenance, well_texts
 
     meta = provenance(*datasets, fig=fig)
-    label_well(fig, meta.get("well"))
+    add_heading(fig, [heading, *well_texts(*datasets, fig=fig)])
     summary = ", ".join(f"{k} {meta[k]}" for k in ("safebasins_version", "git_commit", "config_hash", "well")
                         if k in meta).replace("\n", " / ")
     for path, kw in ((png, dict(format="png", dpi=dpi, metadata=meta)),
@@ -102,14 +110,41 @@ def save_figure(fig, png=None, pdf=None, *, dpi=DEFAULT_DPI, datasets=()):
     return fig
 
 
+def _drawn_extent(fig):
+    """Everything drawn so far, in figure coordinates (the layout applied first): a Bbox."""
+    fig.draw_without_rendering()
+    bb = fig.get_tightbbox(fig.canvas.get_renderer())
+    return bb.transformed(fig.dpi_scale_trans).transformed(fig.transFigure.inverted())
 
-def label_well(fig, well):
-    """Name the potential well in the figure's top-left corner unless it is the paper's quartic
-    (``well``: the datasets' ``well`` attribute; several wells: one a line)."""
-    if not well or well == "quartic" or getattr(fig, "_safebasins_well_label", None) == well:
-        return
-    fig.text(0.005, 0.998, "well: " + well.replace("\n", ", "), ha="left", va="top", fontsize=8, color="0.25")
-    fig._safebasins_well_label = well
+
+def _wrap(fig, text, fontsize, x0, x1):
+    """``text`` wrapped to the width between ``x0`` and ``x1`` (figure coordinates)."""
+    import textwrap
+
+    chars = max(40, int((x1 - x0) * fig.get_figwidth() * 72 / (0.52 * fontsize)))
+    return "\n".join(textwrap.fill(line, chars) for line in str(text).split("\n"))
+
+
+def add_heading(fig, lines, *, fontsize=9):
+    """Write ``lines`` (None and repeated lines skipped) above everything drawn on ``fig``, left-aligned
+    with it, so that no title, legend or label is overlapped.  Returns the Text (None: nothing to
+    write); a figure is headed once (a second call with the same lines does nothing)."""
+    text = "\n".join(dict.fromkeys(str(x) for x in lines if x))
+    if not text or getattr(fig, "_safebasins_heading", None) == text:
+        return None
+    ext = _drawn_extent(fig)
+    t = fig.text(ext.x0, ext.y1 + 0.01, _wrap(fig, text, fontsize, ext.x0, ext.x1), ha="left", va="bottom",
+                 fontsize=fontsize, color="0.15")
+    fig._safebasins_heading = text
+    return t
+
+
+def add_footnote(fig, text, *, fontsize=7.5):
+    """Write ``text`` below everything drawn on ``fig`` (a key to the symbols of a legend, why a panel
+    is empty), wrapped to the width of the drawing; each footnote goes below the previous ones."""
+    ext = _drawn_extent(fig)
+    return fig.text(ext.x0, ext.y0 - 0.01, _wrap(fig, text, fontsize, ext.x0, ext.x1), ha="left", va="top",
+                    fontsize=fontsize, color="0.25")
 
 
 def fmt_value(v, name=None):

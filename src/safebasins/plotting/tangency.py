@@ -6,10 +6,13 @@ Inputs are the Datasets of :func:`safebasins.analysis.tangency.tangency_profile`
 """
 from __future__ import annotations
 
+import textwrap
+
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import ListedColormap
 
+from safebasins.analysis.fractality import MIN_UNCERTAIN
 from safebasins.plotting.captions import add_note
 from safebasins.plotting.data import open_dataset, param
 from safebasins.plotting.style import LABELS, param_text
@@ -54,13 +57,19 @@ def figure_tangency(profile, fractality=None, *, xi_max=None, title=None):
     ax.legend(fontsize=6.5, frameon=False, loc="lower left")
     ax = axes[0, 1]
     if fractality is not None:
-        a, e = fractality["alpha"].values, fractality["alpha_err"].values
-        ax.errorbar(fractality["F"].values, a, yerr=e, fmt="o", ms=4, color="tab:green", capsize=2,
+        Ff, a, e = fractality["F"].values, fractality["alpha"].values, fractality["alpha_err"].values
+        ax.errorbar(Ff, a, yerr=e, fmt="o", ms=4, color="tab:green", capsize=2,
                     label=rf"$\alpha$ (n = {int(param(fractality, 'n'))} base points)")
         ax.axhline(1.0, color="0.5", lw=0.8, ls=":", label=r"$\alpha$ = 1: smooth boundary")
         _melnikov_line(ax, F_M, label=False)
         ax.set_ylim(0.0, 1.4)
+        pad = 0.05 * max(float(np.ptp(np.r_[Ff, F_M])), 1e-3)
+        ax.set_xlim(min(Ff.min(), F_M) - pad, max(Ff.max(), F_M) + pad)
         ax.legend(fontsize=6.5, frameon=False, loc="lower left")
+        why = unfitted_text(fractality)
+        if why:
+            ax.text(0.5, 0.62, textwrap.fill(why, 48), transform=ax.transAxes, ha="center", va="center", fontsize=6.5,
+                    bbox=dict(facecolor="white", edgecolor="0.7", boxstyle="round,pad=0.4"))
     else:
         ax.text(0.5, 0.5, "no fractality dataset", ha="center", va="center", transform=ax.transAxes)
     ax.set_xlabel(LABELS["F"])
@@ -83,6 +92,24 @@ def figure_tangency(profile, fractality=None, *, xi_max=None, title=None):
     return fig
 
 
+def unfitted_text(fractality):
+    """Why alpha is NaN at some F, read from the data (None when it is fitted at every F): the fit
+    needs at least two eps with MIN_UNCERTAIN uncertain base points each."""
+    a = np.atleast_1d(fractality["alpha"].values)
+    bad = ~np.isfinite(a)
+    if not bad.any():
+        return None
+    F = np.atleast_1d(fractality["F"].values)
+    used = np.asarray(fractality["used"].values, bool).reshape(F.size, -1)
+    k = np.asarray(fractality["n_uncertain"].values).reshape(F.size, -1)
+    n, n_eps = int(param(fractality, "n")), used.shape[1]
+    where = "any F" if bad.all() else "F = " + ", ".join(f"{f:g}" for f in F[bad])
+    return (f"alpha not fitted at {where}: too few uncertain initial conditions (the fit needs at least 2 of the "
+            f"{n_eps} eps with {MIN_UNCERTAIN} or more uncertain of the {n:,} base points; here at most "
+            f"{int(used[bad].sum(axis=1).max())} eps and {int(k[bad].max()):,} uncertain points). More base points "
+            "(fractality n) or a box closer to the basin boundary would resolve it.")
+
+
 def _first_below(F, y, level):
     below = np.flatnonzero(y < level)
     return float(F[below[0]]) if below.size else np.nan
@@ -98,7 +125,9 @@ def _notes(fig, profile, fractality, F_M, xi):
     if fractality is not None:
         F, a, e = fractality["F"].values, fractality["alpha"].values, fractality["alpha_err"].values
         add_note(fig, "Uncertainty exponent: " + "; ".join(
-            f"F = {f:g} ({f / F_M:.2f} F_M): {x:.2f} +- {s:.2f}" for f, x, s in zip(F, a, e)) + ".")
+            f"F = {f:g} ({f / F_M:.2f} F_M): " + (f"{x:.2f} +- {s:.2f}" if np.isfinite(x) else "not fitted")
+            for f, x, s in zip(F, a, e)) + ".")
+        add_note(fig, unfitted_text(fractality))
     if "safe" in profile:
         for F in profile["F_basin"].values:
             frac = float(profile["safe"].sel(F_basin=F, xi_max=xi).mean())

@@ -38,7 +38,7 @@ import xarray as xr
 from scipy import optimize
 
 from safebasins.checks import check_finite, check_nonnegative, check_positive, check_positive_int
-from safebasins.theory.slow_flow import SlowFlowProfile, _scalar, unshear
+from safebasins.theory.slow_flow import SlowFlowProfile, _scalar, resolved_shift, unshear
 from safebasins.wells import resolve_well
 from safebasins.io.provenance import api_provenance
 
@@ -176,7 +176,7 @@ def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier=None, n_points=400, wel
     F = _scalar("F", F, check_nonnegative)
     Om = _scalar("Omega", Omega, check_positive)
     Psi = _scalar("Psi", Psi, check_finite)
-    xm = _scalar("xi_max", xi_max, w.check_threshold)
+    xm = _scalar("xi_max", xi_max, w.check_analytic_threshold)
     n_points = check_positive_int("n_points", n_points)
     if n_points < 3:
         raise ValueError("n_points must be >= 3")
@@ -195,16 +195,16 @@ def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier=None, n_points=400, wel
         sg, sx = min(sad, key=lambda t: t[1])
     else:
         sg, sx = np.nan, np.nan
-    if np.isfinite(sx) and w.harmonic_shift(sx) != 0:
-        sg = unshear(sg, w.harmonic_shift(sx))
+    if np.isfinite(sx) and resolved_shift(w, sx) != 0:
+        sg = unshear(sg, resolved_shift(w, sx))
 
     gam, xis, idx = [], [], []
     for k, c in enumerate(curves):
         g, x = c["gamma"], c["xi"]
-        shift = w.harmonic_shift(np.minimum(x, w.barrier_energy))
+        shift = resolved_shift(w, np.minimum(x, w.barrier_energy))
         if np.any(shift != 0):  # back from the sheared rays to the slow phase
             g = unshear(g, shift)
-            c["ray"] = float(unshear(c["ray"], w.harmonic_shift(c["xi_top"])))
+            c["ray"] = float(unshear(c["ray"], resolved_shift(w, c["xi_top"])))
         jump = np.nonzero(np.abs(np.diff(g)) > np.pi)[0]
         if jump.size:
             g = np.insert(g, jump + 1, np.nan)

@@ -44,7 +44,7 @@ import xarray as xr
 
 from safebasins.checks import check_finite, check_positive
 from safebasins.theory.damped import check_damping
-from safebasins.theory.slow_flow import _scalar, _xi_grid, unshear
+from safebasins.theory.slow_flow import _scalar, _xi_grid, resolved_shift, unshear
 from safebasins.wells import resolve_well
 from safebasins.io.provenance import api_provenance
 
@@ -52,6 +52,12 @@ __all__ = ["critical_forcing", "MECHANISMS"]
 
 MECHANISMS = ("none", "MM_0", "MM_pi", "SM", "SMM")
 NONE, MM_0, MM_PI, SM, SMM = range(5)
+
+#: relative accuracy of h(xi) - h0 = xi - Omega J(xi) - h0 as computed (J of a tabulated well is
+#: known to ~1e-13): a branch F = (h - h0) / (G -+ G0 c) within what it resolves is 0, no positive
+#: lower bound.  (At Omega = omega(xi_ini), e.g. Omega = 1 from the zero IC, the saddle branch
+#: tends to F = 0 at xi_ini and its sign is the last bit's.)
+H_ACCURACY = 1e-12
 
 
 def _bisect(fun, lo, hi, n_iter=60):
@@ -170,6 +176,7 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
         # the undamped F_cr seeds the scan; the damped flow's tables end just below the barrier
         F0 = critical_forcing(Om, min(xm, slow_tables(w).xi_top), x0, g0, n_grid=n_grid, well=w)["F_cr"].values
         return damped_critical_forcing(Om, xm, x0, g0, beta, w, F_undamped=F0)
+    w.check_analytic_threshold("xi_max", xm)     # the level curves of C need an orbit at xi_max
 
     nO = Om.size
     xi = _xi_grid(x0, xm, int(n_grid))
@@ -205,12 +212,19 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
     if zB.any():
         infeasible |= np.any(zB[None, :] & (numB > 1e-13), axis=1)
 
+    def resolution(x, rows, den):
+        """F below which a branch (h(x) - h0) / den is not resolved (H_ACCURACY)."""
+        om = Om[rows]
+        with np.errstate(divide="ignore"):
+            return H_ACCURACY * (np.abs(x) + om * np.abs(w.J(x)) + abs(x0) + om * abs(J0)) / np.abs(den)
+
     # --- endpoint tangencies, eq (24)
     end_ok = xm < E_b
     FA_end = np.where(posA[-1] & end_ok, LA[:, -1], np.nan)
     FB_end = np.where(posB[-1] & end_ok, LB[:, -1], np.nan)
-    FA_end = np.where(FA_end > 0, FA_end, np.nan)
-    FB_end = np.where(FB_end > 0, FB_end, np.nan)
+    all_rows = np.arange(nO)
+    FA_end = np.where(FA_end > resolution(xm, all_rows, dA[-1]), FA_end, np.nan)
+    FB_end = np.where(FB_end > resolution(xm, all_rows, dB[-1]), FB_end, np.nan)
 
     # --- interior maxima (saddle mechanism), refined on the sign of dL/dxi
     def dLA(rows, x):
@@ -239,15 +253,17 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
         r = np.nonzero(es)[0]
         if r.size:
             vs[r] = np.maximum(vs[r], L_at(xs[r], r, side))
-    vA = np.where(eA & (vA > 0), vA, np.nan)
-    vB = np.where(eB & (vB > 0), vB, np.nan)
+            den = w.harmonic_amplitude(xs[r]) + (G0 * c if side else -G0 * c)
+            es[r] &= vs[r] > resolution(xs[r], r, den)
+    vA = np.where(eA, vA, np.nan)
+    vB = np.where(eB, vB, np.nan)
     useB = np.nan_to_num(vB, nan=-np.inf) > np.nan_to_num(vA, nan=-np.inf)
     F_SM = np.where(useB, vB, vA)
     xi_saddle = np.where(np.isnan(F_SM), np.nan, np.where(useB, xB, xA))
     gamma_saddle = np.where(np.isnan(F_SM), np.nan, np.where(useB, np.pi, 0.0))
     fin = np.isfinite(gamma_saddle)
     if fin.any():     # gamma' = 0 or pi on the sheared rays: the saddle sits at gamma = gamma' - delta(xi)
-        gamma_saddle[fin] = unshear(gamma_saddle[fin], w.harmonic_shift(xi_saddle[fin]))
+        gamma_saddle[fin] = unshear(gamma_saddle[fin], resolved_shift(w, xi_saddle[fin]))
 
     # --- SMM: does a(xi) = h - F G have a local max in (xi_max, 1/4) at F = FA_end?
     xi_smm = np.full(nO, np.nan)

@@ -149,12 +149,16 @@ def _hermite_max(J0, J1, m0, m1):
     best = np.maximum(J0, J1)
     disc = b * b - 4 * a * c
     sq = np.sqrt(np.maximum(disc, 0.0))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        for tau in ((-b + sq) / (2 * a), (-b - sq) / (2 * a), -c / b):
-            ok = (disc >= 0) & (tau > 0) & (tau < 1)
-            p = ((2 * tau ** 3 - 3 * tau ** 2 + 1) * J0 + (tau ** 3 - 2 * tau ** 2 + tau) * m0
-                 + (-2 * tau ** 3 + 3 * tau ** 2) * J1 + (tau ** 3 - tau ** 2) * m1)
-            best = np.where(ok & np.isfinite(p), np.maximum(best, p), best)
+    # a root of a (nearly) degenerate quadratic is inf, NaN or huge: it lies outside (0, 1) and is
+    # dropped before the cubic is evaluated there (no overflow)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        roots = ((-b + sq) / (2 * a), (-b - sq) / (2 * a), -c / b)
+    for tau in roots:
+        ok = (disc >= 0) & (tau > 0) & (tau < 1)
+        tau = np.where(ok, tau, 0.0)
+        p = ((2 * tau ** 3 - 3 * tau ** 2 + 1) * J0 + (tau ** 3 - 2 * tau ** 2 + tau) * m0
+             + (-2 * tau ** 3 + 3 * tau ** 2) * J1 + (tau ** 3 - tau ** 2) * m1)
+        best = np.where(ok & np.isfinite(p), np.maximum(best, p), best)
     return best
 
 

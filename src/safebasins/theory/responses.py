@@ -44,10 +44,11 @@ def _grid(xi_hi, n):
 def _branches(c, F, Omega, beta):
     """Omega_sigma(xi) - Omega and phi_sigma(xi) on a grid (rows: pairs (F, Omega)); NaN where s >= 1."""
     F = F[:, None]
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # s = inf or huge: outside
         s = beta * c["J"][None, :] / (F * c["A"][None, :])
     inside = s < 1.0
-    root = np.sqrt(np.where(inside, 1.0 - s * s, np.nan))
+    s_in = np.where(inside, s, 0.0)                  # 1 - s^2 only where s < 1 (no overflow outside)
+    root = np.where(inside, np.sqrt(1.0 - s_in * s_in), np.nan)
     wt = (c["omega"] - beta * c["d"])[None, :]
     k = F * (c["omega"] * c["A_xi"])[None, :]
     g = {1: wt - k * root - Omega[:, None], -1: wt + k * root - Omega[:, None]}
@@ -143,12 +144,12 @@ def fixed_points(F, Omega, beta, well, xi_hi, n_grid=1200, n_newton=30):
         for _ in range(n_newton):
             f1, f2, a11, a12, a21, a22, _ = _residuals(well, x, f, Fs, Os, beta, xi_hi)
             det = a11 * a22 - a12 * a21
-            with np.errstate(divide="ignore", invalid="ignore"):
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # a singular step is dropped
                 dx = (a22 * f1 - a12 * f2) / det
                 df = (a11 * f2 - a21 * f1) / det
             bad = ~np.isfinite(dx) | ~np.isfinite(df)
             dx, df = np.where(bad, 0.0, dx), np.where(bad, 0.0, df)
-            dx = np.clip(dx, -0.5 * x, 0.5 * (xi_hi - x))
+            dx = np.clip(dx, -0.5 * (xi_hi - x), 0.5 * x)     # x - dx stays in (x / 2, (x + xi_hi) / 2)
             df = np.clip(df, -0.5, 0.5)
             x, f = x - dx, f - df
             done = (np.abs(dx) <= 1e-14 * x + 1e-300) & (np.abs(df) <= 1e-13)

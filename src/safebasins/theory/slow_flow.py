@@ -85,6 +85,18 @@ def unshear(g, shift):
     return np.pi - np.mod(np.pi - (g - shift), 2.0 * np.pi)
 
 
+#: a shift delta smaller than this in magnitude (rad) is noise of a well's tables (a symmetric
+#: well's delta is 0, its tables give a few 1e-16 of either sign, which would put a point of the
+#: ray gamma' = pi at +pi or -pi)
+SHIFT_RESOLUTION = 1e-12
+
+
+def resolved_shift(well, xi):
+    """``well.harmonic_shift(xi)`` with values below :data:`SHIFT_RESOLUTION` set to exactly 0."""
+    d = np.asarray(well.harmonic_shift(xi), dtype=float)
+    return np.where(np.abs(d) < SHIFT_RESOLUTION, 0.0, d)
+
+
 def _xi_grid(lo, hi, n):
     """Grid on [lo, hi] clustered at both ends (Chebyshev-Lobatto spacing)."""
     t = np.linspace(0.0, 1.0, n)
@@ -205,7 +217,7 @@ def escapes_on_manifold(gamma, xi, F, Omega, xi_max, fourier=None, well=None):
     w = resolve_well(well, fourier)
     gamma = check_finite("gamma", gamma)
     xi = w.check_energy("xi", xi, allow_separatrix=True)
-    prof = slow_flow_profile(F, Omega, xi_max, well=w)
+    prof = slow_flow_profile(F, Omega, _scalar("xi_max", xi_max, w.check_analytic_threshold), well=w)
     return _escapes_rm(gamma, xi, prof)
 
 
@@ -226,6 +238,7 @@ def slow_flow_escapes(q0, p0, F, Omega, Psi, xi_max, fourier=None, well=None, da
     if check_scalar("damping", damping, check_nonnegative) > 0:
         from safebasins.theory.damped_escape import damped_escapes
         return damped_escapes(q0, p0, F, Omega, Psi, xi_max, damping, well=w)
+    xi_max = _scalar("xi_max", xi_max, w.check_analytic_threshold)
     q0 = check_finite("q0", q0)
     p0 = check_finite("p0", p0)
     _scalar("Psi", Psi, check_finite)

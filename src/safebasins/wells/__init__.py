@@ -11,6 +11,9 @@ A well is named in one of these forms, the same in the config (``well:``), the c
 * a name of :data:`NAMED_WELLS` (``"quartic"``, ``"cubic"``, ``"pendulum"``, ``"sech2"``, ``"morse"``);
 * ``{"polynomial": [c0, c1, c2, ...]}`` for V = sum c_k q^k;
 * ``{"expression": "1 - cos(q)"}`` for any formula in q (sympy);
+* either mapping may add ``"tol"``: the relative accuracy of its action-angle interpolants
+  (default 1e-13, in [1e-15, 1e-2]; :class:`~safebasins.wells.numeric.NumericWell`), for a formula
+  whose own rounding does not allow 1e-13 (the construction says so);
 * a :class:`Well` object (e.g. a :class:`~safebasins.wells.numeric.NumericWell` of your own
   numba-compilable V, dV).
 
@@ -27,6 +30,7 @@ from safebasins.wells.quartic import FOURIER_VARIANTS, QUARTIC, QuarticWell
 # (bound here, after the submodule import, so the package attribute is the function)
 from safebasins.wells.polynomial import cubic, polynomial  # noqa: E402
 from safebasins.wells.expression import expression  # noqa: E402
+from safebasins.wells.well_shape import check_options  # noqa: E402
 
 __all__ = ["Well", "QuarticWell", "QUARTIC", "NAMED_WELLS", "resolve_well", "from_spec", "from_attrs", "spec_attrs",
            "well_attrs", "spec_of", "cubic", "polynomial", "expression", "describe_forms"]
@@ -45,18 +49,31 @@ NAMED_WELLS = {
               "the Morse well V = (1 - exp(-q))^2, open at q -> +inf (E_b = 1), closed on the left"),
 }
 SPEC_KEYS = ("polynomial", "expression")
+#: the optional key of a polynomial or expression spec (NumericWell's tol)
+TOL_KEY = "tol"
 
 
 def describe_forms() -> str:
     """The accepted well forms, for error messages and help texts."""
     return (f"a name ({', '.join(NAMED_WELLS)}), {{'polynomial': [c0, c1, c2, ...]}}, "
-            "{'expression': '<formula in q>'} or a safebasins.wells.Well")
+            "{'expression': '<formula in q>'} (either optionally with 'tol': 1e-11) or a safebasins.wells.Well")
+
+
+def _tol_of(spec) -> dict:
+    """``{"tol": float}`` of a spec mapping that has the key, checked (ValueError naming ``well``), else ``{}``."""
+    if TOL_KEY not in spec:
+        return {}
+    try:
+        tol = check_options(tol=spec[TOL_KEY])[0]
+    except ValueError as exc:
+        raise ValueError(f"well: {exc}") from None
+    return {TOL_KEY: tol}
 
 
 def spec_of(config_value) -> dict:
     """Resolved spec of a well form: ``{"name": "cubic"}``, ``{"name": "polynomial",
-    "coefficients": [...]}`` or ``{"name": "expression", "expression": "..."}``; ValueError naming
-    ``well`` for anything else."""
+    "coefficients": [...]}`` or ``{"name": "expression", "expression": "..."}`` (the last two with
+    ``"tol"`` when given); ValueError naming ``well`` for anything else."""
     if isinstance(config_value, str):
         if config_value not in NAMED_WELLS:
             raise ValueError(f"well: unknown well {config_value!r}; give {describe_forms()}")
@@ -69,28 +86,33 @@ def spec_of(config_value) -> dict:
                     key = "coefficients" if name == "polynomial" else name
                     if key not in config_value:
                         raise ValueError(f"well: spec {config_value!r} lacks {key!r}")
-                return spec_of({name: config_value["coefficients" if name == "polynomial" else name]})
+                return spec_of({name: config_value["coefficients" if name == "polynomial" else name],
+                                **{k: config_value[k] for k in (TOL_KEY,) if k in config_value}})
             return spec_of(name)
-        if len(config_value) == 1:
-            (key, value), = config_value.items()
+        keys = [k for k in config_value if k != TOL_KEY]
+        if len(keys) == 1:
+            key = keys[0]
+            value = config_value[key]
             if key == "polynomial":
                 try:
-                    return {"name": "polynomial", "coefficients": [float(c) for c in value]}
+                    coefficients = [float(c) for c in value]
                 except (TypeError, ValueError):
                     raise ValueError(f"well: polynomial coefficients must be a list of numbers, got {value!r}") from None
+                return {"name": "polynomial", "coefficients": coefficients, **_tol_of(config_value)}
             if key == "expression":
                 if not isinstance(value, str):
                     raise ValueError(f"well: expression must be a string in q, got {value!r}")
-                return {"name": "expression", "expression": value}
+                return {"name": "expression", "expression": value, **_tol_of(config_value)}
     raise ValueError(f"well: {config_value!r} is not a well; give {describe_forms()}")
 
 
 @functools.lru_cache(maxsize=64)
-def _build(name, payload):
+def _build(name, payload, tol=None):
+    extra = {} if tol is None else {"tol": tol}
     if name == "polynomial":
-        return polynomial(list(payload))
+        return polynomial(list(payload), **extra)
     if name == "expression":
-        return expression(payload)
+        return expression(payload, **extra)
     return NAMED_WELLS[name][0]()
 
 
@@ -102,7 +124,7 @@ def from_spec(spec, fourier=None) -> Well:
     if name == "quartic":
         return resolve_well(None, fourier)
     payload = tuple(s["coefficients"]) if name == "polynomial" else s.get("expression")
-    return resolve_well(_build(name, payload), fourier)
+    return resolve_well(_build(name, payload, s.get(TOL_KEY)), fourier)
 
 
 def resolve_well(well=None, fourier=None) -> Well:
@@ -128,13 +150,15 @@ def resolve_well(well=None, fourier=None) -> Well:
 
 def spec_attrs(spec) -> dict:
     """Dataset attributes naming a well spec: ``well`` and, for a polynomial, ``well_coefficients``,
-    for an expression, ``well_expression``."""
+    for an expression, ``well_expression``; ``well_tol`` where the spec gives ``tol``."""
     s = spec_of(spec)
     out = {"well": s["name"]}
     if s["name"] == "polynomial":
         out["well_coefficients"] = [float(c) for c in s["coefficients"]]
     if s["name"] == "expression":
         out["well_expression"] = s["expression"]
+    if TOL_KEY in s:
+        out["well_tol"] = s[TOL_KEY]
     return out
 
 
@@ -159,10 +183,11 @@ def from_attrs(attrs) -> Well:
     if needs is not None and needs not in attrs:
         raise ValueError(f"the dataset's well is {name!r} but it lacks the attribute {needs!r} that defines it: "
                          "pass well= explicitly")
+    tol = {TOL_KEY: float(attrs["well_tol"])} if "well_tol" in attrs else {}
     if name == "polynomial":
-        return from_spec({"polynomial": [float(c) for c in np.atleast_1d(attrs["well_coefficients"])]})
+        return from_spec({"polynomial": [float(c) for c in np.atleast_1d(attrs["well_coefficients"])], **tol})
     if name == "expression":
-        return from_spec({"expression": str(attrs["well_expression"])})
+        return from_spec({"expression": str(attrs["well_expression"]), **tol})
     if name not in NAMED_WELLS:
         raise ValueError(f"the dataset was made with the well {name!r}, which is not a named well: pass well= explicitly")
     return from_spec(name)

@@ -51,6 +51,8 @@ STEP_COST_POLY4 = 1.5
 STEP_COST_POLY8 = 3.5
 STEP_COST_ARITHMETIC = 1.5
 STEP_COST_TRANSCENDENTAL = 150.0
+#: top of a resonance-manifold panel as a fraction of the escape energy (:attr:`Well.manifold_top`)
+MANIFOLD_TOP = 0.9996
 
 
 class Well(abc.ABC):
@@ -174,8 +176,11 @@ class Well(abc.ABC):
         return (q > lo) & (q < hi)
 
     def check_threshold(self, name, xi_max):
-        """Energy truncation level in ``(0, barrier_energy]``; in ``(0, barrier_energy)`` when the
-        escape energy is a limit of V at infinity (the orbit at it is unbounded)."""
+        """Energy truncation level of an escape test in ``(0, barrier_energy]``: ``xi_max = E_b`` is
+        escape over the barrier, the numerics' and the damped slow flow's test (escape = H0, or the
+        slow energy, exceeding it); in ``(0, barrier_energy)`` when the escape energy is a limit of V
+        at infinity (the orbit at it is unbounded).  The undamped slow flow needs more:
+        :meth:`check_analytic_threshold`."""
         from safebasins.checks import as_array, value_repr
 
         a = as_array(name, xi_max)
@@ -189,6 +194,29 @@ class Well(abc.ABC):
             raise ValueError(f"{name} must lie in (0, {self.barrier_energy!r}] (the barrier energy of the "
                              f"{self.name} well), got {value_repr(a)}")
         return a
+
+    def check_analytic_threshold(self, name, xi_max):
+        """Truncation level of the undamped slow flow (the level curves of its first integral C):
+        :meth:`check_threshold`, and below the escape energy by more than a relative
+        ``checks.BARRIER_RTOL`` (closer counts as at it).  That theory needs an orbit at xi_max; at
+        the separatrix the period diverges, and F_cr grows like ``log(1 / (E_b - xi_max))`` without
+        a limit (the cubic's F_cr at Omega = 0.7: 0.13, 0.17, 0.21, 0.24 at E_b - xi_max = 1e-6,
+        1e-10, 1e-13 E_b and one ulp), so a value that close measures the float spacing, not the well."""
+        from safebasins.checks import BARRIER_RTOL, reaches, value_repr
+
+        a = self.check_threshold(name, xi_max)
+        if reaches(a, self.barrier_energy).any():
+            raise ValueError(f"{name} must lie below the barrier energy {self.barrier_energy_text} of the {self.name} "
+                             f"well (by more than a relative {BARRIER_RTOL:g}) for the undamped slow flow: it needs an "
+                             "orbit at xi_max, and on the separatrix its period diverges; got "
+                             f"{value_repr(a)}. Escape over the barrier, xi_max = E_b, is what the numerics (escape "
+                             "charts, numeric F_cr) and the damped slow flow test")
+        return a
+
+    @property
+    def barrier_energy_text(self) -> str:
+        """The escape energy as written in messages."""
+        return repr(float(self.barrier_energy))
 
     def unforced_safe(self, q, p, xi_max):
         """The unforced safe set of a threshold: ``H0 < xi_max`` inside the well."""
@@ -265,6 +293,46 @@ class Well(abc.ABC):
             lo, hi = (float(x) for x in self.turning_points(0.99 * E))
         pm = 1.5 * float(np.sqrt(E))
         return (lo, hi), (-pm, pm)
+
+    @property
+    def manifold_top(self) -> float:
+        """Default top ``xi`` of a resonance-manifold panel ``(gamma, xi)``: ``MANIFOLD_TOP`` E_b, just
+        below the separatrix where the slow-flow tables end (the quartic: 0.2499, the paper's Figs 5-9)."""
+        return MANIFOLD_TOP * float(self.barrier_energy)
+
+    @property
+    def static_escape_force(self) -> float:
+        """``F_static``: the largest ``|V'|`` between the well bottom and the turning point of the escape
+        energy E_b (a barrier, the closing point of a closed side; on a side open at infinity all of
+        it), on the side where that is smaller (the quartic: ``2 / (3 sqrt 3) = 0.385``, at its
+        inflection point; the cubic 1/4; the pendulum 1).  A constant force above it has no
+        equilibrium on the way: it pushes the particle from rest at the bottom past that turning
+        point with ``H0 > E_b >= xi_max`` -- the escape threshold of a forcing slow against the well
+        (``Omega -> 0``); resonance lowers it (numerics.bisection's default F bracket)."""
+        f = self.__dict__.get("_static_escape_force")
+        if f is None:
+            f = min(self._largest_force(side) for side in (-1.0, 1.0))
+            self.__dict__["_static_escape_force"] = f
+        return f
+
+    def _largest_force(self, side) -> float:
+        """``max |V'|`` between 0 and the turning point of E_b on one side (``side`` -1 or +1): on 2001
+        uniform and 2001 geometric points (a long open tail), the largest polished by a bounded scalar
+        search between its neighbours."""
+        from scipy import optimize
+
+        E = float(self.barrier_energy)
+        k = 0 if side < 0 else 1
+        q_t = float(self.turning_points(E)[k])
+        if not np.isfinite(q_t):              # open at infinity: V' decays along the tail
+            q_t = float(self.turning_points((1.0 - 1e-9) * E)[k])
+        q = np.unique(np.concatenate([np.linspace(0.0, q_t, 2001), q_t * np.geomspace(1e-7, 1.0, 2001)]))
+        f = np.abs(np.asarray(self.dV(q), dtype=float))
+        i = int(np.argmax(f))
+        lo, hi = sorted((q[max(i - 1, 0)], q[min(i + 1, q.size - 1)]))
+        res = optimize.minimize_scalar(lambda x: -abs(float(self.dV(np.array([x]))[0])), bounds=(lo, hi),
+                                       method="bounded", options={"xatol": 1e-12 * max(abs(q_t), 1.0)})
+        return max(float(f[i]), -float(res.fun))
 
     @property
     def omega_max(self) -> float:

@@ -270,7 +270,7 @@ class ExpressionWell(NumericWell):
     def spec(self):
         if self.name != ExpressionWell.name:            # a named well (wells.NAMED_WELLS)
             return {"name": self.name}
-        return {"name": "expression", "expression": self.expression}
+        return {"name": "expression", "expression": self.expression, **self._tol_spec()}
 
 
 def _mul_stub():

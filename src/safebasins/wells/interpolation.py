@@ -24,9 +24,13 @@ import numpy as np
 from numba import njit
 from numpy.polynomial import chebyshev as _cheb
 
-__all__ = ["EnergyInterpolant"]
+__all__ = ["EnergyInterpolant", "DEFAULT_TOL", "TOL_RANGE"]
 
 BOTTOM, SEPARATRIX = 0, 1
+#: default relative accuracy of the interpolants (a numeric well's ``tol``, the ``tol`` key of a well spec)
+DEFAULT_TOL = 1e-13
+#: the accepted range of that tol
+TOL_RANGE = (1e-15, 1e-2)
 
 
 class EnergyInterpolant:
@@ -37,7 +41,7 @@ class EnergyInterpolant:
     (``kind`` BOTTOM/SEPARATRIX, ``[a, b]`` in that panel's variable).
     """
 
-    def __init__(self, func, E_b, *, E_split=None, n=20, tol=1e-13, noise=None,
+    def __init__(self, func, E_b, *, E_split=None, n=20, tol=DEFAULT_TOL, noise=None,
                  bottom_panels=2, separatrix_step=2.5, max_rounds=12):
         self.E_b = float(E_b)
         self.E_split = 0.5 * self.E_b if E_split is None else float(E_split)
@@ -83,7 +87,8 @@ class EnergyInterpolant:
             where = ", ".join(f"E in [{min(e):.6g}, {max(e):.6g}]" for e in (self._energies(p) for p in todo[:3]))
             raise ValueError(f"tol: the energy interpolation did not reach tol = {self.tol!r} after {max_rounds} rounds "
                              f"({len(todo)} panels, {where}, ...): the orbit data are not smooth in E there, or V, dV "
-                             "are not accurate to tol; give a larger tol or a smoother, more accurate V")
+                             "are not accurate to tol; give a larger tol (a well spec's key, e.g. {expression: '...', "
+                             "tol: 1e-11}) or a smoother, more accurate V")
         self.n_quantities = done[0][1].shape[0]
         self.error_estimate = max(e for _, _, e in done)
         self._build(done)

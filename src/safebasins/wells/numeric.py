@@ -60,7 +60,7 @@ import numpy as np
 from safebasins.checks import as_array, value_repr
 from safebasins.wells.base import STEP_COST_TRANSCENDENTAL, Well
 from safebasins.wells.bottom import cancellation_fix
-from safebasins.wells.interpolation import BOTTOM, EnergyInterpolant
+from safebasins.wells.interpolation import BOTTOM, DEFAULT_TOL, EnergyInterpolant
 from safebasins.wells.orbit_quadrature import EPS, OrbitQuadrature, solve_increasing
 from safebasins.wells.well_shape import WellShape, _call, check_options
 
@@ -68,6 +68,11 @@ __all__ = ["NumericWell", "check_options"]
 
 # interpolated quantities (rows of the interpolant)
 _T, _JE, _H, _THM, _TL, _QM, _QP = range(7)
+
+
+def _minus(f, c, q):
+    """``f(q) - c``."""
+    return f(q) - c
 
 
 class NumericWell(WellShape, Well):
@@ -127,13 +132,14 @@ class NumericWell(WellShape, Well):
 
     name = "numeric"
 
-    def __init__(self, V, dV, *, barriers=None, search_bound=10.0, name=None, n_scan=20001, tol=1e-13,
+    def __init__(self, V, dV, *, barriers=None, search_bound=10.0, name=None, n_scan=20001, tol=DEFAULT_TOL,
                  asymptotes=None):
         if not callable(V):
             raise ValueError(f"V must be a callable V(q), got {V!r}")
         if not callable(dV):
             raise ValueError(f"dV must be a callable V'(q), got {dV!r}")
         tol, n_scan, declared = check_options(tol=tol, n_scan=n_scan, asymptotes=asymptotes)
+        self.tol = tol
         if name is not None:
             self.name = str(name)
         self._V, self._dV = V, dV
@@ -142,6 +148,7 @@ class NumericWell(WellShape, Well):
             raise ValueError(f"search_bound must be finite and > 0, got {search_bound!r}")
         self.search_bound = B
         self._check_bottom()
+        self.walls = {}              # side -> position of a wall (a pole of V' where V -> +inf)
         found = self._locate_barriers(B, n_scan)
         if barriers is not None:
             self._check_given_barriers(barriers, found)
@@ -164,15 +171,26 @@ class NumericWell(WellShape, Well):
             if np.isfinite(b) and not k > 1e-8 * self.omega0 ** 2:
                 raise ValueError(f"V: the barrier at q = {b!r} is degenerate (V''(q_b) = {-k!r}): the logarithmic "
                                  "separatrix behaviour assumed by the interpolation in E does not hold")
-        self._V_bottom = cancellation_fix(partial(_call, V), partial(_call, dV), self._bottom_scales())
+        dV_orbit = partial(_call, dV)
+        slope = float(dV_orbit(np.zeros(1))[0])
+        if slope != 0.0:
+            # V'(0) is 0 up to the rounding of the constants as written (0.3 - 0.243 / 0.81 = -3e-17;
+            # |V'(0)| <= BOTTOM_ATOL is checked): the orbits use V' - V'(0), whose minimum is exactly
+            # at q = 0 (else int_0^q V' / q^2 ~ V'(0) / q, and the orbit data at E -> 0, are singular)
+            dV_orbit = partial(_minus, dV_orbit, slope)
+        self._V_bottom = cancellation_fix(partial(_call, V), dV_orbit, self._bottom_scales())
         V_acc = partial(_call, V) if self._V_bottom is None else self._V_bottom
         opened = ({"tails": self._tails, "core": max(self._bottom_scales()), "n_mean": 8}
                   if self.open_at_infinity else {})
-        self._quad = OrbitQuadrature(V_acc, partial(_call, dV), self.limits, found, kappa, **opened)
+        self._quad = OrbitQuadrature(V_acc, dV_orbit, self.limits, found, kappa, mean_rtol=tol, **opened)
         self._interp = EnergyInterpolant(self._orbit_table, self._E_b, tol=tol, noise=self._noise)
         self.interpolation_error = self._interp.error_estimate
 
     # ------------------------------------------------------------------ construction
+    def _tol_spec(self) -> dict:
+        """``{"tol": tol}`` when it is not the default (the ``tol`` key of a well spec), else ``{}``."""
+        return {} if self.tol == DEFAULT_TOL else {"tol": self.tol}
+
     def _noise(self, kind, a, b):
         """Relative accuracy floor of the tabulated data on a panel (conditioning near E_b)."""
         if kind == BOTTOM:
@@ -349,6 +367,8 @@ class NumericWell(WellShape, Well):
             close = half < 0.5
             if self.open_at_infinity:     # <V'> by a few nodes: only on the scale of the end
                 close &= np.abs(qk - q_end) <= self._quad.end_length(q_end)
+            if np.isfinite(self._quad.mean_length).any():   # V' singular near a side
+                close &= np.abs(qk - q_end) <= self._quad.mean_cap(sigma)
             near = np.nonzero(close)[0]
             if near.size:
                 mean = self._quad.mean_dV(qk[near], q_end[near])

@@ -38,9 +38,16 @@ import numpy as np
 from numpy.polynomial import chebyshev as _cheb
 from numpy.polynomial import legendre as _leg
 
+from safebasins.wells.interpolation import DEFAULT_TOL
+
 __all__ = ["clenshaw_curtis", "solve_increasing", "OrbitQuadrature"]
 
 EPS = np.finfo(float).eps
+#: Gauss-Legendre rules tried for the mean of V' over a segment (:meth:`OrbitQuadrature.mean_dV`)
+MEAN_NODES = (4, 6, 8, 12, 16)
+#: rounding noise of one evaluation of V', relative to its largest value in the well: an absolute
+#: floor of the accuracy of that mean (:meth:`OrbitQuadrature._calibrate_mean`)
+NOISE = 16 * EPS
 
 
 def clenshaw_curtis(n):
@@ -105,6 +112,24 @@ def solve_increasing(fdf, lo, hi, x0, *, xtol=4 * EPS, atol=0.0, maxiter=200):
     raise RuntimeError(f"turning-point / angle solver did not converge for {active.size} items")
 
 
+def _reference_mean(dV, a, b, rtol, floor, panels=16, n=20):
+    """Mean of ``V'`` over ``[a, b]`` (arrays) by composite Gauss-Legendre (``panels`` x ``n`` nodes),
+    and where it agrees with half as many panels to ``rtol`` (relative) plus ``floor`` (absolute):
+    converged."""
+    x, w = _leg.leggauss(n)
+
+    def composite(m):
+        edges = np.linspace(0.0, 1.0, m + 1)
+        total = 0.0
+        for lo, hi in zip(edges[:-1], edges[1:]):
+            for xt, wt in zip(x, w):
+                total = total + 0.5 * (hi - lo) * wt * dV(a + (b - a) * (lo + 0.5 * (hi - lo) * (xt + 1.0)))
+        return total
+
+    fine, coarse = composite(panels), composite(panels // 2)
+    return fine, np.abs(fine - coarse) <= rtol * np.abs(fine) + floor
+
+
 class OrbitQuadrature:
     """Orbit integrals of ``q'' = -V'(q)`` in the coordinates of the module docstring.
 
@@ -136,7 +161,8 @@ class OrbitQuadrature:
     """
 
     def __init__(self, V, dV, limits, barriers, kappa, *, tails=(None, None), core=None, n_nodes=20, n_point=12,
-                 panel_length=1.5, alpha_max=3.0, gap_switch=0.02, n_mean=4, barrier_zone=0.1, span=4.0):
+                 panel_length=1.5, alpha_max=3.0, gap_switch=0.02, n_mean=4, barrier_zone=0.1, span=4.0,
+                 mean_rtol=DEFAULT_TOL):
         self.V, self.dV = V, dV
         self.tails = tuple(tails)
         self.open = any(t is not None for t in self.tails)
@@ -152,9 +178,86 @@ class OrbitQuadrature:
         self.gap_switch = float(gap_switch)
         self.x, self.w, self.S = clenshaw_curtis(n_nodes)      # profiles (cumulative integrals)
         self.gx, self.gw = _leg.leggauss(n_point)                # definite integrals to a point
+        n_mean, self.mean_length = self._calibrate_mean(int(n_mean), float(mean_rtol))
         gx, gw = _leg.leggauss(n_mean)
         self.mean_t = 0.5 * (gx + 1.0)
         self.mean_w = 0.5 * gw
+        self.n_mean = n_mean
+
+    def _mean_segments(self):
+        """Per side, the segments ``(q_end, length)`` over which :meth:`mean_dV` is taken: at the
+        barrier (``barrier_zone |q_b|``, turning points) and at turning points near the limit and
+        inside the well (``gap_switch`` times the orbit's width, the integrand's ``near`` form);
+        none on a side open at infinity (its tail has its own lengths)."""
+        finite = all(np.isfinite(self.limits))
+        width = abs(self.limits[0]) + abs(self.limits[1]) if finite else self.core
+        near = self.gap_switch * width
+        out = []
+        for k, lim in enumerate(self.limits):
+            if self.tails[k] is not None or not np.isfinite(lim):
+                out.append([])
+                continue
+            segs = [(f * lim, near * t) for f in (1.0, 0.75, 0.5) for t in (1.0, 0.5, 0.25)]
+            qb = self.barriers[k]
+            if np.isfinite(qb):
+                segs += [(qb, self.barrier_zone * abs(qb) * t) for t in (1.0, 0.5, 0.25)]
+            out.append(segs)
+        return out
+
+    def _calibrate_mean(self, n_first, rtol):
+        """``(n, (length_left, length_right))``: the Gauss rule of :meth:`mean_dV` and, per side, the
+        longest segment it may span.  ``<V'>`` must reach ``rtol`` (relative, plus the rounding
+        floor :data:`NOISE` of V') against a composite reference on the segments of
+        :meth:`_mean_segments`.  The first of ``n_first`` and the larger
+        :data:`MEAN_NODES` that does so everywhere is used with unrestricted lengths (``inf``: a smooth
+        V', e.g. every polynomial, the pendulum); if none does -- a singularity of V' just beyond a
+        barrier or a closing point, such as the pole of an electrostatic (MEMS) wall -- the largest rule is
+        used and each failing side's segments are halved until they pass: there the barrier form of the
+        turning points and the integrand's end form are used only that close to the end, and ``E - V``
+        is taken directly beyond (accurate there: V' is not small)."""
+        sides = self._mean_segments()
+        ends = [lim for lim, t in zip(self.limits, self.tails) if t is None and np.isfinite(lim)]
+        if not ends:
+            return n_first, (np.inf, np.inf)
+        # the rounding noise of V' itself (~eps of its terms, at least of its largest value in the
+        # well) is not a quadrature error: it sets an absolute floor
+        scan = np.linspace(min(min(ends), 0.0), max(max(ends), 0.0), 401)
+        floor = NOISE * float(np.max(np.abs(self.dV(scan))))
+
+        def passes(n, segs, cap=np.inf):
+            if not segs:
+                return True
+            q_end = np.array([s[0] for s in segs])
+            sigma = np.sign(q_end)
+            q = q_end - sigma * np.minimum([s[1] for s in segs], cap)
+            ref, ok = _reference_mean(self.dV, q, q_end, rtol, floor)
+            x, w = _leg.leggauss(n)
+            got = sum(0.5 * wt * self.dV(q + (q_end - q) * 0.5 * (xt + 1.0)) for xt, wt in zip(x, w))
+            return bool(ok.all() and (np.abs(got - ref) <= rtol * np.abs(ref) + floor).all())
+
+        for n in (n_first,) + tuple(m for m in MEAN_NODES if m > n_first):
+            if all(passes(n, segs) for segs in sides):
+                return n, (np.inf, np.inf)
+        n = max(n_first, MEAN_NODES[-1])
+        lengths = []
+        for segs in sides:
+            if passes(n, segs):
+                lengths.append(np.inf)
+                continue
+            start = cap = max(s[1] for s in segs)
+            while not passes(n, segs, cap):
+                cap *= 0.5
+                if cap < 1e-6 * start:
+                    raise ValueError(f"dV: V' is not smooth near the {'left' if segs[0][0] < 0 else 'right'} end of "
+                                     f"the well (q = {segs[0][0]!r}): its mean over segments of length "
+                                     f"{cap!r} still differs between quadrature rules (a singularity of V' there?)")
+            lengths.append(cap)
+        return n, tuple(lengths)
+
+    def mean_cap(self, sigma):
+        """Longest segment of :meth:`mean_dV` at a turning point of the side ``sigma`` (-1 left, +1
+        right; arrays broadcast): ``inf`` unless V' has a singularity near that side."""
+        return np.where(np.asarray(sigma) < 0, self.mean_length[0], self.mean_length[1])
 
     # ------------------------------------------------------------------ turning points
     def turning_points(self, E, guess=None):
@@ -176,11 +279,11 @@ class OrbitQuadrature:
             # F(s) = V(side s) - E is increasing in s = side q on [0, |lim|]; near a barrier
             # V(q) - E = (V_b - E) - (q_b - q) <V'>_[q, q_b]: only V' and the exact difference
             # V_b - E enter, so q is found to ~eps (the energy to ~eps sqrt(V_b - E)).
-            def fdf(s, idx, side=side, qb=qb, Vb=Vb):
+            def fdf(s, idx, side=side, qb=qb, Vb=Vb, k=k):
                 q = side * s
                 F = self.V(q) - E[idx]
                 if np.isfinite(qb):
-                    zone = np.abs(qb - q) <= self.barrier_zone * abs(qb)
+                    zone = np.abs(qb - q) <= min(self.barrier_zone * abs(qb), self.mean_length[k])
                     if zone.any():
                         qz = q[zone]
                         mean = self.mean_dV(qz, qb)
@@ -318,6 +421,8 @@ class OrbitQuadrature:
         near = 2.0 * s2 <= self.gap_switch
         if self.open:      # <V'> by n_mean nodes only over a short stretch on the scale of the end
             near = near & (2.0 * d * s2 <= self.gap_switch * self.end_length(q_end))
+        if np.isfinite(self.mean_length).any():   # V' singular near a side: <V'> only that close
+            near = near & (2.0 * d * s2 <= self.mean_cap(sigma))
         near = np.broadcast_to(near, shape)
         R = np.empty(shape)
         Eb = np.broadcast_to(E, shape)

@@ -182,7 +182,7 @@ class PolynomialWell(NumericWell):
     def spec(self):
         if self.name != "polynomial":          # a named polynomial well (cubic)
             return super().spec()
-        return {"name": "polynomial", "coefficients": [float(c) for c in self.coefficients]}
+        return {"name": "polynomial", "coefficients": [float(c) for c in self.coefficients], **self._tol_spec()}
 
 
 def polynomial(coefficients, **kwargs):

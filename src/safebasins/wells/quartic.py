@@ -217,6 +217,10 @@ class QuarticWell(Well):
             raise ValueError(f"{name} must lie in (0, 1/4], got {value_repr(a)}")
         return a
 
+    @property
+    def barrier_energy_text(self):
+        return "1/4"
+
     def check_displacement(self, name, q_max):
         """Displacement threshold in (0, 1] (the barrier at ``|q| = 1``)."""
         a = as_array(name, q_max)

@@ -18,6 +18,7 @@ import numpy as np
 from scipy import optimize
 
 from safebasins.checks import as_array
+from safebasins.wells.interpolation import DEFAULT_TOL, TOL_RANGE
 from safebasins.wells.open_sides import CONVERGED, TAIL_START, Tail, converged_limit, geometric_values
 
 __all__ = ["WellShape", "check_options"]
@@ -27,13 +28,13 @@ EPS = np.finfo(float).eps
 BOTTOM_ATOL = 1e-12
 
 
-def check_options(*, tol=1e-13, n_scan=20001, asymptotes=None):
+def check_options(*, tol=DEFAULT_TOL, n_scan=20001, asymptotes=None):
     """Validated ``(tol, n_scan, asymptotes)`` of :class:`NumericWell` (ValueError naming the argument),
     checked before anything is computed.  ``asymptotes``: None or a pair of float-or-None."""
     t = as_array("tol", tol)
-    if t.ndim != 0 or not (1e-15 <= float(t) <= 1e-2):
-        raise ValueError(f"tol must be a number in [1e-15, 1e-2] (relative accuracy of the energy interpolants), "
-                         f"got {tol!r}")
+    if t.ndim != 0 or not (TOL_RANGE[0] <= float(t) <= TOL_RANGE[1]):
+        raise ValueError(f"tol must be a number in [{TOL_RANGE[0]:g}, {TOL_RANGE[1]:g}] (relative accuracy of the "
+                         f"energy interpolants), got {tol!r}")
     if isinstance(n_scan, bool) or not isinstance(n_scan, (int, np.integer)) or n_scan < 100:
         raise ValueError(f"n_scan must be an integer >= 100 (points of the barrier scan on each side), got {n_scan!r}")
     if asymptotes is None:
@@ -94,6 +95,10 @@ class WellShape:
         return s, side * _call(self._dV, side * s)
 
     def _find_barrier(self, side, B, n):
+        """The barrier on one side: the first sign change of V' on the scan, polished by Brent's
+        method; ``side * inf`` where there is none, or where the sign changes through a pole of V'
+        at which V rises without bound (a wall, e.g. the repulsive core of a Lennard-Jones well:
+        the side is closed there, :attr:`walls`)."""
         s, f = self._scan(side, B, n)
         where = "left" if side < 0 else "right"
         stop = np.nonzero((f < 0) | ~np.isfinite(f))[0]
@@ -102,16 +107,33 @@ class WellShape:
         if stop.size == 0:
             return side * np.inf
         i = int(stop[0])
-        if not np.isfinite(f[i]):
-            raise ValueError(f"dV: V'({float(side * s[i])!r}) is not finite, {where} of 0 before any barrier")
         if i == 0:
             raise ValueError("dV: V' has the wrong sign next to q = 0 (q = 0 is not a minimum)")
         a, b = s[i - 1], s[i]
+        if not np.isfinite(f[i]):
+            if self._rises_to_wall(side, s[:i]):
+                self.walls[side] = float(side * b)
+                return side * np.inf
+            raise ValueError(f"dV: V'({float(side * s[i])!r}) is not finite, {where} of 0 before any barrier")
         if f[i - 1] == 0:
             return side * a
         g = lambda x: side * float(_call(self._dV, np.array([side * x]))[0])
         r = optimize.brentq(g, a, b, xtol=1e-300, rtol=4 * EPS, maxiter=500)
+        # a root of V' has |V'| at rounding level there; a pole (V' -> +inf, then -inf beyond) does not
+        if not abs(g(r)) <= 1e-6 * max(abs(f[i - 1]), abs(f[i])):
+            if self._rises_to_wall(side, s[:i]):
+                self.walls[side] = float(side * r)
+                return side * np.inf
+            raise ValueError(f"dV: V' changes sign at q ~ {float(side * r)!r} through a singularity, not a zero, "
+                             "and V does not rise without bound towards it: neither a barrier nor a wall")
         return side * r
+
+    def _rises_to_wall(self, side, s):
+        """Whether V grows without bound along the scan points ``s`` (towards a pole of V'): its last
+        values exceed 1e6 times its largest value over the first half of the scan's extent."""
+        v = _call(self._V, side * s)
+        inner = v[s <= 0.5 * s[-1]]
+        return bool(np.isfinite(v[-1]) and inner.size and v[-1] > 1e6 * max(float(np.max(np.abs(inner))), EPS))
 
     def _check_monotone(self, side, lim):
         """V' must not vanish between 0 and the limit (an interior equilibrium, e.g. an
@@ -154,9 +176,9 @@ class WellShape:
         for k, side in enumerate((-1.0, 1.0)):
             where, sign = ("left", "-") if side < 0 else ("right", "+")
             given = None if declared is None else declared[k]
-            if np.isfinite(found[k]):          # escape over the barrier: a declared limit is not used
-                out.append(None)
-                continue
+            if np.isfinite(found[k]) or side in self.walls:
+                out.append(None)               # escape over the barrier (or closed by a wall): a declared
+                continue                       # limit (beyond the wall: unreachable) is not used
             x, v = geometric_values(partial(_call, self._V), side, B)
             self._sequences[side] = (x, v)
             A, i = converged_limit(v)
@@ -201,10 +223,15 @@ class WellShape:
         if self._tails[0 if side < 0 else 1] is not None:
             return side * np.inf
         s = np.geomspace(1e-9 * B, B, n)
+        if side in self.walls:                 # only inside the wall
+            s = s[s < abs(self.walls[side])]
         v = _call(self._V, side * s)
         above = np.nonzero(v > self._E_b)[0]
         if above.size:
             return float(side * s[above[0]])
+        if side in self.walls:
+            raise ValueError(f"V: on the {'left' if side < 0 else 'right'} side V rises towards the wall at "
+                             f"q = {self.walls[side]!r} but not above the escape energy {self._E_b!r} before it")
         # V rises above E_b only beyond search_bound (slowly growing V, or a limit above E_b)
         x, v = self._sequences[side]
         above = np.nonzero(v > self._E_b)[0]
@@ -215,8 +242,10 @@ class WellShape:
         return float(side * x[above[0]])
 
     def _bottom_scales(self):
-        """Per side the extent of the well proper: the limit, or where the tail of an open side begins."""
-        return tuple(abs(lim) if t is None else t.x0 for lim, t in zip(self.limits, self._tails))
+        """Per side the extent of the well proper: the limit, where the tail of an open side begins, or
+        on a side closed by a wall the distance to the wall (V' is analytic up to it)."""
+        return tuple(abs(self.walls[side]) if side in self.walls else abs(lim) if t is None else t.x0
+                     for side, lim, t in zip((-1.0, 1.0), self.limits, self._tails))
 
     def _check_derivative(self):
         lo, hi = (side * s for side, s in zip((-1.0, 1.0), self._bottom_scales()))

@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 
+from safebasins import wells
 from safebasins.pipeline import values
 from safebasins.pipeline.registry import GridChartKind, Kind, Product, dataset_path, register
 
@@ -168,7 +169,9 @@ class BasinRM(Kind):
                 "properties": {
                     "n_gamma": {"type": "integer", "minimum": 2, "default": 361},
                     "n_xi": {"type": "integer", "minimum": 2, "default": 250},
-                    "xi_top": {"$ref": "#/$defs/energy", "default": 0.2499},
+                    "xi_top": {"description": "top xi of the panel; null: the well's own, 0.9996 E_b "
+                                              "(safebasins.wells.Well.manifold_top; 0.2499 for the quartic)",
+                               "oneOf": [{"type": "null"}, {"$ref": "#/$defs/energy"}], "default": None},
                 },
             },
             "n_points": N_POINTS,
@@ -181,8 +184,9 @@ class BasinRM(Kind):
 
     def check(self, block, key, ctx):
         ctx.check_grid(f"{key}.grid", block["grid"])
-        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key))
-        if block["manifold"]["xi_top"] <= 0:
+        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key),
+                                              block.get("damping", 0.0))
+        if block["manifold"]["xi_top"] is not None and block["manifold"]["xi_top"] <= 0:
             ctx.fail(f"{key}.manifold.xi_top", "must be > 0")
 
     def resolve(self, block, ctx):
@@ -190,7 +194,9 @@ class BasinRM(Kind):
         return dict(fourier=ctx.fourier, F=float(block["F"]), Omega=float(block["Omega"]),
                     Psi=values.angle(block["Psi"]), xi_max=float(block["xi_max"]), grid=values.grid(block["grid"]),
                     n_points=int(block["n_points"]),
-                    manifold={"n_gamma": int(man["n_gamma"]), "n_xi": int(man["n_xi"]), "xi_top": float(man["xi_top"])},
+                    manifold={"n_gamma": int(man["n_gamma"]), "n_xi": int(man["n_xi"]),
+                              "xi_top": float(wells.from_spec(ctx.well).manifold_top if man["xi_top"] is None
+                                              else man["xi_top"])},
                     check_cycles=int(block["check_cycles"]), steps_per_cycle=ctx.steps_per_cycle)
 
     def cost(self, params):
@@ -232,7 +238,8 @@ class BasinChart(GridChartKind):
 
     def check(self, block, key, ctx):
         ctx.check_grid(f"{key}.grid", block["grid"])
-        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key))
+        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key),
+                                              block.get("damping", 0.0))
         if isinstance(block["F"], list) and isinstance(block["xi_max"], list):
             ctx.fail(f"{key}.F", "only one of F and xi_max may be a list (the scanned parameter)")
         ctx.check_unique(f"{key}.F", block["F"])
@@ -309,7 +316,8 @@ class Strobe(Kind):
 
     def check(self, block, key, ctx):
         ctx.check_grid(f"{key}.grid", block["grid"])
-        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key))
+        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key),
+                                              block.get("damping", 0.0))
         if "box" in block:
             ctx.check_interval(f"{key}.box[0]", block["box"][0])
             ctx.check_interval(f"{key}.box[1]", block["box"][1])

@@ -42,22 +42,25 @@ def _level_crossings(ds, level):
 
 
 def build_erosion_analytic(params, data, job):
-    """GIM / LIM / IF versus F from the slow flow on the chart grid, per first-harmonic variant."""
+    """GIM / LIM / IF versus F from the slow flow on the chart grid, per first-harmonic variant
+    (with damping: the damped slow flow, every IC's trajectory followed)."""
     from safebasins.analysis.erosion import erosion_profile_analytic
 
     n = params.get("analytic_n")
     q0, p0 = values.grid_axes(dict(params["grid"], n=[n, n]) if n else params["grid"])
+    beta = values.damping(params)
     print(f"{params['experiment']}: {len(params['F'])} F x {len(params['xi_max'])} xi_max x {params['fourier']} "
-          f"on {q0.size} x {p0.size} ICs")
+          f"on {q0.size} x {p0.size} ICs" + (f", damping {beta}" if beta > 0 else ""))
     ds = erosion_profile_analytic(params["F"], params["Omega"], params["Psi"], params["xi_max"], q0, p0,
-                                  fourier=params["fourier"], well=values.base_well(params))
+                                  fourier=params["fourier"], well=values.base_well(params), damping=beta)
     ds = _level_crossings(ds, params["level"])
     ds.attrs.update(level=params["level"], xi_max=params["xi_max"], grid_n=np.array([q0.size, p0.size]))
     return ds
 
 
 def build_erosion_numeric(params, data, job):
-    """GIM / LIM / IF versus (F, xi_max, t_eval) from one escape chart per F."""
+    """GIM / LIM / IF versus (F, xi_max, t_eval) from one escape chart per F (integrated with the
+    experiment's damping by the chart tiles; the profile carries the charts' ``damping``)."""
     from safebasins.analysis.erosion import profile_from_charts
 
     ds = profile_from_charts(_grid_charts(params, data["tiles"], "F"), params["t_eval"], stack_dim="F")
@@ -114,7 +117,8 @@ def build_fourier(params, data, job, *, what, source):
 
 def _check_grid_block(block, key, ctx):
     ctx.check_grid(f"{key}.grid", block["grid"])
-    ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "the analytic criterion", ctx.well_at(key))
+    ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "the analytic criterion", ctx.well_at(key),
+                                          block.get("damping", 0.0))
     ctx.check_t_eval_within(f"{key}.t_eval", block["t_eval"], block["cycles"])
     for k in ("xi_max", "t_eval"):
         ctx.check_unique(f"{key}.{k}", block[k])
@@ -130,6 +134,7 @@ def _analytic_numeric_inputs(experiment):
 class Erosion(GridChartKind):
     name = "erosion"
     description = "GIM / LIM / IF versus F; one escape chart per F serves every xi_max and t_eval"
+    damped = True
     builder = "safebasins.plotting.extras:figure_erosion"
     schema = {
         "description": description,
@@ -148,7 +153,9 @@ class Erosion(GridChartKind):
             "level": {"description": "integrity level whose first crossing in F is reported (F at GIM = level, ...)",
                       "type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1, "default": 0.5},
             "analytic_n": {"description": "ICs per axis of the analytic (slow-flow) profile on the grid's window "
-                                          "(null: the chart grid); finer than the chart: smooth analytic curves",
+                                          "(null: the chart grid); finer than the chart: smooth analytic curves "
+                                          "(with damping > 0 each IC's damped slow trajectory is integrated, "
+                                          "hundreds of times the cost: a coarser grid, e.g. null)",
                            "oneOf": [{"type": "null"}, {"type": "integer", "minimum": 3}], "default": 481},
         },
     }

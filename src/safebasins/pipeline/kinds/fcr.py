@@ -16,7 +16,7 @@ _CO = ("curve", "Omega")
 ANALYTIC_CONTRACT = {**{v: _CO for v in ("F_cr", "mechanism", "F_MM_0", "F_MM_pi", "F_SM", "F_SMM")},
                      **{c: ("curve",) for c in ("xi_max", "xi_ini", "gamma_ini", "label")}}
 NUMERIC_CONTRACT = {**{v: _CO for v in ("F_cr", "F_cr_low", "F_cr_high", "F_escape_low", "F_escape_all",
-                                         "non_monotone")},
+                                         "non_monotone", "F_bracket_used_high", "F_bracket_widenings")},
                     **{c: ("curve",) for c in ("xi_max", "xi_ini", "gamma_ini", "Psi", "label", "q0", "p0")}}
 
 #: the damped theory's variables (theory.critical_forcing with damping > 0: no mechanism branches)
@@ -52,7 +52,8 @@ def _check_curves(block, key, ctx):
     for k, m in lens.items():
         if m not in (1, n):
             ctx.fail(f"{key}.{k}", f"has {m} values but another curve list has {n}: lists must have equal length")
-    ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "analytic F_cr", ctx.well_at(key))
+    ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "analytic F_cr", ctx.well_at(key),
+                                          block["damping"])
     full = {k: v * (n // len(v)) for k, v in lists.items()}
     xm, xi = full["xi_max"], full["xi_ini"]
     seen = set()
@@ -64,6 +65,15 @@ def _check_curves(block, key, ctx):
         if b >= a:
             ctx.fail(f"{key}.xi_ini" + (f"[{i}]" if lens["xi_ini"] > 1 else ""),
                      f"initial energy {b} must be below the truncation level xi_max = {a}")
+
+
+def _bracket(value, well):
+    """The numeric F bracket of a config: as given, or (null) the well's default."""
+    if value is not None:
+        return [float(x) for x in value]
+    from safebasins.numerics.bisection import default_bracket
+
+    return list(default_bracket(well))
 
 
 def build_fcr_analytic(params, data, job):
@@ -132,8 +142,13 @@ class FcrCompare(Kind):
                     "Omega": {"$ref": "#/$defs/omega_range"},
                     "cycles": {"$ref": "#/$defs/cycles", "default": 3000},
                     "tol": {"type": "number", "exclusiveMinimum": 0, "default": 5.0e-5},
-                    "F_bracket": {"type": "array", "minItems": 2, "maxItems": 2,
-                                  "items": {"type": "number", "minimum": 0}, "default": [0.0, 0.3]},
+                    "F_bracket": {"description": "bisection bracket [F_lo, F_hi] of F; null: the well's own, "
+                                                 "[0, its static escape force] (numerics.bisection.default_bracket); "
+                                                 "its top is doubled (up to 3 times) where it does not escape",
+                                  "oneOf": [{"type": "null"},
+                                            {"type": "array", "minItems": 2, "maxItems": 2,
+                                             "items": {"type": "number", "minimum": 0}}],
+                                  "default": None},
                     "n_scan": {"type": "integer", "minimum": 0, "default": 60},
                     "criterion": {"enum": ["energy", "displacement"], "default": "energy"},
                 },
@@ -145,15 +160,16 @@ class FcrCompare(Kind):
         _check_curves(block, key, ctx)
         num = block["numeric"]
         ctx.check_range(f"{key}.numeric.Omega", num["Omega"], positive=True)
-        lo, hi = num["F_bracket"]
-        if not hi > lo:
-            ctx.fail(f"{key}.numeric.F_bracket", f"empty bracket [{lo}, {hi}]")
+        if num["F_bracket"] is not None:
+            lo, hi = num["F_bracket"]
+            if not hi > lo:
+                ctx.fail(f"{key}.numeric.F_bracket", f"empty bracket [{lo}, {hi}]")
 
     def resolve(self, block, ctx):
         nb = block["numeric"]
         return dict(fourier=ctx.fourier, Omega=values.range_values(block["Omega"]), curves=values.curves(block, True),
                     numeric={"Omega": values.range_values(nb["Omega"]), "cycles": int(nb["cycles"]),
-                             "tol": float(nb["tol"]), "F_bracket": [float(x) for x in nb["F_bracket"]],
+                             "tol": float(nb["tol"]), "F_bracket": _bracket(nb["F_bracket"], ctx.well),
                              "n_scan": int(nb["n_scan"]), "criterion": nb["criterion"],
                              "steps_per_cycle": ctx.steps_per_cycle})
 
@@ -169,8 +185,11 @@ class FcrCompare(Kind):
 
     def cost(self, params):
         n = params["numeric"]
+        from safebasins.numerics.bisection import MAX_WIDENINGS
+
         lo, hi = n["F_bracket"]
-        levels = math.ceil(math.log2((hi - lo) / n["tol"]))
+        # upper bound: every Omega widened to the last doubling (one ensemble each) and bisected there
+        levels = MAX_WIDENINGS + math.ceil(math.log2((hi * 2 ** MAX_WIDENINGS - lo) / n["tol"]))
         return (len(params["curves"]) * len(n["Omega"]) * (levels + n["n_scan"]) * n["cycles"]
                 * n["steps_per_cycle"])
 

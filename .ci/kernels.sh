@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# The tests of the wells, theory, numerics and analysis under other OpenBLAS kernels than the one
+# this CPU selects (make test runs the native one): the last bits of LAPACK/BLAS results differ
+# between kernels, and no test may depend on them.  OPENBLAS_CORETYPE forces a kernel; before each
+# run the kernel actually loaded by numpy's and scipy's OpenBLAS is read back, so a variable that
+# the library ignored (a build without DYNAMIC_ARCH, a CPU without the kernel's instructions)
+# fails here instead of passing silently.  KERNELS="Haswell Sandybridge" by default; the test paths
+# are those below unless KERNEL_TEST_PATHS names others (space-separated).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+PY=.venv/bin/python
+KERNELS=${KERNELS:-"Haswell Sandybridge"}
+read -r -a DIRS <<< "${KERNEL_TEST_PATHS:-tests/wells tests/theory tests/numerics tests/analysis}"
+
+# the core name of every OpenBLAS loaded by numpy and scipy.linalg (threadpoolctl when installed,
+# else the library's own openblas_get_corename through ctypes), one per line
+read -r -d '' CORES <<'EOF' || true
+import ctypes, numpy, scipy.linalg
+try:
+    import threadpoolctl
+    for info in threadpoolctl.threadpool_info():
+        if info["internal_api"] == "openblas":
+            print(info["filepath"], info["architecture"])
+    raise SystemExit
+except ImportError:
+    pass
+paths = sorted({line.split()[-1] for line in open("/proc/self/maps") if "openblas" in line and ".so" in line})
+for path in paths:
+    lib = ctypes.CDLL(path)
+    for sym in ("scipy_openblas_get_corename64_", "scipy_openblas_get_corename", "openblas_get_corename64_",
+                "openblas_get_corename"):
+        if hasattr(lib, sym):
+            f = getattr(lib, sym)
+            f.restype = ctypes.c_char_p
+            print(path, f().decode())
+            break
+    else:
+        print(path, "?")
+EOF
+
+status=0
+for kernel in $KERNELS; do
+    cores=$(OPENBLAS_CORETYPE=$kernel "$PY" -c "$CORES")
+    echo "OPENBLAS_CORETYPE=$kernel:"
+    echo "$cores" | sed 's/^/  /'
+    if [ -z "$cores" ] || echo "$cores" | awk -v k="$kernel" 'tolower($2) != tolower(k) {bad = 1} END {exit !bad}'; then
+        echo "kernels.sh: OPENBLAS_CORETYPE=$kernel was not honoured (loaded kernels above)" >&2
+        exit 1
+    fi
+    start=$(date +%s)
+    rc=0
+    OPENBLAS_CORETYPE=$kernel "$PY" -m pytest -p no:cacheprovider -q -n 2 --dist loadfile --durations=5 "${DIRS[@]}" || rc=$?
+    echo "kernels.sh: OPENBLAS_CORETYPE=$kernel: exit $rc, wall $(( $(date +%s) - start )) s"
+    [ "$rc" -eq 0 ] || status=1
+done
+exit $status
