@@ -401,7 +401,6 @@ def study(args):
               f"{np.quantile(d, 0.99):9.2g} {100 * one_step:10.2f} {(d > 1).sum():8d} {dt_run:6.2f}")
     # and the t_eval-resolved agreement at the default
     from safebasins.numerics import engine
-    from safebasins.numerics.problem import ensemble_problem
     S = engine.DEFAULT_STEPS_PER_CYCLE
     ch = escape_chart(q, q, c["F"], c["Omega"], c["Psi"], xi_max=c["xi_max"], cycles=c["cycles"], steps_per_cycle=S)
     e = ch["escape_cycle_energy"].values[0].ravel()

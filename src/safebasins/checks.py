@@ -71,6 +71,12 @@ def check_positive_int(name, value):
     return int(value)
 
 
+def check_damping(damping):
+    """The damping beta of ``q'' + beta q' + V'(q) = F sin(Omega t + Psi)``: a finite scalar >= 0
+    (ValueError naming ``damping`` otherwise)."""
+    return check_scalar("damping", damping, check_nonnegative)
+
+
 def check_scalar(name, value, check):
     """``check(name, value)`` and a 0-d result, returned as float."""
     a = check(name, value)

@@ -221,7 +221,7 @@ BAD = [
      "'--n-points'", "n_points must be >= 3"),                    # raised by the library, mapped to the option
     (["chart", "--F", "0.01", "--Omega", "0.9", "--Psi", "pi/0", "--xi-max", "0.15"], "'--Psi'", "divides by zero"),
     (["chart", "--F", "0.01", "--Omega", "0.02", "--xi-max", "0.15"], "'--steps-per-cycle'",
-     "use steps_per_cycle >= 297"),                                # checked before anything is integrated
+     "use steps_per_cycle >= 281"),                                # checked before anything is integrated
     (["fcr", "--xi-max", "0.15", "--numeric", "--numeric-Omega", "0.01,0.02,2"], "'--steps-per-cycle'",
      "steps_per_cycle >="),
     (["info", "not_netcdf.txt"], "'FILE'", "not a readable netCDF file"),

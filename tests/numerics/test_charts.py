@@ -1,7 +1,6 @@
 """escape_chart / safe_mask / safe_area: structure, threshold logic, criteria, theory."""
 import numpy as np
 import pytest
-import xarray as xr
 
 from safebasins.analysis.safe import safe_area, safe_mask
 from safebasins.numerics import escape_chart, random_initial_conditions

@@ -49,7 +49,7 @@ def _knife_edges(integrator, ics, Omega, F, Psi, S, n_steps, per_ic=2):
     thresholds 2 xi = e* and nextafter(e*, -inf); the lower one is crossed exactly at that step,
     and a state one ulp off there moves the step of one of the two.  Returns (xi_max, expected):
     expected[j] = (IC, step) at which the CPU must cross xi_max[2 j + 1]."""
-    from safebasins.numerics import kernels, steps
+    from safebasins.numerics import steps
     c = schemes.lane_coefficients(Omega, S, integrator)[0]
     tab = F * schemes.sine_table(S, Psi, integrator)
     xi, expected = [], []

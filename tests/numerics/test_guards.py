@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from safebasins import wells
-from safebasins.numerics import critical_forcing_numeric, engine, escape_chart, stroboscopic_map
+from safebasins.numerics import critical_forcing_numeric, escape_chart, stroboscopic_map
 from tests.numerics.ensemble import run_ensemble
 
 

@@ -4,7 +4,6 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from safebasins.numerics import engine
 from safebasins.numerics import escape_chart
 from safebasins.numerics import kernels
 from safebasins.numerics import schemes

@@ -18,7 +18,7 @@ import pytest
 from numba import njit
 from scipy.integrate import solve_ivp
 
-from safebasins.numerics import (critical_forcing_numeric, displacement_bounds, engine, escape_chart,
+from safebasins.numerics import (critical_forcing_numeric, displacement_bounds, escape_chart,
                                  escape_chart_batch, kernels, steps, stroboscopic_map, wellcode)
 from safebasins.wells.polynomial import PolynomialWell, cubic
 from safebasins.numerics import schemes

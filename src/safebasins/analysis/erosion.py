@@ -41,7 +41,6 @@ from safebasins.analysis.safe import chart_well, safe_stack
 from safebasins.io.cf import annotate
 from safebasins.numerics import escape_chart
 from safebasins.numerics.engine import damping_attrs
-from safebasins.theory.damped import check_damping
 from safebasins.theory.damped_escape import UndecidedWarning, slow_flow_outcomes
 from safebasins.theory.damped_flow import SETTLED, UNDECIDED
 from safebasins.wells import resolve_well, well_attrs
@@ -66,7 +65,7 @@ def _analytic_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier, well, damping
     xi = as_1d("xi_max", xi_max, wl[0].check_threshold)
     Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
-    beta = check_damping(damping)
+    beta = checks.check_damping(damping)
     q, p, Q, P = mesh(q0, p0)
     S0 = unforced_safe_mask(q, p, xi, wl[0])
     out = np.zeros((len(fl), F.size, xi.size, q.size, p.size), dtype=bool)
@@ -231,7 +230,7 @@ def erosion_profile_numeric(F_values, Omega, Psi, xi_max, q0, p0, t_eval=None, c
     checks.check_positive_int("cycles", cycles)
     checks.check_scalar("Omega", Omega, checks.check_positive)
     checks.check_scalar("Psi", Psi, checks.check_finite)
-    beta = check_damping(damping)
+    beta = checks.check_damping(damping)
     q, p, _, _ = mesh(q0, p0)
     charts = []
     for Fi in F:

@@ -22,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
+from safebasins import checks
 from safebasins.io.provenance import api_provenance
 
 __all__ = ["analytic_basin", "analytic_basin_stack", "add_resonance_manifold", "numeric_check", "mask_outline",
@@ -109,9 +110,8 @@ def analytic_basin(F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, l
     outline of its safe mask (:func:`mask_outline`, attribute ``boundary = "mask_outline"``;
     ``n_points`` unused), attribute ``damping``."""
     from safebasins.theory import safe_basin_boundaries, slow_flow_escapes
-    from safebasins.theory.damped import check_damping
-
-    beta = check_damping(damping)
+    
+    beta = checks.check_damping(damping)
     qa, pa = np.asarray(q0, float), np.asarray(p0, float)
     Q, P = np.meshgrid(qa, pa, indexing="ij")
     if beta > 0:
@@ -174,9 +174,8 @@ def numeric_check(basin, F, Omega, Psi, xi_max, *, cycles, steps_per_cycle, well
     :func:`analytic_basin`) the damped one.  ``label``: as :func:`analytic_basin`."""
     from safebasins.analysis.confirm import confirm_regions
     from safebasins.numerics import escape_chart
-    from safebasins.theory.damped import check_damping
-
-    beta = check_damping(basin.attrs.get("damping", 0.0))
+    
+    beta = checks.check_damping(basin.attrs.get("damping", 0.0))
     safe = ~np.asarray(basin["escapes"].transpose("q0", "p0").values, bool)
     Q, P = np.meshgrid(basin["q0"].values, basin["p0"].values, indexing="ij")
     ec = np.full(safe.shape, np.nan)

@@ -269,10 +269,6 @@ def _check_omega(Omega):
     return Om
 
 
-def _check_damping(damping):
-    return checks.check_scalar("damping", damping, checks.check_nonnegative)
-
-
 def separatrix_integrals(Omega, well=None):
     """``(I1, I2, orbit)`` along the separatrix orbit (:func:`separatrix_orbit`) of ``well``, by
     the quadrature of the module docstring: ``I1 = int p0^2 dt`` (float) and the complex
@@ -314,7 +310,7 @@ def melnikov_threshold(Omega, damping, well=None):
     the threshold is F = 0 itself), ``well`` any form :func:`safebasins.wells.resolve_well` reads
     (None: the paper's quartic).  ValueError naming ``Omega``, ``damping`` or ``well`` (no hilltop
     saddle: sech2, morse)."""
-    damping = _check_damping(damping)
+    damping = checks.check_damping(damping)
     I1, I2, _ = separatrix_integrals(Omega, well)
     F = damping * I1 / np.abs(I2)
     return float(F) if np.ndim(F) == 0 else F
@@ -331,7 +327,7 @@ def melnikov_function(t0, F, Omega, damping, well=None, Psi=0.0):
     F = checks.check_scalar("F", F, checks.check_nonnegative)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
     Om = checks.check_scalar("Omega", Omega, lambda n, v: _check_omega(v))
-    damping = _check_damping(damping)
+    damping = checks.check_damping(damping)
     I1, I2, _ = separatrix_integrals(Om, well)
     M = -damping * I1 + F * np.imag(np.exp(1j * (Om * t0 + Psi)) * complex(I2))
     return float(M) if np.ndim(M) == 0 else M
@@ -343,7 +339,7 @@ def melnikov_curve(Omega, damping, well=None) -> xr.Dataset:
     integrals ``I1`` and ``I2_abs(Omega)``, attributes naming the well (:func:`well_attrs`), the
     damping, the orbit kind ("heteroclinic" / "homoclinic"), its saddles and energy."""
     Om = checks.check_1d("Omega", Omega, checks.as_array)
-    damping = _check_damping(damping)
+    damping = checks.check_damping(damping)
     I1, I2, orbit = separatrix_integrals(Om, well)
     A = np.abs(I2)
     w = resolve_well(well)
@@ -520,7 +516,7 @@ def manifold_splitting(F, Omega, damping, well=None, Psi=0.0, n_phase=48, offset
 
     F = checks.check_scalar("F", F, checks.check_nonnegative)
     Om = checks.check_scalar("Omega", Omega, lambda n, v: _check_omega(v))
-    damping = _check_damping(damping)
+    damping = checks.check_damping(damping)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
     n_phase = checks.check_positive_int("n_phase", n_phase)
     if n_phase < 8:

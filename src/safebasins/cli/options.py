@@ -8,6 +8,7 @@ read from the library signatures and the pipeline schema, never restated.
 from __future__ import annotations
 
 import contextlib
+import importlib
 import inspect
 import math
 import re
@@ -450,7 +451,7 @@ def numerics_options(func, what):
                          callback=checked(None, engine_check("check_steps_per_cycle")),
                          help="Fixed integrator steps per forcing period (>= 4).")(f)
         return click.option("--cycles", cls=Deferred, type=int, default=from_library(func, "cycles"),
-                            callback=checked("cycles", engine_check("check_cycles")),
+                            callback=checked("cycles", engine_check("check_cycles", "problem")),
                             help=f"Horizon in forcing cycles (EC) {what}.")(f)
     return deco
 
@@ -467,12 +468,10 @@ def backend_check(ctx, param, value):
     return value
 
 
-def engine_check(name):
-    """A check of safebasins.numerics.engine (imports numba: only when the option is used)."""
+def engine_check(name, module="engine"):
+    """A check of safebasins.numerics.<module> (imports numba: only when the option is used)."""
     def check(*args):
-        from safebasins.numerics import engine
-
-        return getattr(engine, name)(*args)
+        return getattr(importlib.import_module(f"safebasins.numerics.{module}"), name)(*args)
     return check
 
 

@@ -23,7 +23,7 @@ import xarray as xr
 from safebasins import checks
 from safebasins.io.provenance import api_provenance
 from safebasins.numerics import criteria, engine, schemes
-from safebasins.numerics.problem import check_cycles, check_damping, ensemble_problem
+from safebasins.numerics.problem import check_cycles, ensemble_problem
 from safebasins.wells import QuarticWell, resolve_well
 
 DEFAULT_N_SCAN = 301
@@ -125,7 +125,7 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     q0 = checks.check_scalar("q0", q0, checks.check_finite)
     p0 = checks.check_scalar("p0", p0, checks.check_finite)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
-    damping = check_damping(damping)
+    damping = checks.check_damping(damping)
     cycles = check_cycles("cycles", cycles)
     tol = checks.check_scalar("tol", tol, checks.check_positive)
     br = checks.check_nonnegative("F_bracket", default_bracket(w) if F_bracket is None else F_bracket)

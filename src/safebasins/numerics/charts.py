@@ -8,7 +8,7 @@ from safebasins import checks
 from safebasins.io import cf
 from safebasins.io.provenance import api_provenance
 from safebasins.numerics import criteria, engine, schemes
-from safebasins.numerics.problem import check_cycles, check_damping, displacement_pairs, ensemble_problem
+from safebasins.numerics.problem import check_cycles, displacement_pairs, ensemble_problem
 from safebasins.wells import resolve_well
 
 def _monotone(a):
@@ -101,7 +101,7 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=()
     F = checks.check_scalar("F", F, checks.check_nonnegative)
     Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
-    damping = check_damping(damping)
+    damping = checks.check_damping(damping)
     w = resolve_well(well)
     xi, qm, qb = _thresholds(w, xi_max, q_max, q_bounds)
     cycles = check_cycles("cycles", cycles)
@@ -168,7 +168,7 @@ def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bou
     if F.size != Omega.size or F.size == 0:
         raise ValueError(f"F and Omega must be 1-D of the same non-zero length, got {F.size} and {Omega.size}")
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
-    damping = check_damping(damping)
+    damping = checks.check_damping(damping)
     w = resolve_well(well)
     xi, qm, qb = _thresholds(w, xi_max, q_max, q_bounds)
     cycles = check_cycles("cycles", cycles)

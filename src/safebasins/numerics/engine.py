@@ -73,22 +73,23 @@ def check_step(Omega, steps_per_cycle, well=None, integrator=DEFAULT_INTEGRATOR)
     would be all escape, not an answer)."""
     Om = np.atleast_1d(np.asarray(Omega, dtype=float))
     w = resolve_well(well)
-    STEP_LIMIT = schemes.step_limit(integrator)
+    limit = schemes.step_limit(integrator)
     om_min = float(Om.min())
     h = 2.0 * math.pi / (om_min * steps_per_cycle)
     fastest = max(w.omega_max, om_min)
     x = h * fastest
-    if x > STEP_LIMIT:
-        need = 2.0 * math.pi * fastest / (om_min * STEP_LIMIT)
+    if x > limit:
+        need = 2.0 * math.pi * fastest / (om_min * limit)
         if need > MAX_STEPS_PER_CYCLE:
             raise ValueError(
                 f"steps_per_cycle: Omega = {om_min:.6g} is too small to integrate: the step limit h * {fastest:.4g} <= "
-                f"{STEP_LIMIT} of the {w.name} well would need {need:.3g} steps per forcing cycle (more than "
+                f"{limit:.4g} of {integrator} in the {w.name} well would need {need:.3g} steps per forcing cycle (more than "
                 f"{MAX_STEPS_PER_CYCLE:.0e}); use a larger Omega")
         need = math.ceil(need)
         raise ValueError(
             f"steps_per_cycle: {steps_per_cycle} steps per forcing cycle at Omega = {om_min:.6g} give a step "
-            f"h = {h:.4g}, and h * {fastest:.4g} = {x:.4g} exceeds {STEP_LIMIT} ({fastest:.4g} = the larger of Omega "
+            f"h = {h:.4g}, and h * {fastest:.4g} = {x:.4g} exceeds {limit:.4g}, the step limit of {integrator} "
+            f"({fastest:.4g} = the larger of Omega "
             f"and the {w.name} well's largest local frequency sqrt(max |V''|) = {w.omega_max:.4g}): the integrator "
             f"is inaccurate or unstable there; use steps_per_cycle >= {need} (or a larger Omega)")
     return steps_per_cycle

@@ -7,8 +7,8 @@ import xarray as xr
 from safebasins import checks
 from safebasins.io import cf
 from safebasins.io.provenance import api_provenance
-from safebasins.numerics import criteria, engine, schemes
-from safebasins.numerics.problem import check_cycles, check_damping, displacement_pairs, ensemble_problem
+from safebasins.numerics import engine, schemes
+from safebasins.numerics.problem import check_cycles, displacement_pairs, ensemble_problem
 from safebasins.wells import resolve_well
 
 
@@ -51,7 +51,7 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
     Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
     n_iter = check_cycles("n_iter", n_iter)
-    damping = check_damping(damping)
+    damping = checks.check_damping(damping)
     w = resolve_well(well)
     xi = () if xi_max is None else (checks.check_scalar("xi_max", xi_max, w.check_threshold),)
     qm = () if q_max is None else (checks.check_scalar("q_max", q_max, w.check_displacement),)

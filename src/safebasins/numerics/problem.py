@@ -24,8 +24,7 @@ from safebasins.numerics.scheme_code import SchemeCode, scheme_code
 from safebasins.numerics.wellcode import WellCode
 from safebasins.wells import resolve_well
 
-__all__ = ["EnsembleProblem", "ensemble_problem", "displacement_pairs", "engine_code", "check_cycles",
-           "check_damping"]
+__all__ = ["EnsembleProblem", "ensemble_problem", "displacement_pairs", "engine_code", "check_cycles"]
 
 
 def check_cycles(name: str, cycles) -> int:
@@ -33,11 +32,6 @@ def check_cycles(name: str, cycles) -> int:
     if isinstance(cycles, (float, np.floating)) and float(cycles).is_integer() and cycles >= 1:
         cycles = int(cycles)
     return checks.check_positive_int(name, cycles)
-
-
-def check_damping(damping) -> float:
-    """The damping beta of q'' + beta q' + V'(q) = F sin(Omega t + Psi): a finite scalar >= 0."""
-    return checks.check_scalar("damping", damping, checks.check_nonnegative)
 
 
 def displacement_pairs(q_max=(), q_bounds=()) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
@@ -143,7 +137,7 @@ def ensemble_problem(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_boun
         raise ValueError(f"Omega and F must have one value per parameter set, got sizes {Omega.size} and {F.size}")
     if q0.size and (pidx.min() < 0 or pidx.max() >= Omega.size):
         raise ValueError(f"pidx must index the {Omega.size} parameter set(s)")
-    damping = check_damping(damping)
+    damping = checks.check_damping(damping)
     xi = np.asarray(xi_max, dtype=float).ravel()
     lo, hi, order_Q, _ = displacement_pairs(q_max, q_bounds)
     order_E = np.argsort(xi, kind="stable")

@@ -42,8 +42,8 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
+from safebasins import checks
 from safebasins.checks import check_finite, check_positive
-from safebasins.theory.damped import check_damping
 from safebasins.theory.slow_flow import _scalar, _xi_grid, resolved_shift, unshear
 from safebasins.wells import resolve_well
 from safebasins.io.provenance import api_provenance
@@ -169,7 +169,7 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
     g0 = _scalar("gamma_ini", gamma_ini, check_finite)
     if not isinstance(n_grid, (int, np.integer)) or n_grid < 16:
         raise ValueError("n_grid must be an integer >= 16")
-    beta = check_damping(damping)
+    beta = checks.check_damping(damping)
     if beta > 0:
         from safebasins.theory.damped import slow_tables
         from safebasins.theory.damped_escape import damped_critical_forcing

@@ -42,7 +42,7 @@ from safebasins.checks import check_nonnegative, check_positive, check_scalar
 from safebasins.theory.slow_flow import unshear
 from safebasins.wells.quartic import QuarticWell
 
-__all__ = ["check_damping", "coefficients", "xi_of_J", "SlowTables", "slow_tables", "flow_tilde",
+__all__ = ["coefficients", "xi_of_J", "SlowTables", "slow_tables", "flow_tilde",
            "to_tilde", "from_tilde", "rhs_exact", "rhs_gamma_frame"]
 
 #: coefficients at energies below ``XI_FLOOR * barrier_energy`` are taken there (the cancellation
@@ -50,12 +50,6 @@ __all__ = ["check_damping", "coefficients", "xi_of_J", "SlowTables", "slow_table
 XI_FLOOR = 1e-8
 #: the top of the tables: ``(1 - TOP_GAP) * barrier_energy`` (below the separatrix singularity)
 TOP_GAP = 1e-9
-
-
-def check_damping(damping):
-    """The damping beta of ``q'' + beta q' + V'(q) = F sin(Omega tau + Psi)``: a finite scalar >= 0
-    (ValueError naming ``damping`` otherwise)."""
-    return check_scalar("damping", damping, check_nonnegative)
 
 
 def shift_derivative(well, xi):

@@ -23,8 +23,9 @@ import warnings
 import numpy as np
 import xarray as xr
 
+from safebasins import checks
 from safebasins.checks import check_finite, check_scalar
-from safebasins.theory.damped import check_damping, forcing_and_level, slow_tables, to_tilde
+from safebasins.theory.damped import forcing_and_level, slow_tables, to_tilde
 from safebasins.theory.damped_flow import ESCAPED, SETTLED, STATUS, UNDECIDED, default_t_max, integrate_batch, pivots
 from safebasins.wells import resolve_well
 
@@ -67,7 +68,7 @@ def slow_flow_outcomes(q0, p0, F, Omega, Psi, xi_max, damping, fourier=None, wel
         2 = undecided within 10 times the default horizon (not safe, not escaped: check for it).
     """
     w = resolve_well(well, fourier)
-    beta = check_damping(damping)
+    beta = checks.check_damping(damping)
     if beta <= 0:
         raise ValueError("damping must be > 0 here (damping = 0 is the conservative slow flow: "
                          "slow_flow_escapes)")

@@ -19,8 +19,9 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
+from safebasins import checks
 from safebasins.checks import check_1d, check_nonnegative, check_positive, check_positive_int, check_scalar
-from safebasins.theory.damped import TOP_GAP, check_damping, coefficients, slow_tables
+from safebasins.theory.damped import TOP_GAP, coefficients, slow_tables
 from safebasins.theory.slow_flow import unshear
 from safebasins.wells import resolve_well
 from safebasins.io.provenance import api_provenance
@@ -317,7 +318,7 @@ def steady_responses(Omega, F, damping, well=None, xi_max=None, fourier=None, n_
         attrs: F, damping, xi_max, well, fourier.
     """
     w = resolve_well(well, fourier)
-    beta = check_damping(damping)
+    beta = checks.check_damping(damping)
     Om = check_1d("Omega", Omega, check_positive)
     F = check_scalar("F", F, check_nonnegative)
     n_grid = check_positive_int("n_grid", n_grid)

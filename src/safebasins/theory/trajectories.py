@@ -11,8 +11,9 @@ import numpy as np
 import xarray as xr
 from scipy import integrate
 
+from safebasins import checks
 from safebasins.checks import check_finite, check_positive, check_scalar
-from safebasins.theory.damped import check_damping, forcing_and_level, from_tilde, rhs_exact, to_tilde
+from safebasins.theory.damped import forcing_and_level, from_tilde, rhs_exact, to_tilde
 from safebasins.theory.damped_flow import default_t_max, pivots
 from safebasins.wells import resolve_well
 from safebasins.io.provenance import api_provenance
@@ -77,7 +78,7 @@ def slow_trajectory(xi_ini, gamma_ini, F, Omega, xi_max, damping=0.0, well=None,
         otherwise), and the parameters.
     """
     w = resolve_well(well, fourier)
-    beta = check_damping(damping)
+    beta = checks.check_damping(damping)
     x0 = check_scalar("xi_ini", xi_ini, lambda n, v: w.check_energy(n, v))
     g0 = check_scalar("gamma_ini", gamma_ini, check_finite)
     F, Om, xm, tab = forcing_and_level(w, F, Omega, xi_max)
