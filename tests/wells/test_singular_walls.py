@@ -17,6 +17,9 @@ WELLS = {
                                              lambda q: q + 0.05 - 0.05 / (1 - q) ** 2),
     "q**2/2 + 0.1*q - 0.081/(0.9-q) + 0.09": (lambda q: q * q / 2 + 0.1 * q - 0.081 / (0.9 - q) + 0.09,
                                                lambda q: q + 0.1 - 0.081 / (0.9 - q) ** 2),
+    # the pole 0.010 beyond the barrier: no Gauss rule reaches tol over the standard segments
+    "q**2/2 - 0.0001/(1-q) + 0.0001 + 0.0001*q": (lambda q: q * q / 2 - 0.0001 / (1 - q) + 0.0001 + 0.0001 * q,
+                                                   lambda q: q + 0.0001 - 0.0001 / (1 - q) ** 2),
     "(1+q)**-12 - 2*(1+q)**-6 + 1": (lambda q: (1 + q) ** -12 - 2 * (1 + q) ** -6 + 1,
                                      lambda q: -12 * (1 + q) ** -13 + 12 * (1 + q) ** -7),
 }
@@ -36,6 +39,17 @@ def test_mems_barrier_and_closed_side(text):
     qb = optimize.brentq(dV, 0.1, pole - 1e-9, xtol=1e-15)
     assert w.barriers[0] == -np.inf and w.barriers[1] == pytest.approx(qb, rel=1e-13)
     assert w.barrier_energy == pytest.approx(V(qb), rel=1e-13)
+
+
+def test_mean_rule_follows_the_pole():
+    """The rule of <V'> (OrbitQuadrature): 4 nodes for the pendulum (unchanged), more as the pole
+    nears the barrier, and shorter segments at the right end where no rule reaches tol."""
+    rules = {text: wells.from_spec({"expression": text})._quad for text in
+             ("1 - cos(q)", "q**2/2 - 0.05/(1-q) + 0.05 + 0.05*q", "q**2/2 - 0.0001/(1-q) + 0.0001 + 0.0001*q")}
+    quads = list(rules.values())
+    assert [q.n_mean for q in quads] == [4, 8, 16]
+    assert quads[0].mean_length == quads[1].mean_length == (np.inf, np.inf)
+    assert quads[2].mean_length[0] == np.inf and 0 < quads[2].mean_length[1] < 0.5 * 0.1 * quads[2].barriers[1]
 
 
 def test_lennard_jones_core_is_a_wall_not_a_barrier():

@@ -423,7 +423,8 @@ def well_option(f):
         metavar="WELL",
         help="The potential well, as in the config's `well:`: a name (quartic, cubic, pendulum, sech2, morse), "
              "polynomial:c0,c1,c2,... (V = sum c_k q^k), expression:'<formula in q>' (e.g. expression:'1 - cos(q)'), "
-             "or a mapping {expression: '...'}.")(f)
+             "or a mapping {expression: '...'} (a mapping may add tol: 1e-11, the accuracy of the well's "
+             "action-angle tables, for a formula whose rounding does not reach the default 1e-13).")(f)
 
 
 def common_options(f):
