@@ -54,7 +54,7 @@ def displacement_pairs(q_max=(), q_bounds=()) -> tuple[np.ndarray, np.ndarray, n
 
 
 def engine_code(well, q_max=(), q_bounds=()) -> WellCode:
-    """The compiled form the engines integrate ``well`` in: its |q|-tracking form only when every
+    """The compiled form the engines integrate ``well`` in: its abs(q)-tracking form only when every
     displacement bound is symmetric (displacement_pairs)."""
     code = resolve_well(well).compiled
     return code.signed() if displacement_pairs(q_max, q_bounds)[3] else code

@@ -7,7 +7,7 @@
   (schemes.lane_coefficients of one parameter set) and the forcing values ``f`` (F sin(Omega t + Psi)
   at the scheme's distinct force sub-times), calling ``force(w, q, f_k) = -V'(q) + f_k`` of a well's
   compiled form (wellcode.py) and the primitives ``fma`` / ``mul`` (every product that meets an
-  add is an explicit fma; the damped p *= e is a mul: never contracted on the GPU);
+  add is an explicit fma; the damped ``p *= e`` is a mul: never contracted on the GPU);
 * the tuple helpers of its arity: ``row(tab, s)`` (a forcing-table row), ``scaled(F, t)`` (F times
   it: the products the shared path precomputes), ``coefs(c)`` (a coefficient row as a tuple),
   ``column(CL, l)`` (a lane's coefficient column), ``from_h(h)`` (undamped: the coefficients formed
