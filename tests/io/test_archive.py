@@ -23,6 +23,7 @@ import urllib3
 import xarray as xr
 import yaml
 
+import safebasins
 from safebasins.io import archive as sa
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -92,7 +93,8 @@ def test_citation_cff():
     cff = yaml.safe_load((ROOT / "CITATION.cff").read_text())
     project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
     assert cff["cff-version"] == "1.2.0" and cff["type"] == "software"
-    assert cff["version"] == project["version"] and cff["license"] == project["license"]["text"] == "MIT"
+    assert project["dynamic"] == ["version"]            # the version's one home is the package
+    assert cff["version"] == safebasins.__version__ and cff["license"] == project["license"] == "MIT"
     assert cff["authors"] and all("name" in a or "family-names" in a for a in cff["authors"])
     paper = cff["preferred-citation"]
     assert paper["type"] == "article"

@@ -65,7 +65,8 @@ def chart(n=20):
 def numeric_fcr():
     return xr.Dataset({"F_cr": ("Omega", [0.10, 0.12]), "F_cr_low": ("Omega", [0.0995, 0.1195]),
                        "non_monotone": ("Omega", [False, False])},
-                      coords={"Omega": [0.7, 0.9]}, attrs={"title": "numeric F_cr", "tol": 1e-3, "criterion": "energy"})
+                      coords={"Omega": [0.7, 0.9]},
+                      attrs={"title": "numeric F_cr", "tol": 1e-3, "criterion": "energy"})
 
 
 def verdict(old, new):

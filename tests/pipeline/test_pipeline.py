@@ -34,13 +34,7 @@ SUBSET = ["results/data/numeric/chart_fig13.nc", "results/data/numeric/fcr_fig10
           "results/data/numeric/criteria_fig19.nc", "results/data/numeric/chart_fig16.nc"]
 
 
-@pytest.fixture(scope="module")
-def quick(tmp_path_factory):
-    wd = make_sandbox(tmp_path_factory.mktemp("quick"))
-    t0 = time.perf_counter()
-    r = run_snakemake(wd, "-j2", "--keep-going", "all")
-    print(f"\nquick run (all, -j2): {time.perf_counter() - t0:.1f} s")
-    return wd, r
+# the quick run (fixture `quick`) is shared with the other pipeline modules: tests/pipeline/conftest.py
 
 
 def test_quick_run_completes(quick):

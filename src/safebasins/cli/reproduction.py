@@ -23,7 +23,7 @@ def verify_reproduction(reference, new, quiet):
 
     Each dataset is "identical", "within tolerance" (with its worst difference: variable,
     amount, tolerance), "differs" (with the reasons) or "missing".  Exit status 0 when nothing
-    differs or is missing, 1 otherwise.
+    differs or is missing, 1 otherwise, 2 for bad input.
 
     \b
     Example:

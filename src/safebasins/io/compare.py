@@ -4,6 +4,8 @@ Used to prove that a refactor keeps results (``scripts/compare_results.py``) and
 (-j1 vs -j2, tiles, cluster, GPU). Provenance attributes (who/when/which commit/which
 parameter text made the file) are reported but never fail a comparison; everything else must
 be identical: names, dims, dtypes, values (NaN == NaN) and the attributes of every variable.
+Bit for bit is right within one machine; between machines the last bits differ, and
+:mod:`safebasins.io.reproduction` compares with stated tolerances instead.
 """
 from __future__ import annotations
 
