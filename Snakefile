@@ -4,9 +4,9 @@
 #
 #   snakemake -j2                                        # all datasets, figures, archive
 #   snakemake -j2 --configfile config/quick.yaml         # the same DAG at coarse resolution
-#   snakemake -j2 escape_equation                       # the cubic-well study only (issue 12)
-#   snakemake -j2 other_wells                           # the pendulum and sech^2 study (issue 16)
-#   snakemake -j2 damped                                # the damped study (issue 17)
+#   snakemake -j2 escape_equation                       # the cubic-well study only
+#   snakemake -j2 other_wells                           # the pendulum and sech^2 study
+#   snakemake -j2 damped                                # the damped study
 #   snakemake -j2 archive                                # results/archive/*.tar.gz
 #   snakemake --report results/report.html               # HTML report
 import os

@@ -1,4 +1,4 @@
-"""The analytic integrity map as computed before issue 20 (one ``slow_flow_escapes`` and one
+"""The analytic integrity map as computed before the shared slow-flow grid (one ``slow_flow_escapes`` and one
 ``xi_true_analytic`` per control point, ``closed_measures`` per distinct xi_true), kept as the
 reference of ``bench_integrity_map.py --analytic``: same control points, same grid, the
 arrays the map is made of."""
@@ -31,7 +31,7 @@ def reference_arrays(Omega, F, Psi, xi_max, q0, p0, *, fourier=None, n_gamma=128
 
 
 def _unforced_radii2(xi, w, n=1001):
-    """``analysis.integrity.unforced_radii2`` before issue 20: the full (c, q) matrices."""
+    """``analysis.integrity.unforced_radii2`` before the shared grid: the full (c, q) matrices."""
     lo, hi = (float(np.asarray(t)) for t in w.turning_points(xi))
     q = np.union1d(np.linspace(lo, hi, n), [0.0])
     V2 = 2.0 * np.asarray(w.V(q), float)
@@ -47,7 +47,7 @@ def _unforced_radii2(xi, w, n=1001):
 
 
 def _closed_measures(xi_true, xi_max, w):
-    """``analysis.phase_invariant.closed_measures`` before issue 20."""
+    """``analysis.phase_invariant.closed_measures`` before the shared grid."""
     if xi_true <= 0:
         return 0.0, 0.0, 0.0
     loc_t, glob_t = _unforced_radii2(xi_true, w)

@@ -1,4 +1,4 @@
-"""Cold start of the CPU engine (issue 20): the first ``numerics.escape_chart`` call of a fresh
+"""Cold start of the CPU engine: the first ``numerics.escape_chart`` call of a fresh
 process, with an empty numba cache and with the project's cache (``make`` warms it at install).
 
     .venv/bin/python benchmarks/bench_cold_start.py            # 1 run of each

@@ -1,11 +1,11 @@
-"""Wall time of an integrity map's numerics (issue 13): every tile job of the ``integrity_map``
+"""Wall time of an integrity map's numerics: every tile job of the ``integrity_map``
 experiment, computed in one process exactly as the pipeline's ``chart_tile`` rule does
 (``Kind.compute_tile``), on the CPU engine or the CUDA engine, plus the analytic map.
 
     PYTHONPATH=src python benchmarks/bench_integrity_map.py                        # config/integrity_map_fine.yaml, auto
     PYTHONPATH=src python benchmarks/bench_integrity_map.py --backend cpu --configfile config/config.yaml
     PYTHONPATH=src python benchmarks/bench_integrity_map.py --check-tasks 2        # + CPU == GPU on 2 Omega tasks
-    PYTHONPATH=src python benchmarks/bench_integrity_map.py --analytic [--quick]   # analytic map: new / old (issue 20)
+    PYTHONPATH=src python benchmarks/bench_integrity_map.py --analytic [--quick]   # analytic map: new / old
 
 ``--analytic`` times ``integrity_map_analytic`` against the pre-issue-20 loop
 (``benchmarks/_integrity_reference.py``: one ``slow_flow_escapes``, ``xi_true_analytic`` and

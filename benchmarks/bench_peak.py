@@ -1,4 +1,4 @@
-"""CPU engine's dense rate as a fraction of the machine's FP64 peak (issue 20).
+"""CPU engine's dense rate as a fraction of the machine's FP64 peak.
 
     .venv/bin/python benchmarks/bench_peak.py [--quick]
 

@@ -1,4 +1,4 @@
-"""The whole reproduction (issue 20): ``snakemake -j2`` from nothing with the default job layout
+"""The whole reproduction: ``snakemake -j2`` from nothing with the default job layout
 (``numerics.tiles: 0``: each chart experiment integrates its tasks in the job of the dataset that
 reads them) against the per-task layout it replaced (``numerics.tiles: 1``: one ``chart_tile`` job
 per chart task), run one after the other in fresh sandboxes by this script.

@@ -24,7 +24,7 @@ quartic written as coefficients [0, 0, 0.5, 0, -0.25] in the degree-4 class; the
 degree-8 class, i.e. a degree 5-8 well) and the generic V, dV code of an expression well (the
 cubic as an expression, and the pendulum 1 - cos q: transcendental, the lane loop stays scalar).
 
-Measured (docs/numerics.md, "Wells"), AMD EPYC (AVX-512), 1 thread, SRKN6b, after issue 16:
+Measured (docs/numerics.md, "Wells"), AMD EPYC (AVX-512), 1 thread, SRKN6b, with one compiled form per well:
 quartic after / before 1.020 dense, 0.957 chart (escape steps equal); time per step vs the quartic:
 signed 1.12, cubic (degree 4) 1.29, quartic coefficients 1.29, degree-8 class 3.07, cubic as an
 expression 1.19, pendulum (sin, cos: scalar lanes) 68.

@@ -1,4 +1,4 @@
-"""Melnikov threshold checks (issue 17): the numbers of docs/melnikov.md.
+"""Melnikov threshold checks: the numbers of docs/melnikov.md.
 
 1. quadrature vs closed forms: ``I1`` and ``|I2(Omega)|`` of the quartic, cubic and pendulum
    separatrices on 400 Omega in [0.02, 4] (and the large-Omega rounding limit);

@@ -1,4 +1,4 @@
-"""Bad input to the API (issue 18, "nothing silently wrong"): a ValueError that names the argument
+"""Bad input to the API ("nothing silently wrong"): a ValueError that names the argument
 and says why, never a KeyError / IndexError / numpy message, a NaN or a silently wrong number."""
 from __future__ import annotations
 

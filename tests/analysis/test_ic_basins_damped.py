@@ -1,4 +1,4 @@
-"""Damped analytic safe basins (issue 17): ``analytic_basin(..., damping=beta)`` and its stack.
+"""Damped analytic safe basins: ``analytic_basin(..., damping=beta)`` and its stack.
 
 beta = 0 returns what the undamped call returns; beta > 0 classifies every IC by the damped slow
 flow (``slow_flow_escapes(..., damping=beta)``), outlines the safe mask as the boundary curves

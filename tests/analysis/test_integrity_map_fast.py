@@ -1,4 +1,4 @@
-"""The analytic integrity map's shared-grid path (issue 20) gives, bit for bit, what the public
+"""The analytic integrity map's shared-grid path gives, bit for bit, what the public
 per-control-point functions give: ``slow_flow_escapes``, ``xi_true_analytic``,
 ``closed_measures`` and the plain-matrix ``unforced_radii2``."""
 import numpy as np
@@ -63,7 +63,7 @@ def test_closed_measures_cached_equal():
 @pytest.mark.parametrize("well, fourier, xi, Psi, Omega", [(None, ["paper", "exact"], [0.15, 0.2], 0.0, 0.9),
                                                             ("cubic", None, [0.1], 1.0, 0.95)])
 def test_erosion_masks_equal_slow_flow_escapes_per_F(well, fourier, xi, Psi, Omega):
-    """analytic_safe_masks (shared grid, issue 20) = ~slow_flow_escapes & S0 per F, xi_max, variant."""
+    """analytic_safe_masks (shared grid) = ~slow_flow_escapes & S0 per F, xi_max, variant."""
     from safebasins.analysis.common import well_variants
     from safebasins.analysis.erosion import analytic_safe_masks
     from safebasins.analysis.integrity import unforced_safe_mask

@@ -1,4 +1,4 @@
-"""Melnikov threshold of the hilltop saddle (issue 17; safebasins.analysis.melnikov, docs/melnikov.md).
+"""Melnikov threshold of the hilltop saddle (safebasins.analysis.melnikov, docs/melnikov.md).
 
 Independent routes: the closed-form separatrix orbits checked against the equation of motion
 and the energy, their integrals I1 = int p0^2 dt and I2 = int p0 e^{i Omega t} dt by scipy's

@@ -1,4 +1,4 @@
-"""The analysis layer on three wells (issue 12): the paper's quartic, the escape equation's cubic
+"""The analysis layer on three wells: the paper's quartic, the escape equation's cubic
 V = q^2/2 - q^3/3 and an asymmetric quartic polynomial with two barriers.
 
 Independent routes: the F = 0 analytic basin against the well's own ``unforced_safe``; the

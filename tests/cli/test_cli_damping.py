@@ -1,4 +1,4 @@
-"""``--damping`` on `safebasins chart` and `safebasins basin` (issue 17): the damped numerics and
+"""``--damping`` on `safebasins chart` and `safebasins basin`: the damped numerics and
 the damped slow flow's basins, beta recorded in the dataset; bad values and options that do not
 apply with damping are usage errors naming --damping."""
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Datasets the public API returns carry their provenance (issue 19): version, commit, date, the
+"""Datasets the public API returns carry their provenance: version, commit, date, the
 call's parameters and the well, as the pipeline's datasets do."""
 from __future__ import annotations
 

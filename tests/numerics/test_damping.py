@@ -1,4 +1,4 @@
-"""The damped equation q'' + beta q' + V'(q) = F sin(Omega t + Psi) in the engines (issue 17):
+"""The damped equation q'' + beta q' + V'(q) = F sin(Omega t + Psi) in the engines:
 damping = 0 is the undamped code bitwise; the damped schemes (conformal symplectic SRKN6b, RK4
 with -beta p) have order 4 and agree with scipy's DOP853 pixel for pixel on a damped chart of the
 escape equation below the Melnikov tangency."""

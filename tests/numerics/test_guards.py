@@ -1,4 +1,4 @@
-"""A step the scheme cannot integrate is refused; a NaN or inf state is never safe (issue 18)."""
+"""A step the scheme cannot integrate is refused; a NaN or inf state is never safe."""
 from __future__ import annotations
 
 import numpy as np

@@ -1,4 +1,4 @@
-"""Non-polynomial wells in the numerics (issue 16): the pendulum 1 - cos q and the sech^2 well
+"""Non-polynomial wells in the numerics: the pendulum 1 - cos q and the sech^2 well
 tanh^2 q (open at infinity).
 
 * A NumericWell of the user's numpy/numba functions and the same well written as an expression

@@ -1,4 +1,4 @@
-"""The engine in any well (issue 12): the quartic path bitwise unchanged, the polynomial path
+"""The engine in any well: the quartic path bitwise unchanged, the polynomial path
 (Horner from run-time coefficients) against the quartic and against scipy's DOP853, asymmetric
 displacement bounds, the signed lane machinery, bad input.
 

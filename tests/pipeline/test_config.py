@@ -174,7 +174,7 @@ BAD = [
     ({"figures": {"fig10": {"numeric": {"F_bracket": [0.3, 0.1]}}}}, "figures.fig10.numeric.F_bracket", "empty bracket"),
     ({"figures": {"fig10": {"numeric": {"tol": 0}}}}, "figures.fig10.numeric.tol", ""),
     ({"seed": -3}, "seed", "minimum"),
-    # issue 11: non-finite numbers, degenerate grids, duplicates, ranges that stop short, num + step
+    # non-finite numbers, degenerate grids, duplicates, ranges that stop short, num + step
     ({"figures": {"fig05": {"F": float("nan")}}}, "figures.fig05.F", "finite"),
     ({"figures": {"fig05": {"Omega": float("inf")}}}, "figures.fig05.Omega", "finite"),
     ({"figures": {"fig13": {"xi_max": [0.12, float("nan")]}}}, "figures.fig13.xi_max[1]", "finite"),
@@ -190,7 +190,7 @@ BAD = [
     ({"figures": {"fig19": {"F": {"start": 0.001, "stop": 0.07, "step": 0.005}}}}, "figures.fig19.F",
      "not reached by whole steps"),
     ({"figures": {"fig01": {"Omega": {"step": 0.01}}}}, "figures.fig01.Omega", "set the other one to null"),
-    # issue 12: the well of an experiment
+    # the well of an experiment
     ({"figures": {"fig05": {"well": "sextic"}}}, "figures.fig05.well", ""),
     ({"figures": {"fig05": {"well": {"polynomial": [0, 0.1, 0.5, 0, -0.25]}}}}, "figures.fig05.well", "V'(0) = 0"),
     ({"figures": {"fig05": {"well": {"polynomial": [0, 0, -0.5, 0, 1]}}}}, "figures.fig05.well", "c_2"),

@@ -1,4 +1,4 @@
-"""Configurations that were accepted but wrong (issue 18): each is now a ConfigError naming the file
+"""Configurations that were accepted but wrong: each is now a ConfigError naming the file
 or the key and saying why, before any job; the cost guard counts analytic work and the targets
 requested; `snakemake experiments` builds the experiments the user's config file names."""
 from __future__ import annotations

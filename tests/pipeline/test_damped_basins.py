@@ -1,4 +1,4 @@
-"""The damped basin_chart experiment (issue 17, config ``damped.quartic_basins``): resolved with
+"""The damped basin_chart experiment (config ``damped.quartic_basins``): resolved with
 its damping, costed as damped slow trajectories, and built end to end on the quick config."""
 from __future__ import annotations
 

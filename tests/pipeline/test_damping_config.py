@@ -1,4 +1,4 @@
-"""The ``damping`` key of every experiment block (issue 17): validated (finite, >= 0), refused by
+"""The ``damping`` key of every experiment block: validated (finite, >= 0), refused by
 kinds written for the undamped equation (naming the key), recorded in the parameters only when
 beta > 0 (the undamped run's parameter files and datasets stay as they were)."""
 from __future__ import annotations

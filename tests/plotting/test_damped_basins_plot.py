@@ -1,4 +1,4 @@
-"""Damped safe basins drawn (issue 17): figure_nested_basins / plot_escape_chart / plot_basin name
+"""Damped safe basins drawn: figure_nested_basins / plot_escape_chart / plot_basin name
 beta, label the analytic lines as the damped slow flow's mask outline and refuse a basin whose
 damping differs from the chart's."""
 from __future__ import annotations

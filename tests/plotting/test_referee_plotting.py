@@ -1,4 +1,4 @@
-"""The referee's list (issue 18) on small synthetic datasets: what the legends and captions say
+"""The referee's list on small synthetic datasets: what the legends and captions say
 agrees with what is drawn, and the numbers come from the data."""
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """Bad input to the theory API: a ValueError saying which argument and why, never NaN or an
-IndexError (issue 11's list of cases that used to slip through)."""
+IndexError (cases that used to slip through)."""
 import numpy as np
 import pytest
 

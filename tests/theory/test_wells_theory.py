@@ -1,4 +1,4 @@
-"""The isolated-resonance theory on three wells (issue 12): the paper's quartic, the escape
+"""The isolated-resonance theory on three wells: the paper's quartic, the escape
 equation's cubic V = q^2/2 - q^3/3 and an asymmetric quartic polynomial with two barriers.
 
 Independent routes: the slow-flow critical points against finite differences of C; the

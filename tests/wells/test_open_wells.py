@@ -1,4 +1,4 @@
-"""Wells open at infinity (issue 16): V' keeps its sign and V tends to a finite limit, the escape
+"""Wells open at infinity: V' keeps its sign and V tends to a finite limit, the escape
 energy (docs/wells.md).  References, with ``s = E_b - E`` (exact in float near E_b):
 
 * Morse ``V = D (1 - e^{-a q})^2``, ``k = sqrt(E/D)``, ``k' = sqrt(s/D)``:

@@ -58,7 +58,7 @@ def integrity_map_analytic(Omega, F, Psi, xi_max, q0, p0, *, fourier=None, n_gam
     safe = np.zeros((Om.size, Fv.size, q.size, p.size), bool)
     xt = np.zeros((Om.size, Fv.size))
     # = slow_flow_escapes and xi_true_analytic per control point, bit for bit, with the grid's and
-    # the threshold's shared quantities evaluated once (issue 20)
+    # the threshold's shared quantities evaluated once
     grid = GridSlowFlow(Q, P, Psi, xi, w)
     checks.check_positive_int("n_gamma", n_gamma)
     for i, om in enumerate(Om):

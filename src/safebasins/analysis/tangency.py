@@ -1,4 +1,4 @@
-"""Basin erosion across the homoclinic tangency of a damped well (issue 17; docs/melnikov.md).
+"""Basin erosion across the homoclinic tangency of a damped well (docs/melnikov.md).
 
 For ``q'' + beta q' + V'(q) = F sin(Omega t + Psi)`` the stable and unstable manifolds of the
 forced hilltop saddle first touch at the Melnikov threshold ``F_M(Omega, beta)``

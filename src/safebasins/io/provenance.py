@@ -1,4 +1,4 @@
-"""Provenance of the Datasets the public API returns (issue 19).
+"""Provenance of the Datasets the public API returns.
 
 :func:`api_provenance` decorates a public function: the Dataset it returns carries the package
 version, the git commit, the creation date, the call's parameters (JSON: scalars as given,

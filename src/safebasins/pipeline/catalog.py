@@ -305,7 +305,7 @@ DECLARATIONS = (
               'the harmonic enters multiplied by F.')),
 )
 
-# ---------------------------------------------------------------- the escape equation (issue 12)
+# ---------------------------------------------------------------- the escape equation
 # The same kinds, rules and plotting on the cubic well V = q^2/2 - q^3/3 (config block
 # `escape_equation`, every entry with `well: cubic`): the paper's open problem, a well without
 # closed-form action-angle variables (numeric action-angle, safebasins.wells.numeric).
@@ -371,7 +371,7 @@ DECLARATIONS += (
               "bar); dotted oval: the analytic all-phase basin H0 = ξ_true.")),
 )
 
-# ---------------------------------------------------------------- other wells (issue 16)
+# ---------------------------------------------------------------- other wells
 # The same kinds on the pendulum and the sech^2 well (config block `other_wells`), named
 # expression wells: non-polynomial potentials, one with an asymptote instead of a barrier.
 _OTHER = "Other wells: pendulum and sech²"
@@ -403,7 +403,7 @@ DECLARATIONS += tuple(
             look=_NESTED),
     ))
 
-# ---------------------------------------------------------------- damping (issue 17)
+# ---------------------------------------------------------------- damping
 # q'' + beta q' + V'(q) = F sin(Omega t + Psi) (config block `damped`): Thompson's escape equation
 # across the Melnikov tangency of its hilltop saddle, and the paper's quartic with small damping.
 _DAMPED = "Damping: the escape equation across the Melnikov tangency and the damped quartic"

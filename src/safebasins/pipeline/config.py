@@ -134,9 +134,9 @@ def build_schema(base=None) -> dict:
     defs["well"] = well_schema()
     for name, kind in KINDS.items():
         defs[name] = copy.deepcopy(kind.schema)
-        # every experiment may name its well (issue 12); the quartic keeps the paper's results
+        # every experiment may name its well; the quartic keeps the paper's results
         defs[name].setdefault("properties", {})["well"] = {"$ref": "#/$defs/well", "default": "quartic"}
-        # and its damping (issue 17): a kind may declare its own form (a list of curves' values)
+        # and its damping: a kind may declare its own form (a list of curves' values)
         defs[name]["properties"].setdefault("damping", {"$ref": "#/$defs/damping", "default": 0.0})
     props = schema["properties"]
     for d in catalog.DECLARATIONS:

@@ -5,7 +5,7 @@ The analytic product of each is ``basin_<experiment>.nc``: the boundary curves o
 classification ``escapes(q0, p0)`` of :func:`safebasins.theory.slow_flow_escapes` on the
 experiment's grid; ``basin_rm`` adds the first integral ``C`` and ``escapes_rm`` on the
 resonance-manifold grid ``(gamma_rm, xi_rm)``; ``basin_chart`` stacks the basins over the
-scanned parameter (``xi_max`` or ``F``; with damping, issue 17: the damped slow flow's
+scanned parameter (``xi_max`` or ``F``; with damping: the damped slow flow's
 classification and the outline of its safe mask, ``kind = "mask_outline"``).  ``basin_chart``'s numeric product is the escape chart
 gathered from its tiles with the analytic/numeric agreement stored in it; ``strobe``'s is the
 classified period map (:func:`safebasins.analysis.period_map.period_map_portrait`).
@@ -69,7 +69,7 @@ def build_basin_single(params, data, job):
 
 
 def build_basin_stack(params, data, job):
-    """Analytic basins stacked over the scanned parameter (Figs 13-17); with damping (issue 17) the
+    """Analytic basins stacked over the scanned parameter (Figs 13-17); with damping the
     damped slow flow's classification and the outline of its safe mask (analytic_basin)."""
     from safebasins.analysis.ic_basins import analytic_basin_stack
 

@@ -1,4 +1,4 @@
-"""Kind ``tangency`` (issue 17): basin erosion of a damped well across the Melnikov tangency.
+"""Kind ``tangency``: basin erosion of a damped well across the Melnikov tangency.
 
 One escape chart per F on an IC grid (tiles, one integration for every t_eval) gives GIM / LIM /
 IF versus F of the long-time basins, the Melnikov threshold and the basins at two F
