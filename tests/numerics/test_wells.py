@@ -1,4 +1,4 @@
-"""The engine in any well: the quartic path bitwise unchanged, the polynomial path
+"""The engine in any well: the quartic path unchanged (stored numbers of the quartic-only engine), the polynomial path
 (Horner from run-time coefficients) against the quartic and against scipy's DOP853, asymmetric
 displacement bounds, the signed lane machinery, bad input.
 
@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -48,6 +49,8 @@ MAP_ICS = (np.array([0.1, 0.3, -0.6, 0.5]), np.array([0.2, -0.1, 0.3, 0.4]))
 REF_MAP = {"srkn6b": "dc0c7905dd13109915ba8275ad32664ea442d9b9c43a8f06f56bb0355921c9b0",
            "rk4": "af5f63e11f1e98d1788173ad7756da0506afa051b1e3648e9cc5251d40baecb9"}
 REF_MAP_STEPS = [31, 21, 69, 6]
+#: the iterates themselves (their sha256 is REF_MAP: the file holds the old engine's numbers)
+MAP_FILE = Path(__file__).with_name("quartic_map_reference.npz")
 # critical_forcing_numeric([0.85, 0.95], 0.2, cycles=100, n_scan=11, F_bracket=(0, 0.2), tol=1e-3, S=16)
 REF_FCR = {"srkn6b": (["0x1.899999999999ap-5", "0x1.e000000000000p-6"], ["0x1.899999999999ap-5", "0x1.1666666666667p-5"]),
            "rk4": (["0x1.899999999999ap-5", "0x1.e000000000000p-6"], ["0x1.899999999999ap-5", "0x1.2333333333334p-5"])}
@@ -58,27 +61,45 @@ def _steps(cycles, S=16):
     return np.where(np.isinf(s), -1, s).astype(int)
 
 
+def _same_up_to_knife_edges(now, ref):
+    """Escape steps against ones stored from another machine: the engine's arithmetic is IEEE
+    (explicit fma, no libm) but the forcing table is np.sin from the platform's libm, whose last
+    bit may differ, and a trajectory on a knife edge then escapes a few steps earlier or later.
+    At most 5% of the entries may differ and at most 2% change between escaping and not (the
+    reproduction tolerances of escape times and masks, docs/reproduction.md; measured here: 0)."""
+    now, ref = np.asarray(now), np.asarray(ref)
+    assert now.shape == ref.shape
+    assert (now != ref).mean() <= 0.05, (now.tolist(), ref.tolist())
+    assert ((now < 0) != (ref < 0)).mean() <= 0.02, (now.tolist(), ref.tolist())
+
+
 @pytest.mark.parametrize("integrator", ["srkn6b", "rk4"])
-def test_quartic_results_bitwise_unchanged(integrator):
+def test_quartic_results_unchanged(integrator):
     """Chart (shared lanes), batch (per-lane path), map (stored iterates, stop_any) and F_cr
-    bisection of the quartic: the numbers of the engine before the well flag."""
+    bisection of the quartic against the numbers of the engine before the well flag, within the
+    tolerances a last-bit difference of the platform's sin allows (_same_up_to_knife_edges; the
+    map's iterates within 1e-9 relative, F_cr within the bisection's tol).  Bit-for-bit equality of
+    refactors is checked on one machine (scripts/engine_arrays.py, scripts/compare_results.py)."""
     ch = escape_chart(Q0, P0, 0.0876, 0.95, np.pi, integrator=integrator, **KW)
-    assert _steps(ch["escape_cycle_energy"].values).tolist() == REF_E
-    assert _steps(ch["escape_cycle_displacement"].values).tolist() == REF_Q[integrator]
+    _same_up_to_knife_edges(_steps(ch["escape_cycle_energy"].values), REF_E)
+    _same_up_to_knife_edges(_steps(ch["escape_cycle_displacement"].values), REF_Q[integrator])
     assert ch.attrs["well"] == "quartic" and "quartic" in ch.attrs["escape_criteria"]
     b = escape_chart_batch(Q0, P0, [0.0876, 0.05], [0.95, 0.8], np.pi, integrator=integrator, **KW)
-    assert _steps(b["escape_cycle_energy"].values[0]).tolist() == REF_E
-    assert _steps(b["escape_cycle_energy"].values[1]).tolist() == REF_B[integrator][0]
-    assert _steps(b["escape_cycle_displacement"].values[1]).tolist() == REF_B[integrator][1]
+    assert np.array_equal(b["escape_cycle_energy"].values[0], ch["escape_cycle_energy"].values)   # same process
+    _same_up_to_knife_edges(_steps(b["escape_cycle_energy"].values[1]), REF_B[integrator][0])
+    _same_up_to_knife_edges(_steps(b["escape_cycle_displacement"].values[1]), REF_B[integrator][1])
     m = stroboscopic_map(*MAP_ICS, 0.0876, 0.95, np.pi, n_iter=30, xi_max=0.22, q_max=0.85, steps_per_cycle=16,
                          integrator=integrator)
-    it = np.ascontiguousarray(np.stack([m["q"].values, m["p"].values]))
-    assert hashlib.sha256(it.tobytes()).hexdigest() == REF_MAP[integrator]
+    it = np.stack([m["q"].values, m["p"].values])
+    ref = np.load(MAP_FILE)[integrator]
+    assert np.array_equal(np.isnan(it), np.isnan(ref))
+    np.testing.assert_allclose(it, ref, rtol=1e-9, atol=1e-12, equal_nan=True)
+    assert hashlib.sha256(ref.tobytes()).hexdigest() == REF_MAP[integrator]      # the stored iterates
     assert _steps(m["escape_cycle"].values).tolist() == REF_MAP_STEPS
     kw = dict(cycles=100, n_scan=11, F_bracket=(0.0, 0.2), tol=1e-3, steps_per_cycle=16, integrator=integrator)
-    for crit, ref in zip(("energy", "displacement"), REF_FCR[integrator]):
+    for crit, ref_F in zip(("energy", "displacement"), REF_FCR[integrator]):
         f = critical_forcing_numeric([0.85, 0.95], 0.2, criterion=crit, **kw)
-        assert [float(x).hex() for x in f["F_cr"].values] == ref, crit
+        np.testing.assert_allclose(f["F_cr"].values, [float.fromhex(x) for x in ref_F], rtol=0, atol=1e-3)
 
 
 # ---------------------------------------------------------------------------------------------
