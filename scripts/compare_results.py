@@ -6,7 +6,7 @@
 Every ``*.nc`` below either root (tile parts under ``parts/`` excluded unless ``--parts``)
 must exist in both trees; coordinates and data variables must be identical (names, dims,
 dtypes, values bit for bit with NaN == NaN, and their attributes); global attributes must be
-identical except the provenance ones (``safebasins.io.compare.PROVENANCE_ATTRS``), which are
+identical except the provenance ones (``safebasins.core.provenance.PROVENANCE_ATTRS``), which are
 listed when they differ but do not fail the comparison. Exit status 1 on any difference.
 """
 from __future__ import annotations

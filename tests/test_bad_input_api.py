@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from safebasins import checks, wells
+from safebasins import wells
+from safebasins.core import checks
 from safebasins.analysis import agreement, erosion, integrity, integrity_map, safe
 from safebasins.numerics import escape_chart
 

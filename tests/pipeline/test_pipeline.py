@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from safebasins.io.cf import VARIABLES
+from safebasins.core.cf import VARIABLES
 from safebasins.io.compare import assert_same_content
 from safebasins.io.datasets import load, params_hash
 from safebasins.pipeline.plan import plan

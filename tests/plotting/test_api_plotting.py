@@ -76,7 +76,7 @@ def test_plot_basin(basin, tmp_path):
 
 def test_plot_basin_and_chart_with_a_basin_stack(chart, basin, tmp_path):
     """A stack over xi_max (the pipeline's layout, Figs 13-15) draws one colour per value."""
-    from safebasins.io.datasets import stack
+    from safebasins.core.stacking import stack
 
     parts = []
     for x in (0.14, 0.18):

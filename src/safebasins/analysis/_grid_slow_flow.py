@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from safebasins import checks
+from safebasins.core import checks
 from safebasins.theory.slow_flow import SlowFlowProfile, _xi_grid
 
 __all__ = ["GridSlowFlow"]

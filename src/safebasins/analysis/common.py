@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from safebasins import checks
+from safebasins.core import checks
 from safebasins.analysis.integrity import grid_spacing
 from safebasins.wells.quartic import FOURIER_VARIANTS
 

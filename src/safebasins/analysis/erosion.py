@@ -32,19 +32,19 @@ import warnings
 import numpy as np
 import xarray as xr
 
-from safebasins import checks
-from safebasins.io import cf
+from safebasins.core import checks
+from safebasins.core import cf
 from safebasins.analysis._grid_slow_flow import GridSlowFlow
 from safebasins.analysis.common import as_1d, mesh, stack_charts, well_variants
 from safebasins.analysis.integrity import integrity_measures, unforced_safe_mask
 from safebasins.analysis.safe import chart_well, safe_stack
-from safebasins.io.cf import annotate
+from safebasins.core.cf import annotate
 from safebasins.numerics import escape_chart
 from safebasins.numerics.engine import damping_attrs
 from safebasins.theory.damped_escape import UndecidedWarning, slow_flow_outcomes
 from safebasins.theory.damped_flow import SETTLED, UNDECIDED
 from safebasins.wells import resolve_well, well_attrs
-from safebasins.io.provenance import api_provenance
+from safebasins.wells.provenance import api_provenance
 
 __all__ = [
     "analytic_safe_masks",

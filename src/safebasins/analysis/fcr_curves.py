@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from safebasins.io.provenance import api_provenance
+from safebasins.wells.provenance import api_provenance
 
 __all__ = ["analytic_fcr_curves", "numeric_fcr_curves"]
 
@@ -17,7 +17,7 @@ __all__ = ["analytic_fcr_curves", "numeric_fcr_curves"]
 def analytic_fcr_curves(Omega, curves, *, well=None, label=""):
     """One :func:`safebasins.theory.critical_forcing` per curve (eqs 22-26), stacked over ``curve``
     with the coordinates xi_max, xi_ini, gamma_ini, label (and Psi when every curve has one)."""
-    from safebasins.io.datasets import stack
+    from safebasins.core.stacking import stack
     from safebasins.theory import critical_forcing
 
     Omega = np.asarray(Omega, dtype=float)
@@ -43,7 +43,7 @@ def numeric_fcr_curves(Omega, curves, *, well=None, cycles, tol, F_bracket, crit
     """One :func:`safebasins.numerics.critical_forcing_numeric` per curve, from the IC
     ``theory.initial_condition(xi_ini, gamma_ini, Psi)``, stacked over ``curve`` with the
     coordinates xi_max, xi_ini, gamma_ini, Psi, label, q0, p0."""
-    from safebasins.io.datasets import stack
+    from safebasins.core.stacking import stack
     from safebasins.numerics import critical_forcing_numeric
     from safebasins.theory import initial_condition
 

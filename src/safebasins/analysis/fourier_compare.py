@@ -21,16 +21,16 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from safebasins import checks
+from safebasins.core import checks
 from safebasins.analysis.agreement import iou, pixel_agreement
 from safebasins.analysis.common import as_1d, chart_param, mesh
 from safebasins.analysis.integrity import integrity_measures, unforced_safe_mask
 from safebasins.analysis.safe import chart_well, safe_stack
-from safebasins.io.cf import annotate
+from safebasins.core.cf import annotate
 from safebasins.numerics import critical_forcing_numeric
 from safebasins.theory import angle_energy, critical_forcing, initial_condition, slow_flow_escapes
 from safebasins.wells.quartic import FOURIER_VARIANTS, QUARTIC, QuarticWell
-from safebasins.io.provenance import api_provenance
+from safebasins.wells.provenance import api_provenance
 
 __all__ = ["fcr_fourier_comparison", "fcr_fourier_comparison_from_numeric", "iou_fourier_comparison"]
 

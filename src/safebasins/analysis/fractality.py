@@ -18,8 +18,8 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from safebasins import checks
-from safebasins.io.provenance import api_provenance
+from safebasins.core import checks
+from safebasins.wells.provenance import api_provenance
 
 __all__ = ["uncertainty_exponent", "MIN_UNCERTAIN"]
 

@@ -22,8 +22,8 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from safebasins import checks
-from safebasins.io.provenance import api_provenance
+from safebasins.core import checks
+from safebasins.wells.provenance import api_provenance
 
 __all__ = ["analytic_basin", "analytic_basin_stack", "add_resonance_manifold", "numeric_check", "mask_outline",
            "MASK_OUTLINE"]
@@ -136,7 +136,7 @@ def analytic_basin_stack(scan, values, F, Omega, Psi, xi_max, q0, p0, *, well=No
     ``values``; the other one is the scalar argument).  Each basin's saddle point is a coordinate
     along ``scan`` (``saddle_gamma``, ``saddle_xi``; NaN for a damped basin); attribute ``scan``.
     ``damping``: as :func:`analytic_basin`."""
-    from safebasins.io.datasets import stack
+    from safebasins.core.stacking import stack
 
     if scan not in ("F", "xi_max"):
         raise ValueError(f"scan must be 'F' or 'xi_max', got {scan!r}")

@@ -76,7 +76,7 @@ import numpy as np
 import xarray as xr
 from scipy import ndimage
 
-from safebasins import checks
+from safebasins.core import checks
 from safebasins.wells import from_attrs, resolve_well, well_attrs
 
 __all__ = [

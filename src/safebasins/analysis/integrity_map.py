@@ -21,14 +21,14 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from safebasins import checks
+from safebasins.core import checks
 from safebasins.analysis.common import as_1d, mesh, variant_well
 from safebasins.analysis.erosion import level_crossing
 from safebasins.analysis._grid_slow_flow import GridSlowFlow
 from safebasins.analysis.integrity import integrity_measures, unforced_radii2, unforced_safe_mask
 from safebasins.analysis.safe import chart_well, safe_stack
-from safebasins.io.cf import annotate
-from safebasins.io.provenance import api_provenance
+from safebasins.core.cf import annotate
+from safebasins.wells.provenance import api_provenance
 from safebasins.numerics import escape_chart_batch
 from safebasins.wells import well_attrs
 

@@ -66,10 +66,10 @@ import numpy as np
 import xarray as xr
 from numpy.polynomial import legendre as _leg
 
-from safebasins import checks
+from safebasins.core import checks
 from safebasins.wells import resolve_well, well_attrs
 from safebasins.wells.orbit_quadrature import clenshaw_curtis
-from safebasins.io.provenance import api_provenance
+from safebasins.wells.provenance import api_provenance
 
 __all__ = ["melnikov_threshold", "melnikov_curve", "melnikov_function", "separatrix_integrals", "separatrix_orbit",
            "SeparatrixOrbit", "manifold_splitting", "CLOSED_FORMS"]

@@ -38,8 +38,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from safebasins import checks
-from safebasins.io.provenance import api_provenance
+from safebasins.core import checks
+from safebasins.wells.provenance import api_provenance
 
 __all__ = ["birkhoff_weights", "weighted_birkhoff", "rotation_numbers", "island_chains", "classify_orbits",
            "portrait_with_criteria",

@@ -42,15 +42,15 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from safebasins import checks
+from safebasins.core import checks
 from safebasins.analysis.common import as_1d, mesh, stack_charts, variant_well, well_variants
 from safebasins.analysis.integrity import MEASURE_ATTRS, integrity_measures, unforced_radii2, unforced_safe_mask
 from safebasins.analysis.safe import chart_well, safe_stack
-from safebasins.io.cf import annotate
+from safebasins.core.cf import annotate
 from safebasins.numerics import escape_chart
 from safebasins.theory import angle_energy, escapes_on_manifold
 from safebasins.wells import resolve_well, well_attrs
-from safebasins.io.provenance import api_provenance
+from safebasins.wells.provenance import api_provenance
 
 __all__ = [
     "default_phases",

@@ -11,8 +11,8 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from safebasins import checks
-from safebasins.io import cf
+from safebasins.core import checks
+from safebasins.core import cf
 
 __all__ = ["is_safe", "check_t_eval", "check_chart", "safe_mask", "safe_area", "safe_stack", "escape_variable", "chart_well",
            "displacement_energy", "q_max_energy"]

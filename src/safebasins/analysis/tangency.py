@@ -17,14 +17,14 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from safebasins import checks
+from safebasins.core import checks
 from safebasins.analysis.common import as_1d, stack_charts
 from safebasins.analysis.erosion import level_crossing, profile_from_charts
 from safebasins.analysis.fractality import uncertainty_exponent
 from safebasins.analysis.melnikov import melnikov_threshold
 from safebasins.analysis.safe import chart_well, safe_stack
-from safebasins.io.cf import annotate
-from safebasins.io.provenance import api_provenance
+from safebasins.core.cf import annotate
+from safebasins.wells.provenance import api_provenance
 
 __all__ = ["tangency_profile", "fractality_profile", "melnikov_variable"]
 

@@ -77,7 +77,7 @@ def main():
 @click.option("--t-eval", "t_eval", type=Number("t_eval", POSITIVE), default=None,
               help="Evaluation time (EC, <= --cycles) of the basins drawn in the PNG [default: --cycles].")
 @click.option("--n-points", "n_points", cls=Deferred, type=int, default=from_schema("basin_chart", "n_points"),
-              callback=checked("n_points", lib_check("safebasins.checks:check_positive_int")),
+              callback=checked("n_points", lib_check("safebasins.core.checks:check_positive_int")),
               help="Vertices per analytic boundary curve.")
 @click.option("--tiles", type=click.IntRange(min=1), default=None,
               help="Row tiles (blocks of q0) integrated one after another; the progress bar counts them "
@@ -322,7 +322,7 @@ def fcr_numeric(params, job, quiet):
               help="Energy truncation level in (0, E_b) (with --damping > 0 also E_b itself).")
 @grid_options
 @click.option("--n-points", "n_points", cls=Deferred, type=int, default=from_schema("basin_rm", "n_points"),
-              callback=checked("n_points", lib_check("safebasins.checks:check_positive_int")),
+              callback=checked("n_points", lib_check("safebasins.core.checks:check_positive_int")),
               help="Vertices per boundary curve.")
 @click.option("--n-gamma", "n_gamma", type=click.IntRange(min=2),
               cls=Deferred, default=from_schema("basin_rm", "manifold", "n_gamma"),

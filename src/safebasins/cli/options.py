@@ -1,7 +1,7 @@
 """Option values of the command line: parsed here, checked by the library's own checks.
 
 A bad value is rejected while click parses the command line (exit status 2, the option named),
-before anything is computed; the checks are the library's (``safebasins.checks``, the well's
+before anything is computed; the checks are the library's (``safebasins.core.checks``, the well's
 methods, ``numerics.engine``), imported on use so that ``--help`` stays instant.  Defaults are
 read from the library signatures and the pipeline schema, never restated.
 """
@@ -63,9 +63,9 @@ def lib_check(path):
     return check
 
 
-NONNEG = lib_check("safebasins.checks:check_nonnegative")
-POSITIVE = lib_check("safebasins.checks:check_positive")
-FINITE = lib_check("safebasins.checks:check_finite")
+NONNEG = lib_check("safebasins.core.checks:check_nonnegative")
+POSITIVE = lib_check("safebasins.core.checks:check_positive")
+FINITE = lib_check("safebasins.core.checks:check_finite")
 #: where the eager --well option leaves the resolved well for the checks of the other options
 WELL_META = "safebasins.well"
 

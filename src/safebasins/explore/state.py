@@ -11,7 +11,7 @@ import json
 from collections.abc import Mapping
 from urllib.parse import urlencode
 
-from safebasins.checks import check_finite, check_nonnegative, check_positive, check_scalar
+from safebasins.core.checks import check_finite, check_nonnegative, check_positive, check_scalar
 from safebasins.explore.analytic import Forcing
 from safebasins.explore.ranges import WellRanges, well_ranges
 

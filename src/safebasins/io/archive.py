@@ -41,8 +41,8 @@ import yaml
 from rocrate.model.contextentity import ContextEntity
 from rocrate.rocrate import ROCrate
 
-from safebasins import __version__
-from safebasins.io.datasets import git_commit
+from safebasins.core.version import __version__
+from safebasins.core.provenance import git_commit
 from safebasins.io.files import atomic_path
 
 __all__ = ["write_archive", "build_crate", "installed_distributions", "KEY_PACKAGES", "PROFILES"]

@@ -15,9 +15,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-#: global attributes that describe how a file was made, not what it holds
-PROVENANCE_ATTRS = ("date_created", "git_commit", "safebasins_version", "config_hash", "parameters",
-                    "history", "source", "seeds")
+from safebasins.core.provenance import PROVENANCE_ATTRS
 
 
 def same_array(a: np.ndarray, b: np.ndarray) -> bool:

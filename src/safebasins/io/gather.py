@@ -51,7 +51,7 @@ def task_charts(blocks) -> list[xr.Dataset]:
 def gather_chart(charts, *, cycles, scan=None, F=None, t_eval=None) -> xr.Dataset:
     """One dataset of the gathered task charts: stacked over ``F`` (values ``F``) for an F scan,
     else the single chart; attributes ``scan``, ``t_eval`` (if given) and ``cycles``."""
-    from safebasins.io.datasets import stack
+    from safebasins.core.stacking import stack
 
     if scan == "F":
         out = stack(charts, "F", list(F), pad=())

@@ -27,7 +27,7 @@ of which kind.  The numbers are measurements (docs/reproduction.md):
 
 Every NaN or infinity must sit at the same place in both runs (a branch excepted, as above).
 Global attributes are compared by the same rules (numbers by the rule of their name's kind,
-text exactly); the provenance ones (:data:`safebasins.io.compare.PROVENANCE_ATTRS`) never count.
+text exactly); the provenance ones (:data:`safebasins.core.provenance.PROVENANCE_ATTRS`) never count.
 
 :func:`verify_reproduction` compares a new ``results/data`` tree with a reference (a results
 archive ``.tar.gz`` of :mod:`safebasins.io.archive`, an extracted crate or a ``results`` /

@@ -20,8 +20,8 @@ import warnings
 import numpy as np
 import xarray as xr
 
-from safebasins import checks
-from safebasins.io.provenance import api_provenance
+from safebasins.core import checks
+from safebasins.wells.provenance import api_provenance
 from safebasins.numerics import criteria, engine, schemes
 from safebasins.numerics.problem import check_cycles, ensemble_problem
 from safebasins.wells import QuarticWell, resolve_well

@@ -18,7 +18,7 @@ import time
 import numpy as np
 from numba import cuda
 
-from safebasins import checks
+from safebasins.core import checks
 from safebasins.numerics import cuda_kernels
 from safebasins.numerics.problem import EnsembleProblem
 

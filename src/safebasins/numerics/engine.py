@@ -15,7 +15,7 @@ import math
 import numba
 import numpy as np
 
-from safebasins import checks
+from safebasins.core import checks
 from safebasins.numerics import kernels, schemes
 from safebasins.numerics.problem import EnsembleProblem
 from safebasins.wells import resolve_well

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from safebasins import checks
+from safebasins.core import checks
 
 
 def random_initial_conditions(n, seed, box=((-1, 1), (-1, 1))):

@@ -4,9 +4,9 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from safebasins import checks
-from safebasins.io import cf
-from safebasins.io.provenance import api_provenance
+from safebasins.core import checks
+from safebasins.core import cf
+from safebasins.wells.provenance import api_provenance
 from safebasins.numerics import engine, schemes
 from safebasins.numerics.problem import check_cycles, displacement_pairs, ensemble_problem
 from safebasins.wells import resolve_well

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from safebasins import checks
+from safebasins.core import checks
 from safebasins.numerics import schemes
 from safebasins.numerics.scheme_code import SchemeCode, scheme_code
 from safebasins.numerics.wellcode import WellCode

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import yaml
 
-from safebasins.checks import reaches
+from safebasins.core.checks import reaches
 from safebasins.pipeline import catalog
 from safebasins.pipeline.registry import KINDS
 from safebasins.pipeline.validation import CheckContext, ConfigError, fail, indexed, key_path

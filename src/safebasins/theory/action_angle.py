@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from safebasins.checks import check_finite
+from safebasins.core.checks import check_finite
 from safebasins.wells.quartic import (QUARTIC, _G, _J, _angle_energy, _dG_dxi, _nome, _omega,
                                       _phase_point, check_fourier)
 

@@ -37,10 +37,10 @@ import numpy as np
 import xarray as xr
 from scipy import optimize
 
-from safebasins.checks import check_finite, check_nonnegative, check_positive, check_positive_int
+from safebasins.core.checks import check_finite, check_nonnegative, check_positive, check_positive_int
 from safebasins.theory.slow_flow import SlowFlowProfile, _scalar, resolved_shift, unshear
 from safebasins.wells import resolve_well
-from safebasins.io.provenance import api_provenance
+from safebasins.wells.provenance import api_provenance
 
 __all__ = ["safe_basin_boundaries"]
 

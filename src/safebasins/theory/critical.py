@@ -42,11 +42,11 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from safebasins import checks
-from safebasins.checks import check_finite, check_positive
+from safebasins.core import checks
+from safebasins.core.checks import check_finite, check_positive
 from safebasins.theory.slow_flow import _scalar, _xi_grid, resolved_shift, unshear
 from safebasins.wells import resolve_well
-from safebasins.io.provenance import api_provenance
+from safebasins.wells.provenance import api_provenance
 
 __all__ = ["critical_forcing", "MECHANISMS"]
 

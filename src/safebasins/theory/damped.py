@@ -38,7 +38,7 @@ import weakref
 
 import numpy as np
 
-from safebasins.checks import check_nonnegative, check_positive, check_scalar
+from safebasins.core.checks import check_nonnegative, check_positive, check_scalar
 from safebasins.theory.slow_flow import unshear
 from safebasins.wells.quartic import QuarticWell
 

@@ -23,8 +23,8 @@ import warnings
 import numpy as np
 import xarray as xr
 
-from safebasins import checks
-from safebasins.checks import check_finite, check_scalar
+from safebasins.core import checks
+from safebasins.core.checks import check_finite, check_scalar
 from safebasins.theory.damped import forcing_and_level, slow_tables, to_tilde
 from safebasins.theory.damped_flow import ESCAPED, SETTLED, STATUS, UNDECIDED, default_t_max, integrate_batch, pivots
 from safebasins.wells import resolve_well

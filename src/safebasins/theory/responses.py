@@ -19,12 +19,12 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from safebasins import checks
-from safebasins.checks import check_1d, check_nonnegative, check_positive, check_positive_int, check_scalar
+from safebasins.core import checks
+from safebasins.core.checks import check_1d, check_nonnegative, check_positive, check_positive_int, check_scalar
 from safebasins.theory.damped import TOP_GAP, coefficients, slow_tables
 from safebasins.theory.slow_flow import unshear
 from safebasins.wells import resolve_well
-from safebasins.io.provenance import api_provenance
+from safebasins.wells.provenance import api_provenance
 
 __all__ = ["steady_responses", "fixed_points", "FixedPoints", "KINDS"]
 

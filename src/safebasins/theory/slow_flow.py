@@ -35,7 +35,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import optimize
 
-from safebasins.checks import check_finite, check_nonnegative, check_positive, check_scalar
+from safebasins.core.checks import check_finite, check_nonnegative, check_positive, check_scalar
 from safebasins.wells import resolve_well
 from safebasins.wells.quartic import XI_SEPARATRIX, _G, _J, _dG_dxi, _ell, _omega, check_fourier
 

@@ -11,12 +11,12 @@ import numpy as np
 import xarray as xr
 from scipy import integrate
 
-from safebasins import checks
-from safebasins.checks import check_finite, check_positive, check_scalar
+from safebasins.core import checks
+from safebasins.core.checks import check_finite, check_positive, check_scalar
 from safebasins.theory.damped import forcing_and_level, from_tilde, rhs_exact, to_tilde
 from safebasins.theory.damped_flow import default_t_max, pivots
 from safebasins.wells import resolve_well
-from safebasins.io.provenance import api_provenance
+from safebasins.wells.provenance import api_provenance
 
 __all__ = ["slow_trajectory"]
 

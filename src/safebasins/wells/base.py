@@ -181,7 +181,7 @@ class Well(abc.ABC):
         slow energy, exceeding it); in ``(0, barrier_energy)`` when the escape energy is a limit of V
         at infinity (the orbit at it is unbounded).  The undamped slow flow needs more:
         :meth:`check_analytic_threshold`."""
-        from safebasins.checks import as_array, value_repr
+        from safebasins.core.checks import as_array, value_repr
 
         a = as_array(name, xi_max)
         if self.open_at_infinity:
@@ -202,7 +202,7 @@ class Well(abc.ABC):
         the separatrix the period diverges, and F_cr grows like ``log(1 / (E_b - xi_max))`` without
         a limit (the cubic's F_cr at Omega = 0.7: 0.13, 0.17, 0.21, 0.24 at E_b - xi_max = 1e-6,
         1e-10, 1e-13 E_b and one ulp), so a value that close measures the float spacing, not the well."""
-        from safebasins.checks import BARRIER_RTOL, reaches, value_repr
+        from safebasins.core.checks import BARRIER_RTOL, reaches, value_repr
 
         a = self.check_threshold(name, xi_max)
         if reaches(a, self.barrier_energy).any():
@@ -225,7 +225,7 @@ class Well(abc.ABC):
     # ------------------------------------------------------------------ what the numerics need
     def check_displacement(self, name, q_max):
         """Symmetric displacement thresholds ``|q| > q_max``: q_max in (0, nearest barrier]."""
-        from safebasins.checks import as_array, value_repr
+        from safebasins.core.checks import as_array, value_repr
 
         a = as_array(name, q_max)
         lim = min(-self.barriers[0], self.barriers[1])
@@ -237,7 +237,7 @@ class Well(abc.ABC):
     def check_bounds(self, name, q_bounds):
         """Displacement bound pairs ``(lo, hi)`` as an (n, 2) float array: lo < 0 < hi, inside the
         barriers (a single pair may be given as (lo, hi))."""
-        from safebasins.checks import as_array
+        from safebasins.core.checks import as_array
 
         a = as_array(name, q_bounds)
         if a.size == 0:

@@ -57,7 +57,7 @@ from functools import partial
 
 import numpy as np
 
-from safebasins.checks import as_array, value_repr
+from safebasins.core.checks import as_array, value_repr
 from safebasins.wells.base import STEP_COST_TRANSCENDENTAL, Well
 from safebasins.wells.bottom import cancellation_fix
 from safebasins.wells.interpolation import BOTTOM, DEFAULT_TOL, EnergyInterpolant

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.polynomial import polynomial as P
 
-from safebasins.checks import as_array
+from safebasins.core.checks import as_array
 from safebasins.wells.base import STEP_COST_POLY4, STEP_COST_POLY8
 from safebasins.wells.numeric import NumericWell, check_options
 

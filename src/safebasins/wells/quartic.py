@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import special
 
-from safebasins.checks import as_array, check_finite, value_repr
+from safebasins.core.checks import as_array, check_finite, value_repr
 from safebasins.wells.base import Well
 
 __all__ = ["QuarticWell", "QUARTIC", "XI_SEPARATRIX", "FOURIER_VARIANTS", "check_fourier"]

@@ -17,7 +17,7 @@ from functools import partial
 import numpy as np
 from scipy import optimize
 
-from safebasins.checks import as_array
+from safebasins.core.checks import as_array
 from safebasins.wells.interpolation import DEFAULT_TOL, TOL_RANGE
 from safebasins.wells.open_sides import CONVERGED, TAIL_START, Tail, converged_limit, geometric_values
 

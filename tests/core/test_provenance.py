@@ -7,8 +7,8 @@ import json
 import numpy as np
 
 from safebasins import __version__
-from safebasins.io.compare import PROVENANCE_ATTRS
-from safebasins.io.datasets import stack
+from safebasins.core.provenance import PROVENANCE_ATTRS
+from safebasins.core.stacking import stack
 from safebasins.numerics import critical_forcing_numeric, escape_chart
 
 
@@ -34,7 +34,7 @@ def test_stack_drops_the_parts_provenance():
 
 def test_every_public_function_returning_a_dataset_is_wrapped():
     """The public functions of theory, numerics and analysis whose result is a Dataset carry the
-    provenance decorator (io.provenance.api_provenance): one list, checked against the modules."""
+    provenance decorator (safebasins.wells.provenance.api_provenance): one list, checked against the modules."""
     import importlib
     import inspect
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-import safebasins.io.datasets as datasets
+import safebasins.core.provenance as provenance
 
 pytestmark = pytest.mark.skipif(shutil.which("git") is None, reason="needs git")
 
@@ -21,25 +21,25 @@ def git(cwd, *args):
 
 def test_an_installed_copy_in_another_repository_records_unknown(tmp_path):
     project = tmp_path / "project"
-    site = project / ".venv" / "lib" / "site-packages" / "safebasins" / "io"
+    site = project / ".venv" / "lib" / "site-packages" / "safebasins" / "core"
     site.mkdir(parents=True)
     (project / ".gitignore").write_text(".venv/\n")
     git(project, "init", "-q")
     git(project, "add", ".gitignore")
     git(project, "-c", "user.name=u", "-c", "user.email=u@example.org", "commit", "-qm", "init")
     assert git(site, "rev-parse", "HEAD")  # git alone would name the project's commit
-    shutil.copy(datasets.__file__, site / "datasets.py")
-    spec = importlib.util.spec_from_file_location("copied_datasets", site / "datasets.py")
+    shutil.copy(provenance.__file__, site / "provenance.py")
+    spec = importlib.util.spec_from_file_location("copied_provenance", site / "provenance.py")
     copy = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(copy)
     assert copy.git_commit() == "unknown"
 
 
 def test_the_checkout_records_its_head():
-    src = Path(datasets.__file__).resolve().parent
+    src = Path(provenance.__file__).resolve().parent
     try:
         head = git(src, "rev-parse", "HEAD")
-        git(src, "ls-files", "--error-unmatch", "datasets.py")
+        git(src, "ls-files", "--error-unmatch", "provenance.py")
     except subprocess.CalledProcessError:
         pytest.skip("the package is not imported from a git checkout")
-    assert datasets.git_commit() in (head, head + "-dirty")
+    assert provenance.git_commit() in (head, head + "-dirty")

@@ -64,7 +64,7 @@ def fallback_cache_dir(package_dir: Path, environ) -> Path | None:
 def configure() -> None:
     """Point numba at :func:`fallback_cache_dir` for this package when it needs one (before the
     package defines its kernels; numba reads NUMBA_CACHE_DIR when it is imported)."""
-    path = fallback_cache_dir(Path(__file__).resolve().parent, os.environ)
+    path = fallback_cache_dir(Path(__file__).resolve().parent.parent, os.environ)   # the package
     if path is None:
         return
     os.environ["NUMBA_CACHE_DIR"] = str(path)

@@ -1,4 +1,4 @@
-"""Where numba caches the package's kernels (safebasins._numba_cache): beside the sources when
+"""Where numba caches the package's kernels (safebasins.core.numba_cache): beside the sources when
 they are writable, else in the user's cache directory, else in a private temp directory; never in
 the working directory, never in a directory someone else can write."""
 from __future__ import annotations
@@ -10,7 +10,7 @@ import tempfile
 
 import pytest
 
-from safebasins import _numba_cache as nc
+from safebasins.core import numba_cache as nc
 
 pytestmark = pytest.mark.skipif(sys.platform != "linux", reason="the fallback is for Linux (numba's own elsewhere)")
 

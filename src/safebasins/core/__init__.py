@@ -1,0 +1,12 @@
+"""The dependency-free core: what every other layer uses, importing nothing of safebasins.
+
+checks       argument checks (a ValueError naming the argument)
+cf           the one CF table of units and long names; CF global texts
+provenance   provenance attributes of API results, the git commit of the source tree
+stacking     datasets stacked along a new dimension (variable-length parts padded)
+version      the package version (``safebasins.__version__``)
+numba_cache  where numba caches the compiled kernels of an installed package
+
+Layers (docs/architecture.md): core -> wells -> numerics | theory -> analysis -> io ->
+plotting | pipeline | explore -> cli; a layer imports only layers below it.
+"""
