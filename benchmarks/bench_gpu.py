@@ -15,7 +15,7 @@ flags, cores, GPU name and SMs) and
      Omega = 0.95, Psi = pi, xi_max = 0.25, q_max = 1, 11,000 cycles of 32 steps: GPU kernel time
      (CUDA events) and wall time, CPU time (all rows, or --cpu-sample rows), and the number of
      escape steps that differ between CPU and GPU (must be 0).
---wells adds (c): the kernel per compiled well (numerics/wellcode.py) on the GPU: the dense job
+--wells adds (c): the kernel per compiled well (wells/compiled.py) on the GPU: the dense job
 (F = 0, nothing escapes) in the quartic (|q| tracking; signed tracking with asymmetric bounds),
 the cubic V = q^2/2 - q^3/3 (degree-4 polynomial class), a degree-6 well (degree-8 class) and the
 pendulum (an expression well: libdevice sin/cos on the GPU, glibc on the CPU, so its escape

@@ -8,7 +8,7 @@ per-step rate of the shared vector loop, all numba threads); best of ``--repeat`
 warm-up.
 
 FLOPs per SRKN6b step of the quartic, counting an FMA as 2 (steps.scheme_steps,
-wellcode.quartic_force / quartic_energy2, periods._keep_abs): 7 kicks x (force ``fma(q*q, q,
+wells.compiled.quartic_force / quartic_energy2, periods._keep_abs): 7 kicks x (force ``fma(q*q, q,
 f - q)``: mul + sub + fma = 4; ``p = fma(c, force, p)``: 2) = 42, 6 drifts ``q = fma(c, p, q)``
 = 12, the energy for the escape test ``fma(q*q, fma(-0.5, q*q, 1), p*p)`` = 6: 60 FLOP/step
 (comparisons, abs and the forcing table's F*sin, formed once per period for all lanes, not
@@ -60,7 +60,7 @@ def measured_ghz(links=200_000_000):
     import numba
     from numba import njit, prange
 
-    from safebasins.numerics.wellcode import fma_cpu
+    from safebasins.wells.compiled import fma_cpu
 
     @njit(parallel=True)
     def chains(x0, m, c, n):

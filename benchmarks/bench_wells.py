@@ -17,7 +17,7 @@ Jobs (kernel only: kernels.ensemble with the arrays engine.run_cpu would pass):
   chart  the 100x100 chart of bench_escape.py (quartic: F = 0.0876, Omega = 0.95, Psi = pi,
          xi_max = 0.25, 300 cycles; cubic: F = 0.06, Omega = 0.85, xi_max = 1/6), steps
          counted to the escape step or the horizon.
-Wells, each in its one compiled form (Well.compiled, numerics.wellcode): the quartic's closed
+Wells, each in its one compiled form (Well.compiled, wells.compiled): the quartic's closed
 form (before and after; its signed variant: the same arithmetic with signed maxima, for
 asymmetric displacement bounds), the polynomial codes (the cubic V = q^2/2 - q^3/3 and the
 quartic written as coefficients [0, 0, 0.5, 0, -0.25] in the degree-4 class; the cubic in the
@@ -178,7 +178,8 @@ def main(argv=None):
     import numba
     numba.set_num_threads(args.threads)
     from safebasins import wells
-    from safebasins.numerics import kernels, wellcode
+    from safebasins.numerics import kernels
+    from safebasins.wells import compiled
     print("machine:", machine())
     print(f"numba {numba.__version__}, threads {args.threads}, steps_per_cycle {args.steps_per_cycle}, "
           f"best of {args.repeat} interleaved runs, kernel only (kernels.ensemble)")
@@ -195,7 +196,7 @@ def main(argv=None):
     quartic = wells.QUARTIC.compiled
     quartic_poly = wells.polynomial(QUARTIC_COEFS).compiled
     cubic = wells.cubic().compiled
-    cubic8 = wellcode.polynomial_code(CUBIC_COEFS, (-np.inf, 1.0), "cubic", degree_class=8)
+    cubic8 = compiled.polynomial_code(CUBIC_COEFS, (-np.inf, 1.0), "cubic", degree_class=8)
     cubic_expr = wells.expression("q**2/2 - q**3/3").compiled
     pendulum = wells.resolve_well("pendulum")
     qp, pp = disc_ics(args.dense_n, lambda q, p: 0.5 * p * p + pendulum.V(q), 1.0, seed=2)

@@ -15,6 +15,7 @@ from pathlib import Path
 
 #: package -> page title
 PACKAGES = {
+    "core": "Core: argument checks, CF table, provenance",
     "wells": "Potential wells",
     "theory": "Theory: the isolated 1:1 resonance",
     "numerics": "Numerics: compiled escape ensembles",
@@ -27,7 +28,7 @@ PACKAGES = {
 INTERNAL = {
     "safebasins.numerics.engine", "safebasins.numerics.kernels", "safebasins.numerics.steps",
     "safebasins.numerics.cuda_engine", "safebasins.numerics.cuda_kernels", "safebasins.numerics.periods",
-    "safebasins.numerics.wellcode", "safebasins.analysis.common",
+    "safebasins.wells.compiled", "safebasins.analysis.common",
 }
 #: submodules shown first on their page (the rest follow in alphabetical order)
 FIRST = {"plotting": ["safebasins.plotting.api"], "theory": ["safebasins.theory.action_angle",

@@ -11,7 +11,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from safebasins import wells
-from safebasins.numerics import escape_chart, kernels, schemes, steps, wellcode
+from safebasins.numerics import escape_chart, kernels, schemes, steps
+from safebasins.wells import compiled
 from safebasins.numerics.engine import check_step
 from safebasins.numerics.scheme_code import scheme_code
 
@@ -26,7 +27,7 @@ def with_verlet(monkeypatch):
 
 
 #: the free oscillator V = q^2/2 as a compiled code (no Well: it has no barrier)
-HARMONIC = wellcode.polynomial_code([0.0, 0.0, 0.5], (-np.inf, np.inf), name="harmonic")
+HARMONIC = compiled.polynomial_code([0.0, 0.0, 0.5], (-np.inf, np.inf), name="harmonic")
 
 
 def _final(integrator, q0, p0, F, Omega, beta, S, n, code=None):

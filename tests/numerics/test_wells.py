@@ -20,7 +20,8 @@ from numba import njit
 from scipy.integrate import solve_ivp
 
 from safebasins.numerics import (critical_forcing_numeric, displacement_bounds, escape_chart,
-                                 escape_chart_batch, kernels, steps, stroboscopic_map, wellcode)
+                                 escape_chart_batch, kernels, steps, stroboscopic_map)
+from safebasins.wells import compiled
 from safebasins.wells.polynomial import PolynomialWell, cubic
 from safebasins.numerics import schemes
 from tests.numerics.ensemble import run_ensemble
@@ -148,7 +149,7 @@ def test_signed_tracking_equals_abs_tracking_bitwise(npar):
     Q, P = (a.ravel() for a in np.meshgrid(q, q, indexing="ij"))
     N, S = Q.size, 16
     out = []
-    code = wellcode.quartic_code()
+    code = compiled.quartic_code()
     for flag in (code, code.signed()):
         oE = np.full((N, 2), -1, np.int64)
         oQ = np.full((N, 2), -1, np.int64)
@@ -252,7 +253,7 @@ def test_cubic_map_and_bisection(wells):
 @njit
 def _horner(key, wpar, q, p):
     w = steps.wtuple(wpar)
-    return wellcode.well_force(key, w, q, 0.25), wellcode.well_energy2(key, w, q, p)
+    return compiled.well_force(key, w, q, 0.25), compiled.well_energy2(key, w, q, p)
 
 
 def _horner_of(code):
@@ -265,7 +266,7 @@ def test_horner_classes():
     runs bitwise the same in the degree-4 and degree-8 classes (leading zeros are exact)."""
     P = np.polynomial.polynomial
     c6 = [0.0, 0.0, 0.5, 0.1, -0.3, 0.02, 0.05]
-    code6 = wellcode.polynomial_code(c6, (-1.0, 1.0))
+    code6 = compiled.polynomial_code(c6, (-1.0, 1.0))
     assert "class 8" in code6.name
     h8 = _horner_of(code6)
     for q, p in ((0.3, -0.2), (-0.7, 0.4), (1.3, 0.0)):
@@ -273,9 +274,9 @@ def test_horner_classes():
         assert f == pytest.approx(0.25 - P.polyval(q, P.polyder(c6)), rel=1e-14, abs=1e-15)
         assert e == pytest.approx(2 * P.polyval(q, c6) + p * p, rel=1e-14, abs=1e-15)
     c3 = [0.0, 0.0, 0.5, -1.0 / 3.0]
-    code3 = wellcode.polynomial_code(c3, (-np.inf, 1.0))
+    code3 = compiled.polynomial_code(c3, (-np.inf, 1.0))
     assert "class 4" in code3.name
-    as8 = wellcode.polynomial_code(c3, (-np.inf, 1.0), degree_class=8)
+    as8 = compiled.polynomial_code(c3, (-np.inf, 1.0), degree_class=8)
     h4 = _horner_of(code3)
     for q, p in ((0.3, -0.2), (-0.7, 0.4)):
         assert h4(code3.wpar, q, p) == h8(code3.wpar, q, p)
@@ -286,7 +287,7 @@ def test_horner_classes():
     b = kernels.final_states(*args, well=as8)
     np.testing.assert_array_equal(a, b)
     with pytest.raises(ValueError, match="degree 9"):
-        wellcode.polynomial_code([0, 0, 1, 0, 0, 0, 0, 0, 0, -1], (-1.0, 1.0))
+        compiled.polynomial_code([0, 0, 1, 0, 0, 0, 0, 0, 0, -1], (-1.0, 1.0))
 
 
 # ---------------------------------------------------------------------------------------------

@@ -27,6 +27,39 @@ __all__ = ["uncertainty_exponent", "MIN_UNCERTAIN"]
 MIN_UNCERTAIN = 10
 
 
+def exponent_dataset(eps, n_uncertain, n, eps_attrs) -> xr.Dataset:
+    """f(eps) = n_uncertain / n of n random base points, its binomial standard error and the
+    weighted least-squares fit of log f against log eps over the eps with at least MIN_UNCERTAIN
+    uncertain points: a Dataset over ``eps`` (``n_uncertain``, ``fraction``, ``fraction_err``,
+    ``used``) with attributes ``alpha``, ``alpha_err`` (NaN when fewer than two eps qualify) and
+    ``boundary_dimension`` (2 - alpha).  Shared by the exponent of fresh integrations
+    (:func:`uncertainty_exponent`) and of a labelled grid
+    (:func:`safebasins.analysis.basin_measures.grid_uncertainty_exponent`)."""
+    e = np.asarray(eps, dtype=float)
+    k = np.asarray(n_uncertain, dtype=np.int64)
+    f = k / n
+    err = np.sqrt(np.maximum(f * (1 - f), 1.0 / n) / n)
+    used = k >= MIN_UNCERTAIN
+    alpha = alpha_err = np.nan
+    if used.sum() >= 2:
+        x, y = np.log(e[used]), np.log(f[used])
+        wgt = (f[used] / err[used]) ** 2                # 1 / var(log f)
+        A = np.stack([x, np.ones_like(x)], axis=1)
+        cov = np.linalg.inv(A.T @ (wgt[:, None] * A))
+        alpha, _ = cov @ (A.T @ (wgt * y))
+        alpha_err = float(np.sqrt(cov[0, 0]))
+        alpha = float(alpha)
+    ds = xr.Dataset(
+        {"n_uncertain": ("eps", k, {"units": "1", "long_name": "eps-uncertain base points"}),
+         "fraction": ("eps", f, {"units": "1", "long_name": "fraction of eps-uncertain initial conditions f(eps)"}),
+         "fraction_err": ("eps", err, {"units": "1", "long_name": "binomial standard error of f(eps)"}),
+         "used": ("eps", used, {"long_name": f"in the fit (at least {MIN_UNCERTAIN} uncertain points)"})},
+        coords={"eps": ("eps", e, dict(eps_attrs))},
+    )
+    ds.attrs.update(alpha=alpha, alpha_err=alpha_err, boundary_dimension=2.0 - alpha if np.isfinite(alpha) else np.nan)
+    return ds
+
+
 def _box(box):
     b = checks.check_finite("box", box)
     if b.shape != (2, 2) or not (b[:, 1] > b[:, 0]).all():
@@ -86,28 +119,9 @@ def uncertainty_exponent(F, Omega, Psi, xi_max, box, *, eps=(1e-2, 3e-3, 1e-3, 3
     plus = safe[n:n + e.size * n].reshape(e.size, n)
     minus = safe[n + e.size * n:].reshape(e.size, n)
     uncertain = (plus != base[None, :]) | (minus != base[None, :])
-    k = uncertain.sum(axis=1)
-    f = k / n
-    err = np.sqrt(np.maximum(f * (1 - f), 1.0 / n) / n)
-    used = k >= MIN_UNCERTAIN
-    alpha = alpha_err = np.nan
-    if used.sum() >= 2:
-        x, y = np.log(e[used]), np.log(f[used])
-        wgt = (f[used] / err[used]) ** 2                # 1 / var(log f)
-        A = np.stack([x, np.ones_like(x)], axis=1)
-        cov = np.linalg.inv(A.T @ (wgt[:, None] * A))
-        alpha, _ = cov @ (A.T @ (wgt * y))
-        alpha_err = float(np.sqrt(cov[0, 0]))
-        alpha = float(alpha)
-    ds = xr.Dataset(
-        {"n_uncertain": ("eps", k.astype(np.int64), {"units": "1", "long_name": "eps-uncertain base points"}),
-         "fraction": ("eps", f, {"units": "1", "long_name": "fraction of eps-uncertain initial conditions f(eps)"}),
-         "fraction_err": ("eps", err, {"units": "1", "long_name": "binomial standard error of f(eps)"}),
-         "used": ("eps", used, {"long_name": f"in the fit (at least {MIN_UNCERTAIN} uncertain points)"})},
-        coords={"eps": ("eps", e, {"units": "1", "long_name": "perturbation of the initial condition"})},
-    )
-    ds.attrs.update(alpha=alpha, alpha_err=alpha_err, boundary_dimension=2.0 - alpha if np.isfinite(alpha) else np.nan,
-                    n=n, seed=int(seed), safe_fraction=float(base.mean()), F=float(F), Omega=float(Omega),
+    ds = exponent_dataset(e, uncertain.sum(axis=1), n,
+                          {"units": "1", "long_name": "perturbation of the initial condition"})
+    ds.attrs.update(n=n, seed=int(seed), safe_fraction=float(base.mean()), F=float(F), Omega=float(Omega),
                     Psi=float(Psi), xi_max=float(xi_max), cycles=int(cycles), t_eval=t_eval,
                     **{k: ch.attrs[k] for k in ("damping",) if k in ch.attrs},
                     method="f(eps) ~ eps^alpha, x and x +- eps e with e along q0 or p0 at random; weighted fit of log f")

@@ -8,7 +8,7 @@ random_initial_conditions        initial_conditions.py
 displacement_bounds              criteria.py  (asymmetric displacement bounds from energy levels)
 SCHEMES                          schemes.py   (the integrators by name: each a constant)
 Every function takes ``well=``: any form safebasins.wells.resolve_well reads (None: the quartic),
-integrated in its one compiled form (``Well.compiled``, numerics.wellcode).
+integrated in its one compiled form (``Well.compiled``, wells.compiled).
 """
 from safebasins.numerics.bisection import critical_forcing_numeric
 from safebasins.numerics.charts import escape_chart, escape_chart_batch

@@ -2,7 +2,7 @@
 
 Any well reaches the numerics through ``safebasins.wells.resolve_well`` (a name, a spec, a
 :class:`~safebasins.wells.Well`) and its one compiled form ``well.compiled``
-(:mod:`safebasins.numerics.wellcode`).
+(:mod:`safebasins.wells.compiled`).
 
 Escape criteria (wells.base): energy ``H0 = p^2/2 + V(q) > xi_max`` or ``q`` beyond a barrier
 (``q > q_right`` or ``q < q_left``; a side without a finite barrier, ``+-inf``, never escapes

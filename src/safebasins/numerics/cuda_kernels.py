@@ -2,7 +2,7 @@
 
 The GPU twin of kernels.py: same schemes (schemes.py: each a constant, its step generated once by
 scheme_code.py and compiled here as a device function), same
-wells (the one compiled form of a well, wellcode.WellCode: the SAME Python source of its force
+wells (the one compiled form of a well, wells.compiled.WellCode: the SAME Python source of its force
 and energy, compiled here as device functions), same forcing tables, same escape
 criteria, and the SAME SEQUENCE OF IEEE OPERATIONS per trajectory, so the recorded
 first-crossing steps are bitwise equal to the CPU engine's.
@@ -29,12 +29,12 @@ operand is the result of a multiply; this module leaves no such pair:
 * RK4's sums (p2 + p3 etc.) contain no product.  LLVM may rewrite s + s as s * 2.0 and NVVM
   then fuse that into fma(s, 2, x): doubling is exact, so round(x + 2 s) is the same number
   either way (short of overflow, long after escape).
-* a well written as an expression writes every product with wellcode.mul (mul.rn.f64 here:
+* a well written as an expression writes every product with wells.compiled.mul (mul.rn.f64 here:
   never contracted).
 No fast-math anywhere; no division and no transcendental in the kernel (sin is in the host
 table), except what a well's own formula contains: IEEE division and sqrt are correctly rounded
 on both targets, but transcendental functions come from libdevice here and glibc on the CPU, so
-a well with sin, exp, ... may differ from the CPU in the last bit (wellcode docstring).
+a well with sin, exp, ... may differ from the CPU in the last bit (wells.compiled docstring).
 FP64 has no flush-to-zero on the GPU.  benchmarks/bench_gpu.py counts the f64 instructions of
 the compiled kernel and the multiplies that feed an add (must be none), and compares the escape
 steps with the CPU engine.  On an H100 (numba-cuda 0.30.4) the SASS has exactly the PTX's DFMA
@@ -42,7 +42,7 @@ and DMUL counts (nothing fused) and the Fig 21 chart (90,000 ICs, 11,000 cycles)
 1e5-trajectory job gave 0 differing escape steps for both schemes.
 
 The simulator (NUMBA_ENABLE_CUDASIM=1) implements cuda.fma as a*b + c (two roundings); under
-the simulator the wells' `fma` (wellcode.fma) runs its Python body, the CPU's correctly rounded
+the simulator the wells' `fma` (wells.compiled.fma) runs its Python body, the CPU's correctly rounded
 llvm.fma, so the simulator runs the same arithmetic as the GPU.
 
 Kernel organisation (one thread = one trajectory at a time)
@@ -67,7 +67,7 @@ Kernel organisation (one thread = one trajectory at a time)
   another lane does not change its arithmetic.
 * Forcing table in shared memory when it fits (one parameter set: S * 7 doubles); many
   parameter sets (bisection) read it from global memory (cached).
-* The well is the kernel factory's compiled well (wellcode.WellCode): its force -V'(q) + f and
+* The well is the kernel factory's compiled well (wells.compiled.WellCode): its force -V'(q) + f and
   energy 2 H0 compiled from the one source (make_step, the coefficients w loaded from `wpar`
   once per thread) and its escape tests (make_criteria): |q| tracking compares |q| with the
   q_max thresholds and the barrier, signed tracking compares q with the bound pairs (lo, hi)
@@ -82,7 +82,8 @@ import numpy as np
 from numba import cuda, float64, int32, int64, uint64
 from numba.cuda.core import config as cuda_config
 
-from safebasins.numerics import schemes, wellcode
+from safebasins.numerics import schemes
+from safebasins.wells import compiled
 from safebasins.numerics.scheme_code import scheme_code
 
 SIMULATOR = bool(cuda_config.ENABLE_CUDASIM)
@@ -101,27 +102,27 @@ def _device(fn):
     return cuda.jit(device=True)(fn)
 
 
-# the GPU's primitives of the wells' one source (wellcode.fma / wellcode.mul): fma.rn.f64 and
+# the GPU's primitives of the wells' one source (wells.compiled.fma / mul): fma.rn.f64 and
 # mul.rn.f64 (a rounded product the compiler may not contract).  Under the simulator the device
 # functions run as Python and the primitives' Python bodies are the CPU's correctly rounded ones.
 if not SIMULATOR:
     from numba.cuda import libdevice
     from numba.cuda.extending import overload as cuda_overload
 
-    @cuda_overload(wellcode.fma, inline="always")
+    @cuda_overload(compiled.fma, inline="always")
     def _ol_fma(a, b, c):
         return lambda a, b, c: cuda.fma(a, b, c)
 
-    @cuda_overload(wellcode.mul, inline="always")
+    @cuda_overload(compiled.mul, inline="always")
     def _ol_mul(a, b):
         return lambda a, b: libdevice.dmul_rn(a, b)
 
-fma = wellcode.fma
+fma = compiled.fma
 
 
 # ------------------------------------------------------------------------------- the well and the scheme
 def make_step(code, sc):
-    """(step, energy2, flat_coefs) device functions of a compiled well (wellcode.WellCode) and a
+    """(step, energy2, flat_coefs) device functions of a compiled well (wells.compiled.WellCode) and a
     scheme code (scheme_code.SchemeCode): the well's one source and the scheme's one generated
     source, compiled for the GPU.
 
@@ -232,7 +233,7 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
     integrator: a name of schemes.SCHEMES; shared_table: copy the forcing table into dynamic shared
     memory (launch with its size in bytes); block: threads per block (static shared buffers);
     warp: compaction granularity (32 on a GPU; smaller values exercise compaction in the
-    simulator); well: the compiled well (wellcode.WellCode; None: the quartic); damped: the
+    simulator); well: the compiled well (wells.compiled.WellCode; None: the quartic); damped: the
     scheme's damped variant (coefficients from schemes.lane_coefficients with the damping).
 
     Launch: kernel[grid, block, 0, table_bytes if shared_table else 0](
@@ -243,13 +244,13 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
     thrLo, thrHi (>= max(nQ, 1),) the nested displacement bounds, inside out (|q| tracking: thrHi
     = sorted q_max, thrLo unused); A: scrambling multiplier (coprime to N); counter (1,) int64
     = 0; outE (N*nE,), outQ (N*nQ,) int64 pre-filled with -1; wpar (steps.N_WPAR,) the well's
-    barriers and coefficients (wellcode.WellCode.wpar).
+    barriers and coefficients (wells.compiled.WellCode.wpar).
     """
     sc = scheme_code(schemes.check_integrator(integrator), bool(damped))
     UW = np.uint64(sc.width)
-    code = wellcode.quartic_code() if well is None else well
-    if not isinstance(code, wellcode.WellCode):
-        raise ValueError(f"well must be a compiled well (wellcode.WellCode), got {well!r}")
+    code = compiled.quartic_code() if well is None else well
+    if not isinstance(code, compiled.WellCode):
+        raise ValueError(f"well must be a compiled well (wells.compiled.WellCode), got {well!r}")
     step, energy2w, flat_coefs = make_step(code, sc)
     crossed, check_state, next_filters = make_criteria(code.abs_tracking)
     NC = np.uint64(sc.n_coef)

@@ -2,12 +2,12 @@
 
 The schemes are constants (schemes.py) whose steps are generated once (scheme_code.py) and
 compiled for the CPU in steps.py, the vectorised period loops over the lanes live in periods.py,
-the well's force and energy in its compiled form (wellcode.py); this module holds the lane
+the well's force and energy in its compiled form (wells/compiled.py); this module holds the lane
 machinery: escape detection, replay, refill, compaction, and the entry points.
 
 Schemes and wells are compile-time constants of the inline period bodies: `scheme`, the key of a
 scheme's compiled form (scheme_code.SchemeCode.key; the forcing table's width and the coefficient
-table match it) and `well`, the kernel key of a compiled well (wellcode.WellCode.key), which
+table match it) and `well`, the kernel key of a compiled well (wells.compiled.WellCode.key), which
 _run_task forces to numba literals (`literally`): every pair of keys is its own compiled kernel,
 cached on disk and compiled on first use, and holds only its own scheme's and well's code (numba
 @overload on the literal, resolved at typing time).  Keys hash the arithmetic and the engine's
@@ -54,7 +54,7 @@ from numba.extending import overload
 from safebasins.numerics.periods import _period_lanes_body, _period_shared_body
 from safebasins.numerics.scheme_code import SchemeCode, scheme_code
 from safebasins.numerics.steps import coefs, is_damped, scaled_row, step, wtuple
-from safebasins.numerics.wellcode import WellCode, abs_tracking, quartic_code, well_energy2
+from safebasins.wells.compiled import WellCode, abs_tracking, quartic_code, well_energy2
 
 # smallest lane segment of the 4-chain vector loop (lanes run: 4 * segment)
 MIN_SEGMENT = 16
@@ -62,7 +62,9 @@ MIN_SEGMENT = 16
 SEGMENTS = 4
 
 
-@njit(cache=True)
+# not cached on disk by itself: keyed by the well alone, its cache would not see an edit of steps.py;
+# it is compiled into the cached kernels that call it (their scheme key hashes the engine)
+@njit
 def _check_state(well, wpar, i, q, p, step, thrE2, thrLo, thrHi, iE, iQ, outE, outQ):
     """Record, at `step`, every next-uncrossed threshold the state (q, p) is beyond."""
     e = well_energy2(well, wtuple(wpar), q, p)
@@ -361,7 +363,7 @@ def run_tasks(fn, n_tasks):
 
 def _check_code(well):
     if not isinstance(well, WellCode):
-        raise ValueError(f"well must be a compiled well (safebasins.numerics.wellcode.WellCode: Well.compiled), "
+        raise ValueError(f"well must be a compiled well (safebasins.wells.compiled.WellCode: Well.compiled), "
                          f"got {well!r}")
     return well
 
@@ -383,7 +385,7 @@ def ensemble(q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQ, cycles, stop_a
     store (N, cycles+1, 2): period-map iterates when do_store (pre-filled with NaN).
     scheme: the scheme's compiled form (scheme_code.scheme_code(integrator, damped); None: SRKN6b
     undamped), with schemes.sine_table / lane_coefficients of the same scheme and damping; the
-    well is its compiled form `well` (wellcode.WellCode; None: the quartic).
+    well is its compiled form `well` (wells.compiled.WellCode; None: the quartic).
     Trajectory i is run by task i % n_tasks (one thread each); the results do not depend on
     n_tasks, lanes or the thread count (each trajectory is the same sequence of IEEE operations).
     """

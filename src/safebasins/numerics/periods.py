@@ -5,10 +5,10 @@ Two loops, each specialised at compile time on the scheme key (scheme_code.Schem
 scheme and damped or not) and the well's kernel key (steps.py): _period_shared_body (every lane with the same
 Omega and F: 4 dependency chains per iteration) and _period_lanes_body (per-lane Omega and F:
 one chain), numba overloads whose body is picked at typing time on the literal kernel key: a
-code with |q| tracking (the quartic's closed form, wellcode.WellCode.abs_tracking) tracks
+code with |q| tracking (the quartic's closed form, wells.compiled.WellCode.abs_tracking) tracks
 max 2 H0 and max |q|; every other code tracks max 2 H0, max q and max -q.
 
-The kernel keys hash this file's source (wellcode.engine_fingerprint): an edit here never
+The kernel keys hash this file's source (scheme_code.engine_fingerprint): an edit here never
 reuses a kernel cached before it.
 """
 from __future__ import annotations
@@ -18,7 +18,7 @@ from numba import njit
 from numba.extending import overload
 
 from safebasins.numerics.steps import cpu_helpers, cpu_lane, cpu_step, literal_scheme, wtuple
-from safebasins.numerics.wellcode import _literal_code, cpu_functions
+from safebasins.wells.compiled import literal_code, cpu_functions
 
 
 @njit(cache=True, inline="always")
@@ -63,9 +63,9 @@ def _arithmetic(scheme, well):
     HL[l] for an undamped scheme, the IEEE products lane_coefficients precomputes; read from its
     column of CL, copied at load, for a damped one).  The loop bodies below call them directly
     (inlined into the untyped IR, typed once with the body), not through the generic inline
-    overloads of steps.py / wellcode.py, which numba types anew at every call site and
+    overloads of steps.py / wells/compiled.py, which numba types anew at every call site and
     type-inference round (~30 ms each, ~0.8 s of a kernel's first compile)."""
-    sc, code = literal_scheme(scheme), _literal_code(well)
+    sc, code = literal_scheme(scheme), literal_code(well)
     return (cpu_helpers(sc.key), code.abs_tracking, cpu_step(sc.key, code.key), cpu_functions(code.key)[1],
             cpu_lane(sc.key))
 

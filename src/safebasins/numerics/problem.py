@@ -21,7 +21,7 @@ import numpy as np
 from safebasins.core import checks
 from safebasins.numerics import schemes
 from safebasins.numerics.scheme_code import SchemeCode, scheme_code
-from safebasins.numerics.wellcode import WellCode
+from safebasins.wells.compiled import WellCode
 from safebasins.wells import resolve_well
 
 __all__ = ["EnsembleProblem", "ensemble_problem", "displacement_pairs", "engine_code", "check_cycles"]

@@ -6,7 +6,7 @@
 * ``step(w, q, p, c, f) -> (q, p)``: one step with the coefficient tuple ``c``
   (schemes.lane_coefficients of one parameter set) and the forcing values ``f`` (F sin(Omega t + Psi)
   at the scheme's distinct force sub-times), calling ``force(w, q, f_k) = -V'(q) + f_k`` of a well's
-  compiled form (wellcode.py) and the primitives ``fma`` / ``mul`` (every product that meets an
+  compiled form (wells/compiled.py) and the primitives ``fma`` / ``mul`` (every product that meets an
   add is an explicit fma; the damped ``p *= e`` is a mul: never contracted on the GPU);
 * the tuple helpers of its arity: ``row(tab, s)`` (a forcing-table row), ``scaled(F, t)`` (F times
   it: the products the shared path precomputes), ``coefs(c)`` (a coefficient row as a tuple),
@@ -14,24 +14,50 @@
   from the step h, the same IEEE products as lane_coefficients), ``flat_row(tab, o)`` and
   ``flat_coefs(coef, o)`` (CUDA: flat arrays at an unsigned offset).
 
-``make(jit, force)`` compiles the step for a target (the CPU lanes: wellcode.cpu_jit; CUDA:
+``make(jit, force)`` compiles the step for a target (the CPU lanes: wells.compiled.cpu_jit; CUDA:
 ``cuda.jit(device=True)``), ``helpers(jit)`` the tuple helpers.  ``key`` hashes the generated
-source and the engine's: the numba literal on which the CPU kernels are specialised and cached,
-as a well's key (wellcode.WellCode.key).
+source and the engine's (:func:`engine_fingerprint`): the numba literal on which the CPU kernels
+are specialised and cached, as a well's key (wells.compiled.WellCode.key) is the other.
+
+numba's disk cache checks only the source file of the cached function itself, not the modules
+inlined into it; every cached kernel of the engine is specialised on a scheme key, so an edit of
+any file the kernels inline changes that key and compiles the kernel anew.
 """
 from __future__ import annotations
 
 import functools
 import hashlib
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 
-from safebasins.numerics import wellcode
 from safebasins.numerics.schemes import RungeKutta, Scheme, Splitting, scheme_of
+from safebasins.wells import compiled
 
-__all__ = ["SchemeCode", "scheme_code", "code_of_scheme"]
+__all__ = ["SchemeCode", "scheme_code", "code_of_scheme", "engine_fingerprint", "fingerprint", "ENGINE_FILES"]
+
+#: the source files inlined into the engine's cached CPU kernels (tests/numerics/test_cache_keys.py
+#: checks the list against the modules the kernels import)
+ENGINE_FILES = (compiled.__file__, *(str(Path(__file__).with_name(name)) for name in
+                ("schemes.py", "scheme_code.py", "steps.py", "periods.py", "kernels.py")))
+
+
+def fingerprint(paths) -> str:
+    """Hash of the bytes of the files ``paths``, in order."""
+    h = hashlib.blake2b(digest_size=16)
+    for path in paths:
+        h.update(Path(path).read_bytes())
+    return h.hexdigest()
+
+
+@functools.cache
+def engine_fingerprint() -> str:
+    """Hash of the engine's source (:data:`ENGINE_FILES`: the wells' compiled form, the schemes,
+    this module, steps, periods, kernels): part of every scheme key, so an edit of the engine
+    never reuses a kernel cached before it."""
+    return fingerprint(ENGINE_FILES)
 
 
 def _splitting_step(s: Splitting, damped: bool) -> list[str]:
@@ -151,7 +177,7 @@ class SchemeCode:
     key: int = field(init=False)
 
     def __post_init__(self) -> None:
-        text = f"{wellcode.engine_fingerprint()}\0scheme\0{self.source}"
+        text = f"{engine_fingerprint()}\0scheme\0{self.source}"
         key = int.from_bytes(hashlib.blake2b(text.encode(), digest_size=8).digest(), "little") >> 3
         object.__setattr__(self, "key", key)
         _CODES.setdefault(key, self)
@@ -176,7 +202,7 @@ class SchemeCode:
 
     def make(self, jit: Callable, force: Callable) -> Callable:
         """The step compiled with ``jit`` around ``force`` (already compiled for the target)."""
-        return jit(self._namespace(force, {"fma": wellcode.fma, "mul": wellcode.mul})["step"])
+        return jit(self._namespace(force, {"fma": compiled.fma, "mul": compiled.mul})["step"])
 
     def helpers(self, jit: Callable) -> dict[str, Callable]:
         """The tuple helpers (row, scaled, coefs, column, from_h, flat_row, flat_coefs) compiled with jit."""

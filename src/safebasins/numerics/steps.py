@@ -3,7 +3,7 @@
 Equation: q'' + beta q' + V'(q) = F sin(Omega t + Psi), first order q' = p,
 p' = -beta p - V'(q) + f(t).  The schemes are constants (schemes.py); their steps are generated
 once (scheme_code.py) and compiled here for the CPU lanes with the well's force and energy
-(wellcode.py), the CUDA kernels compile the same source (cuda_kernels.py).
+(wells/compiled.py), the CUDA kernels compile the same source (cuda_kernels.py).
 
 Every operation is written with explicit fused multiply-adds (llvm.fma), no fast-math flags:
 vector loop and scalar replay produce bitwise identical numbers.
@@ -12,11 +12,11 @@ Compile-time keys
 -----------------
 The kernels are specialised on two numba literals threaded through every call: ``scheme``, the
 key of a scheme's compiled form (scheme_code.SchemeCode.key: the scheme and damped or not), and
-``well``, the key of a well's compiled form (wellcode.WellCode.key).  Each pair is its own
+``well``, the key of a well's compiled form (wells.compiled.WellCode.key).  Each pair is its own
 compiled, cached kernel; keys hash the generated arithmetic and the engine's source, so editing
 the engine invalidates the cache.
 
-``wpar`` (float64, ``wellcode.N_WPAR``): [q_left, q_right, w_0 .. w_13]; the barriers (+-inf
+``wpar`` (float64, ``wells.compiled.N_WPAR``): [q_left, q_right, w_0 .. w_13]; the barriers (+-inf
 where there is none) and the well's run-time coefficients (``wtuple``).
 """
 from __future__ import annotations
@@ -29,7 +29,7 @@ from numba.core import errors
 from numba.extending import overload
 
 from safebasins.numerics.scheme_code import SchemeCode, code_of_scheme, scheme_code
-from safebasins.numerics.wellcode import _literal_code, cpu_functions, cpu_jit, quartic_code, well_energy2, well_force
+from safebasins.wells.compiled import literal_code, cpu_functions, cpu_jit, quartic_code, well_energy2, well_force
 
 #: kernel key of the paper's quartic (a global constant: numba types it as a literal)
 QUARTIC_KEY = quartic_code().key
@@ -46,19 +46,22 @@ def wtuple(wpar):
 W0 = (0.0,) * 14
 
 
-@njit(cache=True, inline="always")
+# force, energy2, energy: the quartic for plain loops (tests); not cached on disk, since their
+# quartic key is a global, which numba's cache does not check (an edit of wells/compiled.py would
+# reuse them)
+@njit(inline="always")
 def force(q, f):
     """q^3 - q + f (the quartic), with f = F sin(Omega t_k + Psi)."""
     return well_force(QUARTIC_KEY, W0, q, f)
 
 
-@njit(cache=True, inline="always")
+@njit(inline="always")
 def energy2(q, p):
     """2 H0 = p^2 + q^2 - q^4/2 of the quartic (eq 7, untruncated)."""
     return well_energy2(QUARTIC_KEY, W0, q, p)
 
 
-@njit(cache=True)
+@njit
 def energy(q, p):
     return 0.5 * energy2(q, p)
 
@@ -106,7 +109,7 @@ def cpu_step(scheme_key: int, well_key: int) -> Callable:
 def scalar_step(integrator: str = "srkn6b", damped: bool = False, well=None) -> Callable:
     """A step of the scheme for plain compiled loops (tests, benchmarks): ``step(w, q, p, c, f)``
     with c a tuple of lane_coefficients, f a tuple of forcing values; well: a compiled well
-    (wellcode.WellCode; None: the quartic).  ``steps.wtuple(code.wpar)`` gives w."""
+    (wells.compiled.WellCode; None: the quartic).  ``steps.wtuple(code.wpar)`` gives w."""
     code = scheme_code(integrator, damped)
     return cpu_step(code.key, (quartic_code() if well is None else well).key)
 
@@ -119,7 +122,7 @@ def step(scheme, well, w, q, p, c, f):
 
 @overload(step, inline="always")
 def _ol_step(scheme, well, w, q, p, c, f):
-    STEP = cpu_step(literal_scheme(scheme).key, _literal_code(well).key)
+    STEP = cpu_step(literal_scheme(scheme).key, literal_code(well).key)
     return lambda scheme, well, w, q, p, c, f: STEP(w, q, p, c, f)
 
 

@@ -60,7 +60,7 @@ def _figure(name, kind, params, decl):
 
 def _check_compiled(exp, spec):
     """The well of an experiment with numerics has a compiled form (a polynomial up to the degree
-    of numerics.wellcode.POLY_DEGREES): refused here, naming the key, not when its job runs."""
+    of wells.compiled.POLY_DEGREES): refused here, naming the key, not when its job runs."""
     if spec["name"] == "polynomial" and exp.kind.cost(exp.params) > 0:
         try:
             wells.from_spec(spec).compiled

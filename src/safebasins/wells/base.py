@@ -351,7 +351,7 @@ class Well(abc.ABC):
 
     @property
     def compiled(self):
-        """The well's one compiled form (:class:`safebasins.numerics.wellcode.WellCode`: force and
+        """The well's one compiled form (:class:`safebasins.wells.compiled.WellCode`: force and
         energy for the CPU and CUDA engines), built on first use and kept."""
         code = self.__dict__.get("_compiled")
         if code is None:

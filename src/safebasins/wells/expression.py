@@ -5,7 +5,7 @@ The text is parsed by sympy; ``V'`` is its symbolic derivative.  One generated P
 
 * the theory (action-angle variables by quadrature, :class:`~safebasins.wells.numeric.NumericWell`)
   runs it vectorised on numpy arrays;
-* the compiled engines run it through the well's compiled form (numerics.wellcode.callable_code),
+* the compiled engines run it through the well's compiled form (wells.compiled.callable_code),
   compiled by numba for the CPU and by numba-cuda for the GPU; every product is written with
   ``mul`` (never contracted into an fma by the GPU compiler).
 
@@ -26,6 +26,7 @@ import numpy as np
 
 from safebasins.wells.base import STEP_COST_ARITHMETIC, STEP_COST_TRANSCENDENTAL
 from safebasins.wells.numeric import NumericWell
+from safebasins.wells.compiled import callable_code, mul
 
 __all__ = ["ExpressionWell", "expression", "FUNCTIONS"]
 
@@ -38,7 +39,7 @@ _NAMESPACE_NUMPY = {"math": _NUMPY_MATH, "mul": np.multiply}
 
 
 def _sympy():
-    import sympy
+    import sympy  # noqa: PLC0415  (lazy: sympy takes ~0.5 s to import, needed only to build an expression well)
 
     return sympy
 
@@ -54,7 +55,7 @@ def parse(text):
     q = sp.Symbol("q", real=True)
     names = {"q": q, "pi": sp.pi, "E": sp.E, "sech": sp.sech}
     names.update({k: getattr(sp, k) for k in FUNCTIONS})
-    from sympy.parsing.sympy_parser import parse_expr, standard_transformations
+    from sympy.parsing.sympy_parser import parse_expr, standard_transformations  # noqa: PLC0415  (lazy: as _sympy)
 
     try:
         V = parse_expr(text, local_dict=names, global_dict={"Integer": sp.Integer, "Float": sp.Float,
@@ -260,8 +261,6 @@ class ExpressionWell(NumericWell):
         super().__init__(Vn, dVn, name=name, **kwargs)
 
     def _compiled_form(self):
-        from safebasins.numerics.wellcode import callable_code
-
         return callable_code(self._V_scalar, self._dV_scalar, self.barriers, self.name, self.source)
 
     def potential_text(self):
@@ -274,8 +273,6 @@ class ExpressionWell(NumericWell):
 
 
 def _mul_stub():
-    from safebasins.numerics.wellcode import mul
-
     return mul
 
 

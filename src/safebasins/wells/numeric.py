@@ -63,6 +63,7 @@ from safebasins.wells.bottom import cancellation_fix
 from safebasins.wells.interpolation import BOTTOM, DEFAULT_TOL, EnergyInterpolant
 from safebasins.wells.orbit_quadrature import EPS, OrbitQuadrature, solve_increasing
 from safebasins.wells.well_shape import WellShape, _call, check_options
+from safebasins.wells.compiled import user_code
 
 __all__ = ["NumericWell", "check_options"]
 
@@ -435,8 +436,6 @@ class NumericWell(WellShape, Well):
     step_cost = STEP_COST_TRANSCENDENTAL
 
     def _compiled_form(self):
-        from safebasins.numerics.wellcode import user_code
-
         return user_code(self._V, self._dV, self.barriers, self.name)
 
     def potential_text(self):

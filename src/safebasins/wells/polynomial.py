@@ -26,6 +26,7 @@ from numpy.polynomial import polynomial as P
 from safebasins.core.checks import as_array
 from safebasins.wells.base import STEP_COST_POLY4, STEP_COST_POLY8
 from safebasins.wells.numeric import NumericWell, check_options
+from safebasins.wells.compiled import POLY_DEGREES, polynomial_code
 
 __all__ = ["PolynomialWell", "polynomial", "cubic", "quartic_polynomial"]
 
@@ -162,13 +163,9 @@ class PolynomialWell(NumericWell):
     def step_cost(self) -> float:
         """Step cost of its degree class (``STEP_COST_POLY4`` / ``STEP_COST_POLY8`` of
         safebasins.wells.base)."""
-        from safebasins.numerics.wellcode import POLY_DEGREES
-
         return STEP_COST_POLY4 if self.coefficients.size - 1 <= POLY_DEGREES[0] else STEP_COST_POLY8
 
     def _compiled_form(self):
-        from safebasins.numerics.wellcode import polynomial_code
-
         return polynomial_code(self.coefficients, self.barriers, self.name)
 
     def potential_text(self):

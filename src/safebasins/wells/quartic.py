@@ -31,6 +31,7 @@ from scipy import special
 
 from safebasins.core.checks import as_array, check_finite, value_repr
 from safebasins.wells.base import Well
+from safebasins.wells.compiled import quartic_code
 
 __all__ = ["QuarticWell", "QUARTIC", "XI_SEPARATRIX", "FOURIER_VARIANTS", "check_fourier"]
 
@@ -230,8 +231,6 @@ class QuarticWell(Well):
 
     # -- the numerics
     def _compiled_form(self):
-        from safebasins.numerics.wellcode import quartic_code
-
         return quartic_code()
 
     def potential_text(self):

@@ -9,19 +9,22 @@ A well reaches the engines as a :class:`WellCode` (``Well.compiled``, built once
   without one).
 * ``make(jit) -> (force, energy2)`` compiles them with a target's decorator: the CPU lanes use
   :func:`cpu_jit`, ``numba.njit(inline="always")`` with the primitives bound to their CPU
-  intrinsics (kernels.py, through :func:`well_force` / :func:`well_energy2`),
-  the CUDA kernels ``numba.cuda.jit(device=True)`` (cuda_kernels.py).  The SAME Python source
-  serves both; only the two primitives below differ by target.
-* ``key``: a 61-bit hash of the source text of the arithmetic (and of the engine's own source),
-  the compile-time constant (numba literal) on which the CPU kernels are specialised and cached
-  on disk.  Equal keys mean equal arithmetic, so a cached kernel is never reused for other code.
+  intrinsics (numerics/kernels.py, through :func:`well_force` / :func:`well_energy2`),
+  the CUDA kernels ``numba.cuda.jit(device=True)`` (numerics/cuda_kernels.py).  The SAME Python
+  source serves both; only the two primitives below differ by target.
+* ``key``: a 61-bit hash of the source text of the arithmetic and of this module (the primitives,
+  the templates), the compile-time constant (numba literal) on which the CPU kernels are
+  specialised and cached on disk.  Equal keys mean equal arithmetic, so a cached kernel is never
+  reused for other code; the engine's own source enters through the scheme's key
+  (numerics.scheme_code.engine_fingerprint, which hashes this module too), the kernels' other
+  literal.
 * ``abs_tracking``: a well symmetric about q = 0 may track max |q| (one maximum per lane: the
   quartic's closed-form path, eq (4)); every other code tracks max q and max -q.
 
 Primitives (one name each, an implementation per target):
 
 * :func:`fma` -- correctly rounded a*b + c: llvm.fma on the CPU, fma.rn.f64 on the GPU
-  (registered by cuda_kernels), the CPU's llvm.fma when called from Python (numba's CUDA
+  (registered by numerics.cuda_kernels), the CPU's llvm.fma when called from Python (numba's CUDA
   simulator runs device functions as Python);
 * :func:`mul` -- a rounded product that the GPU compiler may not contract with a following add
   (``__dmul_rn`` on the GPU, a plain product on the CPU, which never contracts).  Generated code
@@ -41,6 +44,7 @@ import functools
 import hashlib
 import inspect
 import operator
+import re
 import types as types_module
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -51,8 +55,9 @@ from numba import njit, types
 from numba.core import errors
 from numba.extending import intrinsic, overload
 
-__all__ = ["WellCode", "fma", "mul", "N_WPAR", "quartic_code", "polynomial_code", "callable_code",
-           "well_force", "well_energy2", "abs_tracking", "code_of", "POLY_DEGREES"]
+__all__ = ["WellCode", "fma", "mul", "fma_cpu", "mul_cpu", "N_WPAR", "quartic_code", "polynomial_code", "callable_code",
+           "well_force", "well_energy2", "abs_tracking", "code_of", "literal_code", "cpu_jit", "cpu_functions",
+           "POLY_DEGREES"]
 
 #: wpar = [q_left, q_right, w_0 .. w_13]
 N_WPAR = 16
@@ -98,16 +103,9 @@ def _ol_mul(a, b):
 
 
 # ------------------------------------------------------------------------------- the compiled form
-@functools.cache
-def engine_fingerprint() -> str:
-    """Hash of the engine's source (schemes, steps, periods, kernels and this module): part of every
-    key, so an edit of the engine never reuses a kernel cached before it."""
-    h = hashlib.blake2b(digest_size=16)
-    here = Path(__file__).parent
-    for name in ("wellcode.py", "schemes.py", "scheme_code.py", "steps.py", "periods.py", "kernels.py"):
-        h.update((here / name).read_bytes())
-    return h.hexdigest()
-
+#: hash of this module's source: part of every well's key (an edit of the primitives or the
+#: templates never reuses a kernel cached before it)
+MODULE_HASH = hashlib.blake2b(Path(__file__).read_bytes(), digest_size=16).hexdigest()
 
 _CODES: dict[int, "WellCode"] = {}
 
@@ -128,7 +126,7 @@ class WellCode:
         if w.shape != (N_WPAR,):
             raise ValueError(f"wpar must have {N_WPAR} entries [q_left, q_right, w_0 .. w_13], got shape {w.shape}")
         object.__setattr__(self, "wpar", w)
-        text = f"{engine_fingerprint()}\0{self.source}\0abs={bool(self.abs_tracking)}"
+        text = f"{MODULE_HASH}\0{self.source}\0abs={bool(self.abs_tracking)}"
         key = int.from_bytes(hashlib.blake2b(text.encode(), digest_size=8).digest(), "little") >> 3
         object.__setattr__(self, "key", key)
         _CODES.setdefault(key, self)
@@ -283,7 +281,8 @@ def callable_code(V, dV, barriers, name, source) -> WellCode:
 
 
 # ------------------------------------------------------------------------------- CPU dispatch
-def _literal_code(well):
+def literal_code(well) -> WellCode:
+    """The registered code of a numba literal kernel key (typing time of the CPU kernels)."""
     if not isinstance(well, types.IntegerLiteral):
         raise errors.TypingError(f"well must be a compile-time constant kernel key (a numba literal), got {well}")
     return code_of(well.literal_value)
@@ -340,19 +339,19 @@ def abs_tracking(well):
 # the code of a key is chosen at typing time: a kernel holds only its own well's arithmetic
 @overload(well_force, inline="always")
 def _ol_well_force(well, w, q, f):
-    FORCE = cpu_functions(_literal_code(well).key)[0]
+    FORCE = cpu_functions(literal_code(well).key)[0]
     return lambda well, w, q, f: FORCE(w, q, f)
 
 
 @overload(well_energy2, inline="always")
 def _ol_well_energy2(well, w, q, p):
-    ENERGY2 = cpu_functions(_literal_code(well).key)[1]
+    ENERGY2 = cpu_functions(literal_code(well).key)[1]
     return lambda well, w, q, p: ENERGY2(w, q, p)
 
 
 @overload(abs_tracking, inline="always")
 def _ol_abs_tracking(well):
-    if _literal_code(well).abs_tracking:
+    if literal_code(well).abs_tracking:
         return lambda well: True
     return lambda well: False
 
@@ -360,8 +359,6 @@ def _ol_abs_tracking(well):
 def _ir_identity(arg, fn):
     """(plain Python function, text identifying its float64 -> float64 compilation): the LLVM IR of
     its CPU compilation with the mangled symbol names removed (they carry process-local counters)."""
-    import re
-
     py = getattr(fn, "py_func", fn)
     if not callable(py):
         raise ValueError(f"{arg} must be a callable, got {fn!r}")
