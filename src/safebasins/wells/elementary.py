@@ -1,0 +1,578 @@
+"""Elementary functions written once in the wells' code language: the same bits on every target.
+
+The functions are plain Python over +, -, *, /, comparisons, the wells' two primitives
+(:func:`~safebasins.wells.compiled.fma`; :func:`~safebasins.wells.compiled.mul` for every
+product that feeds an add, which the GPU compiler may then not contract), ``math.sqrt`` (IEEE,
+correctly rounded: llvm.sqrt on the CPU, sqrt.rn.f64 on CUDA) and two bit casts,
+:func:`as_bits` / :func:`from_bits`.  No libm call: glibc (CPU) and libdevice (GPU) round
+differently; these functions round identically wherever they are compiled.  They are written
+with selects rather than branches, so that a loop calling them vectorises on the CPU.
+
+* sin, cos, sincos: x = n pi/2 + r, Cody-Waite in three parts (r as a double-double, exact for
+  |x| <= 2^30), exact Payne-Hanek reduction beyond (elementary_reduction: a branch that on the
+  CPU is a vector-masked call, taken only by the lanes that need it); minimax kernels on
+  [-pi/4, pi/4] with their r^3/6 and r^2/2 terms in double-double.
+* exp, expm1: x = n ln2 + r (r a double-double), e^r - 1 by a minimax polynomial with r^2/2
+  exact, 2^n applied in two factors (no spurious overflow), one rounding in the subnormal range.
+* log, log1p: x = 2^E z, z in [sqrt(1/2), sqrt(2)), log z = 2 atanh(s), s = (z-1)/(z+1) as a
+  double-double, minimax polynomial in s^2.
+* cosh, sinh, tanh: from the double-double e^|x| and its reciprocal (sinh below 1/4 by its own
+  polynomial); tanh = E/(E + 2) with E = expm1(2|x|) as a double-double.
+* pow(x, y) = exp(y log x) with log x as a double-double to 2^-70 and y log x a double-double;
+  the special cases of C99 Annex F.  powi(x, n): binary powering in double-double.
+* sqrt: the IEEE square root (NaN below zero, without the exception Python would raise).
+
+Accuracy (ulps against mpmath), special values and speed: docs/elementary.md;
+tests/numerics/test_elementary.py checks them.
+
+Targets: the source is compiled per target by :func:`cpu` (numba njit, the primitives bound to
+their CPU intrinsics) and :func:`cuda_device` (numba-cuda device functions); ``@njit`` code may
+call this module's functions directly (CPU overloads).  Under numba's CUDA simulator the device
+functions run as this Python: its integer arithmetic never leaves int64 (nothing wraps around
+to differ from the compiled code) and it never divides by zero or takes a negative square root
+(Python would raise).
+"""
+from __future__ import annotations
+
+import functools
+import math
+import sys
+
+from numba import njit
+
+from safebasins.wells import elementary_reduction
+from safebasins.wells.elementary_reduction import reduce_pio2 as _payne_hanek
+from safebasins.wells.elementary_targets import (as_bits, as_bits_cpu, cold_call_cpu, compile_code, from_bits,
+                                                    from_bits_cpu, register_cpu_overload)
+from safebasins.wells.compiled import fma, fma_cpu, mul, mul_cpu
+
+__all__ = ["sin", "cos", "sincos", "exp", "expm1", "log", "log1p", "tanh", "cosh", "sinh", "sqrt", "pow",
+           "powi", "cpu", "cuda_device", "FUNCTIONS", "SIN_COS_FAST_LIMIT"]
+
+#: the public functions
+FUNCTIONS = ("sin", "cos", "sincos", "exp", "expm1", "log", "log1p", "tanh", "cosh", "sinh", "sqrt", "pow", "powi")
+#: |x| up to which sin and cos reduce by Cody-Waite (beyond: Payne-Hanek)
+SIN_COS_FAST_LIMIT = 2.0 ** 30
+
+
+# ------------------------------------------------------------------------------- constants
+_h = float.fromhex
+_SHIFT = _h("0x1.8p52")             # (x + SHIFT) - SHIFT rounds |x| < 2^51 to an integer
+_SHIFT_BITS = 0x4338000000000000    # bits(SHIFT + n) - SHIFT_BITS = n
+_SIGN = -0x8000000000000000         # the sign bit (int64)
+_ABS = 0x7FFFFFFFFFFFFFFF
+_SQRT_HALF_BITS = 0x3FE6A09E667F3BCD
+_INF = math.inf
+_NAN = math.nan
+_P52, _P53, _P54 = 2.0 ** 52, 2.0 ** 53, 2.0 ** 54
+_M1022, _M54, _M27, _M26 = 2.0 ** -1022, 2.0 ** -54, 2.0 ** -27, 2.0 ** -26
+
+_INV_LN2 = _h("0x1.71547652b82fep+0")
+_LN2_HI = _h("0x1.62e42fefa39efp-1")     # 53 bits: fma(-n, LN2_HI, x) is exact
+_LN2_LO = _h("0x1.abc9e3b39803fp-56")
+_LN2_42 = _h("0x1.62e42fefa3800p-1")     # 42 bits: E LN2_42 is exact for |E| < 2^11
+_LN2_42M = _h("0x1.ef35793c76730p-45")
+_LN2_42L = _h("0x1.f97b57a079a19p-103")
+
+_TWO_OVER_PI = _h("0x1.45f306dc9c883p-1")
+_PIO2_1 = _h("0x1.921fb54442d18p+0")      # pi/2 = PIO2_1 + PIO2_2 + PIO2_3 + O(2^-163)
+_PIO2_2 = _h("0x1.1a62633145c07p-54")
+_PIO2_3 = _h("-0x1.f1976b7ed8fbcp-110")
+
+_TWO3_HI, _TWO3_LO = _h("0x1.5555555555555p-1"), _h("0x1.5555555555555p-55")
+_TWO5_HI, _TWO5_LO = _h("0x1.999999999999ap-2"), _h("-0x1.999999999999ap-56")
+_SIXTH_HI, _SIXTH_LO = _h("0x1.5555555555555p-3"), _h("0x1.5555555555555p-57")
+_THIRD_HI, _THIRD_LO = _h("0x1.5555555555555p-2"), _h("0x1.5555555555555p-56")
+
+# minimax polynomials (benchmarks/elementary_coefficients.py), relative error with these doubles:
+# e^r - 1 - r - r^2/2 = r^3 (E0 + E1 r + ... + E9 r^9), |r| <= ln2/2: 2^-62.6 (relative to e^r)
+_E0, _E1, _E2, _E3, _E4, _E5, _E6, _E7, _E8, _E9 = map(_h, (
+    "0x1.555555555555bp-3", "0x1.555555555553cp-5", "0x1.111111110ee66p-7", "0x1.6c16c16c21b6dp-10",
+    "0x1.a01a01b297f7ep-13", "0x1.a01a016b50205p-16", "0x1.71ddf279daa6ap-19", "0x1.27e55f2fdf8c6p-22",
+    "0x1.af67e69d7a574p-26", "0x1.1ea0810d654fbp-29"))
+# e^r - 1 - r - r^2/2 - r^3/6 = r^4 (F0 + F1 r + ... + F9 r^9): 2^-66.2 (relative to e^r - 1)
+_F0, _F1, _F2, _F3, _F4, _F5, _F6, _F7, _F8, _F9 = map(_h, (
+    "0x1.5555555555557p-5", "0x1.111111111110ep-7", "0x1.6c16c16c157aep-10", "0x1.a01a01a01c88ap-13",
+    "0x1.a01a01aaf559ap-16", "0x1.71de3a4a0def8p-19", "0x1.27e4d18dccd14p-22", "0x1.ae6479f2af7dap-26",
+    "0x1.1f83858a6889ep-29", "0x1.613beb3013609p-33"))
+# 2 atanh(s) = 2 s + s z (L0 + L1 z + ... + L7 z^7), z = s^2 <= (3 - 2 sqrt 2)^2: 2^-66.3
+_L0, _L1, _L2, _L3, _L4, _L5, _L6, _L7 = map(_h, (
+    "0x1.5555555555555p-1", "0x1.9999999999d33p-2", "0x1.2492492435cf6p-2", "0x1.c71c725057eaap-3",
+    "0x1.745ce02241ff8p-3", "0x1.3b206f7ac178ep-3", "0x1.0f60813f8e27dp-3", "0x1.0f4c3f3395016p-3"))
+# 2 atanh(s) = 2 s + 2 s^3/3 + 2 s^5/5 + s z^3 (M0 + ... + M6 z^6): 2^-70.3 (pow's logarithm)
+_M0, _M1, _M2, _M3, _M4, _M5, _M6 = map(_h, (
+    "0x1.249249249265cp-2", "0x1.c71c71c6a5341p-3", "0x1.745d17a975632p-3", "0x1.3b1385e47f1b6p-3",
+    "0x1.111baba317c66p-3", "0x1.def45c9c15738p-4", "0x1.e5333184de147p-4"))
+# sin r = r - r^3/6 + r^5 (S0 + S1 z + ... + S5 z^5), z = r^2, |r| <= pi/4 + 2^-20: 2^-67.4
+_S0, _S1, _S2, _S3, _S4, _S5 = map(_h, (
+    "0x1.111111111110fp-7", "-0x1.a01a01a0194b2p-13", "0x1.71de3a53f2fd2p-19", "-0x1.ae64537b27b3dp-26",
+    "0x1.61211c7af2333p-33", "-0x1.aae6ec007d962p-41"))
+# cos r = 1 - r^2/2 + z^2 (C0 + C1 z + ... + C5 z^5): 2^-63.4
+_C0, _C1, _C2, _C3, _C4, _C5 = map(_h, (
+    "0x1.555555555554bp-5", "-0x1.6c16c16c150c8p-10", "0x1.a01a019caf829p-16", "-0x1.27e4f81097945p-22",
+    "0x1.1ee9f46249f29p-29", "-0x1.8fb46a41c8459p-37"))
+# sinh x = x + x z (H0 + H1 z + ... + H4 z^4), z = x^2, |x| <= 1/4: 2^-65.0
+_H0, _H1, _H2, _H3, _H4 = map(_h, (
+    "0x1.5555555555555p-3", "0x1.111111111132ap-7", "0x1.a01a019f98f55p-13", "0x1.71de34379e275p-19",
+    "0x1.aec387149524dp-26"))
+
+
+# ------------------------------------------------------------------------------- double-double
+def _two_sum(a, b):
+    """(s, e): s = a + b rounded, e its exact error (Knuth)."""
+    s = a + b
+    bb = s - a
+    return s, (a - (s - bb)) + (b - bb)
+
+
+def _fast_two_sum(a, b):
+    """(s, e) as _two_sum, for |a| >= |b| or a = 0 (Dekker)."""
+    s = a + b
+    return s, b - (s - a)
+
+
+def _two_prod(a, b):
+    """(p, e): p = a b rounded, e = fma(a, b, -p) its exact error."""
+    p = mul(a, b)
+    return p, fma(a, b, -p)
+
+
+def _dd_mul(ah, al, bh, bl):
+    """(a_h + a_l)(b_h + b_l), normalised (relative error ~2^-104)."""
+    p = mul(ah, bh)
+    return _fast_two_sum(p, fma(ah, bh, -p) + (mul(ah, bl) + mul(al, bh)))
+
+
+def _pow2(k):
+    """2^k for an integer -1022 <= k <= 1023."""
+    return from_bits((k + 1023) << 52)
+
+
+def _copysign(a, x):
+    return from_bits((as_bits(a) & _ABS) | (as_bits(x) & _SIGN))
+
+
+# ------------------------------------------------------------------------------- exp family
+def _exp_reduce(xh, xl):
+    """(n, r_h, r_l): x_h + x_l = n ln2 + r_h + r_l, |r| <= ln2/2 (1 + 2^-40), for |x_h| <= 746."""
+    k = fma(xh, _INV_LN2, _SHIFT)
+    nf = k - _SHIFT
+    t = fma(-nf, _LN2_HI, xh)                        # exact
+    rh, rl = _two_sum(t, fma(-nf, _LN2_LO, xl))
+    return as_bits(k) - _SHIFT_BITS, rh, rl
+
+
+def _poly10(r, r2, r4, c0, c1, c2, c3, c4, c5, c6, c7, c8, c9):
+    """c0 + c1 r + ... + c9 r^9 (Estrin: half Horner's chain of dependent operations)."""
+    p = fma(fma(fma(c7, r, c6), r2, fma(c5, r, c4)), r4, fma(fma(c3, r, c2), r2, fma(c1, r, c0)))
+    return fma(fma(c9, r, c8), mul(r4, r4), p)
+
+
+def _exp_poly(rh, rl):
+    """e^r = b_h + b_l for r = r_h + r_l, |r| <= 0.35, to ~2^-60 relative; b_l is not normalised."""
+    hr = mul(0.5, rh)
+    h = mul(hr, rh)                                  # r^2/2 = h + hl exactly
+    hl = fma(hr, rh, -h)
+    r2 = mul(rh, rh)
+    q = _poly10(rh, r2, mul(r2, r2), _E0, _E1, _E2, _E3, _E4, _E5, _E6, _E7, _E8, _E9)
+    uh, e = _fast_two_sum(rh, h)
+    bh, be = _fast_two_sum(1.0, uh)
+    return bh, be + (e + ((hl + mul(r2, mul(rh, q))) + fma(rl, uh, rl)))      # r_l e^r
+
+
+def _expm1_poly(rh, rl):
+    """e^r - 1 = u_h + u_l for r = r_h + r_l, |r| <= 0.35, to ~2^-62 relative (r^2/2 and r^3/6 in
+    double-double); u_l is not normalised."""
+    hr = mul(0.5, rh)
+    h = mul(hr, rh)                                  # r^2/2 = h + hl exactly
+    hl = fma(hr, rh, -h)
+    ch, cl = _two_prod(h, rh)                        # r^3/2 = ch + cl
+    cl = fma(hl, rh, cl)
+    th = mul(ch, _THIRD_HI)                          # r^3/6 = th + tl
+    tl = fma(ch, _THIRD_HI, -th) + fma(ch, _THIRD_LO, mul(cl, _THIRD_HI))
+    r2 = mul(rh, rh)
+    r4 = mul(r2, r2)
+    q = _poly10(rh, r2, r4, _F0, _F1, _F2, _F3, _F4, _F5, _F6, _F7, _F8, _F9)
+    uh, e1 = _fast_two_sum(rh, h)
+    rle = fma(rl, uh, rl)                            # r_l e^r
+    uh, e2 = _fast_two_sum(uh, th)
+    return uh, (e1 + e2) + ((hl + tl) + (mul(r4, q) + rle))
+
+
+def _scale(n, y):
+    """y 2^n for |n| <= 1100: two exact factors, so the only rounding is a subnormal result's."""
+    n1 = n >> 1
+    return mul(mul(y, _pow2(n1)), _pow2(n - n1))
+
+
+def _exp_finish(n, bh, bl):
+    """2^n (b_h + b_l) for b in [0.7, 1.42], rounded once also into the subnormal range."""
+    normal = _scale(n, bh + bl)
+    # n <= -1022: scale by 2^(n+1022) first and round at 2^-52 (1.0 + y), which the exact
+    # scaling by 2^-1022 turns into the subnormal ulp 2^-1074 (other lanes scale by 1: a
+    # subnormal intermediate costs a microcode assist per operation)
+    tiny = n < -1021
+    sc = _pow2(min(max(n, -1075), -1022) + 1022)
+    y = mul(bh, sc)
+    hi = 1.0 + y
+    lo = ((1.0 - hi) + y) + mul(bl, sc)
+    sub = mul((hi + lo) - 1.0, _M1022 if tiny else 1.0)
+    return sub if tiny else normal
+
+
+def exp(x):
+    """e^x."""
+    xc = x if x > -746.0 else -746.0                 # NaN -> -746 here, restored at the end
+    xc = xc if xc < 710.0 else 710.0
+    n, rh, rl = _exp_reduce(xc, 0.0)
+    bh, bl = _exp_poly(rh, rl)
+    res = _exp_finish(n, bh, bl)
+    return x + x if x != x else res
+
+
+def _expm1_dd(n, rh, rl):
+    """2^n (1 + u) - 1, u = e^r - 1, for -55 <= n <= 60, as a double-double (exact sums)."""
+    uh, ul = _expm1_poly(rh, rl)
+    s = _pow2(n)
+    th, tl = _two_sum(s, -1.0)                       # 2^n - 1 exactly
+    sh, se = _two_sum(mul(s, uh), th)
+    return _fast_two_sum(sh, se + (tl + mul(s, ul)))
+
+
+def expm1(x):
+    """e^x - 1."""
+    xc = x if x > -38.0 else -38.0                   # e^-38 < 2^-54: expm1 = -1 rounded
+    xc = xc if xc < 710.0 else 710.0
+    n, rh, rl = _exp_reduce(xc, 0.0)
+    dh, dl = _expm1_dd(n if n < 60 else 60, rh, rl)
+    bh, bl = _exp_poly(rh, rl)
+    res = _exp_finish(n, bh, bl) if n > 60 else dh + dl    # n > 60: the -1 is below 2^-8 ulp
+    res = x if abs(x) < _M54 else res
+    return x + x if x != x else res
+
+
+def _exp_dd(ax):
+    """(n, b_h, b_l, i_h, i_l): e^ax = 2^n (b_h + b_l), 1/(b_h + b_l) = i_h + i_l, 0 <= ax <= 711."""
+    n, rh, rl = _exp_reduce(ax, 0.0)
+    uh, ul = _expm1_poly(rh, rl)                     # sinh cancels up to 2 bits: e^r to 2^-62
+    bh, be = _fast_two_sum(1.0, uh)
+    bh, bl = _fast_two_sum(bh, be + ul)
+    ih = 1.0 / bh
+    return n, bh, bl, ih, mul(fma(-bh, ih, 1.0) - mul(bl, ih), ih)
+
+
+def cosh(x):
+    """cosh x = 2^(n-1) (b + 2^-2n / b)."""
+    ax = abs(x)
+    ax = ax if ax < 711.0 else 711.0                 # NaN -> 711 here, restored at the end
+    n, bh, bl, ih, il = _exp_dd(ax)
+    g = _pow2(-2 * (n if n < 511 else 511))
+    ch, ce = _two_sum(bh, mul(g, ih))
+    res = _scale(n - 1, ch + (ce + (bl + mul(g, il))))
+    return x + x if x != x else res
+
+
+def sinh(x):
+    """sinh x: 2^(n-1) (b - 2^-2n / b), below 1/4 a polynomial."""
+    ax = abs(x)
+    n, bh, bl, ih, il = _exp_dd(ax if ax < 711.0 else 711.0)
+    g = _pow2(-2 * (n if n < 511 else 511))
+    ch, ce = _two_sum(bh, -mul(g, ih))
+    res = _scale(n - 1, ch + (ce + (bl - mul(g, il))))
+    z = mul(ax, ax)
+    p = fma(fma(fma(fma(_H4, z, _H3), z, _H2), z, _H1), z, _H0)
+    res = fma(mul(ax, z), p, ax) if ax < 0.25 else res
+    res = _copysign(res, x)
+    res = x if ax < _M26 else res
+    return x + x if x != x else res
+
+
+def tanh(x):
+    """tanh x = sign(x) E/(E + 2), E = expm1(2|x|) as a double-double."""
+    ax = abs(x)
+    ax2 = ax + ax if ax < 20.0 else 40.0             # tanh(20) = 1 - 2^-56.7: 1 rounded
+    n, rh, rl = _exp_reduce(ax2, 0.0)
+    dh, dl = _expm1_dd(n, rh, rl)
+    sh, se = _two_sum(dh, 2.0)
+    inv = 1.0 / sh
+    qh = mul(dh, inv)
+    ql = mul((fma(-qh, sh, dh) + dl) - mul(qh, se + dl), inv)
+    res = _copysign(qh + ql, x)
+    res = x if ax < _M27 else res
+    return x + x if x != x else res
+
+
+# ------------------------------------------------------------------------------- log family
+def _log_reduce(x):
+    """(E, e, z): x = 2^E z, z in [sqrt(1/2), sqrt(2)), E as an int and a float, 0 < x < inf."""
+    sub = x < _M1022
+    ix = as_bits(mul(x, _P54) if sub else x) & _ABS
+    k = (ix - _SQRT_HALF_BITS) >> 52
+    z = from_bits(ix - (k << 52))
+    k = k - 54 if sub else k
+    return k, from_bits(k + _SHIFT_BITS) - _SHIFT, z
+
+
+def _atanh_arg(fh, fl):
+    """s = f/(2 + f) as a double-double, f = f_h + f_l, |f| <= 0.42."""
+    dh, de = _fast_two_sum(2.0, fh)
+    inv = 1.0 / dh
+    sh = mul(fh, inv)
+    return sh, mul((fma(-sh, dh, fh) + fl) - mul(sh, de + fl), inv)
+
+
+def _log_core(e, fh, fl):
+    """e ln2 + log1p(f_h + f_l), rounded."""
+    sh, sl = _atanh_arg(fh, fl)
+    z = mul(sh, sh)
+    v = fma(fma(fma(fma(fma(fma(fma(_L7, z, _L6), z, _L5), z, _L4), z, _L3), z, _L2), z, _L1), z, _L0)
+    hi, he = _fast_two_sum(mul(e, _LN2_42), sh + sh)
+    return hi + (he + (mul(e, _LN2_42M) + ((sl + sl) + mul(mul(sh, z), v))))
+
+
+def log(x):
+    """Natural logarithm."""
+    k, e, z = _log_reduce(x)
+    res = _log_core(e, z - 1.0, 0.0)
+    res = -_INF if x == 0.0 else res
+    res = x + x if not (x < _INF) else res           # +inf, NaN
+    return _NAN if x < 0.0 else res
+
+
+def log1p(x):
+    """log(1 + x): for x in [sqrt(1/2) - 1, sqrt(2) - 1] log1p(x) itself, beyond the log of
+    1 + x as the double-double u_h + u_l."""
+    xc = x if x > -1.0 else 0.0                      # x <= -1, NaN: special values below
+    uh, ul = _two_sum(1.0, xc if xc < _INF else 0.0)
+    k, e, z = _log_reduce(uh)
+    near = (x > -0.2928) & (x < 0.4142)
+    fh = x if near else z - 1.0
+    fl = 0.0 if near else mul(ul, _pow2(-(k if k < 1000 else 1000)))
+    res = _log_core(0.0 if near else e, fh, fl)
+    res = x if abs(x) < _M54 else res
+    res = -_INF if x == -1.0 else res
+    res = x + x if not (x < _INF) else res           # +inf, NaN
+    return _NAN if x < -1.0 else res
+
+
+def _log_dd(x):
+    """log x as a double-double of relative error ~2^-70 (pow), 0 < x < inf."""
+    k, e, z = _log_reduce(x)
+    sh, sl = _atanh_arg(z - 1.0, 0.0)
+    zh, zl = _two_prod(sh, sh)
+    zl = zl + mul(sh + sh, sl)
+    v = fma(fma(fma(fma(fma(fma(_M6, zh, _M5), zh, _M4), zh, _M3), zh, _M2), zh, _M1), zh, _M0)
+    t = mul(zh, v)                                   # w = 2/5 + z v
+    wh, we = _fast_two_sum(_TWO5_HI, t)
+    wl = we + (_TWO5_LO + (fma(zh, v, -t) + mul(zl, v)))
+    ph, pl = _dd_mul(zh, zl, wh, wl)                 # u = 2/3 + z w
+    uh, ue = _fast_two_sum(_TWO3_HI, ph)
+    yh, yl = _dd_mul(zh, zl, uh, ue + (_TWO3_LO + pl))
+    qh, ql = _dd_mul(sh, sl, yh, yl)                 # 2 atanh s = 2 s + s z u
+    th, te = _fast_two_sum(sh + sh, qh)
+    lh, le = _fast_two_sum(mul(e, _LN2_42), th)
+    mh, ml = _two_prod(e, _LN2_42M)
+    return _fast_two_sum(lh, le + ((te + ((sl + sl) + ql)) + (mh + (ml + mul(e, _LN2_42L)))))
+
+
+# ------------------------------------------------------------------------------- powers
+def _parity(y):
+    """(y is an integer, y is an odd integer); neither for inf or NaN."""
+    ay = abs(y)
+    small = ay < _P52
+    k = ay + _P52 if small else ay                   # |y| < 2^52: rounds to an integer
+    integer = (k - _P52 == ay) if small else (ay < _INF)
+    return integer, integer & ((as_bits(k) & 1) == 1) & (ay < _P53)
+
+
+def pow(x, y):
+    """x^y (C99 Annex F special cases: pow(x, 0) = pow(1, y) = 1 even for NaN, ...)."""
+    ax = abs(x)
+    lh, ll = _log_dd(ax)
+    th = mul(y, lh)
+    tl = fma(y, lh, -th) + mul(y, ll)
+    big = th > 710.0
+    small = not (th > -746.0)                        # NaN too: a finite path, replaced below
+    n, rh, rl = _exp_reduce(710.0 if big else (-746.0 if small else th), 0.0 if big | small else tl)
+    bh, bl = _exp_poly(rh, rl)
+    res = _exp_finish(n, bh, bl)
+    integer, odd = _parity(y)
+    negative = as_bits(x) < 0
+    res = -res if negative & odd else res
+    res = _NAN if (x < 0.0) & (x > -_INF) & (not integer) & (abs(y) < _INF) else res
+    # x = +-0 and x = +-inf: 0 or inf, with the sign of x for an odd integer y
+    tiny = (y > 0.0) == (ax == 0.0)
+    res = (_copysign(0.0 if tiny else _INF, x) if odd else (0.0 if tiny else _INF)) if (ax == 0.0) | (ax == _INF) else res
+    res = ((1.0 if ax == 1.0 else (_INF if (ax < 1.0) == (y < 0.0) else 0.0)) if abs(y) == _INF else res)
+    res = x + y if (x != x) | (y != y) else res
+    return 1.0 if (x == 1.0) | (y == 0.0) else res
+
+
+def powi(x, n):
+    """x^n for an integer n (C23 pown special cases), by binary powering in double-double."""
+    m = -n if n < 0 else n
+    xi = x if x != 0.0 else 1.0                      # no division by zero (x = 0: below)
+    ih = 1.0 / xi
+    bh = ih if n < 0 else x
+    bl = mul(fma(-xi, ih, 1.0), ih) if n < 0 else 0.0
+    rh, rl = 1.0, 0.0
+    while m > 0:
+        if m & 1:
+            rh, rl = _dd_mul(rh, rl, bh, bl)
+        bh, bl = _dd_mul(bh, bl, bh, bl)
+        m >>= 1
+    res = rh + rl
+    odd = (n & 1) == 1
+    res = (_copysign(_INF, x if odd else 1.0)) if (res != res) & (x == x) else res   # overflow
+    tiny = (n > 0) == (x == 0.0)
+    special = _copysign(0.0 if tiny else _INF, x) if odd else (0.0 if tiny else _INF)
+    res = special if (x == 0.0) | (abs(x) == _INF) else res
+    return 1.0 if n == 0 else res
+
+
+def sqrt(x):
+    """The IEEE square root; NaN below zero (sqrt(-0) = -0)."""
+    return math.sqrt(x) if x >= 0.0 else _NAN
+
+
+# ------------------------------------------------------------------------------- sin, cos
+def _reduce_pio2(x):
+    """(n mod 4, r_h, r_l): x = n pi/2 + r_h + r_l, |r| <= pi/4 + 2^-23, for |x| <= 2^30."""
+    k = fma(x, _TWO_OVER_PI, _SHIFT)
+    nf = k - _SHIFT
+    t = fma(-nf, _PIO2_1, x)                         # exact
+    p, pe = _two_prod(nf, _PIO2_2)
+    th, te = _two_sum(t, -p)
+    rh, rl = _fast_two_sum(th, (te - pe) - mul(nf, _PIO2_3))
+    return as_bits(k) & 3, rh, rl
+
+
+def _sin_kernel(rh, rl):
+    """sin(r_h + r_l), |r| <= pi/4 + 2^-20: r - r^3/6 in double-double, the rest a polynomial."""
+    zh = mul(rh, rh)
+    zl = fma(rh, rh, -zh)
+    ch = mul(zh, rh)                                 # r^3 = ch + cl
+    cl = fma(zh, rh, -ch) + mul(zl, rh)
+    th = mul(ch, -_SIXTH_HI)                         # -r^3/6 = th + tl
+    tl = fma(ch, -_SIXTH_HI, -th) - (mul(ch, _SIXTH_LO) + mul(cl, _SIXTH_HI))
+    p = fma(fma(fma(fma(fma(_S5, zh, _S4), zh, _S3), zh, _S2), zh, _S1), zh, _S0)
+    sh, se = _fast_two_sum(rh, th)
+    return sh + (se + (tl + (fma(mul(ch, zh), p, rl) - mul(mul(0.5, zh), rl))))
+
+
+def _cos_kernel(rh, rl):
+    """cos(r_h + r_l), |r| <= pi/4 + 2^-20: 1 - r^2/2 and C0 r^4 in double-double, the rest a
+    polynomial."""
+    zh = mul(rh, rh)
+    zl = fma(rh, rh, -zh)
+    hz = mul(0.5, zh)
+    w = 1.0 - hz
+    e = (1.0 - w) - hz                               # exact
+    z2 = mul(zh, zh)
+    z2l = fma(zh, zh, -z2)
+    p = fma(fma(fma(fma(_C5, zh, _C4), zh, _C3), zh, _C2), zh, _C1)
+    sr = fma(mul(zh, -_SIXTH_HI), rh, rh)             # sin r to ~r^5/120: the factor of r_l
+    tail = fma(z2l, _C0, (e - mul(0.5, zl)) - mul(sr, rl))
+    return w + fma(z2, _C0, fma(mul(z2, zh), p, tail))
+
+
+def _quadrant(q, s, c):
+    """sin(n pi/2 + r) from n mod 4 = q, s = sin r, c = cos r (cos: q + 1)."""
+    v = c if (q & 1) == 1 else s
+    return -v if (q & 2) == 2 else v
+
+
+def _sincos_huge(x):
+    """(sin x, cos x) for 2^30 < |x| < inf, reduced exactly (Payne-Hanek)."""
+    b = as_bits(x) & _ABS
+    q, a0, a1, a2 = _payne_hanek((b & 0xFFFFFFFFFFFFF) | 0x10000000000000, (b >> 52) - 1023)
+    fh, fl = _fast_two_sum(a0, a1)
+    rh, rl = _dd_mul(fh, fl + a2, _PIO2_1, _PIO2_2)
+    s = _sin_kernel(rh, rl)
+    c = _cos_kernel(rh, rl)
+    sn = _quadrant(q, s, c)
+    return (-sn if x < 0.0 else sn), _quadrant(q + 1, s, c)
+
+
+def _sin_huge(x):
+    return _sincos_huge(x)[0]
+
+
+def _cos_huge(x):
+    return _sincos_huge(x)[1]
+
+
+def sincos(x):
+    """(sin x, cos x)."""
+    ax = abs(x)
+    fast = ax <= SIN_COS_FAST_LIMIT                  # False for NaN
+    q, rh, rl = _reduce_pio2(x if fast else 0.0)
+    s = _sin_kernel(rh, rl)
+    c = _cos_kernel(rh, rl)
+    sn = _quadrant(q, s, c)
+    cs = _quadrant(q + 1, s, c)
+    if (not fast) & (ax < _INF):
+        sn = _sin_huge(x)
+        cs = _cos_huge(x)
+    sn = x if ax < _M27 else sn                      # sin(-0) = -0
+    bad = not (ax < _INF)
+    return (x - x if bad else sn), (x - x if bad else cs)
+
+
+def sin(x):
+    """sin x."""
+    ax = abs(x)
+    fast = ax <= SIN_COS_FAST_LIMIT
+    q, rh, rl = _reduce_pio2(x if fast else 0.0)
+    res = _quadrant(q, _sin_kernel(rh, rl), _cos_kernel(rh, rl))
+    if (not fast) & (ax < _INF):
+        res = _sin_huge(x)
+    res = x if ax < _M27 else res
+    return x - x if not (ax < _INF) else res         # sin(+-inf) = NaN
+
+
+def cos(x):
+    """cos x."""
+    ax = abs(x)
+    fast = ax <= SIN_COS_FAST_LIMIT
+    q, rh, rl = _reduce_pio2(x if fast else 0.0)
+    res = _quadrant(q + 1, _sin_kernel(rh, rl), _cos_kernel(rh, rl))
+    if (not fast) & (ax < _INF):
+        res = _cos_huge(x)
+    return x - x if not (ax < _INF) else res
+
+
+# ------------------------------------------------------------------------------- targets
+NOT_CODE = ("cpu", "cuda_device")   # functions here that are not code (compile_code)
+_MODULES = (sys.modules[__name__], elementary_reduction)
+
+
+@functools.cache
+def cpu():
+    """The functions compiled for the CPU (njit, numpy error model: a division never raises), fma,
+    mul and the bit casts bound to their CPU intrinsics; the huge-argument sin/cos paths as masked
+    cold calls.  A namespace of dispatchers: ``cpu().sin`` etc."""
+    prims = {"fma": fma_cpu, "mul": mul_cpu, "as_bits": as_bits_cpu, "from_bits": from_bits_cpu}
+    cold = {k: (lambda ns, k=k: cold_call_cpu(getattr(ns, k), k)) for k in ("_sin_huge", "_cos_huge")}
+    return compile_code(_MODULES, njit(error_model="numpy", forceinline=True), prims, cold)
+
+
+@functools.cache
+def cuda_device():
+    """The functions as numba-cuda device functions: fma.rn.f64, mul.rn.f64 (never contracted) and
+    libdevice's bit casts; under the simulator (NUMBA_ENABLE_CUDASIM=1) the Python primitives (the
+    CPU's correctly rounded fma), as cuda_kernels does for the wells."""
+    from numba import cuda
+    from numba.cuda.core import config as cuda_config
+
+    prims = {}
+    if not cuda_config.ENABLE_CUDASIM:
+        from numba.cuda import libdevice
+
+        prims = {"fma": cuda.fma, "mul": libdevice.dmul_rn, "as_bits": libdevice.double_as_longlong,
+                 "from_bits": libdevice.longlong_as_double}
+    return compile_code(_MODULES, cuda.jit(device=True), prims)
+
+
+for _name in FUNCTIONS:
+    register_cpu_overload(globals()[_name], lambda _name=_name: getattr(cpu(), _name))
