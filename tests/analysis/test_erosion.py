@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from safebasins.analysis import erosion, fourier_compare, integrity, phase_invariant
+from safebasins.analysis import erosion, fourier_compare, phase_invariant
 from safebasins.numerics import escape_chart
 from safebasins.theory import slow_flow_escapes
 

@@ -3,7 +3,6 @@ hilltop saddle's manifolds tangle (Thompson's escape equation, beta = 0.1, Omega
 tangency at F = 0.0634)."""
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 from safebasins.analysis.fractality import uncertainty_exponent

@@ -131,7 +131,7 @@ def test_quadrature_matches_dop853_separatrix():
     event.terminal = True
     sol = solve_ivp(lambda t, y: [y[1], -P.polyval(y[0], dV), y[1] ** 2, *(y[1] * np.sin(W * t))], (0.0, 200.0),
                     [qt, 0.0, 0.0, 0.0, 0.0, 0.0], method="DOP853", rtol=1e-13, atol=1e-15, events=event)
-    te, (q, p, J1, *S) = sol.t[-1], sol.y[:, -1]
+    te, (q, _p, J1, *S) = sol.t[-1], sol.y[:, -1]
     x = q - qb
     I1 = 2.0 * (J1 + 0.5 * lam * x * x)
     I2 = 2j * (np.array(S) + np.imag(-lam * x * np.exp(1j * W * te) / (lam - 1j * W)))   # p0 odd about t = 0

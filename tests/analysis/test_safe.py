@@ -6,7 +6,7 @@ import xarray as xr
 from safebasins.analysis.safe import is_safe, safe_area, safe_mask
 
 
-def chart(q0=np.linspace(-1, 1, 5), p0=np.linspace(-0.5, 0.5, 3), cycles=100):
+def chart(q0=np.linspace(-1, 1, 5), p0=np.linspace(-0.5, 0.5, 3), cycles=100):  # noqa: B008  (read only)
     e = np.full((1, q0.size, p0.size), np.inf)
     e[0, 0, :] = 0.0
     e[0, -1, -1] = 40.0

@@ -5,7 +5,6 @@ and the static picture of the current view is captured by a plain `chromium --sc
 from __future__ import annotations
 
 import io
-import json
 import socket
 import subprocess
 import sys

@@ -1,6 +1,5 @@
 """safebasins.io.datasets: CF attributes, provenance, atomic zlib writes."""
 import json
-import os
 
 import numpy as np
 import pytest
@@ -52,7 +51,7 @@ def test_write_is_atomic_compressed_and_roundtrips(tmp_path):
 
 def test_failed_write_leaves_nothing(tmp_path):
     ds = xr.Dataset({"x": ("a", [1.0])}, attrs={"bad": {1, 2}})  # a set is not a netCDF attribute
-    with pytest.raises(Exception):
+    with pytest.raises(Exception):  # noqa: B017  (whatever netCDF4 raises: the test is that nothing is left)
         sd.write_netcdf(ds, tmp_path / "y.nc")
     assert list(tmp_path.iterdir()) == []
 

@@ -4,7 +4,6 @@ file removed and a changed file are each reported by name."""
 from __future__ import annotations
 
 import io
-import shutil
 import tarfile
 from pathlib import Path
 

@@ -34,7 +34,7 @@ def dop853_escape(q0, p0, F, Omega, Psi, xi_max, q_max, cycles):
         e = (lambda m: lambda t, y: abs(y[0]) - m)(m)
         e.direction = 1
         events.append(e)
-    barrier = lambda t, y: abs(y[0]) - 1.0  # noqa: E731
+    barrier = lambda t, y: abs(y[0]) - 1.0
     barrier.direction, barrier.terminal = 1, True
     sol = solve_ivp(rhs, (0, cycles * T), [q0, p0], method="DOP853", rtol=1e-11, atol=1e-13, max_step=T / 64,
                     events=events + [barrier])

@@ -88,7 +88,7 @@ def test_damped_map_and_bisection():
     with it."""
     m = stroboscopic_map([0.1, -0.05], [0.0, 0.1], 0.02, 0.85, 0.0, n_iter=400, xi_max=1.0 / 6.0, well="cubic",
                          damping=0.1)
-    q, p = m["q"].values, m["p"].values
+    q = m["q"].values
     assert not m["escaped"].values.any()
     np.testing.assert_allclose(q[0, -1], q[1, -1], atol=1e-9)
     np.testing.assert_allclose(q[:, -1], q[:, -2], atol=1e-9)

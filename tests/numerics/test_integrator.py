@@ -96,7 +96,7 @@ def test_escape_step_exact_constructed_case():
     h_cyc = 1.0 / S
     T = 2 * np.pi / Om
     for j, x in enumerate(qm):
-        ev = lambda t, y, x=x: abs(y[0]) - x  # noqa: E731
+        ev = lambda t, y, x=x: abs(y[0]) - x
         ev.terminal = True
         ev.direction = 1
         sol = dop853(0.0, 0.0, F, Om, Psi, 200 * T, events=ev)

@@ -183,7 +183,7 @@ def dop853_cubic(q0, p0, F, Omega, Psi, xi_max, bounds, cycles):
         events.append((lambda lo: lambda t, y: lo - y[0])(lo))
     for e in events:
         e.direction = 1
-    barrier = lambda t, y: y[0] - 1.0  # noqa: E731
+    barrier = lambda t, y: y[0] - 1.0
     barrier.direction, barrier.terminal = 1, True
     sol = solve_ivp(rhs, (0, cycles * T), [q0, p0], method="DOP853", rtol=1e-11, atol=1e-13, max_step=T / 64,
                     events=events + [barrier])

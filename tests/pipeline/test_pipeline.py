@@ -12,7 +12,6 @@ import signal
 import subprocess
 import tarfile
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -108,7 +107,7 @@ def test_figures_built_without_errors(quick):
 def test_extras_datasets_and_figures(quick):
     """Beyond-the-paper products (rule `extras`, built by `all`): layout, invariants, reuse."""
     wd, _ = quick
-    L = lambda f: load(wd / "results" / "data" / "extras" / f)  # noqa: E731
+    L = lambda f: load(wd / "results" / "data" / "extras" / f)
     ero_p = RES["extra_erosion"]
     an, nu = L("extra_erosion_analytic.nc"), L("extra_erosion_numeric.nc")
     assert an["GIM"].dims == ("fourier", "F", "xi_max") and list(an["fourier"].values) == ["paper", "exact"]

@@ -7,14 +7,14 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pytest  # noqa: E402
-import xarray as xr  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+import xarray as xr
 
-import safebasins.numerics as nu  # noqa: E402
-import safebasins.theory as th  # noqa: E402
-from safebasins.plotting import plot_basin, plot_escape_chart, plot_fcr, plot_integrity_map, save_figure  # noqa: E402
+import safebasins.numerics as nu
+import safebasins.theory as th
+from safebasins.plotting import plot_basin, plot_escape_chart, plot_fcr, plot_integrity_map, save_figure
 
 Q0, P0 = np.linspace(-0.9, 0.9, 30), np.linspace(-0.7, 0.7, 30)
 ARGS = dict(F=0.01, Omega=0.9, Psi=np.pi)

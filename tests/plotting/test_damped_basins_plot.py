@@ -7,16 +7,16 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pytest  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
 
-from safebasins.analysis.agreement import chart_agreement  # noqa: E402
-from safebasins.analysis.ic_basins import analytic_basin_stack  # noqa: E402
-from safebasins.numerics import escape_chart  # noqa: E402
-from safebasins.plotting import plot_basin, plot_escape_chart  # noqa: E402
-from safebasins.plotting.captions import notes  # noqa: E402
-from safebasins.plotting.charts import figure_nested_basins  # noqa: E402
+from safebasins.analysis.agreement import chart_agreement
+from safebasins.analysis.ic_basins import analytic_basin_stack
+from safebasins.numerics import escape_chart
+from safebasins.plotting import plot_basin, plot_escape_chart
+from safebasins.plotting.captions import notes
+from safebasins.plotting.charts import figure_nested_basins
 
 Q, P = np.linspace(-0.9, 0.9, 30), np.linspace(-0.7, 0.7, 24)
 ARGS = ("xi_max", [0.14, 0.18], 0.01, 0.9, np.pi, None, Q, P)

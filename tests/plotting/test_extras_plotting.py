@@ -4,18 +4,18 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from safebasins.analysis import erosion, fourier_compare, phase_invariant  # noqa: E402
-from safebasins.plotting import extras as plotting_extras  # noqa: E402
-from tests.analysis.test_extras_plumbing import _escape_chart, toy  # noqa: E402,F401
-from tests.plotting.test_plotting import render  # noqa: E402
+from safebasins.analysis import erosion, fourier_compare, phase_invariant
+from safebasins.plotting import extras as plotting_extras
+from tests.analysis.test_extras_plumbing import _escape_chart, toy  # noqa: F401
+from tests.plotting.test_plotting import render
 
 Q = np.linspace(-1, 1, 31)
 P = np.linspace(-0.75, 0.75, 25)
 
 
-def test_three_figures(toy, tmp_path):  # noqa: F811
+def test_three_figures(toy, tmp_path):
     F = np.linspace(0, 0.05, 6)
     an = erosion.erosion_profile_analytic(F, 0.9, np.pi, [0.18, 0.22], Q, P, fourier=["paper", "exact"])
     nu = erosion.erosion_profile_numeric(F, 0.9, np.pi, [0.18, 0.22], Q, P, t_eval=[10, 100], cycles=100)
@@ -42,7 +42,7 @@ def test_three_figures(toy, tmp_path):  # noqa: F811
     render(fig, tmp_path, "extra_fourier")
 
 
-def test_extra_figure_labels(toy):  # noqa: F811
+def test_extra_figure_labels(toy):
     """Angles as pi fractions in titles; short per-curve labels (only what varies); grouped bar ticks."""
     F = np.linspace(0, 0.05, 3)
     an = erosion.erosion_profile_analytic(F, 0.9, np.pi, [0.18], Q, P)

@@ -6,19 +6,19 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import numpy as np  # noqa: E402
-import pytest  # noqa: E402
-import xarray as xr  # noqa: E402
+import numpy as np
+import pytest
+import xarray as xr
 
-from safebasins import theory  # noqa: E402
-from safebasins.analysis.ic_basins import analytic_basin  # noqa: E402
-from safebasins.analysis.tangency import fractality_profile, tangency_profile  # noqa: E402
-from safebasins.numerics import escape_chart  # noqa: E402
-from safebasins.plotting import plot_escape_chart, plot_fcr, save_figure  # noqa: E402
-from safebasins.plotting.captions import notes  # noqa: E402
-from safebasins.plotting.data import well_text  # noqa: E402
-from safebasins.plotting.fcr import MECHANISM_WORDS, figure_fcr  # noqa: E402
-from safebasins.plotting.tangency import figure_tangency  # noqa: E402
+from safebasins import theory
+from safebasins.analysis.ic_basins import analytic_basin
+from safebasins.analysis.tangency import fractality_profile, tangency_profile
+from safebasins.numerics import escape_chart
+from safebasins.plotting import plot_escape_chart, plot_fcr, save_figure
+from safebasins.plotting.captions import notes
+from safebasins.plotting.data import well_text
+from safebasins.plotting.fcr import MECHANISM_WORDS, figure_fcr
+from safebasins.plotting.tangency import figure_tangency
 
 PEND_Q, PEND_P = np.linspace(-2.9, 2.9, 24), np.linspace(-2.05, 2.05, 18)
 

@@ -7,15 +7,15 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import matplotlib.image as mpimg  # noqa: E402
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pytest  # noqa: E402
-import xarray as xr  # noqa: E402
+import matplotlib.image as mpimg
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+import xarray as xr
 
-from safebasins.plotting import basins, charts, curves, fcr, maps  # noqa: E402
-from safebasins.plotting.captions import notes  # noqa: E402
-from safebasins.plotting.style import SB_EDGE, fmt_value, save_figure  # noqa: E402
+from safebasins.plotting import basins, charts, curves, fcr, maps
+from safebasins.plotting.captions import notes
+from safebasins.plotting.style import SB_EDGE, fmt_value, save_figure
 
 RNG = np.random.default_rng(0)
 

@@ -6,13 +6,13 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import xarray as xr  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import xarray as xr
 
-from safebasins.plotting import basins, fcr, integrity_maps  # noqa: E402
-from safebasins.plotting.captions import notes  # noqa: E402
-from tests.plotting.test_plotting import fcr_stack, rm_basin  # noqa: E402
+from safebasins.plotting import basins, fcr, integrity_maps
+from safebasins.plotting.captions import notes
+from tests.plotting.test_plotting import fcr_stack, rm_basin
 
 
 def test_fig3_names_the_largest_branch_operative():

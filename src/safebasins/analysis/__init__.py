@@ -9,5 +9,10 @@ fourier_compare  the paper's first harmonic (eq 20) versus the exact one
 period_map       rotation numbers, island chains and chaotic orbits of the period map (Fig 18)
 confirm          numeric check of the connected parts of an analytic safe basin (Figs 5-9)
 melnikov         Melnikov threshold F_M(Omega) of the hilltop saddle: first homoclinic/heteroclinic tangency
+basin_measures   basin entropy S_b / S_bb (log 2 criterion), the fractal test, the grid uncertainty exponent
+wada             the Wada test of three or more basins (merging method)
+basin_labels     labelled basins from escape charts and damped maps; reference_basins: known answers
 """
-from safebasins.analysis.melnikov import melnikov_curve, melnikov_threshold  # noqa: F401,E402
+from safebasins.analysis.basin_measures import basin_entropy, fractal_test  # noqa: F401
+from safebasins.analysis.wada import wada_test  # noqa: F401
+from safebasins.analysis.melnikov import melnikov_curve, melnikov_threshold  # noqa: F401

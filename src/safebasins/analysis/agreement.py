@@ -15,7 +15,7 @@ __all__ = ["iou", "pixel_agreement", "mask_agreement", "criteria_counts", "crite
 
 def _boolean(name, a):
     dtype = a.dtype if isinstance(a, xr.DataArray) else np.asarray(a).dtype
-    if dtype != bool:
+    if dtype.kind != "b":
         raise ValueError(f"{name} must be a boolean mask (True = safe), got dtype {dtype}")
 
 

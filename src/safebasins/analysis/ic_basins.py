@@ -110,7 +110,7 @@ def analytic_basin(F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, l
     outline of its safe mask (:func:`mask_outline`, attribute ``boundary = "mask_outline"``;
     ``n_points`` unused), attribute ``damping``."""
     from safebasins.theory import safe_basin_boundaries, slow_flow_escapes
-    
+
     beta = checks.check_damping(damping)
     qa, pa = np.asarray(q0, float), np.asarray(p0, float)
     Q, P = np.meshgrid(qa, pa, indexing="ij")
@@ -174,7 +174,7 @@ def numeric_check(basin, F, Omega, Psi, xi_max, *, cycles, steps_per_cycle, well
     :func:`analytic_basin`) the damped one.  ``label``: as :func:`analytic_basin`."""
     from safebasins.analysis.confirm import confirm_regions
     from safebasins.numerics import escape_chart
-    
+
     beta = checks.check_damping(basin.attrs.get("damping", 0.0))
     safe = ~np.asarray(basin["escapes"].transpose("q0", "p0").values, bool)
     Q, P = np.meshgrid(basin["q0"].values, basin["p0"].values, indexing="ij")

@@ -374,7 +374,6 @@ def period_map_portrait(q0, p0, F, Omega, Psi, *, n_keep, n_iter=3000, xi_max=No
         ``n_candidates``, ``n_non_escaping``, ``n_main``, ``n_chain``, ``n_chaotic`` and the
         classification settings.
     """
-    import xarray as xr
 
     from safebasins.numerics import stroboscopic_map
 

@@ -219,7 +219,7 @@ def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fouri
     gim_c = np.zeros((nf, nx))
     lim_c = np.zeros((nf, nx))
     if_c = np.zeros((nf, nx))
-    for a, f in enumerate(fl):
+    for a in range(len(fl)):
         for j, x in enumerate(xi):
             s, c, t, g, l, r = _one_analytic(F, Omega, float(x), q, p, Psi, wl[a], n_gamma)
             safe[:, a, j], cont[a, j], xt[a, j], gim_c[a, j], lim_c[a, j], if_c[a, j] = s, c, t, g, l, r
@@ -318,7 +318,7 @@ def phase_boundaries(F, Omega, xi_max, Psi_values, *, fourier=None, n_points=400
     Psi = as_1d("Psi_values", Psi_values, checks.check_finite)
     parts = {}
     for k, ps in enumerate(Psi):
-        for a, f in enumerate(fl):
+        for a in range(len(fl)):
             for j, x in enumerate(xi):
                 b = safe_basin_boundaries(F, Omega, float(ps), float(x), well=wl[a], n_points=n_points)
                 parts[k, a, j] = (np.asarray(b["q0_vertex"], float), np.asarray(b["p0_vertex"], float),

@@ -9,7 +9,7 @@ import sys
 
 import click
 
-from safebasins.pipeline.values import fmt  # the one number/angle formatter (commands import it from here)
+from safebasins.pipeline.values import fmt  # noqa: F401  (the one number/angle formatter: commands import it from here)
 
 #: global attributes shown under "provenance" (never among the physical parameters)
 PROVENANCE = ("safebasins_version", "git_commit", "date_created", "config_hash", "source", "history",

@@ -47,7 +47,7 @@ def git_commit() -> str:
         dirty = subprocess.run(["git", "-C", str(here), "status", "--porcelain", "--untracked-files=no"],
                                capture_output=True, text=True, timeout=20).stdout.strip()
         return out + ("-dirty" if dirty else "")
-    except Exception:
+    except Exception:  # noqa: BLE001  (no git, not a work tree, a timeout: the commit is unknown)
         return "unknown"
 
 
@@ -66,7 +66,7 @@ def _value(v):
         return {str(k): _value(x) for k, x in v.items()}
     try:
         a = np.asarray(v)
-    except Exception:                   # an object numpy cannot hold: its repr names it
+    except Exception:  # noqa: BLE001  (an object numpy cannot hold: its repr names it)
         return repr(v)
     if a.dtype.kind in "fiub":
         if a.size <= FULL_ARRAY:
@@ -107,7 +107,7 @@ def api_provenance(fn: Callable | None = None, *, well_attrs: Callable[[Any], di
             out.attrs.update(well_attrs(inspect.signature(fn).bind(*args, **kwargs).arguments.get("well")))
         out.attrs.update(
             safebasins_version=__version__, git_commit=git_commit(),
-            date_created=_dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat(),
+            date_created=_dt.datetime.now(_dt.UTC).replace(microsecond=0).isoformat(),
             parameters=json.dumps(params, sort_keys=True, default=repr),
             history=f"{fn.__module__}.{fn.__qualname__} (safebasins {__version__} API)")
         return out

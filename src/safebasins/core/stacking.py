@@ -66,7 +66,7 @@ def _same(a, b):
         if a.dtype.kind in "fc" and b.dtype.kind in "fc":
             return np.array_equal(a, b, equal_nan=True)
         return np.array_equal(a, b)
-    except Exception:
+    except Exception:  # noqa: BLE001  (values numpy cannot compare: compared as Python objects)
         return a == b
 
 

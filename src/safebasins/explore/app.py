@@ -193,7 +193,7 @@ class Explorer:
             safe = numeric.numeric_safe(r, f, n, cycles, progress=self.progress_later,
                                         stop=lambda: self.version != token)
             value = None if safe is None else numeric.agreement(analytic.ic_safe(r, f, n), safe)
-        except Exception as exc:  # noqa: BLE001
+        except Exception as exc:
             log.exception("numeric run failed")
             self.doc.add_next_tick_callback(partial(self.finished, None, None, error_text(exc)))
             return

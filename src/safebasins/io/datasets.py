@@ -76,7 +76,7 @@ def finalize(ds: xr.Dataset, *, title: str, params: dict | None = None, config_h
     attrs["source"] = source or f"safebasins {__version__}"
     attrs["history"] = history or f"created by safebasins {__version__}"
     attrs["references"] = REFERENCE
-    attrs["date_created"] = _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()
+    attrs["date_created"] = _dt.datetime.now(_dt.UTC).replace(microsecond=0).isoformat()
     attrs["safebasins_version"] = __version__
     attrs["git_commit"] = git_commit()
     if config_hash is None and params:

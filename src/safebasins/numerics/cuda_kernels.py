@@ -226,7 +226,7 @@ def finished(iE, iQ, nE, nQ, stop_any):
 
 
 # ------------------------------------------------------------------------------- the kernel
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WARP, well=None, damped=False):
     """The compiled ensemble kernel for one scheme and well (cached per argument set).
 

@@ -425,7 +425,7 @@ def _final_states(well, scheme, wpar, q0, p0, pidx, coef, Fpar, sintab, n_period
         cc = coefs(scheme, coef[k])
         q = q0[i]
         p = p0[i]
-        for n in range(n_periods):
+        for _ in range(n_periods):
             for s in range(S):
                 q, p = step(scheme, well, w, q, p, cc, scaled_row(scheme, sintab, s, F))
         qo[i] = q

@@ -24,7 +24,6 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass, field
-from typing import Union
 
 import numpy as np
 
@@ -160,7 +159,7 @@ class RungeKutta:
         return complex(1.0 + self.weight_scale * sum(w * k for w, k in zip(self.weights, K)))
 
 
-Scheme = Union[Splitting, RungeKutta]
+Scheme = Splitting | RungeKutta
 
 # --- the constants ---------------------------------------------------------------------------
 _A1 = 0.245298957184271

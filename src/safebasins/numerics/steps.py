@@ -22,7 +22,7 @@ where there is none) and the well's run-time coefficients (``wtuple``).
 from __future__ import annotations
 
 import functools
-from typing import Callable
+from collections.abc import Callable
 
 from numba import njit, types
 from numba.core import errors

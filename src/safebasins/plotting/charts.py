@@ -14,7 +14,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from safebasins.analysis.safe import is_safe, safe_area
-from safebasins.plotting.curves import (analytic_safe, boundary_polylines, draw_boundaries, plot_curve, safe_fill,
+from safebasins.plotting.curves import (analytic_safe, boundary_polylines, plot_curve, safe_fill,
                                         separates_mask, xy_grid)
 from safebasins.plotting.captions import add_note, count
 from safebasins.plotting import data

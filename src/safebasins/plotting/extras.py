@@ -167,7 +167,6 @@ def _draw_basin_panel(ax, ds, sel, label):
     safe = _sel(ds["safe"], **sel)
     true = _sel(ds["true_safe"], **sel)
     q, p = ds["q0"].values, ds["p0"].values
-    ext = [q[0], q[-1], p[0], p[-1]]
     n = safe.sizes["Psi"]
     sv = safe.transpose("Psi", "q0", "p0").values
     union = sv.any(axis=0)

@@ -454,7 +454,7 @@ def figure_fcr_comparison(analytic, numeric, *, layout="overlay", F_max=None, ti
         sub.append(f"{fmt_value(cycles)} EC")
     if tol:
         sub.append(f"tol {fmt_value(tol)}")
-    fig.suptitle(title or (f"Escape threshold: theory (lines) vs numerics (markers)" +
+    fig.suptitle(title or ("Escape threshold: theory (lines) vs numerics (markers)" +
                            (f", {head}" if head else "") + (f"  [{', '.join(sub)}]" if sub else "")),
                  fontsize=10)
     _comparison_notes(fig, pairs, cycles, tol)

@@ -50,7 +50,6 @@ def figure_period_map(analytic, numeric, *, title=None, figsize=(8.2, 7.4), s=0.
     rho = np.asarray(var(strobe, "rotation_number"), float)
     digits = np.asarray(var(strobe, "birkhoff_digits"), float)
     chain = np.asarray(var(strobe, "chain_index"), int)
-    period = np.asarray(var(strobe, "period"), int)
     origin = np.asarray(var(strobe, "origin")).astype(str)
     e_esc = np.asarray(var(strobe, "escape_cycle_energy"), float)
     d_esc = np.asarray(var(strobe, "escape_cycle_displacement"), float)
@@ -143,7 +142,7 @@ def figure_period_map(analytic, numeric, *, title=None, figsize=(8.2, 7.4), s=0.
     ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.08), ncol=2, fontsize=7.5, frameon=False)
     shown = {k: param(strobe, k) for k in ("F", "Omega", "Psi", "xi_max")}
     crit = (rf"escape: $|q| > q_{{max}}(\xi_{{max}})$ = {q_max:.3f}" if criterion == "displacement"
-            else rf"escape: $H_0 > \xi_{{max}}$")
+            else r"escape: $H_0 > \xi_{max}$")
     ax.set_title(title or (rf"Period map $(q,p)(t) \mapsto (q,p)(t+2\pi/\Omega)$: {n} non-escaping orbits, "
                            f"{n_iter} iterations\n" + param_text(shown) + f"; {crit}"))
 

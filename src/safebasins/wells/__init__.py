@@ -28,9 +28,9 @@ import numpy as np
 from safebasins.wells.base import Well
 from safebasins.wells.quartic import FOURIER_VARIANTS, QUARTIC, QuarticWell
 # (bound here, after the submodule import, so the package attribute is the function)
-from safebasins.wells.polynomial import cubic, polynomial  # noqa: E402
-from safebasins.wells.expression import expression  # noqa: E402
-from safebasins.wells.well_shape import check_options  # noqa: E402
+from safebasins.wells.polynomial import cubic, polynomial
+from safebasins.wells.expression import expression
+from safebasins.wells.well_shape import check_options
 
 __all__ = ["Well", "QuarticWell", "QUARTIC", "NAMED_WELLS", "resolve_well", "from_spec", "from_attrs", "spec_attrs",
            "well_attrs", "spec_of", "cubic", "polynomial", "expression", "describe_forms"]
