@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import copy
 import importlib.util
-import time
 
 import pytest
 
@@ -155,7 +154,6 @@ def test_experiments_target_builds_the_users_experiments(tmp_path):
     project's own integrity map), and the cost guard reports that target's cost."""
     wd = make_sandbox(tmp_path / "wd")
     (wd / "mine.yaml").write_text(MINE)
-    t = time.time()
     r = run_snakemake(wd, "-n", "experiments", configfiles=("mine.yaml",))
     assert r.returncode == 0, r.stderr
     assert "results/figures/my_map.png" in r.stdout and "integrity_map_" not in r.stdout
@@ -164,4 +162,3 @@ def test_experiments_target_builds_the_users_experiments(tmp_path):
     r = run_snakemake(wd, "-n", "results/figures/fig13.png", configfiles=("dup.yaml",))
     assert r.returncode != 0
     assert "dup.yaml, line 12: key numerics is given twice (first on line 11)" in r.stdout + r.stderr
-    assert time.time() - t < 30

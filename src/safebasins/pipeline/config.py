@@ -22,7 +22,7 @@ from pathlib import Path
 import yaml
 
 from safebasins.core.checks import reaches
-from safebasins.pipeline import catalog
+from safebasins.pipeline import catalog, well_defaults
 from safebasins.pipeline.registry import KINDS
 from safebasins.pipeline.validation import CheckContext, ConfigError, fail, indexed, key_path
 
@@ -278,6 +278,7 @@ def validate_config(config: dict) -> dict:
     ctx = CheckContext(config, kinds={n: k for n, k, *_ in exps}, blocks={n: b for n, _, _, b, _ in exps},
                        keys={n: key for n, _, key, _, _ in exps})
     for name, kind, key, blk, _ in exps:
+        well_defaults.fill(blk, KINDS[kind].well_defaults, ctx.well(name))
         _check_well(blk, key, ctx.well(name), KINDS[kind])
         KINDS[kind].check(blk, key, ctx)
     return config

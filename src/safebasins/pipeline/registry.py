@@ -23,6 +23,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable, ClassVar, Mapping
 
+from safebasins.pipeline.well_defaults import WellDefault
+
 __all__ = ["Kind", "Job", "Product", "FigureSpec", "Experiment", "KINDS", "register", "STAGES"]
 
 #: dataset stages and their directories under results/data
@@ -129,6 +131,10 @@ class Kind:
     #: experiment's ``damping`` (params["damping"], safebasins.pipeline.values.damping); False: a
     #: config with damping > 0 for it is refused, naming the key
     damped: ClassVar[bool] = False
+    #: config keys whose schema default is null and whose value follows the experiment's well:
+    #: key -> the quartic's value carried over by the well's own scale (pipeline.well_defaults),
+    #: filled in before ``check``
+    well_defaults: ClassVar[dict[str, WellDefault]] = {}
 
     def check(self, block: dict, key: str, ctx) -> None:
         """Checks beyond the schema; raise ``ctx.fail(key + ".field", message)``."""

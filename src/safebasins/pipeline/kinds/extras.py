@@ -12,6 +12,7 @@ from functools import partial
 import numpy as np
 
 from safebasins.pipeline import values
+from safebasins.pipeline import well_defaults as WD
 from safebasins.pipeline.registry import GridChartKind, Kind, Product, dataset_path, register
 
 FOURIER_LIST = {"description": "first-harmonic variants of the analytic products (\"paper\", \"exact\")",
@@ -140,16 +141,17 @@ class Erosion(GridChartKind):
         "description": description,
         "type": "object", "additionalProperties": False, "default": {},
         "properties": {
-            "F": {"default": {"start": 0.0, "stop": 0.15, "step": 0.005},
-                  "oneOf": [{"$ref": "#/$defs/range"},
-                            {"type": "array", "minItems": 2, "items": {"$ref": "#/$defs/forcing"}}]},
-            "Omega": {"$ref": "#/$defs/frequency", "default": 0.9},
+            "F": WD.nullable({"oneOf": [{"$ref": "#/$defs/range"},
+                                        {"type": "array", "minItems": 2, "items": {"$ref": "#/$defs/forcing"}}]},
+                             "31 values from 0 to 0.39 of the well's static escape force (the quartic: 0 to 0.15)"),
+            "Omega": WD.nullable({"$ref": "#/$defs/frequency"}, "0.9 of the well's linear frequency"),
             "Psi": {"$ref": "#/$defs/angle", "default": "pi"},
-            "xi_max": {"$ref": "#/$defs/threshold_list", "default": [0.18, 0.22]},
-            "grid": {"$ref": "#/$defs/grid", "default": {"q0": [-0.85, 0.85], "p0": [-0.70, 0.70], "n": 121}},
+            "xi_max": WD.nullable({"$ref": "#/$defs/threshold_list"}, "0.72 and 0.88 of the barrier energy"),
+            "grid": WD.nullable({"$ref": "#/$defs/grid"}, "121 x 121 nodes on 0.85 x 0.93 of the well's IC window "
+                                                         "(the quartic: q0 in [-0.85, 0.85], p0 in [-0.7, 0.7])"),
             "cycles": {"$ref": "#/$defs/cycles", "default": 1000},
             "t_eval": {**T_EVAL_LIST, "default": [10, 50, 200, 1000]},
-            "fourier": {**FOURIER_LIST, "default": ["paper", "exact"]},
+            "fourier": WD.nullable(FOURIER_LIST, "[paper, exact] for the quartic, [exact] for other wells"),
             "level": {"description": "integrity level whose first crossing in F is reported (F at GIM = level, ...)",
                       "type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1, "default": 0.5},
             "analytic_n": {"description": "ICs per axis of the analytic (slow-flow) profile on the grid's window "
@@ -159,6 +161,9 @@ class Erosion(GridChartKind):
                            "oneOf": [{"type": "null"}, {"type": "integer", "minimum": 3}], "default": 481},
         },
     }
+
+    well_defaults = {"F": WD.force_range(0.15, 31), "Omega": WD.frequency(0.9), "xi_max": WD.energies([0.18, 0.22]),
+                     "grid": WD.window((-0.85, 0.85), (-0.70, 0.70), 121), "fourier": WD.fourier(["paper", "exact"])}
 
     def check(self, block, key, ctx):
         _check_grid_block(block, key, ctx)
@@ -207,20 +212,24 @@ class TrueBasin(GridChartKind):
         "description": description,
         "type": "object", "additionalProperties": False, "default": {},
         "properties": {
-            "F": {"$ref": "#/$defs/forcing", "default": 0.01},
-            "Omega": {"$ref": "#/$defs/frequency", "default": 0.9},
-            "xi_max": {"$ref": "#/$defs/threshold_list", "default": 0.18},
+            "F": WD.nullable({"$ref": "#/$defs/forcing"}, "0.026 of the well's static escape force (the quartic: 0.01)"),
+            "Omega": WD.nullable({"$ref": "#/$defs/frequency"}, "0.9 of the well's linear frequency"),
+            "xi_max": WD.nullable({"$ref": "#/$defs/threshold_list"}, "0.72 of the barrier energy"),
             "n_psi": {"type": "integer", "minimum": 1, "default": 16},
-            "grid": {"$ref": "#/$defs/grid", "default": {"q0": [-0.72, 0.72], "p0": [-0.63, 0.63], "n": 121}},
+            "grid": WD.nullable({"$ref": "#/$defs/grid"}, "121 x 121 nodes on 0.72 x 0.84 of the well's IC window "
+                                                         "(the quartic: q0 in [-0.72, 0.72], p0 in [-0.63, 0.63])"),
             "cycles": {"$ref": "#/$defs/cycles", "default": 1000},
             "t_eval": {**T_EVAL_LIST, "default": [50, 1000]},
-            "fourier": {**FOURIER_LIST, "default": ["paper", "exact"]},
+            "fourier": WD.nullable(FOURIER_LIST, "[paper, exact] for the quartic, [exact] for other wells"),
             "n_gamma": {"description": "gamma resolution of the continuous-phase energy radius xi_true",
                         "type": "integer", "minimum": 8, "default": 512},
             "n_points": {"description": "samples in xi per branch of each per-phase analytic boundary curve",
                          "type": "integer", "minimum": 16, "default": 400},
         },
     }
+
+    well_defaults = {"F": WD.force(0.01), "Omega": WD.frequency(0.9), "xi_max": WD.energy(0.18),
+                     "grid": WD.window((-0.72, 0.72), (-0.63, 0.63), 121), "fourier": WD.fourier(["paper", "exact"])}
 
     def check(self, block, key, ctx):
         _check_grid_block(block, key, ctx)

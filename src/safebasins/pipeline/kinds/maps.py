@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from safebasins.pipeline import values
+from safebasins.pipeline import well_defaults as WD
 from safebasins.pipeline.registry import Kind, Product, dataset_path, register
 
 MEASURES = ("GIM", "LIM", "IF")
@@ -66,17 +67,20 @@ class IntegrityMap(Kind):
             "Omega": {"$ref": "#/$defs/omega_range"},
             "F": {"$ref": "#/$defs/range"},
             "Psi": {"$ref": "#/$defs/angle", "default": "pi"},
-            "xi_max": {"$ref": "#/$defs/threshold", "default": 0.18},
-            "grid": {"$ref": "#/$defs/grid", "default": {"q0": [-0.72, 0.72], "p0": [-0.63, 0.63], "n": 61}},
+            "xi_max": WD.nullable({"$ref": "#/$defs/threshold"}, "0.72 of the barrier energy (the quartic: 0.18)"),
+            "grid": WD.nullable({"$ref": "#/$defs/grid"}, "61 x 61 nodes on 0.72 x 0.84 of the well's IC window "
+                                                         "(the quartic: q0 in [-0.72, 0.72], p0 in [-0.63, 0.63])"),
             "cycles": {"$ref": "#/$defs/cycles", "default": 500},
             "t_eval": {"type": "array", "minItems": 1, "items": {"type": "number", "minimum": 0},
                        "description": "evaluation times (default: the horizon)"},
-            "fourier": {"enum": ["paper", "exact"], "default": "paper"},
+            "fourier": WD.nullable({"enum": ["paper", "exact"]}, "paper for the quartic, exact for other wells"),
             "level": {"type": "number", "exclusiveMinimum": 0, "exclusiveMaximum": 1, "default": 0.5},
             "n_gamma": {"type": "integer", "minimum": 8, "default": 128},
             "n_xi": {"type": "integer", "minimum": 8, "default": 64},
         },
     }
+    well_defaults = {"xi_max": WD.energy(0.18), "grid": WD.window((-0.72, 0.72), (-0.63, 0.63), 61),
+                     "fourier": WD.fourier("paper")}
 
     def check(self, block, key, ctx):
         ctx.check_grid(f"{key}.grid", block["grid"])
