@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from safebasins.analysis import integrity
-from safebasins.analysis._grid_slow_flow import GridSlowFlow
+from safebasins.theory.slow_flow_grid import GridSlowFlow
 from safebasins.analysis.common import mesh, variant_well
 from safebasins.analysis.integrity_map import _closed_measures
 from safebasins.analysis.phase_invariant import closed_measures, xi_true_analytic

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from safebasins.theory import critical_forcing, safe_basin_boundaries
-from safebasins.theory.slow_flow import SHIFT_RESOLUTION, resolved_shift
+from safebasins.theory.profile import SHIFT_RESOLUTION, resolved_shift
 from safebasins.wells import resolve_well
 
 OMEGA = np.array([0.74, 0.86, 1.0])     # 1.0 = omega(0) of the wells with V''(0) = 1

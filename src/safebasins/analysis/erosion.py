@@ -34,7 +34,7 @@ import xarray as xr
 
 from safebasins.core import checks
 from safebasins.core import cf
-from safebasins.analysis._grid_slow_flow import GridSlowFlow
+from safebasins.theory.slow_flow_grid import GridSlowFlow
 from safebasins.analysis.common import as_1d, mesh, stack_charts, well_variants
 from safebasins.analysis.integrity import integrity_measures, unforced_safe_mask
 from safebasins.analysis.safe import chart_well, safe_stack

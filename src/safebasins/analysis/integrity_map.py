@@ -24,7 +24,7 @@ import xarray as xr
 from safebasins.core import checks
 from safebasins.analysis.common import as_1d, mesh, variant_well
 from safebasins.analysis.erosion import level_crossing
-from safebasins.analysis._grid_slow_flow import GridSlowFlow
+from safebasins.theory.slow_flow_grid import GridSlowFlow
 from safebasins.analysis.integrity import integrity_measures, unforced_radii2, unforced_safe_mask
 from safebasins.analysis.safe import chart_well, safe_stack
 from safebasins.core.cf import annotate

@@ -1,9 +1,11 @@
 """Analytic theory: isolated 1:1 resonance (paper Sec. 2).
 
-Modules: action_angle (eqs 4, 7, 13-20), slow_flow (eqs 11, 18, 21), critical (eqs 22-26),
-basins (eqs 27-28); with damping (docs/damping.md): damped (the damped slow flow and its frames),
-responses (fixed points, frequency responses), damped_flow (batch integration with settling
-certificates), damped_escape (safe ICs, F_cr), trajectories (one slow trajectory).
+Modules, each importing only those listed before it: action_angle (eqs 4, 7, 13-20); profile
+(the tables of the escape criterion, eqs 18, 21, 25) and slow_flow_grid (an IC grid classified by
+it); with damping (docs/damping.md): damped (the damped slow flow and its frames), responses
+(fixed points, frequency responses), damped_flow (batch integration with settling certificates),
+damped_escape (safe ICs, F_cr), trajectories (one slow trajectory); then the entry points of both
+slow flows: slow_flow (eqs 11, 18, 21), critical (eqs 22-26), basins (eqs 27-28).
 """
 from .action_angle import (H0, q_max_from_xi, J, omega, G, dJ_dxi, dG_dxi, nome,
                            angle_energy, phase_point, initial_condition)

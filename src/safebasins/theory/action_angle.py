@@ -8,50 +8,52 @@ versus the exact first harmonic).  Default everywhere is ``fourier="paper"``.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from safebasins.core.checks import check_finite
-from safebasins.wells.quartic import (QUARTIC, _G, _J, _angle_energy, _dG_dxi, _nome, _omega,
-                                      _phase_point, check_fourier)
+from safebasins.theory.types import FloatArray, WellArg
+from safebasins.wells import resolve_well
+from safebasins.wells.quartic import QUARTIC, _nome, check_fourier
 
 __all__ = ["H0", "q_max_from_xi", "J", "omega", "G", "dJ_dxi", "dG_dxi", "nome",
            "angle_energy", "phase_point", "initial_condition", "check_fourier"]
 
 
-def H0(q, p):
+def H0(q: ArrayLike, p: ArrayLike) -> FloatArray:
     """Basic Hamiltonian, eq (7) untruncated: ``p^2/2 + q^2/2 - q^4/4``."""
     return QUARTIC.H0(check_finite("q", q), check_finite("p", p))
 
 
-def q_max_from_xi(xi_max):
+def q_max_from_xi(xi_max: ArrayLike) -> FloatArray:
     """Displacement threshold for an energy threshold, eq (4): ``sqrt(1 - sqrt(1 - 4 xi_max))``."""
     return QUARTIC.q_max(QUARTIC.check_threshold("xi_max", xi_max))
 
 
-def J(xi):
+def J(xi: ArrayLike) -> FloatArray:
     """Averaged action as a function of energy, eqs (13)/(19).
 
     ``J = 2 sqrt(2) / (3 pi) sqrt(1 + mu) (E(k) - mu K(k))``, ``mu = sqrt(1 - 4 xi)``.
     Defined on ``0 <= xi <= 1/4`` (``J(1/4) = 2 sqrt(2) / (3 pi)``).
     """
-    return _J(QUARTIC.check_energy("xi", xi, allow_separatrix=True))
+    return QUARTIC.J(QUARTIC.check_energy("xi", xi, allow_separatrix=True))
 
 
-def omega(xi):
+def omega(xi: ArrayLike) -> FloatArray:
     """Frequency of free oscillation ``dE/dI``, eq (16): ``pi sqrt(1 + mu) / (2 sqrt(2) K)``.
 
     ``omega(0) = 1``, ``omega(1/4) = 0``.  Equals ``1 / J'(xi)``.
     """
-    return _omega(QUARTIC.check_energy("xi", xi, allow_separatrix=True))
+    return QUARTIC.omega(QUARTIC.check_energy("xi", xi, allow_separatrix=True))
 
 
-def dJ_dxi(xi):
+def dJ_dxi(xi: ArrayLike) -> FloatArray:
     """``dJ/dxi = 1 / omega(xi)`` (eq 16); infinite on the separatrix."""
-    xi = QUARTIC.check_energy("xi", xi, allow_separatrix=True)
+    x = QUARTIC.check_energy("xi", xi, allow_separatrix=True)
     with np.errstate(divide="ignore"):
-        return 1.0 / _omega(xi)
+        return 1.0 / QUARTIC.omega(x)
 
 
-def G(xi, fourier="paper"):
+def G(xi: ArrayLike, fourier: str = "paper") -> FloatArray:
     """First-harmonic coefficient of ``q(theta)`` entering C, eq (20).
 
     ``fourier="paper"``: eq (20) exactly as printed,
@@ -63,24 +65,24 @@ def G(xi, fourier="paper"):
     ``G(0) = 0``; ``G(1/4) = 0`` (limit).
     """
     check_fourier(fourier)
-    return _G(QUARTIC.check_energy("xi", xi, allow_separatrix=True), fourier)
+    return resolve_well(None, fourier).harmonic_amplitude(QUARTIC.check_energy("xi", xi, allow_separatrix=True))
 
 
-def dG_dxi(xi, fourier="paper"):
+def dG_dxi(xi: ArrayLike, fourier: str = "paper") -> FloatArray:
     """Analytic derivative ``dG/dxi`` of eq (20) (or its exact form); xi in (0, 1/4)."""
     check_fourier(fourier)
-    xi = QUARTIC.check_energy("xi", xi)
-    if (xi <= 0).any():
+    x = QUARTIC.check_energy("xi", xi)
+    if (x <= 0).any():
         raise ValueError("xi must be > 0 for dG_dxi (G ~ sqrt(xi/2) at the well bottom)")
-    return _dG_dxi(xi, fourier)
+    return resolve_well(None, fourier).harmonic_amplitude_derivative(x)
 
 
-def nome(xi):
+def nome(xi: ArrayLike) -> FloatArray:
     """Jacobi nome ``exp(-pi K'/K)`` of the free orbit with energy xi (0 at xi = 0, 1 at 1/4)."""
     return _nome(QUARTIC.check_energy("xi", xi, allow_separatrix=True))
 
 
-def angle_energy(q, p, well=None):
+def angle_energy(q: ArrayLike, p: ArrayLike, well: WellArg = None) -> tuple[FloatArray, FloatArray]:
     """Angle and energy ``(theta, xi)`` of a phase point, eqs (7) and (14).
 
     ``xi = H0(q, p)``; ``theta = pi F(phi|m) / (2 K)`` with the Jacobi amplitude ``phi`` taken
@@ -91,37 +93,30 @@ def angle_energy(q, p, well=None):
     ``well``: another well (safebasins.wells) with the same angle convention (theta = 0 at
     q = 0 with p > 0); the default is the quartic.
     """
-    return (QUARTIC if well is None else _well(well)).angle_energy(q, p)
+    return resolve_well(well).angle_energy(q, p)
 
 
-def phase_point(theta, xi, well=None):
+def phase_point(theta: ArrayLike, xi: ArrayLike, well: WellArg = None) -> tuple[FloatArray, FloatArray]:
     """Phase point ``(q, p)`` of angle theta on the free orbit of energy xi, eqs (15), (17).
 
     ``q = sqrt(1 - mu) sn(2 K theta / pi | m)``,
     ``p = sqrt((1 - mu^2)/2) cn(.) dn(.)``.  Inverse of :func:`angle_energy`; ``well``: another
     well's orbit (numeric action-angle for wells without closed forms).
     """
-    theta = check_finite("theta", theta)
+    th = check_finite("theta", theta)
     if well is not None:
-        return _well(well).phase_point(theta, xi)
-    xi = QUARTIC.check_energy("xi", xi)
-    theta, xi = np.broadcast_arrays(theta, xi)
-    return _phase_point(theta, xi)
+        return resolve_well(well).phase_point(th, xi)
+    return QUARTIC.phase_point(th, QUARTIC.check_energy("xi", xi))
 
 
-def initial_condition(xi_ini, gamma_ini, Psi, well=None):
+def initial_condition(xi_ini: ArrayLike, gamma_ini: ArrayLike, Psi: ArrayLike,
+                      well: WellArg = None) -> tuple[FloatArray, FloatArray]:
     """IC ``(q0, p0)`` with averaged energy xi_ini and slow phase gamma_ini at tau = 0.
 
     ``gamma = theta - Psi - Omega tau`` so ``theta0 = gamma_ini + Psi``:
     returns ``phase_point(gamma_ini + Psi, xi_ini)`` (of ``well``; default the quartic).
     """
-    xi = (QUARTIC if well is None else _well(well)).check_energy("xi_ini", xi_ini)
+    xi = resolve_well(well).check_energy("xi_ini", xi_ini)
     g = check_finite("gamma_ini", gamma_ini)
     ps = check_finite("Psi", Psi)
     return phase_point(g + ps, xi, well)
-
-
-def _well(well):
-    from safebasins.wells import resolve_well
-
-    return resolve_well(well)

@@ -37,8 +37,8 @@ import numpy as np
 import xarray as xr
 from scipy import optimize
 
-from safebasins.core.checks import check_finite, check_nonnegative, check_positive, check_positive_int
-from safebasins.theory.slow_flow import SlowFlowProfile, _scalar, resolved_shift, unshear
+from safebasins.core.checks import check_finite, check_nonnegative, check_positive, check_positive_int, check_scalar
+from safebasins.theory.profile import SlowFlowProfile, resolved_shift, unshear
 from safebasins.wells import resolve_well
 from safebasins.wells.provenance import api_provenance
 
@@ -173,10 +173,10 @@ def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier=None, n_points=400, wel
       Brent's method on dC/dxi = 0 along the ray, cf. Newton-Raphson in Sec. 3.2).
     """
     w = resolve_well(well, fourier)
-    F = _scalar("F", F, check_nonnegative)
-    Om = _scalar("Omega", Omega, check_positive)
-    Psi = _scalar("Psi", Psi, check_finite)
-    xm = _scalar("xi_max", xi_max, w.check_analytic_threshold)
+    F = check_scalar("F", F, check_nonnegative)
+    Om = check_scalar("Omega", Omega, check_positive)
+    Psi = check_scalar("Psi", Psi, check_finite)
+    xm = check_scalar("xi_max", xi_max, w.check_analytic_threshold)
     n_points = check_positive_int("n_points", n_points)
     if n_points < 3:
         raise ValueError("n_points must be >= 3")

@@ -43,8 +43,10 @@ import numpy as np
 import xarray as xr
 
 from safebasins.core import checks
-from safebasins.core.checks import check_finite, check_positive
-from safebasins.theory.slow_flow import _scalar, _xi_grid, resolved_shift, unshear
+from safebasins.core.checks import check_finite, check_positive, check_scalar
+from safebasins.theory.damped import slow_tables
+from safebasins.theory.damped_escape import damped_critical_forcing
+from safebasins.theory.profile import resolved_shift, unshear, xi_grid
 from safebasins.wells import resolve_well
 from safebasins.wells.provenance import api_provenance
 
@@ -162,24 +164,22 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
     Om = np.atleast_1d(check_positive("Omega", Omega)).astype(float)
     if Om.ndim != 1:
         raise ValueError("Omega must be a scalar or 1-D array")
-    xm = _scalar("xi_max", xi_max, w.check_threshold)
-    x0 = _scalar("xi_ini", xi_ini, w.check_energy)
+    xm = check_scalar("xi_max", xi_max, w.check_threshold)
+    x0 = check_scalar("xi_ini", xi_ini, w.check_energy)
     if x0 >= xm:
         raise ValueError(f"xi_ini must be < xi_max ({xm}), got {x0}")
-    g0 = _scalar("gamma_ini", gamma_ini, check_finite)
+    g0 = check_scalar("gamma_ini", gamma_ini, check_finite)
     if not isinstance(n_grid, (int, np.integer)) or n_grid < 16:
         raise ValueError("n_grid must be an integer >= 16")
     beta = checks.check_damping(damping)
     if beta > 0:
-        from safebasins.theory.damped import slow_tables
-        from safebasins.theory.damped_escape import damped_critical_forcing
         # the undamped F_cr seeds the scan; the damped flow's tables end just below the barrier
         F0 = critical_forcing(Om, min(xm, slow_tables(w).xi_top), x0, g0, n_grid=n_grid, well=w)["F_cr"].values
         return damped_critical_forcing(Om, xm, x0, g0, beta, w, F_undamped=F0)
     w.check_analytic_threshold("xi_max", xm)     # the level curves of C need an orbit at xi_max
 
     nO = Om.size
-    xi = _xi_grid(x0, xm, int(n_grid))
+    xi = xi_grid(x0, xm, int(n_grid))
     Jg, Gg = w.J(xi), w.harmonic_amplitude(xi)
     J0, G0 = float(w.J(np.asarray(x0))), float(w.harmonic_amplitude(np.asarray(x0)))
     c = np.cos(g0 + float(w.harmonic_shift(np.asarray(x0))))
@@ -271,7 +271,7 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
     rows = np.nonzero(np.isfinite(FA_end))[0]
     # energies strictly below the barrier (xi_max = 1/6 of the cubic lies one ulp below its rounded
     # barrier energy: grid points there round onto it, and no interval is left for an SMM)
-    up = _xi_grid(xm, E_b, 600)[:-1] if xm < E_b else np.empty(0)
+    up = xi_grid(xm, E_b, 600)[:-1] if xm < E_b else np.empty(0)
     up = up[up < E_b]
     if rows.size and up.size >= 2:
         dG_up = w.harmonic_amplitude_derivative(up)

@@ -39,7 +39,7 @@ import weakref
 import numpy as np
 
 from safebasins.core.checks import check_nonnegative, check_positive, check_scalar
-from safebasins.theory.slow_flow import unshear
+from safebasins.theory.profile import unshear
 from safebasins.wells.quartic import QuarticWell
 
 __all__ = ["coefficients", "xi_of_J", "SlowTables", "slow_tables", "flow_tilde",

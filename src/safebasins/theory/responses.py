@@ -22,7 +22,7 @@ import xarray as xr
 from safebasins.core import checks
 from safebasins.core.checks import check_1d, check_nonnegative, check_positive, check_positive_int, check_scalar
 from safebasins.theory.damped import TOP_GAP, coefficients, slow_tables
-from safebasins.theory.slow_flow import unshear
+from safebasins.theory.profile import unshear
 from safebasins.wells import resolve_well
 from safebasins.wells.provenance import api_provenance
 

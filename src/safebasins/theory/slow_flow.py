@@ -28,29 +28,33 @@ Interior maxima of ``a`` are the saddles on gamma = 0 (``a'(xi) = 0``, i.e.
 ``1 - Omega/omega - F G' = 0``, eq 25); interior minima of ``b`` are saddles on gamma = pi;
 the ends ``xi = xi_max`` are the tangencies of eqs (22)-(24).  ``a`` and ``b`` are tabulated
 on a fine xi grid with their critical points (located by Brent's method) inserted as nodes,
-so that ``a`` is monotone between nodes and the suffix max/min are exact.
+so that ``a`` is monotone between nodes and the suffix max/min are exact
+(:mod:`safebasins.theory.profile`; the ICs of a grid are classified by
+:mod:`safebasins.theory.slow_flow_grid`).
+
+This module is the entry point of both slow flows: :func:`slow_flow_escapes` with damping > 0
+hands over to the damped slow flow (:mod:`safebasins.theory.damped_escape`), which builds on
+the profile's module, never on this one.
 """
 from __future__ import annotations
 
 import numpy as np
-from scipy import optimize
+from numpy.typing import ArrayLike
 
 from safebasins.core.checks import check_finite, check_nonnegative, check_positive, check_scalar
+from safebasins.theory.damped_escape import damped_escapes
+from safebasins.theory.profile import SlowFlowProfile, level_escapes, xi_grid
+from safebasins.theory.slow_flow_grid import GridSlowFlow
+from safebasins.theory.types import BoolArray, FloatArray, WellArg
 from safebasins.wells import resolve_well
-from safebasins.wells.quartic import XI_SEPARATRIX, _G, _J, _dG_dxi, _ell, _omega, check_fourier
+from safebasins.wells.quartic import QUARTIC, XI_SEPARATRIX, check_fourier
 
 __all__ = ["first_integral", "escapes_on_manifold", "slow_flow_escapes", "slow_flow_profile",
            "slow_flow_rhs", "xi_from_J", "saddles"]
 
 
-def _scalar(name, value, check):
-    a = check(name, value)
-    if a.ndim != 0:
-        raise ValueError(f"{name} must be a scalar here, got shape {a.shape}")
-    return float(a)
-
-
-def first_integral(gamma, xi, F, Omega, fourier=None, well=None):
+def first_integral(gamma: ArrayLike, xi: ArrayLike, F: ArrayLike, Omega: ArrayLike, fourier: str | None = None,
+                   well: WellArg = None) -> FloatArray:
     """First integral of the slow flow, eq (18): ``C = xi - Omega J(xi) - F G(xi) cos(gamma)``;
     for any well ``C = xi - Omega J(xi) - F A(xi) cos(gamma + delta(xi))`` with
     ``q_1 = -i A e^{i delta}`` (wells.base).
@@ -68,112 +72,21 @@ def first_integral(gamma, xi, F, Omega, fourier=None, well=None):
 
 
 # ----------------------------------------------------------------------------- profile
-def _h_prime(xi, Omega, well):
-    with np.errstate(divide="ignore"):
-        return 1.0 - Omega / well.omega(xi)
-
-
-def _ab_prime(xi, F, Omega, well):
-    hp = _h_prime(xi, Omega, well)
-    gp = well.harmonic_amplitude_derivative(xi)
-    return hp - F * gp, hp + F * gp
-
-
-def unshear(g, shift):
-    """The slow phase gamma (in (-pi, pi]) of a point at gamma' = g on the sheared rays
-    gamma' = gamma + delta(xi) (``shift`` = delta; 0 for a symmetric well: g itself)."""
-    return np.pi - np.mod(np.pi - (g - shift), 2.0 * np.pi)
-
-
-#: a shift delta smaller than this in magnitude (rad) is noise of a well's tables (a symmetric
-#: well's delta is 0, its tables give a few 1e-16 of either sign, which would put a point of the
-#: ray gamma' = pi at +pi or -pi)
-SHIFT_RESOLUTION = 1e-12
-
-
-def resolved_shift(well, xi):
-    """``well.harmonic_shift(xi)`` with values below :data:`SHIFT_RESOLUTION` set to exactly 0."""
-    d = np.asarray(well.harmonic_shift(xi), dtype=float)
-    return np.where(np.abs(d) < SHIFT_RESOLUTION, 0.0, d)
-
-
-def _xi_grid(lo, hi, n):
-    """Grid on [lo, hi] clustered at both ends (Chebyshev-Lobatto spacing)."""
-    t = np.linspace(0.0, 1.0, n)
-    x = lo + (hi - lo) * 0.5 * (1.0 - np.cos(np.pi * t))
-    x[0], x[-1] = lo, hi
-    return x
-
-
-def _critical_points(xi, F, Omega, well, which):
-    """Roots of a'(xi) (which=0) or b'(xi) (which=1) on the open interval of the grid.
-
-    Returns (roots, kinds) with kind +1 for a local max, -1 for a local min.
-    """
-    inner = xi[1:-1] if xi[-1] >= well.barrier_energy else xi[1:]
-    if inner.size < 2:
-        return np.empty(0), np.empty(0, int)
-    d = _ab_prime(inner, F, Omega, well)[which]
-    s = np.sign(d)
-    idx = np.nonzero(s[:-1] * s[1:] < 0)[0]
-    roots, kinds = [], []
-
-    def f(x):
-        return float(_ab_prime(np.asarray(x), F, Omega, well)[which])
-
-    for i in idx:
-        r = optimize.brentq(f, inner[i], inner[i + 1], xtol=1e-15, rtol=1e-15, maxiter=200)
-        roots.append(r)
-        kinds.append(1 if s[i] > 0 else -1)
-    return np.asarray(roots, float), np.asarray(kinds, int)
-
-
-class SlowFlowProfile:
-    """Tabulated ``a(xi)``, ``b(xi)`` on [0, xi_max] with critical points as nodes.
-
-    Attributes: ``xi``, ``h``, ``a``, ``b``, ``A`` (suffix max of a), ``B`` (suffix min of b),
-    ``a_max``/``b_min`` (xi of interior local maxima of a / minima of b: saddles on
-    gamma = 0 / pi), ``a_min``/``b_max`` (centres).  For a well whose first harmonic has a
-    phase delta(xi), a and b are C on the sheared rays gamma + delta(xi) = 0, pi.
-    """
-
-    def __init__(self, F, Omega, xi_max, well, n=1500, lo=0.0):
-        self.F, self.Omega, self.xi_max, self.well = F, Omega, xi_max, well
-        base = _xi_grid(lo, xi_max, n)
-        ra, ka = _critical_points(base, F, Omega, well, 0)
-        rb, kb = _critical_points(base, F, Omega, well, 1)
-        self.a_max, self.a_min = ra[ka > 0], ra[ka < 0]
-        self.b_min, self.b_max = rb[kb < 0], rb[kb > 0]
-        xi = np.unique(np.concatenate([base, ra, rb]))
-        self.xi = xi
-        self.J = well.J(xi)
-        self.Gv = well.harmonic_amplitude(xi)
-        self.h = xi - Omega * self.J
-        self.a = self.h - F * self.Gv
-        self.b = self.h + F * self.Gv
-        self.A = np.maximum.accumulate(self.a[::-1])[::-1]
-        self.B = np.minimum.accumulate(self.b[::-1])[::-1]
-
-    def suffix(self, xi_ini):
-        """(max a, min b) over [xi_ini, xi_max] for xi_ini < xi_max, excluding a(xi_ini), b(xi_ini)."""
-        j = np.searchsorted(self.xi, xi_ini, side="right")
-        j = np.minimum(j, self.xi.size - 1)
-        return self.A[j], self.B[j]
-
-
-def slow_flow_profile(F, Omega, xi_max, fourier=None, n=1500, well=None):
+def slow_flow_profile(F: ArrayLike, Omega: ArrayLike, xi_max: ArrayLike, fourier: str | None = None, n: int = 1500,
+                      well: WellArg = None) -> SlowFlowProfile:
     """Build the :class:`SlowFlowProfile` (a, b, suffix extrema, critical points) for one
     parameter set; see the module docstring."""
     w = resolve_well(well, fourier)
-    F = _scalar("F", F, check_nonnegative)
-    Omega = _scalar("Omega", Omega, check_positive)
-    xi_max = _scalar("xi_max", xi_max, w.check_threshold)
+    F = check_scalar("F", F, check_nonnegative)
+    Omega = check_scalar("Omega", Omega, check_positive)
+    xi_max = check_scalar("xi_max", xi_max, w.check_threshold)
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 16:
         raise ValueError(f"n must be an integer >= 16 (nodes of the xi grid of the profile), got {n!r}")
     return SlowFlowProfile(F, Omega, xi_max, w, n)
 
 
-def saddles(F, Omega, xi_max=None, fourier=None, well=None):
+def saddles(F: ArrayLike, Omega: ArrayLike, xi_max: ArrayLike | None = None, fourier: str | None = None,
+            well: WellArg = None) -> list[tuple[float, float]]:
     """Saddles of the slow flow below xi_max (eq 25), as a list of ``(gamma, xi)``.
 
     gamma = 0 saddles are interior maxima of ``a(xi)``, gamma = pi saddles interior minima of
@@ -190,24 +103,19 @@ def saddles(F, Omega, xi_max=None, fourier=None, well=None):
     return sorted(out, key=lambda t: t[1])
 
 
-def _escapes_rm(gamma, xi, prof):
+def _escapes_rm(gamma: FloatArray, xi: FloatArray, prof: SlowFlowProfile) -> BoolArray:
     """Escape classification for validated points (gamma, xi) given a profile."""
-    F, Omega, xi_max = prof.F, prof.Omega, prof.xi_max
     gamma, xi = np.broadcast_arrays(gamma, xi)
     out = np.ones(gamma.shape, dtype=bool)
-    inside = xi < xi_max
-    if F == 0.0:
-        out[inside] = False
-        return out
+    inside = xi < prof.xi_max
     g, x = gamma[inside], xi[inside]
     w = prof.well
-    c0 = x - Omega * w.J(x) - F * w.harmonic_amplitude(x) * np.cos(g + w.harmonic_shift(x))
-    A, B = prof.suffix(x)
-    out[inside] = (A <= c0) & (c0 <= B)
+    out[inside] = level_escapes(prof, x, w.J(x), w.harmonic_amplitude(x), np.cos(g + w.harmonic_shift(x)))
     return out
 
 
-def escapes_on_manifold(gamma, xi, F, Omega, xi_max, fourier=None, well=None):
+def escapes_on_manifold(gamma: ArrayLike, xi: ArrayLike, F: ArrayLike, Omega: ArrayLike, xi_max: ArrayLike,
+                        fourier: str | None = None, well: WellArg = None) -> BoolArray:
     """Does the slow-flow level curve (21) through ``(gamma, xi)`` reach ``xi = xi_max``?
 
     Boolean array (True = escapes), broadcast over gamma and xi; points with
@@ -217,11 +125,13 @@ def escapes_on_manifold(gamma, xi, F, Omega, xi_max, fourier=None, well=None):
     w = resolve_well(well, fourier)
     gamma = check_finite("gamma", gamma)
     xi = w.check_energy("xi", xi, allow_separatrix=True)
-    prof = slow_flow_profile(F, Omega, _scalar("xi_max", xi_max, w.check_analytic_threshold), well=w)
+    prof = slow_flow_profile(F, Omega, check_scalar("xi_max", xi_max, w.check_analytic_threshold), well=w)
     return _escapes_rm(gamma, xi, prof)
 
 
-def slow_flow_escapes(q0, p0, F, Omega, Psi, xi_max, fourier=None, well=None, damping=0.0):
+def slow_flow_escapes(q0: ArrayLike, p0: ArrayLike, F: ArrayLike, Omega: ArrayLike, Psi: ArrayLike,
+                      xi_max: ArrayLike, fourier: str | None = None, well: WellArg = None,
+                      damping: ArrayLike = 0.0) -> BoolArray:
     """Analytic escape prediction for initial conditions ``(q0, p0)`` at tau = 0.
 
     Each IC is mapped to ``(theta0, xi_ini)`` (eqs 7, 14), ``gamma_ini = theta0 - Psi``, and
@@ -236,37 +146,31 @@ def slow_flow_escapes(q0, p0, F, Omega, Psi, xi_max, fourier=None, well=None, da
     """
     w = resolve_well(well, fourier)
     if check_scalar("damping", damping, check_nonnegative) > 0:
-        from safebasins.theory.damped_escape import damped_escapes
         return damped_escapes(q0, p0, F, Omega, Psi, xi_max, damping, well=w)
-    xi_max = _scalar("xi_max", xi_max, w.check_analytic_threshold)
+    xi_max = check_scalar("xi_max", xi_max, w.check_analytic_threshold)
     q0 = check_finite("q0", q0)
     p0 = check_finite("p0", p0)
-    _scalar("Psi", Psi, check_finite)
+    Psi = check_scalar("Psi", Psi, check_finite)
     prof = slow_flow_profile(F, Omega, xi_max, well=w)
-    q0, p0 = np.broadcast_arrays(q0, p0)
-    H = w.H0(q0, p0)
-    inside = w.in_well(q0) & (H < prof.xi_max)
-    out = np.ones(q0.shape, dtype=bool)
-    theta, xi = w.angle_energy(q0[inside], p0[inside])
-    out[inside] = _escapes_rm(theta - float(Psi), xi, prof)
-    return out
+    grid = GridSlowFlow(q0, p0, Psi, prof.xi_max, w, reuse=False)
+    return grid.escapes(grid.profile(prof.F, prof.Omega))
 
 
 # ----------------------------------------------------------------------------- Cartesian flow
-_TABLE = []
+_TABLE: list[tuple[FloatArray, FloatArray]] = []
 
 
-def _J_table():
+def _J_table() -> tuple[FloatArray, FloatArray]:
     if not _TABLE:
-        tab_x = _xi_grid(0.0, XI_SEPARATRIX, 4001)
-        _TABLE.append((tab_x, _J(tab_x)))
+        tab_x = xi_grid(0.0, XI_SEPARATRIX, 4001)
+        _TABLE.append((tab_x, QUARTIC.J(tab_x)))
     return _TABLE[0]
 
 
-def xi_from_J(Jv):
+def xi_from_J(Jv: ArrayLike) -> FloatArray:
     """Invert eq (19): energy xi with ``J(xi) = Jv`` (0 <= Jv <= 4/(3 pi)), Newton on dJ/dxi = 1/omega."""
     Jv = check_nonnegative("Jv", Jv)
-    Jmax = float(_J(np.asarray(XI_SEPARATRIX)))
+    Jmax = float(QUARTIC.J(XI_SEPARATRIX))
     if (Jv > Jmax).any():
         raise ValueError(f"Jv must be <= J(1/4) = {Jmax}")
     # initial guess from a monotone table, then Newton steps
@@ -275,13 +179,13 @@ def xi_from_J(Jv):
     for _ in range(3):
         inner = (x > 0) & (x < XI_SEPARATRIX)
         xs = np.where(inner, x, 0.1)
-        e = _ell(xs)
-        x = np.where(inner, x - (_J(xs, e) - Jv) * _omega(xs, e), x)
+        x = np.where(inner, x - (QUARTIC.J(xs) - Jv) * QUARTIC.omega(xs), x)
         x = np.clip(x, 0.0, XI_SEPARATRIX)
     return x
 
 
-def slow_flow_rhs(X, Y, F, Omega, fourier="paper"):
+def slow_flow_rhs(X: ArrayLike, Y: ArrayLike, F: ArrayLike, Omega: ArrayLike,
+                  fourier: str = "paper") -> tuple[FloatArray, FloatArray]:
     """Slow flow (11) in Cartesian slow variables ``X = sqrt(2J) cos(gamma)``, ``Y = sqrt(2J) sin(gamma)``.
 
     With ``J' = -F G sin(gamma)`` and ``gamma' = omega - Omega - F omega G'(xi) cos(gamma)``:
@@ -299,19 +203,22 @@ def slow_flow_rhs(X, Y, F, Omega, fourier="paper"):
     X = np.asarray(X, float)
     Y = np.asarray(Y, float)
     r2 = X * X + Y * Y
-    if (0.5 * r2 > float(_J(np.asarray(XI_SEPARATRIX)))).any():
+    if (0.5 * r2 > float(QUARTIC.J(XI_SEPARATRIX))).any():
         raise ValueError("X, Y must lie inside the separatrix: X^2 + Y^2 <= 2 J(1/4) = "
-                         f"{2 * float(_J(np.asarray(XI_SEPARATRIX)))!r}")
+                         f"{2 * float(QUARTIC.J(XI_SEPARATRIX))!r}")
     r = np.sqrt(r2)
     xi = xi_from_J(0.5 * r2)
     small = r < 1e-12
     rs = np.where(small, 1.0, r)
     xs = np.where(small, 1e-30, xi)
     c, s = np.where(small, 1.0, X / rs), np.where(small, 0.0, Y / rs)
-    e = _ell(xs)
-    w = _omega(xs, e)
-    Jdot = -F * _G(xs, fourier, e) * s
-    gdot = w - Omega - F * w * _dG_dxi(xs, fourier, e) * c
+    well = resolve_well(None, fourier)
+    w = well.omega(xs)
+    dG = np.full(xs.shape, np.nan)            # no derivative on the separatrix (xi = 1/4)
+    below = xs < XI_SEPARATRIX
+    dG[below] = well.harmonic_amplitude_derivative(xs[below])
+    Jdot = -F * well.harmonic_amplitude(xs) * s
+    gdot = w - Omega - F * w * dG * c
     dX = Jdot * c / rs - Y * gdot
     dY = Jdot * s / rs + X * gdot
     dX = np.where(small, 0.0, dX)

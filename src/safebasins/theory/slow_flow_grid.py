@@ -1,29 +1,35 @@
-"""Slow-flow classification of one IC grid for many control points (the analytic
-integrity map).
+"""Slow-flow escape classification of one IC grid, for one or many control points.
 
-:func:`safebasins.theory.slow_flow_escapes` and
-:func:`safebasins.analysis.phase_invariant.xi_true_analytic` evaluate, for every control point
-``(F, Omega)``, quantities that depend on the grid and the threshold only: the angle-energy
+:func:`safebasins.theory.slow_flow_escapes` is :class:`GridSlowFlow` for one control point.
+The analytic integrity map and erosion profiles classify one grid for many control points
+``(F, Omega)``: the quantities that depend on the grid and the threshold only (the angle-energy
 variables of the ICs, ``J``, ``A`` and ``delta`` at their energies, and ``omega``, ``A'``, ``J``,
-``A`` on the xi grid of the slow-flow profile.  :class:`GridSlowFlow` evaluates them once and
-does per control point only what depends on ``(F, Omega)``: the critical points of the profile
-(Brent's method, as before), the suffix extrema and the comparisons.
+``A`` on the xi grid of the slow-flow profile) are then evaluated once (``reuse=True``), and per
+control point only what depends on ``(F, Omega)``: the critical points of the profile (Brent's
+method), the suffix extrema and the comparisons (:func:`~safebasins.theory.profile.level_escapes`).
 
-Every number is the one the public functions give, bit for bit: the shared quantities are the
-same functions evaluated on the same arrays (or on array slices of them: the well functions are
-elementwise on arrays, which ``tests/analysis/test_integrity_map_fast.py`` checks against the
-public functions), and every per-control-point expression keeps their order of operations.
+Reuse changes no number: the shared quantities are the same functions evaluated on the same
+arrays (or on array slices of them: the well functions are elementwise on arrays, which
+``tests/theory/test_slow_flow_grid.py`` checks against the points classified one by one).
+:meth:`GridSlowFlow.xi_true` is
+:func:`safebasins.analysis.phase_invariant.xi_true_analytic` on the shared tables.
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from safebasins.core import checks
-from safebasins.theory.slow_flow import SlowFlowProfile, _xi_grid
+from safebasins.theory.profile import SlowFlowProfile, level_escapes, xi_grid
+from safebasins.theory.types import BoolArray, FloatArray
+from safebasins.wells.base import Well
 
 __all__ = ["GridSlowFlow"]
 
-_N_PROFILE = 1500          # nodes of slow_flow_profile's xi grid (its default ``n``)
+#: nodes of the xi grid of the slow-flow profile (slow_flow_profile's default ``n``)
+N_PROFILE = 1500
 
 
 class _PinnedWell:
@@ -34,24 +40,24 @@ class _PinnedWell:
 
     _NAMES = ("omega", "harmonic_amplitude_derivative", "J", "harmonic_amplitude")
 
-    def __init__(self, well):
+    def __init__(self, well: Well) -> None:
         self._well = well
-        self._pinned = {k: [] for k in self._NAMES}
-        self._base = None
+        self._pinned: dict[str, list[tuple[FloatArray, FloatArray]]] = {k: [] for k in self._NAMES}
+        self._base: FloatArray | None = None
 
-    def __getattr__(self, name):
+    def __getattr__(self, name: str) -> Any:
         return getattr(self._well, name)
 
-    def pin(self, name, x):
+    def pin(self, name: str, x: ArrayLike) -> None:
         x = np.array(x, float)
         self._pinned[name].append((x, np.asarray(getattr(self._well, name)(x))))
 
-    def pin_base(self, x):
+    def pin_base(self, x: ArrayLike) -> None:
         self._base = np.array(x, float)
         for k in ("J", "harmonic_amplitude"):
             self.pin(k, self._base)
 
-    def _lookup(self, name, x):
+    def _lookup(self, name: str, x: ArrayLike) -> Any:
         x = np.asarray(x)
         if x.ndim == 0:
             return getattr(self._well, name)(x)
@@ -70,16 +76,16 @@ class _PinnedWell:
                 return out
         return getattr(self._well, name)(x)
 
-    def omega(self, E):
+    def omega(self, E: ArrayLike) -> Any:
         return self._lookup("omega", E)
 
-    def harmonic_amplitude_derivative(self, E):
+    def harmonic_amplitude_derivative(self, E: ArrayLike) -> Any:
         return self._lookup("harmonic_amplitude_derivative", E)
 
-    def J(self, E):
+    def J(self, E: ArrayLike) -> Any:
         return self._lookup("J", E)
 
-    def harmonic_amplitude(self, E):
+    def harmonic_amplitude(self, E: ArrayLike) -> Any:
         return self._lookup("harmonic_amplitude", E)
 
 
@@ -88,25 +94,30 @@ class GridSlowFlow:
     ``xi_max`` and phase ``Psi``, for any number of control points ``(F, Omega)``.
 
     ``well`` is a resolved well object (one first-harmonic variant); ``xi_max`` and ``Psi``
-    validated floats.  :meth:`escapes` equals ``theory.slow_flow_escapes(Q, P, F, Omega, Psi,
-    xi_max, well=well)`` and :meth:`xi_true` equals
+    validated floats, ``Q`` and ``P`` finite (broadcast).  ``reuse``: tabulate the profile's
+    F-independent well values once for many control points (False: the well is asked each time,
+    for one control point).  ``escapes(profile(F, Omega))`` is ``theory.slow_flow_escapes(Q, P,
+    F, Omega, Psi, xi_max, well=well)`` and :meth:`xi_true` equals
     ``analysis.phase_invariant.xi_true_analytic(F, Omega, xi_max, n_gamma=..., n_xi=...,
     well=well)``, both bit for bit.
     """
 
-    def __init__(self, Q, P, Psi, xi_max, well):
+    def __init__(self, Q: ArrayLike, P: ArrayLike, Psi: float, xi_max: float, well: Well,
+                 reuse: bool = True) -> None:
         self.well = well
         self.xi_max = float(xi_max)
-        pw = _PinnedWell(well)
-        base = _xi_grid(0.0, self.xi_max, _N_PROFILE)
-        inner = base[1:-1] if base[-1] >= well.barrier_energy else base[1:]
-        if inner.size >= 2:
-            with np.errstate(divide="ignore"):
-                pw.pin("omega", inner)
-            pw.pin("harmonic_amplitude_derivative", inner)
-        pw.pin_base(base)
-        self._pw = pw
-        # the ICs (slow_flow_escapes): inside the well and below xi_max, their (theta, xi)
+        self._pw: Well | _PinnedWell = well
+        if reuse:
+            pw = _PinnedWell(well)
+            base = xi_grid(0.0, self.xi_max, N_PROFILE)
+            inner = base[1:-1] if base[-1] >= well.barrier_energy else base[1:]
+            if inner.size >= 2:
+                with np.errstate(divide="ignore"):
+                    pw.pin("omega", inner)
+                pw.pin("harmonic_amplitude_derivative", inner)
+            pw.pin_base(base)
+            self._pw = pw
+        # the ICs: inside the well and below xi_max, their (theta, xi)
         q0 = checks.check_finite("q0", Q)
         p0 = checks.check_finite("p0", P)
         q0, p0 = np.broadcast_arrays(q0, p0)
@@ -115,7 +126,7 @@ class GridSlowFlow:
         self.inside = well.in_well(q0) & (H < self.xi_max)
         theta, xi = well.angle_energy(q0[self.inside], p0[self.inside])
         gamma = theta - float(Psi)
-        # _escapes_rm on (gamma, xi): the points below xi_max and their F-independent parts
+        # the points (gamma, xi) below xi_max and their F-independent parts
         gamma, xi = np.broadcast_arrays(gamma, xi)
         self._n_in = gamma.shape
         self._below = xi < self.xi_max
@@ -125,45 +136,37 @@ class GridSlowFlow:
         self._Jx = well.J(x)
         self._Gx = well.harmonic_amplitude(x)
         self._cos = np.cos(g + well.harmonic_shift(x))
-        self._gamma_cache = {}
-        self._cos_cache = {}
+        self._gamma_cache: dict[int, FloatArray] = {}
+        self._cos_cache: dict[tuple[int, bytes], FloatArray] = {}
 
-    def profile(self, F, Omega):
+    def profile(self, F: float, Omega: float) -> SlowFlowProfile:
         """``slow_flow_profile(F, Omega, xi_max, well=well)`` (F, Omega validated floats)."""
-        prof = SlowFlowProfile(float(F), float(Omega), self.xi_max, self._pw, _N_PROFILE)
+        prof = SlowFlowProfile(float(F), float(Omega), self.xi_max, self._pw, N_PROFILE)  # type: ignore[arg-type]
         prof.well = self.well
         return prof
 
-    def escapes(self, prof):
+    def escapes(self, prof: SlowFlowProfile) -> BoolArray:
         """Bool array over the grid, True = escapes (``slow_flow_escapes``)."""
-        F, Omega = prof.F, prof.Omega
         sub = np.ones(self._n_in, dtype=bool)
-        if F == 0.0:
-            sub[self._below] = False
-        else:
-            c0 = self._x - Omega * self._Jx - F * self._Gx * self._cos
-            A, B = prof.suffix(self._x)
-            sub[self._below] = (A <= c0) & (c0 <= B)
+        sub[self._below] = level_escapes(prof, self._x, self._Jx, self._Gx, self._cos)
         out = np.ones(self.shape, dtype=bool)
         out[self.inside] = sub
         return out
 
     # ------------------------------------------------------------------ xi_true_analytic
-    def _gamma(self, n_gamma):
+    def _gamma(self, n_gamma: int) -> FloatArray:
         n_gamma = checks.check_positive_int("n_gamma", n_gamma)
         n_gamma += n_gamma % 2
         if n_gamma not in self._gamma_cache:
             self._gamma_cache[n_gamma] = 2 * np.pi * np.arange(n_gamma) / n_gamma
         return self._gamma_cache[n_gamma]
 
-    def _circle_escapes(self, gamma, xs, prof):
+    def _circle_escapes(self, gamma: FloatArray, xs: FloatArray, prof: SlowFlowProfile) -> BoolArray:
         """``escapes_on_manifold(gamma[:, None], xs[None, :], ...).any(axis=0)`` for
         ``xs < xi_max`` (the xi-dependent factors evaluated once per circle)."""
-        F, Omega, w = prof.F, prof.Omega, self.well
-        if F == 0.0:
+        w = self.well
+        if prof.F == 0.0:
             return np.zeros(xs.size, dtype=bool)
-        t1 = xs - Omega * w.J(xs)
-        t2 = F * w.harmonic_amplitude(xs)
         shift = w.harmonic_shift(xs)
         key = (gamma.size, shift.tobytes())       # a symmetric well: shift = 0 for every circle
         cosm = self._cos_cache.get(key)
@@ -171,11 +174,10 @@ class GridSlowFlow:
             cosm = np.cos(gamma[:, None] + shift[None, :])
             if len(self._cos_cache) < 8:
                 self._cos_cache[key] = cosm
-        c0 = t1[None, :] - t2[None, :] * cosm
-        A, B = prof.suffix(xs)
-        return ((A[None, :] <= c0) & (c0 <= B[None, :])).any(axis=0)
+        out: BoolArray = level_escapes(prof, xs, w.J(xs), w.harmonic_amplitude(xs), cosm).any(axis=0)
+        return out
 
-    def xi_true(self, prof, *, n_gamma=512, n_xi=400, levels=3):
+    def xi_true(self, prof: SlowFlowProfile, *, n_gamma: int = 512, n_xi: int = 400, levels: int = 3) -> float:
         """``xi_true_analytic(F, Omega, xi_max, n_gamma=, n_xi=, levels=, well=well)`` for the
         control point of ``prof``."""
         gamma = self._gamma(n_gamma)
@@ -187,8 +189,8 @@ class GridSlowFlow:
             k = np.flatnonzero(self._circle_escapes(gamma, xs, prof))
             if k.size == 0:
                 return hi if hi >= xi_max * (1 - 1e-9) else lo
-            k = int(k[0])
-            if k == 0:
+            k0 = int(k[0])
+            if k0 == 0:
                 return lo
-            lo, hi = xs[k - 1], xs[k]
+            lo, hi = float(xs[k0 - 1]), float(xs[k0])
         return lo
