@@ -11,6 +11,16 @@ cd "$(dirname "$0")/.."
 PY=.venv/bin/python
 KERNELS=${KERNELS:-"Haswell Sandybridge"}
 read -r -a DIRS <<< "${KERNEL_TEST_PATHS:-tests/wells tests/theory tests/numerics tests/analysis}"
+# Left out here (run by make test under the native kernel): the slowest tests that compare two
+# code paths on the same inputs in one process (the CUDA simulator against the CPU engine, a
+# numeric well against its expression twin) or the compiled engine against scipy's DOP853 on the
+# quartic, whose arithmetic calls no BLAS/LAPACK: a kernel changes neither side of them.
+DESELECT=(
+    tests/numerics/test_cuda_simulator.py::test_cuda_simulator_matches_cpu_engine_bitwise
+    tests/numerics/test_damping.py::test_damped_chart_matches_dop853_pixel_for_pixel
+    tests/numerics/test_other_wells.py::test_numeric_well_equals_expression_bitwise
+    tests/theory/test_damped.py::test_batch_decisions_match_per_ic_reference
+)
 
 # the core name of every OpenBLAS loaded by numpy and scipy.linalg (threadpoolctl when installed,
 # else the library's own openblas_get_corename through ctypes), one per line
@@ -49,7 +59,7 @@ for kernel in $KERNELS; do
     fi
     start=$(date +%s)
     rc=0
-    OPENBLAS_CORETYPE=$kernel "$PY" -m pytest -p no:cacheprovider -q -n 2 --dist loadfile --durations=5 "${DIRS[@]}" || rc=$?
+    OPENBLAS_CORETYPE=$kernel "$PY" -m pytest -p no:cacheprovider -q -n 2 --dist loadfile --durations=5 "${DESELECT[@]/#/--deselect=}" "${DIRS[@]}" || rc=$?
     echo "kernels.sh: OPENBLAS_CORETYPE=$kernel: exit $rc, wall $(( $(date +%s) - start )) s"
     [ "$rc" -eq 0 ] || status=1
 done
