@@ -29,7 +29,8 @@ _S21 = np.uint64(21)
 _TWO_M53 = 2.0 ** -53
 
 
-def philox4x32(c0, c1, c2, c3, k0, k1):
+def philox4x32(c0: np.uint64, c1: np.uint64, c2: np.uint64, c3: np.uint64, k0: np.uint64,
+               k1: np.uint64) -> tuple[np.uint64, np.uint64, np.uint64, np.uint64]:
     """The four 32-bit output words (uint64 values < 2^32) of Philox4x32-10 for the counter
     (c0, c1, c2, c3) and the key (k0, k1), all uint64 values < 2^32.  (One function, no calls:
     a target compiles it as it is.)"""
@@ -43,7 +44,7 @@ def philox4x32(c0, c1, c2, c3, k0, k1):
     return c0, c1, c2, c3
 
 
-def uniform53(hi, lo):
+def uniform53(hi: np.uint64, lo: np.uint64) -> float:
     """A double in (0, 1] from two 32-bit words: the 53-bit integer (hi << 21) ^ (lo >> 11), plus
     one, times 2^-53 (exact; never 0, so that log(u) is finite)."""
     return float(((hi << _S21) ^ (lo >> _S11)) + np.uint64(1)) * _TWO_M53
