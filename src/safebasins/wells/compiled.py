@@ -48,7 +48,10 @@ import re
 import types as types_module
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from numpy.typing import ArrayLike
 
 import numpy as np
 from numba import njit, types
@@ -56,9 +59,14 @@ from numba.core import errors
 from numba.extending import intrinsic, overload
 
 __all__ = ["WellCode", "fma", "mul", "fma_cpu", "mul_cpu", "N_WPAR", "quartic_code", "polynomial_code", "callable_code",
+           "target_code",
            "well_force", "well_energy2", "abs_tracking", "code_of", "literal_code", "cpu_jit", "cpu_functions",
            "POLY_DEGREES"]
 
+#: a target's decorator (njit-like, cuda.jit(device=True)): a plain function -> its compiled form
+Jit = Callable[[Callable[..., Any]], Any]
+#: the well's run-time coefficients as the compiled functions see them (a tuple of 14 floats)
+Coefs = tuple[float, ...]
 #: wpar = [q_left, q_right, w_0 .. w_13]
 N_WPAR = 16
 #: degree classes of the polynomial codes (a well of degree n runs in the smallest class >= n)
@@ -67,39 +75,44 @@ POLY_DEGREES = (4, 8)
 
 # ------------------------------------------------------------------------------- primitives
 @intrinsic
-def fma_cpu(typingctx, a, b, c):
+def fma_cpu(typingctx: Any, a: Any, b: Any, c: Any) -> Any:
     """Correctly rounded a*b + c (llvm.fma.f64): same bits in vector and scalar code."""
     sig = types.float64(types.float64, types.float64, types.float64)
 
-    def codegen(context, builder, signature, args):
+    def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
         return builder.fma(*args)
 
     return sig, codegen
 
 
 @njit(cache=True)
-def _fma_python(a, b, c):
-    return fma_cpu(a, b, c)
+def _fma_python(a: float, b: float, c: float) -> float:
+    return fma_cpu(a, b, c)  # type: ignore[call-arg]  # numba types an intrinsic with its typing context
 
 
-def fma(a, b, c):
+def fma(a: float, b: float, c: float) -> float:
     """Correctly rounded ``a*b + c`` on every target (see the module docstring)."""
     return _fma_python(a, b, c)
 
 
-def mul(a, b):
+def mul(a: float, b: float) -> float:
     """``a * b``, never contracted with a following add (see the module docstring)."""
     return a * b
 
 
 @overload(fma, inline="always")
-def _ol_fma(a, b, c):
-    return lambda a, b, c: fma_cpu(a, b, c)
+def _ol_fma(a: Any, b: Any, c: Any) -> Callable[..., float]:
+    # an overload's implementation takes its parameters with the same annotations (numba compares them)
+    def impl(a: Any, b: Any, c: Any) -> float:
+        return fma_cpu(a, b, c)  # type: ignore[call-arg]  # as in _fma_python
+    return impl
 
 
 @overload(mul, inline="always")
-def _ol_mul(a, b):
-    return lambda a, b: a * b
+def _ol_mul(a: Any, b: Any) -> Callable[..., float]:
+    def impl(a: Any, b: Any) -> float:
+        return a * b  # type: ignore[no-any-return]  # floats (numba types the call)
+    return impl
 
 
 # ------------------------------------------------------------------------------- the compiled form
@@ -107,7 +120,7 @@ def _ol_mul(a, b):
 #: templates never reuses a kernel cached before it)
 MODULE_HASH = hashlib.blake2b(Path(__file__).read_bytes(), digest_size=16).hexdigest()
 
-_CODES: dict[int, "WellCode"] = {}
+_CODES: dict[int, WellCode] = {}
 
 
 @dataclass(frozen=True, eq=False)
@@ -115,13 +128,13 @@ class WellCode:
     """A well as the compiled engines see it (module docstring)."""
 
     name: str
-    make: Callable = field(repr=False)
+    make: Callable[[Jit], tuple[Any, Any]] = field(repr=False)
     wpar: np.ndarray = field(repr=False)
     abs_tracking: bool
     source: str = field(repr=False)
     key: int = field(init=False)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         w = np.ascontiguousarray(self.wpar, dtype=float)
         if w.shape != (N_WPAR,):
             raise ValueError(f"wpar must have {N_WPAR} entries [q_left, q_right, w_0 .. w_13], got shape {w.shape}")
@@ -132,10 +145,10 @@ class WellCode:
         _CODES.setdefault(key, self)
 
     @property
-    def barriers(self):
+    def barriers(self) -> tuple[float, float]:
         return float(self.wpar[0]), float(self.wpar[1])
 
-    def signed(self) -> "WellCode":
+    def signed(self) -> WellCode:
         """The same arithmetic with max q / max -q tracking (asymmetric displacement bounds)."""
         if not self.abs_tracking:
             return self
@@ -143,7 +156,7 @@ class WellCode:
 
 
 @functools.cache
-def _signed_variant(code):
+def _signed_variant(code: WellCode) -> WellCode:
     return WellCode(code.name, code.make, code.wpar, False, code.source)
 
 
@@ -155,7 +168,7 @@ def code_of(key: int) -> WellCode:
         raise ValueError(f"no compiled well with key {key!r} (build it from a well: Well.compiled)") from None
 
 
-def _wpar(barriers, coefficients=()):
+def _wpar(barriers: Sequence[float], coefficients: ArrayLike = ()) -> np.ndarray:
     w = np.zeros(N_WPAR)
     w[0], w[1] = float(barriers[0]), float(barriers[1])
     c = np.asarray(coefficients, dtype=float)
@@ -163,21 +176,20 @@ def _wpar(barriers, coefficients=()):
     return w
 
 
-def _plain(force, energy2):
-    """``make`` of a code whose two functions need nothing but the primitives."""
-    def make(jit):
+def _plain(force: Callable[..., float], energy2: Callable[..., float]) -> tuple[Callable[[Jit], tuple[Any, Any]], str]:
+    """(``make``, source) of a code whose two functions need nothing but the primitives."""
+    def make(jit: Jit) -> tuple[Any, Any]:
         return jit(force), jit(energy2)
-    make.source = inspect.getsource(force) + inspect.getsource(energy2)
-    return make
+    return make, inspect.getsource(force) + inspect.getsource(energy2)
 
 
 # ------------------------------------------------------------------------------- the quartic, eq (2)
-def quartic_force(w, q, f):
+def quartic_force(w: Coefs, q: float, f: float) -> float:
     """q^3 - q + f for V = q^2/2 - q^4/4 (eq 1)."""
     return fma(q * q, q, f - q)
 
 
-def quartic_energy2(w, q, p):
+def quartic_energy2(w: Coefs, q: float, p: float) -> float:
     """2 H0 = p^2 + q^2 - q^4/2 (eq 7, untruncated)."""
     q2 = q * q
     return fma(q2, fma(-0.5, q2, 1.0), p * p)
@@ -189,7 +201,7 @@ _QUARTIC_MAKE = _plain(quartic_force, quartic_energy2)
 @functools.cache
 def quartic_code() -> WellCode:
     """The paper's quartic in closed form, barriers +-1, |q| tracking."""
-    return WellCode("quartic", _QUARTIC_MAKE, _wpar((-1.0, 1.0)), True, _QUARTIC_MAKE.source)
+    return WellCode("quartic", _QUARTIC_MAKE[0], _wpar((-1.0, 1.0)), True, _QUARTIC_MAKE[1])
 
 
 # ------------------------------------------------------------------------------- polynomial wells
@@ -197,16 +209,16 @@ def quartic_code() -> WellCode:
 # 2 V(q) + p^2 = q^2 (e_2 + q (e_3 + ...)) + p^2, e_k = 2 c_k:   w[7 .. 13] = e_2 .. e_8
 # Horner with explicit fma over the class's full length: a missing top coefficient is a zero,
 # and fma(0, q, g) = g for finite q leaves the value bitwise unchanged.
-def poly4_force(w, q, f):
+def poly4_force(w: Coefs, q: float, f: float) -> float:
     return fma(fma(fma(w[2], q, w[1]), q, w[0]), q, f)
 
 
-def poly4_energy2(w, q, p):
+def poly4_energy2(w: Coefs, q: float, p: float) -> float:
     h = fma(fma(w[9], q, w[8]), q, w[7])
     return fma(h, q * q, p * p)
 
 
-def poly8_force(w, q, f):
+def poly8_force(w: Coefs, q: float, f: float) -> float:
     a = fma(w[6], q, w[5])
     a = fma(a, q, w[4])
     a = fma(a, q, w[3])
@@ -216,7 +228,7 @@ def poly8_force(w, q, f):
     return fma(a, q, f)
 
 
-def poly8_energy2(w, q, p):
+def poly8_energy2(w: Coefs, q: float, p: float) -> float:
     h = fma(w[13], q, w[12])
     h = fma(h, q, w[11])
     h = fma(h, q, w[10])
@@ -229,7 +241,8 @@ def poly8_energy2(w, q, p):
 _POLY_MAKE = {4: _plain(poly4_force, poly4_energy2), 8: _plain(poly8_force, poly8_energy2)}
 
 
-def polynomial_code(coefficients, barriers, name="polynomial", degree_class=None) -> WellCode:
+def polynomial_code(coefficients: ArrayLike, barriers: Sequence[float], name: str = "polynomial",
+                    degree_class: int | None = None) -> WellCode:
     """Code of ``V = sum_k c_k q^k`` (c_0 = c_1 = 0, degree <= 8) with its barriers: one compiled
     kernel per degree class (the coefficients are run-time numbers); ``degree_class`` (4 or 8)
     forces a class at least the degree's (None: the smallest)."""
@@ -248,18 +261,19 @@ def polynomial_code(coefficients, barriers, name="polynomial", degree_class=None
         w[k - 1] = -(k + 1) * c[k + 1]
     for k in range(2, n + 1):
         w[7 + k - 2] = 2.0 * c[k]
-    make = _POLY_MAKE[cls]
-    return WellCode(f"{name} (degree class {cls})", make, _wpar(barriers, w), False, make.source)
+    make, source = _POLY_MAKE[cls]
+    return WellCode(f"{name} (degree class {cls})", make, _wpar(barriers, w), False, source)
 
 
 # ------------------------------------------------------------------------------- any V, dV
-def _template(V, dV):
+def _template(V: Callable[[float], float], dV: Callable[[float], float]
+              ) -> tuple[Callable[[Coefs, float, float], float], Callable[[Coefs, float, float], float]]:
     """force and energy of a well given by scalar functions V, dV (already compiled for the
     target): the same two lines for every such well."""
-    def force(w, q, f):
+    def force(w: Coefs, q: float, f: float) -> float:
         return f - dV(q)
 
-    def energy2(w, q, p):
+    def energy2(w: Coefs, q: float, p: float) -> float:
         return fma(p, p, 2.0 * V(q))
 
     return force, energy2
@@ -268,20 +282,31 @@ def _template(V, dV):
 _TEMPLATE_SOURCE = inspect.getsource(_template)
 
 
-def callable_code(V, dV, barriers, name, source) -> WellCode:
-    """Code of a well from scalar, numba-compilable Python functions ``V(q)``, ``dV(q)`` (plain
-    functions: each target compiles them).  ``source`` must identify their arithmetic exactly
-    (the expression well's generated text; for user functions the LLVM IR of their CPU
-    compilation): it is the cache key of the compiled kernels."""
-    def make(jit):
+def target_code(functions: Callable[[Jit], tuple[Callable[[float], float], Callable[[float], float]]],
+                barriers: Sequence[float], name: str, source: str) -> WellCode:
+    """Code of a well from ``functions(jit) -> (V, dV)``: scalar, numba-compilable plain Python
+    functions for the target whose decorator is ``jit`` (each target compiles them; what they
+    call may differ by target, e.g. wells.elementary compiled for it).  ``source`` must identify
+    their arithmetic exactly (the expression well's generated text and the elementary functions'
+    hash; for user functions the LLVM IR of their CPU compilation): it is the cache key of the
+    compiled kernels."""
+    def make(jit: Jit) -> tuple[Any, Any]:
+        V, dV = functions(jit)
         force, energy2 = _template(jit(V), jit(dV))
         return jit(force), jit(energy2)
 
     return WellCode(name, make, _wpar(barriers), False, f"{_TEMPLATE_SOURCE}\0{source}")
 
 
+def callable_code(V: Callable[[float], float], dV: Callable[[float], float], barriers: Sequence[float], name: str,
+                  source: str) -> WellCode:
+    """Code of a well from scalar, numba-compilable Python functions ``V(q)``, ``dV(q)``, the same
+    on every target (:func:`target_code`)."""
+    return target_code(lambda jit: (V, dV), barriers, name, source)
+
+
 # ------------------------------------------------------------------------------- CPU dispatch
-def literal_code(well) -> WellCode:
+def literal_code(well: Any) -> WellCode:
     """The registered code of a numba literal kernel key (typing time of the CPU kernels)."""
     if not isinstance(well, types.IntegerLiteral):
         raise errors.TypingError(f"well must be a compile-time constant kernel key (a numba literal), got {well}")
@@ -289,11 +314,11 @@ def literal_code(well) -> WellCode:
 
 
 @intrinsic
-def mul_cpu(typingctx, a, b):
+def mul_cpu(typingctx: Any, a: Any, b: Any) -> Any:
     """``a * b`` exactly as numba compiles it (the CPU's mul)."""
     sig = typingctx.resolve_function_type(operator.mul, (a, b), {})
 
-    def codegen(context, builder, signature, args):
+    def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
         return context.get_function(operator.mul, signature)(builder, args)
 
     return sig, codegen
@@ -302,7 +327,7 @@ def mul_cpu(typingctx, a, b):
 _CPU_PRIMITIVES = {"fma": (fma, fma_cpu), "mul": (mul, mul_cpu)}
 
 
-def cpu_jit(fn):
+def cpu_jit(fn: Callable[..., Any]) -> Any:
     """``njit(inline="always")`` of a function of the wells' one source (a force, an energy, a
     scheme's step) for the CPU lanes, with its globals ``fma`` and ``mul`` (when they are this
     module's) bound to the CPU primitives: the same operations, typed once per signature; through
@@ -316,47 +341,56 @@ def cpu_jit(fn):
 
 
 @functools.cache
-def cpu_functions(key):
+def cpu_functions(key: int) -> tuple[Any, Any]:
     """(force, energy2) of a code compiled for the CPU lanes (inlined into the kernels)."""
     return code_of(key).make(cpu_jit)
 
 
-def well_force(well, w, q, f):
+def well_force(well: int, w: Coefs, q: float, f: float) -> float:
     """-V'(q) + f of the code with kernel key ``well`` (a compile-time constant), f = F sin(...)."""
     raise NotImplementedError("well_force is compiled code (numba)")
 
 
-def well_energy2(well, w, q, p):
+def well_energy2(well: int, w: Coefs, q: float, p: float) -> float:
     """2 H0 = p^2 + 2 V(q) of the code with kernel key ``well`` (a compile-time constant)."""
     raise NotImplementedError("well_energy2 is compiled code (numba)")
 
 
-def abs_tracking(well):
+def abs_tracking(well: int) -> bool:
     """True when the code of kernel key ``well`` tracks max |q| (a compile-time constant)."""
     raise NotImplementedError("abs_tracking is compiled code (numba)")
 
 
 # the code of a key is chosen at typing time: a kernel holds only its own well's arithmetic
 @overload(well_force, inline="always")
-def _ol_well_force(well, w, q, f):
+def _ol_well_force(well: Any, w: Any, q: Any, f: Any) -> Callable[..., float]:
     FORCE = cpu_functions(literal_code(well).key)[0]
-    return lambda well, w, q, f: FORCE(w, q, f)
+
+    def impl(well: Any, w: Any, q: Any, f: Any) -> float:
+        return FORCE(w, q, f)  # type: ignore[no-any-return]  # a compiled force (numba dispatcher)
+    return impl
 
 
 @overload(well_energy2, inline="always")
-def _ol_well_energy2(well, w, q, p):
+def _ol_well_energy2(well: Any, w: Any, q: Any, p: Any) -> Callable[..., float]:
     ENERGY2 = cpu_functions(literal_code(well).key)[1]
-    return lambda well, w, q, p: ENERGY2(w, q, p)
+
+    def impl(well: Any, w: Any, q: Any, p: Any) -> float:
+        return ENERGY2(w, q, p)  # type: ignore[no-any-return]  # a compiled energy (numba dispatcher)
+    return impl
 
 
 @overload(abs_tracking, inline="always")
-def _ol_abs_tracking(well):
-    if literal_code(well).abs_tracking:
-        return lambda well: True
-    return lambda well: False
+def _ol_abs_tracking(well: Any) -> Callable[..., bool]:
+    def yes(well: Any) -> bool:
+        return True
+
+    def no(well: Any) -> bool:
+        return False
+    return yes if literal_code(well).abs_tracking else no
 
 
-def _ir_identity(arg, fn):
+def _ir_identity(arg: str, fn: Callable[..., Any]) -> tuple[Callable[..., Any], str]:
     """(plain Python function, text identifying its float64 -> float64 compilation): the LLVM IR of
     its CPU compilation with the mangled symbol names removed (they carry process-local counters)."""
     py = getattr(fn, "py_func", fn)
@@ -377,7 +411,7 @@ def _ir_identity(arg, fn):
     return py, re.sub(r"_ZN\w+", "_Z", ir)
 
 
-def user_code(V, dV, barriers, name) -> WellCode:
+def user_code(V: Callable[..., Any], dV: Callable[..., Any], barriers: Sequence[float], name: str) -> WellCode:
     """Code of a well from the user's callables (a NumericWell): V, dV compiled by numba for a
     scalar q (plain Python functions or numba dispatchers); ValueError naming V / dV otherwise."""
     pv, iv = _ir_identity("V", V)

@@ -23,7 +23,7 @@ with selects rather than branches, so that a loop calling them vectorises on the
 * sqrt: the IEEE square root (NaN below zero, without the exception Python would raise).
 
 Accuracy (ulps against mpmath), special values and speed: docs/elementary.md;
-tests/numerics/test_elementary.py checks them.
+tests/wells/test_elementary.py checks them.
 
 Targets: the source is compiled per target by :func:`cpu` (numba njit, the primitives bound to
 their CPU intrinsics) and :func:`cuda_device` (numba-cuda device functions); ``@njit`` code may
@@ -35,22 +35,36 @@ to differ from the compiled code) and it never divides by zero or takes a negati
 from __future__ import annotations
 
 import functools
+import hashlib
 import math
 import sys
+from collections.abc import Callable
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
 
 from numba import njit
 
-from safebasins.wells import elementary_reduction
+from safebasins.wells import elementary_reduction, elementary_targets
 from safebasins.wells.elementary_reduction import reduce_pio2 as _payne_hanek
 from safebasins.wells.elementary_targets import (as_bits, as_bits_cpu, cold_call_cpu, compile_code, from_bits,
                                                     from_bits_cpu, register_cpu_overload)
-from safebasins.wells.compiled import fma, fma_cpu, mul, mul_cpu
+from safebasins.wells.compiled import cpu_jit, fma, fma_cpu, mul, mul_cpu
 
-__all__ = ["sin", "cos", "sincos", "exp", "expm1", "log", "log1p", "tanh", "cosh", "sinh", "sqrt", "pow",
-           "powi", "cpu", "cuda_device", "FUNCTIONS", "SIN_COS_FAST_LIMIT"]
+__all__ = ["sin", "cos", "tan", "sincos", "exp", "expm1", "log", "log1p", "tanh", "cosh", "sinh", "sqrt", "pow",
+           "powi", "cpu", "cuda_device", "for_target", "FUNCTIONS", "SIN_COS_FAST_LIMIT", "ULP_BOUNDS", "MODULE_HASH"]
 
 #: the public functions
-FUNCTIONS = ("sin", "cos", "sincos", "exp", "expm1", "log", "log1p", "tanh", "cosh", "sinh", "sqrt", "pow", "powi")
+FUNCTIONS = ("sin", "cos", "tan", "sincos", "exp", "expm1", "log", "log1p", "tanh", "cosh", "sinh", "sqrt", "pow",
+             "powi")
+#: the largest error in ulps (against mpmath) that each function may make on its whole domain,
+#: tested (tests/wells/test_elementary.py); the measured maxima: docs/elementary.md
+ULP_BOUNDS = {"sin": 0.55, "cos": 0.55, "sincos": 0.55, "tan": 1.6, "exp": 0.55, "expm1": 0.55, "log": 0.55,
+              "log1p": 0.55, "tanh": 0.55, "cosh": 0.55, "sinh": 0.55, "sqrt": 0.5, "pow": 0.55, "powi": 0.55}
+#: hash of the source of the functions (this module and the two it compiles with): part of the key
+#: of every compiled well that calls them (an edit never reuses a kernel cached before it)
+MODULE_HASH = hashlib.blake2b(b"".join(Path(str(m.__file__)).read_bytes() for m in (
+    sys.modules[__name__], elementary_reduction, elementary_targets)), digest_size=16).hexdigest()
 #: |x| up to which sin and cos reduce by Cody-Waite (beyond: Payne-Hanek)
 SIN_COS_FAST_LIMIT = 2.0 ** 30
 
@@ -118,42 +132,42 @@ _H0, _H1, _H2, _H3, _H4 = map(_h, (
 
 
 # ------------------------------------------------------------------------------- double-double
-def _two_sum(a, b):
+def _two_sum(a: float, b: float) -> tuple[float, float]:
     """(s, e): s = a + b rounded, e its exact error (Knuth)."""
     s = a + b
     bb = s - a
     return s, (a - (s - bb)) + (b - bb)
 
 
-def _fast_two_sum(a, b):
+def _fast_two_sum(a: float, b: float) -> tuple[float, float]:
     """(s, e) as _two_sum, for |a| >= |b| or a = 0 (Dekker)."""
     s = a + b
     return s, b - (s - a)
 
 
-def _two_prod(a, b):
+def _two_prod(a: float, b: float) -> tuple[float, float]:
     """(p, e): p = a b rounded, e = fma(a, b, -p) its exact error."""
     p = mul(a, b)
     return p, fma(a, b, -p)
 
 
-def _dd_mul(ah, al, bh, bl):
+def _dd_mul(ah: float, al: float, bh: float, bl: float) -> tuple[float, float]:
     """(a_h + a_l)(b_h + b_l), normalised (relative error ~2^-104)."""
     p = mul(ah, bh)
     return _fast_two_sum(p, fma(ah, bh, -p) + (mul(ah, bl) + mul(al, bh)))
 
 
-def _pow2(k):
+def _pow2(k: int) -> float:
     """2^k for an integer -1022 <= k <= 1023."""
     return from_bits((k + 1023) << 52)
 
 
-def _copysign(a, x):
+def _copysign(a: float, x: float) -> float:
     return from_bits((as_bits(a) & _ABS) | (as_bits(x) & _SIGN))
 
 
 # ------------------------------------------------------------------------------- exp family
-def _exp_reduce(xh, xl):
+def _exp_reduce(xh: float, xl: float) -> tuple[int, float, float]:
     """(n, r_h, r_l): x_h + x_l = n ln2 + r_h + r_l, |r| <= ln2/2 (1 + 2^-40), for |x_h| <= 746."""
     k = fma(xh, _INV_LN2, _SHIFT)
     nf = k - _SHIFT
@@ -162,13 +176,14 @@ def _exp_reduce(xh, xl):
     return as_bits(k) - _SHIFT_BITS, rh, rl
 
 
-def _poly10(r, r2, r4, c0, c1, c2, c3, c4, c5, c6, c7, c8, c9):
+def _poly10(r: float, r2: float, r4: float, c0: float, c1: float, c2: float, c3: float, c4: float, c5: float, c6: float,
+            c7: float, c8: float, c9: float) -> float:
     """c0 + c1 r + ... + c9 r^9 (Estrin: half Horner's chain of dependent operations)."""
     p = fma(fma(fma(c7, r, c6), r2, fma(c5, r, c4)), r4, fma(fma(c3, r, c2), r2, fma(c1, r, c0)))
     return fma(fma(c9, r, c8), mul(r4, r4), p)
 
 
-def _exp_poly(rh, rl):
+def _exp_poly(rh: float, rl: float) -> tuple[float, float]:
     """e^r = b_h + b_l for r = r_h + r_l, |r| <= 0.35, to ~2^-60 relative; b_l is not normalised."""
     hr = mul(0.5, rh)
     h = mul(hr, rh)                                  # r^2/2 = h + hl exactly
@@ -180,7 +195,7 @@ def _exp_poly(rh, rl):
     return bh, be + (e + ((hl + mul(r2, mul(rh, q))) + fma(rl, uh, rl)))      # r_l e^r
 
 
-def _expm1_poly(rh, rl):
+def _expm1_poly(rh: float, rl: float) -> tuple[float, float]:
     """e^r - 1 = u_h + u_l for r = r_h + r_l, |r| <= 0.35, to ~2^-62 relative (r^2/2 and r^3/6 in
     double-double); u_l is not normalised."""
     hr = mul(0.5, rh)
@@ -199,19 +214,21 @@ def _expm1_poly(rh, rl):
     return uh, (e1 + e2) + ((hl + tl) + (mul(r4, q) + rle))
 
 
-def _scale(n, y):
+def _scale(n: int, y: float) -> float:
     """y 2^n for |n| <= 1100: two exact factors, so the only rounding is a subnormal result's."""
     n1 = n >> 1
     return mul(mul(y, _pow2(n1)), _pow2(n - n1))
 
 
-def _exp_finish(n, bh, bl):
+def _exp_finish(n: int, bh: float, bl: float) -> float:
     """2^n (b_h + b_l) for b in [0.7, 1.42], rounded once also into the subnormal range."""
-    normal = _scale(n, bh + bl)
-    # n <= -1022: scale by 2^(n+1022) first and round at 2^-52 (1.0 + y), which the exact
-    # scaling by 2^-1022 turns into the subnormal ulp 2^-1074 (other lanes scale by 1: a
-    # subnormal intermediate costs a microcode assist per operation)
-    tiny = n < -1021
+    b = bh + bl
+    normal = _scale(n, b)
+    # a subnormal result (n < -1022, or n = -1022 and b < 1): scale by 2^(n+1022) first and round
+    # at 2^-52 (1.0 + y, y < 1), which the exact scaling by 2^-1022 turns into the subnormal ulp
+    # 2^-1074 (other lanes scale by 1: a subnormal intermediate costs a microcode assist per
+    # operation)
+    tiny = (n < -1022) | ((n == -1022) & (b < 1.0))
     sc = _pow2(min(max(n, -1075), -1022) + 1022)
     y = mul(bh, sc)
     hi = 1.0 + y
@@ -220,7 +237,7 @@ def _exp_finish(n, bh, bl):
     return sub if tiny else normal
 
 
-def exp(x):
+def exp(x: float) -> float:
     """e^x."""
     xc = x if x > -746.0 else -746.0                 # NaN -> -746 here, restored at the end
     xc = xc if xc < 710.0 else 710.0
@@ -230,7 +247,7 @@ def exp(x):
     return x + x if x != x else res
 
 
-def _expm1_dd(n, rh, rl):
+def _expm1_dd(n: int, rh: float, rl: float) -> tuple[float, float]:
     """2^n (1 + u) - 1, u = e^r - 1, for -55 <= n <= 60, as a double-double (exact sums)."""
     uh, ul = _expm1_poly(rh, rl)
     s = _pow2(n)
@@ -239,7 +256,7 @@ def _expm1_dd(n, rh, rl):
     return _fast_two_sum(sh, se + (tl + mul(s, ul)))
 
 
-def expm1(x):
+def expm1(x: float) -> float:
     """e^x - 1."""
     xc = x if x > -38.0 else -38.0                   # e^-38 < 2^-54: expm1 = -1 rounded
     xc = xc if xc < 710.0 else 710.0
@@ -251,7 +268,7 @@ def expm1(x):
     return x + x if x != x else res
 
 
-def _exp_dd(ax):
+def _exp_dd(ax: float) -> tuple[int, float, float, float, float]:
     """(n, b_h, b_l, i_h, i_l): e^ax = 2^n (b_h + b_l), 1/(b_h + b_l) = i_h + i_l, 0 <= ax <= 711."""
     n, rh, rl = _exp_reduce(ax, 0.0)
     uh, ul = _expm1_poly(rh, rl)                     # sinh cancels up to 2 bits: e^r to 2^-62
@@ -261,7 +278,7 @@ def _exp_dd(ax):
     return n, bh, bl, ih, mul(fma(-bh, ih, 1.0) - mul(bl, ih), ih)
 
 
-def cosh(x):
+def cosh(x: float) -> float:
     """cosh x = 2^(n-1) (b + 2^-2n / b)."""
     ax = abs(x)
     ax = ax if ax < 711.0 else 711.0                 # NaN -> 711 here, restored at the end
@@ -272,7 +289,7 @@ def cosh(x):
     return x + x if x != x else res
 
 
-def sinh(x):
+def sinh(x: float) -> float:
     """sinh x: 2^(n-1) (b - 2^-2n / b), below 1/4 a polynomial."""
     ax = abs(x)
     n, bh, bl, ih, il = _exp_dd(ax if ax < 711.0 else 711.0)
@@ -287,7 +304,7 @@ def sinh(x):
     return x + x if x != x else res
 
 
-def tanh(x):
+def tanh(x: float) -> float:
     """tanh x = sign(x) E/(E + 2), E = expm1(2|x|) as a double-double."""
     ax = abs(x)
     ax2 = ax + ax if ax < 20.0 else 40.0             # tanh(20) = 1 - 2^-56.7: 1 rounded
@@ -303,7 +320,7 @@ def tanh(x):
 
 
 # ------------------------------------------------------------------------------- log family
-def _log_reduce(x):
+def _log_reduce(x: float) -> tuple[int, float, float]:
     """(E, e, z): x = 2^E z, z in [sqrt(1/2), sqrt(2)), E as an int and a float, 0 < x < inf."""
     sub = x < _M1022
     ix = as_bits(mul(x, _P54) if sub else x) & _ABS
@@ -313,7 +330,7 @@ def _log_reduce(x):
     return k, from_bits(k + _SHIFT_BITS) - _SHIFT, z
 
 
-def _atanh_arg(fh, fl):
+def _atanh_arg(fh: float, fl: float) -> tuple[float, float]:
     """s = f/(2 + f) as a double-double, f = f_h + f_l, |f| <= 0.42."""
     dh, de = _fast_two_sum(2.0, fh)
     inv = 1.0 / dh
@@ -321,7 +338,7 @@ def _atanh_arg(fh, fl):
     return sh, mul((fma(-sh, dh, fh) + fl) - mul(sh, de + fl), inv)
 
 
-def _log_core(e, fh, fl):
+def _log_core(e: float, fh: float, fl: float) -> float:
     """e ln2 + log1p(f_h + f_l), rounded."""
     sh, sl = _atanh_arg(fh, fl)
     z = mul(sh, sh)
@@ -330,7 +347,7 @@ def _log_core(e, fh, fl):
     return hi + (he + (mul(e, _LN2_42M) + ((sl + sl) + mul(mul(sh, z), v))))
 
 
-def log(x):
+def log(x: float) -> float:
     """Natural logarithm."""
     k, e, z = _log_reduce(x)
     res = _log_core(e, z - 1.0, 0.0)
@@ -339,7 +356,7 @@ def log(x):
     return _NAN if x < 0.0 else res
 
 
-def log1p(x):
+def log1p(x: float) -> float:
     """log(1 + x): for x in [sqrt(1/2) - 1, sqrt(2) - 1] log1p(x) itself, beyond the log of
     1 + x as the double-double u_h + u_l."""
     xc = x if x > -1.0 else 0.0                      # x <= -1, NaN: special values below
@@ -355,7 +372,7 @@ def log1p(x):
     return _NAN if x < -1.0 else res
 
 
-def _log_dd(x):
+def _log_dd(x: float) -> tuple[float, float]:
     """log x as a double-double of relative error ~2^-70 (pow), 0 < x < inf."""
     k, e, z = _log_reduce(x)
     sh, sl = _atanh_arg(z - 1.0, 0.0)
@@ -376,7 +393,7 @@ def _log_dd(x):
 
 
 # ------------------------------------------------------------------------------- powers
-def _parity(y):
+def _parity(y: float) -> tuple[bool, bool]:
     """(y is an integer, y is an odd integer); neither for inf or NaN."""
     ay = abs(y)
     small = ay < _P52
@@ -385,7 +402,7 @@ def _parity(y):
     return integer, integer & ((as_bits(k) & 1) == 1) & (ay < _P53)
 
 
-def pow(x, y):
+def pow(x: float, y: float) -> float:
     """x^y (C99 Annex F special cases: pow(x, 0) = pow(1, y) = 1 even for NaN, ...)."""
     ax = abs(x)
     lh, ll = _log_dd(ax)
@@ -402,13 +419,14 @@ def pow(x, y):
     res = _NAN if (x < 0.0) & (x > -_INF) & (not integer) & (abs(y) < _INF) else res
     # x = +-0 and x = +-inf: 0 or inf, with the sign of x for an odd integer y
     tiny = (y > 0.0) == (ax == 0.0)
-    res = (_copysign(0.0 if tiny else _INF, x) if odd else (0.0 if tiny else _INF)) if (ax == 0.0) | (ax == _INF) else res
+    edge = 0.0 if tiny else _INF
+    res = (_copysign(edge, x) if odd else edge) if (ax == 0.0) | (ax == _INF) else res
     res = ((1.0 if ax == 1.0 else (_INF if (ax < 1.0) == (y < 0.0) else 0.0)) if abs(y) == _INF else res)
     res = x + y if (x != x) | (y != y) else res
     return 1.0 if (x == 1.0) | (y == 0.0) else res
 
 
-def powi(x, n):
+def powi(x: float, n: int) -> float:
     """x^n for an integer n (C23 pown special cases), by binary powering in double-double."""
     m = -n if n < 0 else n
     xi = x if x != 0.0 else 1.0                      # no division by zero (x = 0: below)
@@ -430,13 +448,13 @@ def powi(x, n):
     return 1.0 if n == 0 else res
 
 
-def sqrt(x):
+def sqrt(x: float) -> float:
     """The IEEE square root; NaN below zero (sqrt(-0) = -0)."""
     return math.sqrt(x) if x >= 0.0 else _NAN
 
 
 # ------------------------------------------------------------------------------- sin, cos
-def _reduce_pio2(x):
+def _reduce_pio2(x: float) -> tuple[int, float, float]:
     """(n mod 4, r_h, r_l): x = n pi/2 + r_h + r_l, |r| <= pi/4 + 2^-23, for |x| <= 2^30."""
     k = fma(x, _TWO_OVER_PI, _SHIFT)
     nf = k - _SHIFT
@@ -447,7 +465,7 @@ def _reduce_pio2(x):
     return as_bits(k) & 3, rh, rl
 
 
-def _sin_kernel(rh, rl):
+def _sin_kernel(rh: float, rl: float) -> float:
     """sin(r_h + r_l), |r| <= pi/4 + 2^-20: r - r^3/6 in double-double, the rest a polynomial."""
     zh = mul(rh, rh)
     zl = fma(rh, rh, -zh)
@@ -460,7 +478,7 @@ def _sin_kernel(rh, rl):
     return sh + (se + (tl + (fma(mul(ch, zh), p, rl) - mul(mul(0.5, zh), rl))))
 
 
-def _cos_kernel(rh, rl):
+def _cos_kernel(rh: float, rl: float) -> float:
     """cos(r_h + r_l), |r| <= pi/4 + 2^-20: 1 - r^2/2 and C0 r^4 in double-double, the rest a
     polynomial."""
     zh = mul(rh, rh)
@@ -476,13 +494,13 @@ def _cos_kernel(rh, rl):
     return w + fma(z2, _C0, fma(mul(z2, zh), p, tail))
 
 
-def _quadrant(q, s, c):
+def _quadrant(q: int, s: float, c: float) -> float:
     """sin(n pi/2 + r) from n mod 4 = q, s = sin r, c = cos r (cos: q + 1)."""
     v = c if (q & 1) == 1 else s
     return -v if (q & 2) == 2 else v
 
 
-def _sincos_huge(x):
+def _sincos_huge(x: float) -> tuple[float, float]:
     """(sin x, cos x) for 2^30 < |x| < inf, reduced exactly (Payne-Hanek)."""
     b = as_bits(x) & _ABS
     q, a0, a1, a2 = _payne_hanek((b & 0xFFFFFFFFFFFFF) | 0x10000000000000, (b >> 52) - 1023)
@@ -494,15 +512,15 @@ def _sincos_huge(x):
     return (-sn if x < 0.0 else sn), _quadrant(q + 1, s, c)
 
 
-def _sin_huge(x):
+def _sin_huge(x: float) -> float:
     return _sincos_huge(x)[0]
 
 
-def _cos_huge(x):
+def _cos_huge(x: float) -> float:
     return _sincos_huge(x)[1]
 
 
-def sincos(x):
+def sincos(x: float) -> tuple[float, float]:
     """(sin x, cos x)."""
     ax = abs(x)
     fast = ax <= SIN_COS_FAST_LIMIT                  # False for NaN
@@ -519,7 +537,7 @@ def sincos(x):
     return (x - x if bad else sn), (x - x if bad else cs)
 
 
-def sin(x):
+def sin(x: float) -> float:
     """sin x."""
     ax = abs(x)
     fast = ax <= SIN_COS_FAST_LIMIT
@@ -531,7 +549,13 @@ def sin(x):
     return x - x if not (ax < _INF) else res         # sin(+-inf) = NaN
 
 
-def cos(x):
+def tan(x: float) -> float:
+    """tan x = sin x / cos x (both from one reduction)."""
+    s, c = sincos(x)
+    return s / c
+
+
+def cos(x: float) -> float:
     """cos x."""
     ax = abs(x)
     fast = ax <= SIN_COS_FAST_LIMIT
@@ -543,36 +567,52 @@ def cos(x):
 
 
 # ------------------------------------------------------------------------------- targets
-NOT_CODE = ("cpu", "cuda_device")   # functions here that are not code (compile_code)
+#: functions here that are not code (compile_code compiles the others)
+NOT_CODE = ("cpu", "cuda_device", "for_target", "_cold", "_cpu_function")
 _MODULES = (sys.modules[__name__], elementary_reduction)
 
 
+def _cold(ns: SimpleNamespace, name: str) -> Any:
+    """The masked cold call (CPU) of the compiled function ``name`` of ``ns``."""
+    return cold_call_cpu(getattr(ns, name), name)
+
+
 @functools.cache
-def cpu():
+def cpu() -> SimpleNamespace:
     """The functions compiled for the CPU (njit, numpy error model: a division never raises), fma,
     mul and the bit casts bound to their CPU intrinsics; the huge-argument sin/cos paths as masked
     cold calls.  A namespace of dispatchers: ``cpu().sin`` etc."""
     prims = {"fma": fma_cpu, "mul": mul_cpu, "as_bits": as_bits_cpu, "from_bits": from_bits_cpu}
-    cold = {k: (lambda ns, k=k: cold_call_cpu(getattr(ns, k), k)) for k in ("_sin_huge", "_cos_huge")}
+    cold = {k: functools.partial(_cold, name=k) for k in ("_sin_huge", "_cos_huge")}
     return compile_code(_MODULES, njit(error_model="numpy", forceinline=True), prims, cold)
 
 
 @functools.cache
-def cuda_device():
+def cuda_device() -> SimpleNamespace:
     """The functions as numba-cuda device functions: fma.rn.f64, mul.rn.f64 (never contracted) and
     libdevice's bit casts; under the simulator (NUMBA_ENABLE_CUDASIM=1) the Python primitives (the
     CPU's correctly rounded fma), as cuda_kernels does for the wells."""
-    from numba import cuda
-    from numba.cuda.core import config as cuda_config
+    from numba import cuda  # noqa: PLC0415  (lazy: numba.cuda reads the simulator switch when first imported)
+    from numba.cuda.core import config as cuda_config  # noqa: PLC0415  (as numba.cuda)
 
-    prims = {}
+    prims: dict[str, Any] = {}
     if not cuda_config.ENABLE_CUDASIM:
-        from numba.cuda import libdevice
+        from numba.cuda import libdevice  # noqa: PLC0415  (as numba.cuda; not there under the simulator)
 
-        prims = {"fma": cuda.fma, "mul": libdevice.dmul_rn, "as_bits": libdevice.double_as_longlong,
+        prims = {"fma": cuda.fma,  # type: ignore[attr-defined]  # numba.cuda's attributes are set at import "mul": libdevice.dmul_rn, "as_bits": libdevice.double_as_longlong,
                  "from_bits": libdevice.longlong_as_double}
     return compile_code(_MODULES, cuda.jit(device=True), prims)
 
 
+def for_target(jit: Callable[..., Any]) -> SimpleNamespace:
+    """The functions compiled for the target whose decorator is ``jit``: the CPU lanes'
+    (:func:`~safebasins.wells.compiled.cpu_jit`) or, for any other, CUDA's device functions."""
+    return cpu() if jit is cpu_jit else cuda_device()
+
+
+def _cpu_function(name: str) -> Any:
+    return getattr(cpu(), name)
+
+
 for _name in FUNCTIONS:
-    register_cpu_overload(globals()[_name], lambda _name=_name: getattr(cpu(), _name))
+    register_cpu_overload(globals()[_name], functools.partial(_cpu_function, _name))

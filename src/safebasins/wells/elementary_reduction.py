@@ -25,18 +25,18 @@ _MASK = 0xFFFFFF
 _P48, _P96, _P144 = 2.0 ** -48, 2.0 ** -96, 2.0 ** -144
 
 
-def _digit(i):
+def _digit(i: int) -> int:
     """D[i], 0 for i < 0 (digits above 2^-1: none)."""
     d = TWO_OVER_PI_DIGITS[i if i > 0 else 0]
     return d if i >= 0 else 0
 
 
-def _column(c, a, l0, l1, l2, l3):
+def _column(c: int, a: int, l0: int, l1: int, l2: int, l3: int) -> int:
     """Sum of the partial products of weight 2^(-24 (c + 1)): l_j D[c + j + a]."""
     return (l0 * _digit(c + a) + l1 * _digit(c + 1 + a)) + (l2 * _digit(c + 2 + a) + l3 * _digit(c + 3 + a))
 
 
-def reduce_pio2(m, e):
+def reduce_pio2(m: int, e: int) -> tuple[int, float, float, float]:
     """(n mod 4, a0, a1, a2): x (2/pi) = n + a0 + a1 + a2 for x = m 2^(e-52), 2^52 <= m < 2^53,
     e >= 30; |a0 + a1 + a2| <= 1/2, a0 a multiple of 2^-48, |a1| < 2^-48, |a2| < 2^-96."""
     ex = e - 52

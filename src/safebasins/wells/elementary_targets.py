@@ -1,4 +1,4 @@
-"""Compiling code written once in the wells' code language (numerics.elementary) for each target.
+"""Compiling code written once in the wells' code language (wells.elementary) for each target.
 
 * Bit casts, the primitives the code adds to wellcode's fma and mul: :func:`as_bits`,
   :func:`from_bits` (Python bodies for plain Python and numba's CUDA simulator; an LLVM bitcast
@@ -18,7 +18,9 @@ from __future__ import annotations
 
 import struct
 import types as pytypes
-from types import SimpleNamespace
+from collections.abc import Callable, Mapping, Sequence
+from types import FunctionType, ModuleType, SimpleNamespace
+from typing import Any, cast
 
 import llvmlite.binding as llvm
 from llvmlite import ir
@@ -33,34 +35,34 @@ VECTOR_WIDTHS = (2, 4, 8)
 
 
 # ------------------------------------------------------------------------------- bit casts
-def as_bits(x):
+def as_bits(x: float) -> int:
     """The IEEE 754 bits of a double as a signed 64-bit integer."""
-    return struct.unpack("<q", struct.pack("<d", x))[0]
+    return cast(int, struct.unpack("<q", struct.pack("<d", x))[0])
 
 
-def from_bits(i):
+def from_bits(i: int) -> float:
     """The double whose IEEE 754 bits are the signed 64-bit integer ``i``."""
-    return struct.unpack("<d", struct.pack("<q", i))[0]
+    return cast(float, struct.unpack("<d", struct.pack("<q", i))[0])
 
 
 @intrinsic
-def as_bits_cpu(typingctx, x):
+def as_bits_cpu(typingctx: Any, x: Any) -> Any:
     """:func:`as_bits` on the CPU: an LLVM bitcast (vectorises)."""
-    def codegen(context, builder, signature, args):
+    def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
         return builder.bitcast(args[0], ir.IntType(64))
     return types.int64(types.float64), codegen
 
 
 @intrinsic
-def from_bits_cpu(typingctx, i):
+def from_bits_cpu(typingctx: Any, i: Any) -> Any:
     """:func:`from_bits` on the CPU: an LLVM bitcast."""
-    def codegen(context, builder, signature, args):
+    def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
         return builder.bitcast(args[0], ir.DoubleType())
     return types.float64(types.int64), codegen
 
 
 # ------------------------------------------------------------------------------- one source, per target
-def _code_functions(module):
+def _code_functions(module: ModuleType) -> dict[str, FunctionType]:
     """{name: function} of the module-level functions defined in ``module``, except those it names
     in its ``NOT_CODE``."""
     skip = set(getattr(module, "NOT_CODE", ()))
@@ -68,7 +70,8 @@ def _code_functions(module):
             if isinstance(v, pytypes.FunctionType) and v.__module__ == module.__name__ and k not in skip}
 
 
-def compile_code(modules, jit, primitives, replace=None):
+def compile_code(modules: Sequence[ModuleType], jit: Callable[[Callable[..., Any]], Any], primitives: dict[str, Any],
+                 replace: Mapping[str, Callable[[SimpleNamespace], Any]] | None = None) -> SimpleNamespace:
     """SimpleNamespace of every code function of ``modules`` compiled by ``jit``; in each, the
     globals named in ``primitives`` are bound to the given objects and every global that is a code
     function (under any name) to its compiled version.  ``replace`` maps a name to a function of
@@ -95,7 +98,7 @@ def compile_code(modules, jit, primitives, replace=None):
 _PURE = ("nounwind", "willreturn", "memory(none)" if llvm.llvm_version_info >= (16,) else "readnone")
 
 
-def _cold_functions(context, module, sym, fndesc, sig):
+def _cold_functions(context: Any, module: ir.Module, sym: str, fndesc: Any, sig: Any) -> ir.Function:
     """The scalar function ``sym(double) -> double`` (out of line, calling the compiled code) and its
     masked vector variants ``sym_v<N>(<N x double>, <N x i1>)``; returns the scalar one."""
     d = ir.DoubleType()
@@ -134,7 +137,7 @@ def _cold_functions(context, module, sym, fndesc, sig):
     return scalar
 
 
-def _keep_alive(module, functions):
+def _keep_alive(module: ir.Module, functions: list[ir.Function]) -> None:
     """Append ``functions`` to the module's llvm.compiler.used (the variants are unreferenced until the
     loop vectoriser calls them); llvmlite cannot resize a global, so the array is replaced."""
     ptr = ir.PointerType(ir.IntType(8))
@@ -149,7 +152,7 @@ def _keep_alive(module, functions):
     module.globals[keep.name] = keep
 
 
-def cold_call_cpu(dispatcher, name):
+def cold_call_cpu(dispatcher: Any, name: str) -> Any:
     """An intrinsic calling the compiled ``dispatcher(x)`` (float -> float, pure) out of line, with
     masked vector variants: in a vectorised loop only the lanes that reach the call make it."""
     sig = types.float64(types.float64)
@@ -157,8 +160,8 @@ def cold_call_cpu(dispatcher, name):
     variants = ",".join(f"_ZGV_LLVM_M{n}v_{sym}({sym}_v{n})" for n in VECTOR_WIDTHS)
 
     @intrinsic
-    def cold(typingctx, x):
-        def codegen(context, builder, signature, args):
+    def cold(typingctx: Any, x: Any) -> Any:
+        def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
             cres = context.compile_subroutine(builder, dispatcher.py_func, sig)
             fn = builder.module.globals.get(sym)
             if fn is None:
@@ -173,7 +176,7 @@ def cold_call_cpu(dispatcher, name):
 
 
 # ------------------------------------------------------------------------------- @njit callers
-def register_cpu_overload(generic, compiled):
+def register_cpu_overload(generic: Callable[..., Any], compiled: Callable[[], Any]) -> None:
     """Let ``@njit`` code call the code function ``generic`` (one to three arguments): it compiles to
     a call of ``compiled()`` (a CPU dispatcher, built at the first such call)."""
     names = generic.__code__.co_varnames[:generic.__code__.co_argcount]

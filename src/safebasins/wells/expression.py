@@ -20,22 +20,24 @@ Allowed: the variable ``q``, numbers, ``+ - * / **``, ``pi``, ``E`` and the func
 from __future__ import annotations
 
 import math
-from types import SimpleNamespace
-
 import numpy as np
 
 from safebasins.wells.base import STEP_COST_ARITHMETIC, STEP_COST_TRANSCENDENTAL
 from safebasins.wells.numeric import NumericWell
-from safebasins.wells.compiled import callable_code, mul
+from safebasins.wells import elementary
+from safebasins.wells.compiled import mul, target_code
 
 __all__ = ["ExpressionWell", "expression", "FUNCTIONS"]
 
-#: functions an expression may use -> (math-module name, numpy function)
+#: functions an expression may use -> their numpy version (the theory's arrays); in the compiled
+#: engines those of wells.elementary (the same bits on the CPU and the GPU), atan and asinh the
+#: target's libm
 FUNCTIONS = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "log": np.log, "sqrt": np.sqrt,
              "sinh": np.sinh, "cosh": np.cosh, "tanh": np.tanh, "atan": np.arctan, "asinh": np.arcsinh}
-#: the ``math`` of the generated source when it runs on numpy arrays (the theory)
-_NUMPY_MATH = SimpleNamespace(pow=np.power, **FUNCTIONS)
-_NAMESPACE_NUMPY = {"math": _NUMPY_MATH, "mul": np.multiply}
+#: the functions of the generated source that are not wells.elementary's
+_LIBM = {"atan": math.atan, "asinh": math.asinh}
+#: the namespace of the generated source when it runs on numpy arrays (the theory)
+_NAMESPACE_NUMPY = {"mul": np.multiply, "pow": np.power, **FUNCTIONS}
 
 
 def _sympy():
@@ -61,7 +63,7 @@ def parse(text):
         V = parse_expr(text, local_dict=names, global_dict={"Integer": sp.Integer, "Float": sp.Float,
                                                             "Rational": sp.Rational, "Symbol": sp.Symbol},
                        transformations=standard_transformations)
-    except Exception as exc:   # sympy raises SyntaxError, TokenError, TypeError, NameError ...
+    except Exception as exc:  # noqa: BLE001  (sympy raises SyntaxError, TokenError, TypeError, NameError ...)
         raise ValueError(f"expression: cannot read {text!r} as a formula in q ({type(exc).__name__}: {exc})") from None
     if not isinstance(V, sp.Expr):
         raise ValueError(f"expression: {text!r} is not a formula in q")
@@ -75,8 +77,8 @@ def parse(text):
 
 
 class _Printer:
-    """Python source of a sympy expression: ``math.<f>`` calls, products with ``mul`` (left to right),
-    quotients as ``/``, integer powers as repeated products."""
+    """Python source of a sympy expression: calls of the functions by their names, products with
+    ``mul`` (left to right), quotients as ``/``, integer powers as repeated products."""
 
     def __init__(self, q):
         self.q = q
@@ -101,10 +103,10 @@ class _Printer:
         if e.is_Pow:
             return self._pow(e.base, e.exp)
         if isinstance(e, sp.sech):
-            return f"1.0 / math.cosh({self(e.args[0])})"
+            return f"1.0 / cosh({self(e.args[0])})"
         name = type(e).__name__
         if isinstance(e, sp.Function) and name in FUNCTIONS and len(e.args) == 1:
-            return f"math.{name}({self(e.args[0])})"
+            return f"{name}({self(e.args[0])})"
         raise ValueError(f"expression: {e} is not supported (functions: {', '.join(sorted(FUNCTIONS))}, sech)")
 
     def _wrap(self, e):
@@ -165,10 +167,10 @@ class _Printer:
                 return f"1.0 / {self._factor(sp.Pow(b, -n, evaluate=False)) if n != -1 else self._factor(b)}"
             return self._product([b] * n)
         if x == sp.Rational(1, 2):
-            return f"math.sqrt({self(b)})"
+            return f"sqrt({self(b)})"
         if x == sp.Rational(-1, 2):
-            return f"1.0 / math.sqrt({self(b)})"
-        return f"math.pow({self(b)}, {self(x)})"
+            return f"1.0 / sqrt({self(b)})"
+        return f"pow({self(b)}, {self(x)})"
 
 
 #: where the candidate forms of V' are compared with a 40-digit evaluation: ``|q|`` from 1e-4 to 30
@@ -255,13 +257,17 @@ class ExpressionWell(NumericWell):
         self.source, dV = generate_source(V, q)
         self.derivative = str(dV)
         self.step_cost = _step_cost(V, dV)
-        self._V_scalar, self._dV_scalar = _functions(self.source, {"math": math, "mul": _mul_stub()})
         Vn, dVn = _functions(self.source, _NAMESPACE_NUMPY)
         kwargs.setdefault("asymptotes", (_limit(V, q, -1), _limit(V, q, 1)))
         super().__init__(Vn, dVn, name=name, **kwargs)
 
     def _compiled_form(self):
-        return callable_code(self._V_scalar, self._dV_scalar, self.barriers, self.name, self.source)
+        source = self.source
+
+        def functions(jit):
+            return _functions(source, _compiled_namespace(elementary.for_target(jit)))
+
+        return target_code(functions, self.barriers, self.name, f"{elementary.MODULE_HASH}\0{source}")
 
     def potential_text(self):
         return self.formula
@@ -272,8 +278,11 @@ class ExpressionWell(NumericWell):
         return {"name": "expression", "expression": self.expression, **self._tol_spec()}
 
 
-def _mul_stub():
-    return mul
+def _compiled_namespace(functions):
+    """The generated source's names in a compiled engine: ``functions`` (wells.elementary compiled
+    for the target), the libm functions elementary has not, the wells' ``mul``."""
+    own = {k: getattr(functions, k) for k in (*FUNCTIONS, "pow") if k not in _LIBM}
+    return {"mul": mul, **_LIBM, **own}
 
 
 def expression(text, **kwargs):
