@@ -42,7 +42,8 @@ def test_merged_boundaries_brute_force():
     for k in range(3):
         for i in range(9):
             for j in range(7):
-                nb = [(i + a, j + b) for a, b in ((1, 0), (-1, 0), (0, 1), (0, -1)) if 0 <= i + a < 9 and 0 <= j + b < 7]
+                nb = [(i + a, j + b) for a, b in ((1, 0), (-1, 0), (0, 1), (0, -1))
+                      if 0 <= i + a < 9 and 0 <= j + b < 7]
                 assert B[k, i, j] == any((lab[i, j] == k) != (lab[x, y] == k) for x, y in nb)
 
 

@@ -230,9 +230,9 @@ def _ball_offsets(radius: float) -> tuple[Ints, Ints]:
 
 
 def _ball_entropies(inv: Ints, n_labels: int, radius: float, rng: np.random.Generator,
-                    n: int) -> tuple[Floats, npt.NDArray[np.bool_]]:
+                    n: int) -> tuple[Floats, Ints]:
     """Entropies of ``n`` balls of ``radius`` grid steps at uniform random centres (kept inside
-    the grid), and whether each holds more than one label."""
+    the grid), and the number of labels each holds."""
     nq, np_ = inv.shape
     cq = rng.uniform(radius, nq - 1 - radius, n)
     cp = rng.uniform(radius, np_ - 1 - radius, n)
@@ -243,7 +243,8 @@ def _ball_entropies(inv: Ints, n_labels: int, radius: float, rng: np.random.Gene
     lab = inv[np.clip(I, 0, nq - 1), np.clip(J, 0, np_ - 1)]
     ball = np.broadcast_to(np.arange(n)[:, None], lab.shape)
     counts = np.bincount((ball * n_labels + lab)[inside], minlength=n * n_labels).reshape(n, n_labels)
-    return _entropy(counts), (counts > 0).sum(axis=1) > 1
+    n_held: Ints = (counts > 0).sum(axis=1)
+    return _entropy(counts), n_held
 
 
 @api_provenance
@@ -262,7 +263,10 @@ def fractal_test(labels: LabelsLike, *, radius: float = 20, n_balls: int = 1000,
     S_bb from the band ``[S_bb_smooth, S_bb_smooth + bias]`` in standard errors is ``z``;
     ``p_value = 2 sf(z)`` (normal, two-sided, 1 inside the band); ``fractal`` when ``p_value <
     significance``.  The decision is for structure at the scale of the ball: Puy et al. advise a
-    grid at least 50 radii wide (``grid_over_radius``).
+    grid at least 50 radii wide (``grid_over_radius``).  The smooth value is that of two basins:
+    where three or more basins meet within a ball (``multi_fraction`` of the boundary balls) S_bb
+    rises above it without a fractal boundary, and a smooth boundary curved or folded at the
+    ball's scale departs from it as well.
 
     Parameters
     ----------
@@ -275,7 +279,8 @@ def fractal_test(labels: LabelsLike, *, radius: float = 20, n_balls: int = 1000,
     Returns
     -------
     xr.Dataset of scalars: ``S_bb``, ``S_bb_err``, ``S_bb_smooth``, ``bias``, ``z``, ``p_value``,
-    ``fractal``, ``n_draws`` (balls drawn to find ``n_balls`` on the boundary).  ValueError when
+    ``fractal``, ``multi_fraction`` (boundary balls holding three or more labels), ``n_draws``
+    (balls drawn to find ``n_balls`` on the boundary).  ValueError when
     fewer than ``n_balls`` boundary balls turn up in ``MAX_DRAWS_PER_BALL * n_balls`` draws.
     """
     lab, q0, p0 = check_labels(labels)
@@ -292,6 +297,7 @@ def fractal_test(labels: LabelsLike, *, radius: float = 20, n_balls: int = 1000,
         raise ValueError(f"labels hold a single label ({values[0]}): there is no boundary to test")
     inv = inv.reshape(lab.shape)
     found: list[Floats] = []
+    held: list[Ints] = []
     draws = 0
     while sum(h.size for h in found) < n_balls:
         if draws >= MAX_DRAWS_PER_BALL * n_balls:
@@ -299,10 +305,12 @@ def fractal_test(labels: LabelsLike, *, radius: float = 20, n_balls: int = 1000,
             raise ValueError(f"n_balls: only {got} of {draws} random balls of radius {radius:g} hold two labels, "
                              f"fewer than n_balls = {n_balls}: the boundary is too small a part of the grid "
                              "(crop the grid to the boundary or lower n_balls)")
-        h, bnd = _ball_entropies(inv, values.size, radius, rng, _BATCH)
-        found.append(h[bnd])
+        h, k = _ball_entropies(inv, values.size, radius, rng, _BATCH)
+        found.append(h[k > 1])
+        held.append(k[k > 1])
         draws += _BATCH
     h = np.concatenate(found)[:n_balls]
+    multi = float((np.concatenate(held)[:n_balls] > 2).mean())
     S, err = float(h.mean()), float(h.std(ddof=1) / np.sqrt(n_balls))
     S_s = smooth_boundary_entropy()
     bias = PUY_BIAS[0] * radius ** -PUY_BIAS[1]
@@ -318,6 +326,8 @@ def fractal_test(labels: LabelsLike, *, radius: float = 20, n_balls: int = 1000,
          "z": ((), z, {"units": "1", "long_name": "distance of S_bb from the smooth band in standard errors"}),
          "p_value": ((), p, {"units": "1", "long_name": "probability of so large a z for a smooth boundary"}),
          "fractal": ((), p < sig, {"long_name": f"fractal boundary at significance {sig:g}"}),
+         "multi_fraction": ((), multi, {"units": "1", "long_name": "fraction of the boundary balls holding three "
+                                                                   "or more labels"}),
          "n_draws": ((), draws, {"units": "1", "long_name": "random balls drawn"})})
     ds.attrs.update(_common_attrs(values), radius=radius, n_balls=n_balls, seed=int(seed), significance=sig,
                     grid_over_radius=float(min(lab.shape) / radius),

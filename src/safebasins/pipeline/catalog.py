@@ -407,6 +407,21 @@ DECLARATIONS += tuple(
 # q'' + beta q' + V'(q) = F sin(Omega t + Psi) (config block `damped`): Thompson's escape equation
 # across the Melnikov tangency of its hilltop saddle, and the paper's quartic with small damping.
 _DAMPED = "Damping: the escape equation across the Melnikov tangency and the damped quartic"
+_MEASURES_CAPTION = (
+    "{system}, β, Ω, Ψ in the title: the fate of each initial condition on a grid, read from the stroboscopic map "
+    "(escape over ξ_max, or the attractor inside the well it settles on), at forcing amplitudes below and past "
+    "the Melnikov threshold F_M of the hilltop saddle, and the fractal measures of the basin boundaries "
+    "(docs/basin-measures.md): basin entropy S_b, S_bb with the log 2 criterion (Daza et al. 2016), the ball "
+    "test for a fractal boundary (Puy et al. 2021), the Wada test of three basins (merging method, Daza et al. "
+    "2018) and the uncertainty exponent α of the grid, each with its standard error, for two labellings: "
+    "escape (escaped or safe) and attractors (escaped or each attractor's basin).")
+_MEASURES_LOOK = (
+    "Top: the basins at each F (white: escaped; colours: the attractors). Bottom left: the ball S_bb of the "
+    "fractal test with its standard error against the band of a smooth boundary (grey) and log 2 (dotted); "
+    "bottom right: α (1: smooth). Expect the escape boundary smooth below F_M and tangled past it, where the "
+    "hilltop saddle's manifolds cross. The ball test's smooth value is that of two basins: where three basins "
+    "meet in a ball (the share is in the notes) S_bb rises above it without a fractal boundary, so in the "
+    "attractor labelling read it with that share and with α.")
 DECLARATIONS += (
     Declaration(
         name="damped_tangency", kind="tangency", key=("damped", "escape_equation"), stem="damped_tangency",
@@ -452,6 +467,21 @@ DECLARATIONS += (
               + " Compare with Fig. 14: damping lets ICs whose undamped slow trajectory reaches ξ_max spiral in "
                 "instead, so both the numeric and the analytic basins grow; the IoU in the legend and the notes "
                 "measures how well the damped slow flow tracks that growth.")),
+    Declaration(
+        name="damped_escape_measures", kind="basin_measures", key=("damped", "escape_equation_measures"),
+        stem="damped_escape_measures", label="Damped escape equation: fractal boundary measures",
+        category=_DAMPED, options={}, seed_offset=32000,
+        title="Damped escape equation: basin entropy, fractal and Wada tests below and past the Melnikov tangency",
+        caption=_MEASURES_CAPTION.format(system="Thompson's escape equation q'' + β q' + q - q² = F sin(Ωt + Ψ)"),
+        look=_MEASURES_LOOK),
+    Declaration(
+        name="damped_quartic_measures", kind="basin_measures", key=("damped", "quartic_measures"),
+        stem="damped_quartic_measures", label="Damped quartic: fractal boundary measures",
+        category=_DAMPED, options={}, seed_offset=33000,
+        title="Paper's quartic with damping: basin entropy, fractal and Wada tests around the Melnikov threshold",
+        caption=_MEASURES_CAPTION.format(system="the paper's quartic with damping, q'' + β q' + q - q³ = "
+                                                "F sin(Ωt + Ψ)"),
+        look=_MEASURES_LOOK),
 )
 
 BY_NAME = {d.name: d for d in DECLARATIONS}
