@@ -26,7 +26,7 @@ from safebasins.analysis.tangency import melnikov_variable
 from safebasins.analysis.wada import wada_test
 from safebasins.core import checks
 from safebasins.core.cf import annotate
-from safebasins.numerics import stroboscopic_map
+from safebasins.numerics import DEFAULT_STEPS_PER_CYCLE, stroboscopic_map
 from safebasins.wells.provenance import api_provenance
 
 __all__ = ["boundary_measures", "WADA_FLAGS", "LABELLINGS"]
@@ -72,7 +72,7 @@ def _measures(lab: npt.NDArray[np.int64], box: int, radius: float, n_balls: int,
 def boundary_measures(F_values: float | Sequence[float], Omega: float, Psi: float, xi_max: float,
                       q0: npt.ArrayLike, p0: npt.ArrayLike, *, damping: float, well: Any = None, n_iter: int = 150,
                       box: int = 5, radius: float = 4.0, n_balls: int = 1000, eps: Sequence[int] = (2, 4, 8, 16),
-                      seed: int = 0, tol: float = 1e-4, steps_per_cycle: int = 64,
+                      seed: int = 0, tol: float = 1e-4, steps_per_cycle: int = DEFAULT_STEPS_PER_CYCLE,
                       threads: int | None = None) -> xr.Dataset:
     """Basin entropy, fractal test, Wada test and uncertainty exponent of the basins of escape and
     of each attractor, for each F.
