@@ -7,6 +7,7 @@ import xarray as xr
 from safebasins.core import checks
 from safebasins.analysis.integrity import grid_spacing
 from safebasins.wells.quartic import FOURIER_VARIANTS
+from safebasins.wells import QuarticWell, resolve_well
 
 
 def fourier_list(fourier):
@@ -32,8 +33,6 @@ def variant_well(well, fourier):
       variant is "exact", so ``fourier`` must be None or "exact" (stored as "exact"); "paper"
       (the quartic's truncated eq 20) raises ValueError.
     """
-    from safebasins.wells import QuarticWell, resolve_well
-
     if well is None or isinstance(well, QuarticWell):
         return resolve_well(well, fourier)
     w = resolve_well(well)      # ValueError for something that is not a Well

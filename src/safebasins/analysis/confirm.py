@@ -8,6 +8,9 @@ each connected part of the analytic basin tells them apart from the real basin.
 from __future__ import annotations
 
 import numpy as np
+from scipy import ndimage
+
+from safebasins.analysis.safe import is_safe
 
 __all__ = ["confirm_regions"]
 
@@ -32,10 +35,6 @@ def confirm_regions(safe_analytic, escape_cycle, t_eval):
         numbered by decreasing size), the pixel count and the numerically safe fraction of
         each region (arrays of length n).
     """
-    from scipy import ndimage
-
-    from safebasins.analysis.safe import is_safe
-
     s = np.asarray(safe_analytic, bool)
     e = np.asarray(escape_cycle, float)
     if s.shape != e.shape or s.ndim != 2:

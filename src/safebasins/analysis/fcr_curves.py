@@ -9,6 +9,9 @@ from __future__ import annotations
 import numpy as np
 
 from safebasins.wells.provenance import api_provenance
+from safebasins.core.stacking import stack
+from safebasins.theory import critical_forcing, initial_condition
+from safebasins.numerics import critical_forcing_numeric
 
 __all__ = ["analytic_fcr_curves", "numeric_fcr_curves"]
 
@@ -17,9 +20,6 @@ __all__ = ["analytic_fcr_curves", "numeric_fcr_curves"]
 def analytic_fcr_curves(Omega, curves, *, well=None, label=""):
     """One :func:`safebasins.theory.critical_forcing` per curve (eqs 22-26), stacked over ``curve``
     with the coordinates xi_max, xi_ini, gamma_ini, label (and Psi when every curve has one)."""
-    from safebasins.core.stacking import stack
-    from safebasins.theory import critical_forcing
-
     Omega = np.asarray(Omega, dtype=float)
     parts = []
     for c in curves:
@@ -43,10 +43,6 @@ def numeric_fcr_curves(Omega, curves, *, well=None, cycles, tol, F_bracket, crit
     """One :func:`safebasins.numerics.critical_forcing_numeric` per curve, from the IC
     ``theory.initial_condition(xi_ini, gamma_ini, Psi)``, stacked over ``curve`` with the
     coordinates xi_max, xi_ini, gamma_ini, Psi, label, q0, p0."""
-    from safebasins.core.stacking import stack
-    from safebasins.numerics import critical_forcing_numeric
-    from safebasins.theory import initial_condition
-
     Omega = np.asarray(Omega, dtype=float)
     parts, q0s, p0s = [], [], []
     for c in curves:

@@ -20,6 +20,8 @@ import xarray as xr
 
 from safebasins.core import checks
 from safebasins.wells.provenance import api_provenance
+from safebasins.analysis.safe import is_safe
+from safebasins.numerics import escape_chart
 
 __all__ = ["uncertainty_exponent", "MIN_UNCERTAIN"]
 
@@ -91,9 +93,6 @@ def uncertainty_exponent(F, Omega, Psi, xi_max, box, *, eps=(1e-2, 3e-3, 1e-3, 3
     ``n``, ``seed``, ``safe_fraction`` (of the base points).  alpha is NaN when fewer than two
     eps have at least MIN_UNCERTAIN uncertain ICs.
     """
-    from safebasins.analysis.safe import is_safe
-    from safebasins.numerics import escape_chart
-
     b = _box(box)
     e = np.atleast_1d(checks.check_positive("eps", eps)).astype(float)
     if e.ndim != 1 or np.unique(e).size != e.size:

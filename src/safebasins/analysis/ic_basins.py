@@ -21,9 +21,15 @@ from __future__ import annotations
 
 import numpy as np
 import xarray as xr
+import contourpy
 
 from safebasins.core import checks
 from safebasins.wells.provenance import api_provenance
+from safebasins.wells import resolve_well
+from safebasins.theory import safe_basin_boundaries, slow_flow_escapes, escapes_on_manifold, first_integral
+from safebasins.core.stacking import stack
+from safebasins.analysis.confirm import confirm_regions
+from safebasins.numerics import escape_chart
 
 __all__ = ["analytic_basin", "analytic_basin_stack", "add_resonance_manifold", "numeric_check", "mask_outline",
            "MASK_OUTLINE"]
@@ -52,10 +58,6 @@ def mask_outline(safe, q0, p0, Psi, *, well=None):
     the resonance manifold is split there) and ``xi`` of each vertex from the well's action-angle
     map (NaN outside the well).  The outline is as fine as the grid: within half a grid step of
     the true boundary of the classification."""
-    import contourpy
-
-    from safebasins.wells import resolve_well
-
     w = resolve_well(well)
     qa, pa = np.asarray(q0, float), np.asarray(p0, float)
     S = np.asarray(safe, bool)
@@ -109,8 +111,6 @@ def analytic_basin(F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, l
     docs/damping.md; undecided trajectories count as escaping) and the boundary curves are the
     outline of its safe mask (:func:`mask_outline`, attribute ``boundary = "mask_outline"``;
     ``n_points`` unused), attribute ``damping``."""
-    from safebasins.theory import safe_basin_boundaries, slow_flow_escapes
-
     beta = checks.check_damping(damping)
     qa, pa = np.asarray(q0, float), np.asarray(p0, float)
     Q, P = np.meshgrid(qa, pa, indexing="ij")
@@ -136,8 +136,6 @@ def analytic_basin_stack(scan, values, F, Omega, Psi, xi_max, q0, p0, *, well=No
     ``values``; the other one is the scalar argument).  Each basin's saddle point is a coordinate
     along ``scan`` (``saddle_gamma``, ``saddle_xi``; NaN for a damped basin); attribute ``scan``.
     ``damping``: as :func:`analytic_basin`."""
-    from safebasins.core.stacking import stack
-
     if scan not in ("F", "xi_max"):
         raise ValueError(f"scan must be 'F' or 'xi_max', got {scan!r}")
     parts = [analytic_basin(v if scan == "F" else F, Omega, Psi, v if scan == "xi_max" else xi_max, q0, p0,
@@ -151,8 +149,6 @@ def analytic_basin_stack(scan, values, F, Omega, Psi, xi_max, q0, p0, *, well=No
 def add_resonance_manifold(basin, F, Omega, xi_max, *, n_gamma, n_xi, xi_top, well=None):
     """``basin`` with the first integral ``C(gamma_rm, xi_rm)`` (eq 18) and the escape
     classification ``escapes_rm`` on a gamma in [-pi, pi] x xi in [0, xi_top] grid."""
-    from safebasins.theory import escapes_on_manifold, first_integral
-
     g = np.linspace(-np.pi, np.pi, n_gamma)
     x = np.linspace(0.0, xi_top, n_xi)
     G, X = np.meshgrid(g, x, indexing="ij")
@@ -172,9 +168,6 @@ def numeric_check(basin, F, Omega, Psi, xi_max, *, cycles, steps_per_cycle, well
     ``region_numeric_safe`` (dim ``region_index``), attribute ``check_cycles``.  The numerics
     integrate the equation of the basin: with its ``damping`` attribute (a damped basin of
     :func:`analytic_basin`) the damped one.  ``label``: as :func:`analytic_basin`."""
-    from safebasins.analysis.confirm import confirm_regions
-    from safebasins.numerics import escape_chart
-
     beta = checks.check_damping(basin.attrs.get("damping", 0.0))
     safe = ~np.asarray(basin["escapes"].transpose("q0", "p0").values, bool)
     Q, P = np.meshgrid(basin["q0"].values, basin["p0"].values, indexing="ij")

@@ -65,6 +65,9 @@ import dataclasses
 import numpy as np
 import xarray as xr
 from numpy.polynomial import legendre as _leg
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq, minimize_scalar
+from scipy.interpolate import CubicSpline
 
 from safebasins.core import checks
 from safebasins.wells import resolve_well, well_attrs
@@ -367,8 +370,6 @@ def melnikov_curve(Omega, damping, well=None) -> xr.Dataset:
 def _flow(well, F, Omega, damping, phase, y0, tau_end, rtol, dense=False):
     """DOP853 of ``q' = p, p' = -V'(q) - damping p + F sin(Omega tau + phase_k)`` for the columns of
     ``y0`` (2, N) over local times ``tau`` in ``[0, tau_end]`` (``tau_end < 0``: backward)."""
-    from scipy.integrate import solve_ivp
-
     n = y0.shape[1]
 
     def fun(tau, y):
@@ -443,8 +444,6 @@ def _manifold_section(well, F, Omega, damping, Psi, q_b, direction, unstable, se
     direction of the forced saddle's periodic orbit at each, on the side ``sign(e_q) = direction``;
     flow forward (backward) to the first crossing of the section.  Returns crossing times ``t_c``
     and the states there (2, N)."""
-    from scipy.optimize import brentq
-
     T = 2.0 * np.pi / Omega
     x, (mu_u, e_u), (mu_s, e_s) = _saddle_orbit(well, F, Omega, damping, Psi, q_b, rtol)
     e = e_u if unstable else e_s
@@ -511,9 +510,6 @@ def manifold_splitting(F, Omega, damping, well=None, Psi=0.0, n_phase=48, offset
     ``min_energy_gap``, ``max_energy_gap``, ``manifolds_intersect`` (the gap takes both signs),
     ``F_M``, the parameters and the well.  ValueError naming ``F`` when the forced saddle has no
     hyperbolic periodic orbit (F far too large) or a manifold never reaches the section."""
-    from scipy.interpolate import CubicSpline
-    from scipy.optimize import minimize_scalar
-
     F = checks.check_scalar("F", F, checks.check_nonnegative)
     Om = checks.check_scalar("Omega", Omega, lambda n, v: _check_omega(v))
     damping = checks.check_damping(damping)

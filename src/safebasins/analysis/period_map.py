@@ -40,6 +40,7 @@ import numpy as np
 
 from safebasins.core import checks
 from safebasins.wells.provenance import api_provenance
+from safebasins.numerics import stroboscopic_map, escape_chart
 
 __all__ = ["birkhoff_weights", "weighted_birkhoff", "rotation_numbers", "island_chains", "classify_orbits",
            "portrait_with_criteria",
@@ -255,8 +256,6 @@ def strobe_step(F, Omega, Psi, *, xi_max=None, q_max=None, steps_per_cycle=None,
     """The period map of eq (29) as ``step(q, p) -> (q', p')`` (NaN once a threshold is crossed),
     for :func:`periodic_orbit` and :func:`minimal_period`; ``well``: the well of eq (1) (None: the
     paper's quartic; see ``numerics.stroboscopic_map``)."""
-    from safebasins.numerics import stroboscopic_map
-
     kw = {k: v for k, v in (("steps_per_cycle", steps_per_cycle), ("integrator", integrator)) if v is not None}
 
     def step(q, p):
@@ -375,7 +374,6 @@ def period_map_portrait(q0, p0, F, Omega, Psi, *, n_keep, n_iter=3000, xi_max=No
         classification settings.
     """
 
-    from safebasins.numerics import stroboscopic_map
 
     n_keep = checks.check_positive_int("n_keep", n_keep)
     kw = {} if steps_per_cycle is None else {"steps_per_cycle": steps_per_cycle}
@@ -460,8 +458,6 @@ def portrait_with_criteria(q0, p0, origin, F, Omega, Psi, *, criterion, xi_max, 
     ``criterion`` ("energy": H0 > xi_max, "displacement": ``|q| > q_max``), with each kept orbit's
     ``origin`` label and its escape cycle under BOTH criteria (``escape_cycle_energy``,
     ``escape_cycle_displacement``: one escape chart of the kept ICs, paired samples)."""
-    from safebasins.numerics import escape_chart
-
     thresholds = dict(xi_max=xi_max) if criterion == "energy" else dict(q_max=q_max)
     out = period_map_portrait(q0, p0, F, Omega, Psi, n_keep=n_keep, n_iter=n_iter, steps_per_cycle=steps_per_cycle,
                               threads=threads, min_digits=min_digits, max_period=max_period, **thresholds)

@@ -51,6 +51,7 @@ from safebasins.numerics import escape_chart
 from safebasins.theory import angle_energy, escapes_on_manifold
 from safebasins.wells import resolve_well, well_attrs
 from safebasins.wells.provenance import api_provenance
+from safebasins.theory import safe_basin_boundaries
 
 __all__ = [
     "default_phases",
@@ -311,8 +312,6 @@ def phase_boundaries(F, Omega, xi_max, Psi_values, *, fourier=None, n_points=400
     ``boundary_q0``, ``boundary_p0`` (NaN-padded; NaN rows also split a curve) and
     ``boundary_curve`` (curve index of the vertex, -1 = padding).
     """
-    from safebasins.theory import safe_basin_boundaries
-
     fl, wl, scalar = well_variants(well, fourier)
     xi = as_1d("xi_max", xi_max, wl[0].check_threshold)
     Psi = as_1d("Psi_values", Psi_values, checks.check_finite)

@@ -13,6 +13,7 @@ import xarray as xr
 
 from safebasins.core import checks
 from safebasins.core import cf
+from safebasins.wells import from_attrs, QuarticWell
 
 __all__ = ["is_safe", "check_t_eval", "check_chart", "safe_mask", "safe_area", "safe_stack", "escape_variable", "chart_well",
            "displacement_energy", "q_max_energy"]
@@ -62,8 +63,6 @@ def check_chart(chart, name="chart", variables=_CHART_VARIABLES):
 def chart_well(chart):
     """The well an escape chart was integrated in (its ``well`` attributes, written by
     ``numerics.escape_chart``); ValueError when the chart does not name one."""
-    from safebasins.wells import from_attrs
-
     if "well" not in chart.attrs:
         raise ValueError("the chart names no well (attribute 'well', written by numerics.escape_chart): "
                          "cannot tell its unforced safe set")
@@ -97,8 +96,6 @@ def q_max_energy(well, q_max):
     :func:`displacement_energy` of ``(-q_max, q_max)``; for the quartic its closed form
     ``V(q_max)`` (eq (4) inverted, ``QuarticWell.xi_from_q_max``: both sides are equal, and
     evaluating V(-q_max) separately could differ from V(q_max) in the last bit)."""
-    from safebasins.wells import QuarticWell
-
     if isinstance(well, QuarticWell):
         return well.xi_from_q_max(well.check_displacement("q_max", q_max))
     qm = checks.as_array("q_max", q_max)

@@ -24,6 +24,7 @@ import numpy as np
 
 from safebasins import theory
 from safebasins.explore.ranges import WellRanges
+from safebasins.analysis.ic_basins import mask_outline
 
 __all__ = ["Forcing", "ic_grid", "ic_safe", "ic_plane", "manifold", "pictures", "level_values", "IC_GRID",
            "MANIFOLD_GRID", "DAMPED_IC_GRID", "DAMPED_MANIFOLD_GRID"]
@@ -90,8 +91,6 @@ def ic_plane(r: WellRanges, f: Forcing, n: int) -> dict:
     Damped (``f.damping > 0``): on at most ``DAMPED_IC_GRID`` points per axis, the boundaries the
     outline of the safe mask."""
     if f.damping > 0:
-        from safebasins.analysis.ic_basins import mask_outline
-
         n = min(n, DAMPED_IC_GRID)
         safe = ic_safe(r, f, n)
         bounds = mask_outline(safe, *ic_grid(r, n), f.Psi, well=r.well)

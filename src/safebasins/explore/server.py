@@ -6,6 +6,8 @@ from __future__ import annotations
 import socket
 from functools import partial
 
+from safebasins.explore.state import view
+
 __all__ = ["check_host", "free_port", "check_port", "make_server", "serve", "SNAPSHOT_PATH"]
 
 #: URL path of the static picture of a view
@@ -45,12 +47,11 @@ def snapshot_handler():
     """The tornado handler of ``/snapshot?<query>``: the static page of the query's view (the
     command line's well and point where the query leaves them out); a bad query is answered 400
     with the error in plain text."""
-    from tornado.ioloop import IOLoop
-    from tornado.web import RequestHandler
+    from tornado.ioloop import IOLoop  # noqa: PLC0415 - bokeh (with tornado) is an optional extra
+    from tornado.web import RequestHandler  # noqa: PLC0415 - bokeh (with tornado) is an optional extra
 
-    from safebasins.explore.app import error_text
-    from safebasins.explore.snapshot import static_html
-    from safebasins.explore.state import view
+    from safebasins.explore.app import error_text  # noqa: PLC0415 - imports bokeh, an optional extra
+    from safebasins.explore.snapshot import static_html  # noqa: PLC0415 - imports bokeh, an optional extra
 
     def page(well, values, arguments):
         return static_html(*view(well, values, arguments))
@@ -81,9 +82,9 @@ def make_server(host: str = "127.0.0.1", port: int | None = None, well="quartic"
 
     Browsers may connect through ``host``, ``localhost`` or ``127.0.0.1`` on that port.
     """
-    from bokeh.server.server import Server
+    from bokeh.server.server import Server  # noqa: PLC0415 - bokeh is an optional extra
 
-    from safebasins.explore.app import make_document
+    from safebasins.explore.app import make_document  # noqa: PLC0415 - imports bokeh, an optional extra
 
     check_host(host)
     port = free_port(host) if port is None else check_port(host, port)

@@ -25,6 +25,7 @@ from bokeh.embed import file_html
 from bokeh.layouts import column, row
 from bokeh.models import Div
 from bokeh.resources import INLINE
+from PIL import Image
 
 from safebasins.explore import analytic
 from safebasins.explore.analytic import Forcing
@@ -91,8 +92,6 @@ def find_chromium(browser=None) -> str:
 
 def ink_fraction(png) -> float:
     """Fraction of the picture's pixels that are not (near) white."""
-    from PIL import Image
-
     with Image.open(png) as im:
         a = np.asarray(im.convert("L"))
     return float((a < 245).mean())

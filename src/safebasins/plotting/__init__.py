@@ -17,6 +17,8 @@ extras          beyond the paper: erosion, phase-invariant basin, first harmonic
 captions        report captions with numbers read from the data
 notebooks       the papermill notebook of a figure (scripts/make_notebooks.py, rule figure_notebook)
 """
+import importlib
+
 __all__ = ["plot_escape_chart", "plot_basin", "plot_fcr", "plot_integrity_map", "save_figure", "MissingData"]
 _HOME = {"plot_escape_chart": "api", "plot_basin": "api", "plot_fcr": "api", "plot_integrity_map": "api",
          "save_figure": "style", "MissingData": "data"}
@@ -24,8 +26,6 @@ _HOME = {"plot_escape_chart": "api", "plot_basin": "api", "plot_fcr": "api", "pl
 
 def __getattr__(name):  # exported lazily: `import safebasins.plotting.data` stays light (no pyplot)
     if name in _HOME:
-        import importlib
-
         return getattr(importlib.import_module(f"safebasins.plotting.{_HOME[name]}"), name)
     raise AttributeError(f"module 'safebasins.plotting' has no attribute {name!r}")
 

@@ -15,6 +15,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
+from matplotlib.legend_handler import HandlerTuple
 
 from safebasins.plotting import data
 from safebasins.plotting.charts import CRITERIA, agreement_time, chart_scan, draw_nested_chart, draw_nested_safe
@@ -23,6 +24,9 @@ from safebasins.plotting.data import MissingData, open_dataset, param, source, v
 from safebasins.plotting.integrity_maps import plot_integrity_map
 from safebasins.plotting.style import (LABELS, SB_EDGE, SB_FACE, SYMBOLS, add_footnote, fmt_value, new_axes,
                                        param_text)
+from safebasins.plotting.basins import draw_ic_basin
+from safebasins.plotting.fcr import (CURVE_COLORS, CURVE_MARKERS, bracket_handle, curve_labels, draw_fcr,
+                                     draw_fcr_numeric, ic_text, mechanism_key, mechanism_legend_handles, omega_margins)
 
 __all__ = ["plot_escape_chart", "plot_basin", "plot_fcr", "plot_integrity_map"]
 
@@ -171,8 +175,6 @@ def plot_basin(basin, *, ax=None):
     >>> basin["escapes"] = xr.DataArray(esc, dims=("q0", "p0"), coords={"q0": q0, "p0": p0})
     >>> fig = plot_basin(basin)                      # filled
     """
-    from safebasins.plotting.basins import draw_ic_basin
-
     basin = open_dataset(basin)
     for v in ("q0_vertex", "p0_vertex", "curve_index", "kind"):
         var(basin, v)
@@ -257,12 +259,6 @@ def plot_fcr(analytic=None, numeric=None, *, ax=None):
     >>> num = nu.critical_forcing_numeric([0.7, 0.9, 1.1], 0.15, cycles=100, n_scan=8)
     >>> fig = plot_fcr(ana, num)
     """
-    from matplotlib.legend_handler import HandlerTuple
-
-    from safebasins.plotting.fcr import (CURVE_COLORS, CURVE_MARKERS, bracket_handle, curve_labels, draw_fcr,
-                                         draw_fcr_numeric, ic_text, mechanism_key, mechanism_legend_handles,
-                                         omega_margins)
-
     analytic, numeric = open_dataset(analytic), open_dataset(numeric)
     if analytic is None and numeric is None:
         raise ValueError("give at least one of analytic (theory.critical_forcing) and numeric "

@@ -15,6 +15,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
+from scipy import ndimage
 
 from safebasins.plotting import data
 from safebasins.plotting.captions import add_note, count
@@ -22,6 +23,7 @@ from safebasins.plotting.curves import (IC_LINE, boundary_polylines, break_wraps
                                         safe_fill, separates_mask, xy_grid)
 from safebasins.plotting.data import open_dataset, param, var
 from safebasins.plotting.style import LABELS, SB_EDGE, SB_FACE, TRUNC_COLOR, fmt_value, param_text, pi_ticks
+from safebasins.analysis.safe import is_safe
 
 UNCONFIRMED_COLOR = "tab:orange"  # analytic-safe ICs the numerics do not keep (hatched)
 UNCONFIRMED_EDGE = "#a04000"      # boundary of a part not confirmed (dotted; darker: visible on the hatch)
@@ -51,7 +53,6 @@ def numeric_check(ds):
     without it, the pixels of the refuted parts)."""
     if "region" not in ds.variables:
         return None
-    from safebasins.analysis.safe import is_safe
 
     cycles = float(param(ds, "check_cycles"))
     region = var(ds, "region")
@@ -85,8 +86,6 @@ def cut_width(ds):
     """How far the gamma window must reach beyond +-pi so that no safe part crossing the cut
     gamma = +-pi of the cylinder is drawn in two halves (0 when none does).  A part touching
     both edges of the -pi..pi window (a band around the cylinder) needs nothing."""
-    from scipy import ndimage
-
     safe = ~np.asarray(var(ds, "escapes_rm").transpose("gamma_rm", "xi_rm")).astype(bool)
     g = np.asarray(var(ds, "gamma_rm"), float)
     lab, n = ndimage.label(safe, structure=np.ones((3, 3), bool))

@@ -12,6 +12,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import numpy as np
+
 __all__ = ["add_note", "notes", "caption_rst", "write_caption", "count", "fmt_range"]
 
 _ATTR = "_safebasins_notes"
@@ -37,8 +39,6 @@ def count(n, one, many=None):
 
 def fmt_range(values, fmt="{:.4g}"):
     """``"a-b"`` of the finite values (one value: ``"a"``)."""
-    import numpy as np
-
     v = np.asarray(values, float).ravel()
     v = v[np.isfinite(v)]
     if not v.size:

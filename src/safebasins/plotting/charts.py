@@ -12,6 +12,7 @@ import numpy as np
 from matplotlib.legend_handler import HandlerTuple
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
+from scipy.spatial import cKDTree
 
 from safebasins.analysis.safe import is_safe, safe_area
 from safebasins.plotting.curves import (analytic_safe, boundary_polylines, plot_curve, safe_fill,
@@ -118,8 +119,6 @@ def coincident_groups(curves, tol):
     """Groups of polylines (``curves``: [(slice, xs, ys), ...]) of different slices that run
     along each other (every point of each within ``tol`` of the other): [([i, j, ...], largest
     distance), ...]."""
-    from scipy.spatial import cKDTree
-
     pts = [_resample(np.asarray(x, float), np.asarray(y, float)) for _, x, y in curves]
     parent = list(range(len(curves)))
     dist = {}

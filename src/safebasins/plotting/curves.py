@@ -11,6 +11,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import ListedColormap
+from matplotlib.patches import Polygon
 
 from safebasins.plotting.data import var
 from safebasins.plotting.style import SB_EDGE, SB_FACE
@@ -67,8 +68,6 @@ IC_LINE = dict(solid_capstyle="round", solid_joinstyle="round")
 def plot_curve(ax, xs, ys, **style):
     """A boundary polyline on the IC plane: seams at the gamma cut removed (:func:`join_seams`);
     a curve that closes on itself is drawn as one closed path (no start / end cap)."""
-    from matplotlib.patches import Polygon
-
     xs, ys = join_seams(xs, ys)
     ok = np.isfinite(xs) & np.isfinite(ys)
     if ok.all() and xs.size > 3 and np.hypot(xs[-1] - xs[0], ys[-1] - ys[0]) < 1e-9:

@@ -14,13 +14,14 @@ import numpy as np
 import xarray as xr
 import yaml
 
+from safebasins.io.netcdf import read
+from safebasins.wells import NAMED_WELLS, from_attrs
+
 
 def open_dataset(src):
     """Path -> fully loaded Dataset (file closed again; its path kept in ``encoding["source"]``);
     a Dataset passes through; None stays None.  A corrupted or truncated file is a
     :class:`~safebasins.io.netcdf.NetCDFFileError` naming it."""
-    from safebasins.io.netcdf import read
-
     if src is None or isinstance(src, (xr.Dataset, xr.DataArray)):
         return src
     out = read(src)
@@ -59,8 +60,6 @@ def param(ds, name):
 
 def well(ds):
     """The potential well of a dataset (its ``well`` attributes, safebasins.wells.spec_attrs)."""
-    from safebasins.wells import from_attrs
-
     if "well" not in ds.attrs:
         raise MissingData(f"{source(ds)}: no attribute 'well' (datasets name their potential well)")
     return from_attrs(ds.attrs)
@@ -131,7 +130,6 @@ def well_text(attrs) -> str | None:
         return None
     if name == "expression" and "well_expression" in attrs:      # the formula the dataset defines it by
         return f"well: V(q) = {attrs['well_expression']}"
-    from safebasins.wells import NAMED_WELLS, from_attrs
 
     if name in NAMED_WELLS:                                      # the named well's own description
         return f"well: {name}, {NAMED_WELLS[name][1]}"

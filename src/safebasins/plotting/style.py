@@ -3,9 +3,12 @@ from __future__ import annotations
 
 import os
 from contextlib import contextmanager
+import textwrap
 
 import matplotlib.pyplot as plt
 import numpy as np
+
+from safebasins.plotting.data import provenance, well_texts
 
 DEFAULT_DPI = 180
 
@@ -94,8 +97,6 @@ def save_figure(fig, png=None, pdf=None, *, dpi=DEFAULT_DPI, datasets=(), headin
     ``parameters``, ... (:func:`safebasins.plotting.data.provenance`); the PDF ``Subject``.
     ``heading`` (an experiment's title) and the potential of a well other than the paper's quartic
     are written above everything drawn (:func:`add_heading`)."""
-    from safebasins.plotting.data import provenance, well_texts
-
     meta = provenance(*datasets, fig=fig)
     add_heading(fig, [heading, *well_texts(*datasets, fig=fig)])
     summary = ", ".join(f"{k} {meta[k]}" for k in ("safebasins_version", "git_commit", "config_hash", "well")
@@ -119,8 +120,6 @@ def _drawn_extent(fig):
 
 def _wrap(fig, text, fontsize, x0, x1):
     """``text`` wrapped to the width between ``x0`` and ``x1`` (figure coordinates)."""
-    import textwrap
-
     chars = max(40, int((x1 - x0) * fig.get_figwidth() * 72 / (0.52 * fontsize)))
     return "\n".join(textwrap.fill(line, chars) for line in str(text).split("\n"))
 
