@@ -22,6 +22,8 @@ from matplotlib.colors import to_rgb
 from matplotlib.legend_handler import HandlerTuple
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Patch
+from matplotlib.cm import ScalarMappable
+from matplotlib.colors import Normalize
 
 from safebasins.plotting.curves import draw_well, plot_curve, separates_mask
 from safebasins.plotting.captions import add_note, count, fmt_range
@@ -29,6 +31,7 @@ from safebasins.plotting import data
 from safebasins.plotting.data import open_dataset, param, var
 from safebasins.plotting.fcr import curve_labels, ic_text
 from safebasins.plotting.style import LABELS, fmt_value, param_text
+from safebasins.plotting.style import pi_ticks
 
 __all__ = ["figure_erosion", "figure_true_basin", "figure_fourier", "shade"]
 
@@ -210,11 +213,6 @@ def _draw_basin_panel(ax, ds, sel, label):
 
 def _phase_colorbar(fig, cax):
     """Colour scale of the per-phase outlines: the forcing phase Psi over one period."""
-    from matplotlib.cm import ScalarMappable
-    from matplotlib.colors import Normalize
-
-    from safebasins.plotting.style import pi_ticks
-
     cb = fig.colorbar(ScalarMappable(norm=Normalize(0, 2 * np.pi), cmap="twilight"), cax=cax)
     cb.set_label(r"forcing phase $\Psi$ of the per-phase outlines")
     pi_ticks(cb.ax, 0, 2 * np.pi, axis="y")
