@@ -85,10 +85,11 @@ def chart_labels(chart: xr.Dataset, t_eval: float | None = None, *, threshold: f
 
     Returns
     -------
-    xr.DataArray ``basin`` (q0, p0), int8, CF flags ``flag_values = [0, 1]``, ``flag_meanings =
-    "escaped safe"``; attributes ``t_eval``, ``criterion``, the threshold and the chart's F,
-    Omega, Psi, cycles, damping and well.  The chart does not record the barrier an IC escaped
-    over, so every escaped IC has one label.
+    xr.DataArray
+        ``basin`` (q0, p0), int8, CF flags ``flag_values = [0, 1]``,
+        ``flag_meanings = "escaped safe"``; attributes ``t_eval``, ``criterion``, the threshold
+        and the chart's F, Omega, Psi, cycles, damping and well.  The chart does not record the
+        barrier an IC escaped over, so every escaped IC has one label.
     """
     esc, thr = escape_variable(chart, criterion)
     if not {"q0", "p0"} <= set(esc.dims):
@@ -140,8 +141,9 @@ def map_labels(strobe: xr.Dataset, *, tol: float = 1e-4, period_max: int = 4) ->
 
     Parameters
     ----------
-    strobe : :func:`safebasins.numerics.stroboscopic_map` of ``np.meshgrid(q0, p0,
-        indexing="ij")`` (damped, ``n_iter`` long enough for transients to die out).
+    strobe : xr.Dataset
+        :func:`safebasins.numerics.stroboscopic_map` of ``np.meshgrid(q0, p0, indexing="ij")``
+        (damped, ``n_iter`` long enough for transients to die out).
     tol : an IC has settled on a period-k orbit (k <= ``period_max``) when its last iterate lies
         within ``tol`` (max norm) of the iterate k periods before.  Orbits whose smallest-q
         points lie within ``10 tol`` of each other are one attractor.

@@ -5,15 +5,14 @@ One family over labels on a ``(q0, p0)`` grid (:func:`safebasins.analysis.basin_
 an escape chart's via :func:`~safebasins.analysis.basin_labels.chart_labels`), each returning a
 Dataset with the statistical uncertainty of its numbers:
 
-basin_entropy             S_b and S_bb over boxes of ``box x box`` nodes (Daza et al. 2016) and
-                          the log 2 criterion (S_bb > log 2: fractal; needs three or more labels)
-fractal_test              the test of Puy et al. (2021): S_bb of random balls against the value of
-                          a smooth boundary, with a p-value
-grid_uncertainty_exponent f(eps) ~ eps^alpha of the labelled grid (eps in grid steps): the same
-                          definition, fit and variables as
-                          :func:`safebasins.analysis.fractality.uncertainty_exponent`, which
-                          integrates fresh perturbed initial conditions instead
-wada_test                 (:mod:`safebasins.analysis.wada`) the merging method of Daza et al. 2018
+- ``basin_entropy``: S_b and S_bb over boxes of ``box x box`` nodes (Daza et al. 2016) and the
+  log 2 criterion (S_bb > log 2: fractal; needs three or more labels);
+- ``fractal_test``: the test of Puy et al. (2021), S_bb of random balls against the value of a
+  smooth boundary, with a p-value;
+- ``grid_uncertainty_exponent``: f(eps) ~ eps^alpha of the labelled grid (eps in grid steps), the
+  definition, fit and variables of :func:`safebasins.analysis.fractality.uncertainty_exponent`,
+  which integrates fresh perturbed initial conditions instead;
+- ``wada_test`` (:mod:`safebasins.analysis.wada`): the merging method of Daza et al. 2018.
 
 Entropies use the natural logarithm.  Box sizes, ball radii and eps are counted in grid steps
 (nodes); with grid axes (a DataArray) the widths in q0 and p0 units are coordinates as well.

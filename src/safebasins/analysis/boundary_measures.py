@@ -56,7 +56,7 @@ _VARS = {
 
 def _measures(lab: npt.NDArray[np.int64], box: int, radius: float, n_balls: int, eps: Sequence[int],
               seed: int) -> dict[str, Any]:
-    """Basin entropy (all box**2 tilings), fractal test and grid uncertainty exponent of one labelling."""
+    """Basin entropy (all ``box**2`` tilings), fractal test and grid uncertainty exponent of one labelling."""
     be = basin_entropy(lab, box=box, offsets=box * box, seed=seed)
     ft = fractal_test(lab, radius=radius, n_balls=n_balls, seed=seed)
     ue = grid_uncertainty_exponent(lab, eps=eps, seed=seed)
@@ -86,7 +86,7 @@ def boundary_measures(F_values: float | Sequence[float], Omega: float, Psi: floa
     well, steps_per_cycle, threads : as the numerics.
     n_iter, tol : map iterations and the settling tolerance of
         :func:`~safebasins.analysis.basin_labels.map_labels`.
-    box, seed : :func:`~safebasins.analysis.basin_measures.basin_entropy` (all box**2 tilings).
+    box, seed : :func:`~safebasins.analysis.basin_measures.basin_entropy` (all ``box**2`` tilings).
     radius, n_balls : :func:`~safebasins.analysis.basin_measures.fractal_test` (grid steps).
     eps : :func:`~safebasins.analysis.basin_measures.grid_uncertainty_exponent` (grid steps).
 
