@@ -31,7 +31,7 @@ MELNIKOV_STYLE = dict(color="0.3", ls="--", lw=1.0)
 
 def _decision(ds: xr.Dataset, k: int) -> str:
     flag = int(var(ds, "wada").values[k])
-    return {1: "Wada", 0: "not Wada", -1: "two basins: no Wada test"}[flag]
+    return {1: "Wada", 0: "not Wada", -1: "no Wada test"}[flag]
 
 
 def figure_basin_measures(measures: Any, *, title: str | None = None) -> Figure:
@@ -80,7 +80,7 @@ def figure_basin_measures(measures: Any, *, title: str | None = None) -> Figure:
         pad = 0.1 * max(float(np.ptp(np.r_[F, F_M])), 1e-3)
         ax.set_xlim(min(F.min(), F_M) - pad, max(F.max(), F_M) + pad)
         ax.set_xlabel(LABELS["F"])
-        ax.legend(fontsize=6.5, frameon=False, loc="best")
+        ax.legend(fontsize=6.5, frameon=False, loc="center right" if ax is axS else "lower left")
     axS.set_ylabel(r"ball $S_{bb}$ (fractal test)")
     axS.set_title(f"({chr(ord('a') + n)}) boundary basin entropy, balls of radius {radius:g} steps", fontsize=9)
     axA.set_ylabel(r"uncertainty exponent $\alpha$ = 2 - dim")
