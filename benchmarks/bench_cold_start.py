@@ -46,6 +46,39 @@ t3 = time.perf_counter()
 print(json.dumps({"import": t1 - t0, "first": t2 - t1, "second": t3 - t2}))
 """
 
+# a new expression well (a Coulomb term whose constant no cache has seen) on a cache that holds
+# everything else: what a user waits for at the first chart of a well of their own
+EXPRESSION = r"""
+import json, sys, time
+t0 = time.perf_counter()
+import numpy as np
+import safebasins.numerics as nu
+from safebasins import wells
+from numba.core import event as ev
+t1 = time.perf_counter()
+a = float(sys.argv[1])
+w = wells.expression(f"q**2/2 - {a!r}/(1 - q) + {a!r} + {a!r}*q")
+w.compiled
+class Total(ev.Listener):
+    def __init__(self):
+        self.depth, self.start, self.total = 0, 0.0, 0.0
+    def on_start(self, event):
+        if self.depth == 0:
+            self.start = time.perf_counter()
+        self.depth += 1
+    def on_end(self, event):
+        self.depth -= 1
+        if self.depth == 0:
+            self.total += time.perf_counter() - self.start
+llvm = Total()
+q = np.linspace(-0.2, 0.2, 4)
+t2 = time.perf_counter()
+with ev.install_listener("numba:llvm_lock", llvm):
+    nu.escape_chart(q, q, F=0.01, Omega=0.9, Psi=np.pi, xi_max=(0.05,), cycles=5, well=w)
+t3 = time.perf_counter()
+print(json.dumps({"import": t1 - t0, "well": t2 - t1, "first": t3 - t2, "second": 0.0, "llvm": llvm.total}))
+"""
+
 PLAIN = r"""
 import json, time
 t0 = time.perf_counter()
@@ -70,7 +103,7 @@ print(json.dumps({"import": t1 - t0, "first": t2 - t1, "second": 0.0}))
 """
 
 
-def run(code, cache_dir):
+def run(code, cache_dir, *argv):
     env = dict(os.environ)
     env.pop("NUMBA_CACHE_DIR", None)
     if cache_dir is not None:
@@ -81,7 +114,7 @@ def run(code, cache_dir):
         script = os.path.join(d, "case.py")
         with open(script, "w") as fh:
             fh.write(code)
-        out = subprocess.run([sys.executable, script], env=env, capture_output=True, text=True)
+        out = subprocess.run([sys.executable, script, *argv], env=env, capture_output=True, text=True)
     if out.returncode:
         raise SystemExit(f"case failed:\n{out.stderr}")
     return json.loads(out.stdout.strip().splitlines()[-1])
@@ -94,11 +127,14 @@ def main():
     args = ap.parse_args()
     print(machine())
     rows = {k: [] for k in ("chart, empty cache", "chart, same cache again", "chart, installed cache",
-                            "plain numba kernel, empty cache")}
+                            "new expression well, warm cache", "plain numba kernel, empty cache")}
+    rng = np.random.default_rng()
     for _ in range(max(1, args.runs)):
         with tempfile.TemporaryDirectory() as d:
             rows["chart, empty cache"].append(run(CHART, d))
             rows["chart, same cache again"].append(run(CHART, d))
+            run(EXPRESSION, d, "0.05")          # the engine's well-independent parts cached
+            rows["new expression well, warm cache"].append(run(EXPRESSION, d, repr(rng.uniform(0.01, 0.1))))
         rows["chart, installed cache"].append(run(CHART, None))
         with tempfile.TemporaryDirectory() as d:
             rows["plain numba kernel, empty cache"].append(run(PLAIN, d))
@@ -109,7 +145,14 @@ def main():
     plain = med["plain numba kernel, empty cache"]["first"]
     cold = med["chart, empty cache"]["first"]
     inst = med["chart, installed cache"]["first"]
-    print(f"first chart call / plain kernel compile: empty cache {cold / plain:.1f}, installed cache {inst / plain:.2f}")
+    print(f"first chart call / plain kernel compile: empty cache {cold / plain:.1f}, "
+          f"installed cache {inst / plain:.2f}")
+    ex = rows["new expression well, warm cache"]
+    llvm = float(np.median([r["llvm"] for r in ex]))
+    well = float(np.median([r["well"] for r in ex]))
+    first = med["new expression well, warm cache"]["first"]
+    print(f"new expression well: well built (sympy, orbits) {well:.2f} s; first chart {first:.2f} s, "
+          f"of which LLVM (numba:llvm_lock) {llvm:.2f} s, numba's front end (typing, lowering) the rest")
     report("escape_chart cold start", round(cold / plain, 1),
            "first call with an empty numba cache / compile of a plain @njit loop",
            f"empty cache {cold:.1f} s, installed cache {inst:.2f} s, plain kernel {plain:.2f} s "

@@ -35,10 +35,19 @@ Escape criteria (one definition, used by theory, numerics, integrity and plottin
 from __future__ import annotations
 
 import abc
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
+import numpy.typing as npt
+from scipy import optimize
 
-__all__ = ["Well"]
+from safebasins.core.checks import BARRIER_RTOL, as_array, reaches, value_repr
+
+if TYPE_CHECKING:  # (compiled imports numba: only the checker needs the name here)
+    from safebasins.wells.compiled import WellCode
+
+__all__ = ["Well", "WellLike"]
 
 
 #: Step costs of the compiled forms relative to the quartic's closed form, rounded up from
@@ -51,6 +60,8 @@ STEP_COST_POLY4 = 1.5
 STEP_COST_POLY8 = 3.5
 STEP_COST_ARITHMETIC = 1.5
 STEP_COST_TRANSCENDENTAL = 150.0
+#: a code calling wells.elementary (vectorised sin, exp, tanh, ...; docs/elementary.md)
+STEP_COST_ELEMENTARY = 30.0
 #: top of a resonance-manifold panel as a fraction of the escape energy (:attr:`Well.manifold_top`)
 MANIFOLD_TOP = 0.9996
 
@@ -60,7 +71,9 @@ class Well(abc.ABC):
 
     Array arguments broadcast; every method raises ``ValueError`` naming the argument for
     input outside its domain (an energy outside ``[0, barrier_energy)``, a point outside the
-    well, NaN).
+    well, NaN).  The element-wise methods take a float or an array and return numpy's float or
+    an array of the argument's shape: their results are annotated ``Any`` (numpy's types cannot
+    say "the shape of the argument").
     """
 
     #: short name used in datasets and configs ("quartic", "cubic", "polynomial", ...)
@@ -75,11 +88,11 @@ class Well(abc.ABC):
 
     # ------------------------------------------------------------------ the potential
     @abc.abstractmethod
-    def V(self, q):
+    def V(self, q: npt.ArrayLike) -> Any:
         """Potential energy V(q)."""
 
     @abc.abstractmethod
-    def dV(self, q):
+    def dV(self, q: npt.ArrayLike) -> Any:
         """V'(q) (the restoring force is -V'(q))."""
 
     @property
@@ -89,7 +102,7 @@ class Well(abc.ABC):
         bottom; ``-inf`` / ``+inf`` on a side where ``V -> inf`` (no escape that way)."""
 
     @property
-    def asymptotes(self) -> tuple:
+    def asymptotes(self) -> tuple[float | None, float | None]:
         """``(left, right)``: on a side without a barrier where V tends to a finite limit as
         ``q -> -inf`` / ``+inf`` (open at infinity), that limit; None on a side with a barrier or
         where ``V -> inf``."""
@@ -112,37 +125,37 @@ class Well(abc.ABC):
         lims = [a for a in self.asymptotes if a is not None]
         return bool(lims) and min(lims) <= self.barrier_energy
 
-    def H0(self, q, p):
+    def H0(self, q: npt.ArrayLike, p: npt.ArrayLike) -> Any:
         """Unforced energy ``p^2 / 2 + V(q)`` (eq 7, untruncated)."""
         q = np.asarray(q, dtype=float)
         p = np.asarray(p, dtype=float)
         return 0.5 * p * p + self.V(q)
 
     @abc.abstractmethod
-    def turning_points(self, E):
+    def turning_points(self, E: npt.ArrayLike) -> tuple[Any, Any]:
         """``(q_minus(E), q_plus(E))``: the orbit's turning points, ``q_minus <= 0 <= q_plus``,
         for ``0 <= E <= barrier_energy``."""
 
     # ------------------------------------------------------------------ action-angle
     @abc.abstractmethod
-    def J(self, E):
+    def J(self, E: npt.ArrayLike) -> Any:
         """Action ``J(E) = (1 / 2 pi) oint p dq`` (eq 13 / 19 for the quartic)."""
 
     @abc.abstractmethod
-    def omega(self, E):
+    def omega(self, E: npt.ArrayLike) -> Any:
         """Frequency ``omega(E) = dE/dJ = 2 pi / period`` (eq 16)."""
 
     @abc.abstractmethod
-    def angle_energy(self, q, p):
+    def angle_energy(self, q: npt.ArrayLike, p: npt.ArrayLike) -> tuple[Any, Any]:
         """``(theta, E)`` of phase points inside the well (eqs 7, 14); theta in [0, 2 pi)."""
 
     @abc.abstractmethod
-    def phase_point(self, theta, E):
+    def phase_point(self, theta: npt.ArrayLike, E: npt.ArrayLike) -> tuple[Any, Any]:
         """``(q, p)`` at angle theta on the orbit of energy E (eqs 15, 17); inverse of
         :meth:`angle_energy`."""
 
     @abc.abstractmethod
-    def first_harmonic(self, E):
+    def first_harmonic(self, E: npt.ArrayLike) -> Any:
         """Complex first Fourier coefficient ``q_1(E)`` of ``q(theta)`` (eq 12)."""
 
     # ------------------------------------------------------------------ what the slow flow needs
@@ -153,36 +166,34 @@ class Well(abc.ABC):
     # every circle xi = const, so the escape classification, the critical points and the
     # tangencies of the quartic carry over with G -> A and gamma -> gamma + delta(xi).
     @abc.abstractmethod
-    def harmonic_amplitude(self, E):
+    def harmonic_amplitude(self, E: npt.ArrayLike) -> Any:
         """``A(E) = |q_1(E)|`` (the quartic's G of eq 20)."""
 
     @abc.abstractmethod
-    def harmonic_amplitude_derivative(self, E):
+    def harmonic_amplitude_derivative(self, E: npt.ArrayLike) -> Any:
         """``dA/dE`` for ``0 < E < barrier_energy``."""
 
     @abc.abstractmethod
-    def harmonic_phase(self, E):
+    def harmonic_phase(self, E: npt.ArrayLike) -> Any:
         """``arg q_1(E)``, continuous in E (``-pi/2`` for a symmetric well)."""
 
-    def harmonic_shift(self, E):
+    def harmonic_shift(self, E: npt.ArrayLike) -> Any:
         """``delta(E) = arg q_1(E) + pi/2``: the slow phase shift of the first harmonic (0 for a
         symmetric well)."""
         return self.harmonic_phase(E) + 0.5 * np.pi
 
-    def in_well(self, q):
+    def in_well(self, q: npt.ArrayLike) -> Any:
         """``q`` strictly between the barriers (everything on a side without a barrier)."""
         lo, hi = self.barriers
         q = np.asarray(q, dtype=float)
         return (q > lo) & (q < hi)
 
-    def check_threshold(self, name, xi_max):
+    def check_threshold(self, name: str, xi_max: Any) -> np.ndarray:
         """Energy truncation level of an escape test in ``(0, barrier_energy]``: ``xi_max = E_b`` is
         escape over the barrier, the numerics' and the damped slow flow's test (escape = H0, or the
         slow energy, exceeding it); in ``(0, barrier_energy)`` when the escape energy is a limit of V
         at infinity (the orbit at it is unbounded).  The undamped slow flow needs more:
         :meth:`check_analytic_threshold`."""
-        from safebasins.core.checks import as_array, value_repr
-
         a = as_array(name, xi_max)
         if self.open_at_infinity:
             if ((a <= 0) | (a >= self.barrier_energy)).any():
@@ -195,15 +206,13 @@ class Well(abc.ABC):
                              f"{self.name} well), got {value_repr(a)}")
         return a
 
-    def check_analytic_threshold(self, name, xi_max):
+    def check_analytic_threshold(self, name: str, xi_max: Any) -> np.ndarray:
         """Truncation level of the undamped slow flow (the level curves of its first integral C):
         :meth:`check_threshold`, and below the escape energy by more than a relative
         ``checks.BARRIER_RTOL`` (closer counts as at it).  That theory needs an orbit at xi_max; at
         the separatrix the period diverges, and F_cr grows like ``log(1 / (E_b - xi_max))`` without
         a limit (the cubic's F_cr at Omega = 0.7: 0.13, 0.17, 0.21, 0.24 at E_b - xi_max = 1e-6,
         1e-10, 1e-13 E_b and one ulp), so a value that close measures the float spacing, not the well."""
-        from safebasins.core.checks import BARRIER_RTOL, reaches, value_repr
-
         a = self.check_threshold(name, xi_max)
         if reaches(a, self.barrier_energy).any():
             raise ValueError(f"{name} must lie below the barrier energy {self.barrier_energy_text} of the {self.name} "
@@ -218,15 +227,13 @@ class Well(abc.ABC):
         """The escape energy as written in messages."""
         return repr(float(self.barrier_energy))
 
-    def unforced_safe(self, q, p, xi_max):
+    def unforced_safe(self, q: npt.ArrayLike, p: npt.ArrayLike, xi_max: npt.ArrayLike) -> Any:
         """The unforced safe set of a threshold: ``H0 < xi_max`` inside the well."""
         return (self.H0(q, p) < xi_max) & self.in_well(q)
 
     # ------------------------------------------------------------------ what the numerics need
-    def check_displacement(self, name, q_max):
+    def check_displacement(self, name: str, q_max: Any) -> np.ndarray:
         """Symmetric displacement thresholds ``|q| > q_max``: q_max in (0, nearest barrier]."""
-        from safebasins.core.checks import as_array, value_repr
-
         a = as_array(name, q_max)
         lim = min(-self.barriers[0], self.barriers[1])
         if ((a <= 0) | (a > lim)).any():
@@ -234,11 +241,9 @@ class Well(abc.ABC):
                              f"well at {self.barriers}), got {value_repr(a)}")
         return a
 
-    def check_bounds(self, name, q_bounds):
+    def check_bounds(self, name: str, q_bounds: Any) -> np.ndarray:
         """Displacement bound pairs ``(lo, hi)`` as an (n, 2) float array: lo < 0 < hi, inside the
         barriers (a single pair may be given as (lo, hi))."""
-        from safebasins.core.checks import as_array
-
         a = as_array(name, q_bounds)
         if a.size == 0:
             return np.zeros((0, 2))
@@ -255,7 +260,7 @@ class Well(abc.ABC):
                              f"hi <= {qr!r}; got {a.tolist()}")
         return a
 
-    def spec(self) -> dict:
+    def spec(self) -> dict[str, Any]:
         """The resolved spec that rebuilds this well (:func:`safebasins.wells.from_spec`): its name,
         plus the coefficients or the expression of an unnamed polynomial or expression well."""
         return {"name": self.name}
@@ -274,13 +279,13 @@ class Well(abc.ABC):
         return (f"well {self.name!r}, V(q) = {self.potential_text()}: H0 = p^2/2 + V(q) > xi_max"
                 + (f" or {beyond} (beyond a barrier)" if beyond else ""))
 
-    def numerics_attrs(self) -> dict:
+    def numerics_attrs(self) -> dict[str, Any]:
         """Attributes a numeric dataset records about its well."""
         return {"well": self.name, "well_potential": self.potential_text(),
                 "well_barriers": np.array(self.barriers, dtype=float),
                 "well_barrier_energy": float(self.barrier_energy)}
 
-    def ic_window(self):
+    def ic_window(self) -> tuple[tuple[float, float], tuple[float, float]]:
         """``((q_lo, q_hi), (p_lo, p_hi))``: an initial-condition window holding the whole well, the
         turning points of the escape energy E_b (of 0.99 E_b when they are not finite: a side open
         at infinity) and ``|p| <= 1.5 sqrt(E_b)`` (the quartic: [-1, 1] x [-0.75, 0.75])."""
@@ -315,12 +320,10 @@ class Well(abc.ABC):
             self.__dict__["_static_escape_force"] = f
         return f
 
-    def _largest_force(self, side) -> float:
+    def _largest_force(self, side: float) -> float:
         """``max |V'|`` between 0 and the turning point of E_b on one side (``side`` -1 or +1): on 2001
         uniform and 2001 geometric points (a long open tail), the largest polished by a bounded scalar
         search between its neighbours."""
-        from scipy import optimize
-
         E = float(self.barrier_energy)
         k = 0 if side < 0 else 1
         q_t = float(self.turning_points(E)[k])
@@ -350,7 +353,7 @@ class Well(abc.ABC):
         return om
 
     @property
-    def compiled(self):
+    def compiled(self) -> WellCode:
         """The well's one compiled form (:class:`safebasins.wells.compiled.WellCode`: force and
         energy for the CPU and CUDA engines), built on first use and kept."""
         code = self.__dict__.get("_compiled")
@@ -359,5 +362,10 @@ class Well(abc.ABC):
             self.__dict__["_compiled"] = code
         return code
 
-    def _compiled_form(self):
+    def _compiled_form(self) -> WellCode:
         raise ValueError(f"the {self.name} well ({type(self).__name__}) has no compiled form for the numerics")
+
+
+#: any form :func:`safebasins.wells.resolve_well` reads: None (the paper's quartic), a name, a
+#: spec mapping (``{"polynomial": [...]}``, ``{"expression": "..."}``) or a :class:`Well`
+WellLike: TypeAlias = "Well | str | Mapping[str, Any] | None"

@@ -20,12 +20,16 @@ Allowed: the variable ``q``, numbers, ``+ - * / **``, ``pi``, ``E`` and the func
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from types import SimpleNamespace
+from typing import Any
+
 import numpy as np
 
-from safebasins.wells.base import STEP_COST_ARITHMETIC, STEP_COST_TRANSCENDENTAL
+from safebasins.wells.base import STEP_COST_ARITHMETIC, STEP_COST_ELEMENTARY, STEP_COST_TRANSCENDENTAL
 from safebasins.wells.numeric import NumericWell
 from safebasins.wells import elementary
-from safebasins.wells.compiled import mul, target_code
+from safebasins.wells.compiled import Jit, WellCode, mul, target_code
 
 __all__ = ["ExpressionWell", "expression", "FUNCTIONS"]
 
@@ -40,13 +44,13 @@ _LIBM = {"atan": math.atan, "asinh": math.asinh}
 _NAMESPACE_NUMPY = {"mul": np.multiply, "pow": np.power, **FUNCTIONS}
 
 
-def _sympy():
+def _sympy() -> Any:
     import sympy  # noqa: PLC0415  (lazy: sympy takes ~0.5 s to import, needed only to build an expression well)
 
     return sympy
 
 
-def parse(text):
+def parse(text: str) -> tuple[Any, Any]:
     """``(V, q)`` as sympy objects from the text of an expression in q; ValueError naming
     ``expression`` for anything else."""
     sp = _sympy()
@@ -80,11 +84,11 @@ class _Printer:
     """Python source of a sympy expression: calls of the functions by their names, products with
     ``mul`` (left to right), quotients as ``/``, integer powers as repeated products."""
 
-    def __init__(self, q):
+    def __init__(self, q: Any) -> None:
         self.q = q
         self.sp = _sympy()
 
-    def __call__(self, e):
+    def __call__(self, e: Any) -> str:
         sp = self.sp
         if e == self.q:
             return "q"
@@ -109,11 +113,11 @@ class _Printer:
             return f"{name}({self(e.args[0])})"
         raise ValueError(f"expression: {e} is not supported (functions: {', '.join(sorted(FUNCTIONS))}, sech)")
 
-    def _wrap(self, e):
+    def _wrap(self, e: Any) -> str:
         s = self(e)
         return f"({s})" if e.is_Add or (e.is_Number and float(e) < 0) else s
 
-    def _add(self, e):
+    def _add(self, e: Any) -> str:
         terms = list(e.args)
         out = self._wrap(terms[0]) if terms[0].is_Add else self(terms[0])
         for t in terms[1:]:
@@ -123,22 +127,21 @@ class _Printer:
                 out = f"{out} + {self._term(t)}"
         return out
 
-    def _term(self, t):
+    def _term(self, t: Any) -> str:
         s = self(t)
         return f"({s})" if t.is_Add or s.startswith("-") else s
 
-    def _product(self, factors):
-        out = None
-        for f in factors:
-            s = self._factor(f)
-            out = s if out is None else f"mul({out}, {s})"
+    def _product(self, factors: list[Any]) -> str:
+        out = self._factor(factors[0])
+        for f in factors[1:]:
+            out = f"mul({out}, {self._factor(f)})"
         return out
 
-    def _factor(self, f):
+    def _factor(self, f: Any) -> str:
         s = self(f)
         return f"({s})" if f.is_Add or s.startswith("-") or " / " in s else s
 
-    def _mul(self, e):
+    def _mul(self, e: Any) -> str:
         sp = self.sp
         if e.could_extract_minus_sign():
             return f"-{self._factor(-e)}"
@@ -157,7 +160,7 @@ class _Printer:
             return top
         return f"{top} / {self._factor(den[0]) if len(den) == 1 else '(' + self._product(den) + ')'}"
 
-    def _pow(self, b, x):
+    def _pow(self, b: Any, x: Any) -> str:
         sp = self.sp
         if x.is_Integer or (x.is_Float and float(x).is_integer()):
             n = int(x)
@@ -177,7 +180,7 @@ class _Printer:
 _PROBE = np.concatenate([-np.geomspace(1e-4, 30.0, 40)[::-1], np.geomspace(1e-4, 30.0, 40)])
 
 
-def _relative_error(form, exact, pr, q):
+def _relative_error(form: Any, exact: Any, pr: _Printer, q: Any) -> float:
     """Largest relative error of the double-precision evaluation of ``form`` (the generated
     source, on numpy) against ``exact`` (40 digits) on the probe points where both are finite."""
     sp = _sympy()
@@ -193,7 +196,7 @@ def _relative_error(form, exact, pr, q):
     return worst
 
 
-def generate_source(V, q):
+def generate_source(V: Any, q: Any) -> tuple[str, Any]:
     """(source text of ``V(q)`` and ``dV(q)``, the sympy derivative as printed).
 
     V' is printed in whichever of sympy's equivalent forms (as differentiated, simplified,
@@ -204,7 +207,7 @@ def generate_source(V, q):
     sp = _sympy()
     dV = sp.diff(V, q)
     pr = _Printer(q)
-    forms = []
+    forms: list[Any] = []
     for f in (dV, sp.simplify(dV), sp.cancel(dV)):
         if all(f != g for g in forms):
             forms.append(f)
@@ -214,21 +217,30 @@ def generate_source(V, q):
     return f"def V(q):\n    return {pr(V)}\n\n\ndef dV(q):\n    return {pr(dV)}\n", dV
 
 
-def _step_cost(V, dV) -> float:
+def _step_cost(V: Any, dV: Any) -> float:
     """Step cost of the generated code (safebasins.wells.base): arithmetic (sums, products,
-    quotients, powers: vectorised lanes) or calling a libm function (sin, exp, tanh, ...: scalar
-    lanes)."""
+    quotients, powers: vectorised lanes), calling wells.elementary (sin, exp, tanh, ...: vectorised
+    lanes, each call some tens of operations) or a libm function (atan, asinh: scalar lanes)."""
     sp = _sympy()
-    return STEP_COST_TRANSCENDENTAL if V.atoms(sp.Function) | dV.atoms(sp.Function) else STEP_COST_ARITHMETIC
+    called = {type(f).__name__ for f in V.atoms(sp.Function) | dV.atoms(sp.Function)}
+    if called & set(_LIBM):
+        return STEP_COST_TRANSCENDENTAL
+    return STEP_COST_ELEMENTARY if called or not _integer_powers(V, dV) else STEP_COST_ARITHMETIC
 
 
-def _functions(source, namespace):
+def _integer_powers(V: Any, dV: Any) -> bool:
+    """True when every power of V and V' has an integer or +-1/2 exponent (products, sqrt)."""
+    sp = _sympy()
+    return all(p.exp.is_Integer or abs(p.exp) == sp.Rational(1, 2) for p in V.atoms(sp.Pow) | dV.atoms(sp.Pow))
+
+
+def _functions(source: str, namespace: dict[str, Any]) -> tuple[Callable[..., Any], Callable[..., Any]]:
     ns = dict(namespace)
     exec(compile(source, "<safebasins expression well>", "exec"), ns)   # our own generated text
     return ns["V"], ns["dV"]
 
 
-def _limit(V, q, side):
+def _limit(V: Any, q: Any, side: int) -> float | None:
     """Finite limit of V as q -> side * inf, or None (unbounded or oscillating)."""
     sp = _sympy()
     try:
@@ -250,7 +262,7 @@ class ExpressionWell(NumericWell):
 
     name = "expression"
 
-    def __init__(self, expression, *, name=None, **kwargs):
+    def __init__(self, expression: str, *, name: str | None = None, **kwargs: Any) -> None:
         V, q = parse(expression)
         self.expression = expression
         self.formula = str(V)
@@ -261,30 +273,30 @@ class ExpressionWell(NumericWell):
         kwargs.setdefault("asymptotes", (_limit(V, q, -1), _limit(V, q, 1)))
         super().__init__(Vn, dVn, name=name, **kwargs)
 
-    def _compiled_form(self):
+    def _compiled_form(self) -> WellCode:
         source = self.source
 
-        def functions(jit):
+        def functions(jit: Jit) -> tuple[Callable[[float], float], Callable[[float], float]]:
             return _functions(source, _compiled_namespace(elementary.for_target(jit)))
 
         return target_code(functions, self.barriers, self.name, f"{elementary.MODULE_HASH}\0{source}")
 
-    def potential_text(self):
+    def potential_text(self) -> str:
         return self.formula
 
-    def spec(self):
+    def spec(self) -> dict[str, Any]:
         if self.name != ExpressionWell.name:            # a named well (wells.NAMED_WELLS)
             return {"name": self.name}
         return {"name": "expression", "expression": self.expression, **self._tol_spec()}
 
 
-def _compiled_namespace(functions):
+def _compiled_namespace(functions: SimpleNamespace) -> dict[str, Any]:
     """The generated source's names in a compiled engine: ``functions`` (wells.elementary compiled
     for the target), the libm functions elementary has not, the wells' ``mul``."""
     own = {k: getattr(functions, k) for k in (*FUNCTIONS, "pow") if k not in _LIBM}
     return {"mul": mul, **_LIBM, **own}
 
 
-def expression(text, **kwargs):
+def expression(text: str, **kwargs: Any) -> ExpressionWell:
     """The well ``V(q) = text`` (see :class:`ExpressionWell`)."""
     return ExpressionWell(text, **kwargs)
