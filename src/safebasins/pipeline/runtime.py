@@ -19,6 +19,7 @@ import os
 import sys
 from pathlib import Path
 
+import numba
 import yaml
 
 from safebasins.pipeline.config import load_kinds
@@ -35,11 +36,14 @@ def redirect_output(log_path):
 
 
 def set_threads(n):
-    """Limit numba's thread pool to the rule's ``threads:`` (no oversubscription under -j2)."""
-    n = max(1, int(n))
-    os.environ.setdefault("NUMBA_NUM_THREADS", str(n))
-    import numba
+    """Limit numba's thread pool to the rule's ``threads:`` (no oversubscription under -j2).
 
+    Only the number of threads in use is set (``numba.set_num_threads``), never the environment's
+    ``NUMBA_NUM_THREADS``: numba has read that at import (the wells import it, so it is loaded
+    before any rule runs) and re-reads it when it compiles; a value changed after its threads
+    started is refused ("Cannot set NUMBA_NUM_THREADS to a different value once the threads have
+    been launched")."""
+    n = max(1, int(n))
     numba.set_num_threads(min(n, numba.config.NUMBA_NUM_THREADS))
 
 
