@@ -482,6 +482,22 @@ DECLARATIONS += (
         caption=_MEASURES_CAPTION.format(system="the paper's quartic with damping, q'' + β q' + q - q³ = "
                                                 "F sin(Ωt + Ψ)"),
         look=_MEASURES_LOOK),
+    Declaration(
+        name="damped_escape_saddle", kind="hilltop_saddle", key=("damped", "escape_equation_saddle"),
+        stem="damped_escape_saddle", label="Damped escape equation: the hilltop saddle's manifolds",
+        category=_DAMPED, options={},
+        title="Damped escape equation: the hilltop saddle's manifolds over the escape chart, and their tangency",
+        caption=("Thompson's escape equation q'' + β q' + q - q² = F sin(Ωt + Ψ) (β, Ω, Ψ in the title): the "
+                 "hilltop saddle's T-periodic orbit found by multiple shooting (Newton on the stroboscopic map, "
+                 "DOP853), its stable manifold W^s and unstable manifold W^u grown on the stroboscopic map of the "
+                 "section t = 0, drawn over the escape chart of the same section (energy criterion at the "
+                 "hilltop's energy) below and past the Melnikov threshold F_M. The F where the manifolds first "
+                 "touch is found numerically (Brent on their signed distance) and compared with F_M, which is "
+                 "first order in F and β (docs/melnikov.md)."),
+        look=("Grey: initial conditions safe over the horizon; blue: W^s, red: W^u (solid: the branches on the "
+              "well's side, dashed: outer); black dot: the saddle fixed point. Below the tangency the inner W^s "
+              "is the edge of the safe basin and the inner W^u spirals onto the attractor inside it; past the "
+              "tangency W^u crosses W^s and the edge of the safe basin is tangled.")),
 )
 
 BY_NAME = {d.name: d for d in DECLARATIONS}

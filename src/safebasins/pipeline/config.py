@@ -34,7 +34,8 @@ REPO_ROOT = Path(__file__).resolve().parents[3]
 #: the kind modules of the package (importing them registers the kinds)
 KIND_MODULES = ("safebasins.pipeline.kinds.fcr", "safebasins.pipeline.kinds.basins",
                 "safebasins.pipeline.kinds.charts", "safebasins.pipeline.kinds.extras", "safebasins.pipeline.kinds.maps",
-                "safebasins.pipeline.kinds.damped", "safebasins.pipeline.kinds.basin_measures")
+                "safebasins.pipeline.kinds.damped", "safebasins.pipeline.kinds.basin_measures",
+                "safebasins.pipeline.kinds.saddle")
 
 __all__ = ["ConfigError", "load_yaml", "merge_config", "build_schema", "validate_config", "experiment_blocks", "SCHEMA_PATH"]
 
