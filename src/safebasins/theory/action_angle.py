@@ -21,12 +21,14 @@ __all__ = ["H0", "q_max_from_xi", "J", "omega", "G", "dJ_dxi", "dG_dxi", "nome",
 
 def H0(q: ArrayLike, p: ArrayLike) -> FloatArray:
     """Basic Hamiltonian, eq (7) untruncated: ``p^2/2 + q^2/2 - q^4/4``."""
-    return QUARTIC.H0(check_finite("q", q), check_finite("p", p))
+    out: FloatArray = QUARTIC.H0(check_finite("q", q), check_finite("p", p))
+    return out
 
 
 def q_max_from_xi(xi_max: ArrayLike) -> FloatArray:
     """Displacement threshold for an energy threshold, eq (4): ``sqrt(1 - sqrt(1 - 4 xi_max))``."""
-    return QUARTIC.q_max(QUARTIC.check_threshold("xi_max", xi_max))
+    out: FloatArray = QUARTIC.q_max(QUARTIC.check_threshold("xi_max", xi_max))
+    return out
 
 
 def J(xi: ArrayLike) -> FloatArray:
@@ -35,7 +37,8 @@ def J(xi: ArrayLike) -> FloatArray:
     ``J = 2 sqrt(2) / (3 pi) sqrt(1 + mu) (E(k) - mu K(k))``, ``mu = sqrt(1 - 4 xi)``.
     Defined on ``0 <= xi <= 1/4`` (``J(1/4) = 2 sqrt(2) / (3 pi)``).
     """
-    return QUARTIC.J(QUARTIC.check_energy("xi", xi, allow_separatrix=True))
+    out: FloatArray = QUARTIC.J(QUARTIC.check_energy("xi", xi, allow_separatrix=True))
+    return out
 
 
 def omega(xi: ArrayLike) -> FloatArray:
@@ -43,14 +46,16 @@ def omega(xi: ArrayLike) -> FloatArray:
 
     ``omega(0) = 1``, ``omega(1/4) = 0``.  Equals ``1 / J'(xi)``.
     """
-    return QUARTIC.omega(QUARTIC.check_energy("xi", xi, allow_separatrix=True))
+    out: FloatArray = QUARTIC.omega(QUARTIC.check_energy("xi", xi, allow_separatrix=True))
+    return out
 
 
 def dJ_dxi(xi: ArrayLike) -> FloatArray:
     """``dJ/dxi = 1 / omega(xi)`` (eq 16); infinite on the separatrix."""
     x = QUARTIC.check_energy("xi", xi, allow_separatrix=True)
     with np.errstate(divide="ignore"):
-        return 1.0 / QUARTIC.omega(x)
+        out: FloatArray = 1.0 / QUARTIC.omega(x)
+        return out
 
 
 def G(xi: ArrayLike, fourier: str = "paper") -> FloatArray:
@@ -65,7 +70,9 @@ def G(xi: ArrayLike, fourier: str = "paper") -> FloatArray:
     ``G(0) = 0``; ``G(1/4) = 0`` (limit).
     """
     check_fourier(fourier)
-    return resolve_well(None, fourier).harmonic_amplitude(QUARTIC.check_energy("xi", xi, allow_separatrix=True))
+    x = QUARTIC.check_energy("xi", xi, allow_separatrix=True)
+    out: FloatArray = resolve_well(None, fourier).harmonic_amplitude(x)
+    return out
 
 
 def dG_dxi(xi: ArrayLike, fourier: str = "paper") -> FloatArray:
@@ -74,12 +81,14 @@ def dG_dxi(xi: ArrayLike, fourier: str = "paper") -> FloatArray:
     x = QUARTIC.check_energy("xi", xi)
     if (x <= 0).any():
         raise ValueError("xi must be > 0 for dG_dxi (G ~ sqrt(xi/2) at the well bottom)")
-    return resolve_well(None, fourier).harmonic_amplitude_derivative(x)
+    out: FloatArray = resolve_well(None, fourier).harmonic_amplitude_derivative(x)
+    return out
 
 
 def nome(xi: ArrayLike) -> FloatArray:
     """Jacobi nome ``exp(-pi K'/K)`` of the free orbit with energy xi (0 at xi = 0, 1 at 1/4)."""
-    return _nome(QUARTIC.check_energy("xi", xi, allow_separatrix=True))
+    out: FloatArray = _nome(QUARTIC.check_energy("xi", xi, allow_separatrix=True))
+    return out
 
 
 def angle_energy(q: ArrayLike, p: ArrayLike, well: WellArg = None) -> tuple[FloatArray, FloatArray]:

@@ -33,33 +33,31 @@ SBMT boundary (27).
 """
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 import xarray as xr
+from numpy.typing import NDArray
 from scipy import optimize
 
 from safebasins.core.checks import check_finite, check_nonnegative, check_positive, check_positive_int, check_scalar
-from safebasins.theory.profile import SlowFlowProfile, resolved_shift, unshear
+from safebasins.theory.profile import SlowFlowProfile, resolved_shift, unshear, xi_grid
+from safebasins.theory.types import BoolArray, FloatArray, WellArg
 from safebasins.wells import resolve_well
 from safebasins.wells.provenance import api_provenance
 
 __all__ = ["safe_basin_boundaries"]
 
 
-def _runs(mask):
+def _runs(mask: BoolArray) -> list[tuple[int, int]]:
     """(start, stop) index pairs (stop exclusive) of consecutive True in a 1-D bool array."""
     m = np.concatenate([[False], mask, [False]]).astype(int)
     d = np.diff(m)
     return list(zip(np.nonzero(d == 1)[0], np.nonzero(d == -1)[0]))
 
 
-def _cheb(lo, hi, n):
-    t = np.linspace(0.0, 1.0, n)
-    x = lo + (hi - lo) * 0.5 * (1.0 - np.cos(np.pi * t))
-    x[0], x[-1] = lo, hi
-    return x
-
-
-def _root(fun, lo, hi):
+def _root(fun: Callable[[float], float], lo: float, hi: float) -> float:
     flo, fhi = fun(lo), fun(hi)
     if flo == 0:
         return lo
@@ -67,10 +65,10 @@ def _root(fun, lo, hi):
         return hi
     if flo * fhi > 0:
         return lo if abs(flo) < abs(fhi) else hi
-    return optimize.brentq(fun, lo, hi, xtol=1e-15, rtol=1e-14)
+    return float(optimize.brentq(fun, lo, hi, xtol=1e-15, rtol=1e-14))
 
 
-def _side_curves(prof, side, n_points):
+def _side_curves(prof: SlowFlowProfile, side: int, n_points: int) -> list[dict[str, Any]]:
     """Boundary curves on one side (0: gamma = 0 side via a/A*, 1: gamma = pi side via b/B*)."""
     F, Om, w = prof.F, prof.Omega, prof.well
     xi = prof.xi
@@ -83,17 +81,17 @@ def _side_curves(prof, side, n_points):
     mask = sgn * (S - f_own) > tol
     n = xi.size
 
-    def own(x, L):
+    def own(x: float, L: float) -> float:
         h = x - Om * w.J(x)
         g = F * w.harmonic_amplitude(x)
         return float((h - g if side == 0 else h + g) - L)
 
-    def opp(x, L):
+    def opp(x: float, L: float) -> float:
         h = x - Om * w.J(x)
         g = F * w.harmonic_amplitude(x)
         return float((h + g if side == 0 else h - g) - L)
 
-    curves = []
+    curves: list[dict[str, Any]] = []
     for i0, i1 in _runs(mask):
         u = i1                                          # upper end node: f_own(u) == level
         if u >= n:                                      # cannot happen (S == f at the last node)
@@ -116,7 +114,7 @@ def _side_curves(prof, side, n_points):
             hi = nodes[j1 - 1] if hi_on_own else _root(lambda x: opp(x, L), nodes[j1 - 1], nodes[j1])
             if hi <= lo:
                 continue
-            x = _cheb(lo, hi, n_points)
+            x = xi_grid(lo, hi, n_points)
             h = x - Om * w.J(x)
             g = F * w.harmonic_amplitude(x)
             with np.errstate(divide="ignore", invalid="ignore"):
@@ -140,7 +138,8 @@ def _side_curves(prof, side, n_points):
 
 
 @api_provenance
-def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier=None, n_points=400, well=None):
+def safe_basin_boundaries(F: float, Omega: float, Psi: float, xi_max: float, fourier: str | None = None,
+                          n_points: int = 400, well: WellArg = None) -> xr.Dataset:
     """Boundaries of the analytic safe basin (paper Sec. 2.3, eqs 27-28).
 
     Parameters
@@ -198,7 +197,9 @@ def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier=None, n_points=400, wel
     if np.isfinite(sx) and resolved_shift(w, sx) != 0:
         sg = unshear(sg, resolved_shift(w, sx))
 
-    gam, xis, idx = [], [], []
+    gam_parts: list[FloatArray] = []
+    xi_parts: list[FloatArray] = []
+    idx_parts: list[NDArray[np.int64]] = []
     for k, c in enumerate(curves):
         g, x = c["gamma"], c["xi"]
         shift = resolved_shift(w, np.minimum(x, w.barrier_energy))
@@ -209,11 +210,14 @@ def safe_basin_boundaries(F, Omega, Psi, xi_max, fourier=None, n_points=400, wel
         if jump.size:
             g = np.insert(g, jump + 1, np.nan)
             x = np.insert(x, jump + 1, np.nan)
-        gam.append(g)
-        xis.append(x)
-        idx.append(np.full(g.size, k, dtype=np.int64))
+        gam_parts.append(g)
+        xi_parts.append(x)
+        idx_parts.append(np.full(g.size, k, dtype=np.int64))
+    gam: FloatArray
+    xis: FloatArray
+    idx: NDArray[np.int64]
     if curves:
-        gam, xis, idx = np.concatenate(gam), np.concatenate(xis), np.concatenate(idx)
+        gam, xis, idx = np.concatenate(gam_parts), np.concatenate(xi_parts), np.concatenate(idx_parts)
     else:
         gam, xis, idx = np.empty(0), np.empty(0), np.empty(0, np.int64)
     fin = np.isfinite(gam)

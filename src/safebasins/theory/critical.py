@@ -39,14 +39,19 @@ Notes on the paper
 """
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 import xarray as xr
+from numpy.typing import ArrayLike, NDArray
 
 from safebasins.core import checks
 from safebasins.core.checks import check_finite, check_positive, check_scalar
 from safebasins.theory.damped import slow_tables
 from safebasins.theory.damped_escape import damped_critical_forcing
 from safebasins.theory.profile import resolved_shift, unshear, xi_grid
+from safebasins.theory.types import BoolArray, FloatArray, WellArg
 from safebasins.wells import resolve_well
 from safebasins.wells.provenance import api_provenance
 
@@ -62,7 +67,8 @@ NONE, MM_0, MM_PI, SM, SMM = range(5)
 H_ACCURACY = 1e-12
 
 
-def _bisect(fun, lo, hi, n_iter=60):
+def _bisect(fun: Callable[[FloatArray], FloatArray], lo: FloatArray, hi: FloatArray,
+            n_iter: int = 60) -> FloatArray:
     """Vectorised bisection for a sign change fun(lo) > 0 > fun(hi)."""
     lo, hi = lo.copy(), hi.copy()
     for _ in range(n_iter):
@@ -73,7 +79,9 @@ def _bisect(fun, lo, hi, n_iter=60):
     return 0.5 * (lo + hi)
 
 
-def _interior_max(L, valid, xi, refine_fun, n_iter=60):
+def _interior_max(L: FloatArray, valid: BoolArray, xi: FloatArray,
+                  refine_fun: Callable[[NDArray[np.intp], FloatArray], FloatArray],
+                  n_iter: int = 60) -> tuple[FloatArray, FloatArray, BoolArray]:
     """Largest interior local maximum of L (rows = Omega) with its xi, refined on the derivative.
 
     refine_fun(rows, x) -> sign-carrying derivative of L at x for the given rows.
@@ -109,8 +117,9 @@ def _interior_max(L, valid, xi, refine_fun, n_iter=60):
 
 
 @api_provenance
-def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_grid=2001, well=None,
-                     damping=0.0):
+def critical_forcing(Omega: ArrayLike, xi_max: float, xi_ini: float = 0.0, gamma_ini: float = 0.0,
+                     fourier: str | None = None, n_grid: int = 2001, well: WellArg = None,
+                     damping: float = 0.0) -> xr.Dataset:
     """Critical forcing amplitude F_cr(Omega) of the slow flow (eqs 22-26).
 
     Parameters
@@ -212,11 +221,12 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
     if zB.any():
         infeasible |= np.any(zB[None, :] & (numB > 1e-13), axis=1)
 
-    def resolution(x, rows, den):
+    def resolution(x: ArrayLike, rows: NDArray[np.intp], den: ArrayLike) -> FloatArray:
         """F below which a branch (h(x) - h0) / den is not resolved (H_ACCURACY)."""
         om = Om[rows]
         with np.errstate(divide="ignore"):
-            return H_ACCURACY * (np.abs(x) + om * np.abs(w.J(x)) + abs(x0) + om * abs(J0)) / np.abs(den)
+            out: FloatArray = H_ACCURACY * (np.abs(x) + om * np.abs(w.J(x)) + abs(x0) + om * abs(J0)) / np.abs(den)
+            return out
 
     # --- endpoint tangencies, eq (24)
     end_ok = xm < E_b
@@ -227,25 +237,29 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
     FB_end = np.where(FB_end > resolution(xm, all_rows, dB[-1]), FB_end, np.nan)
 
     # --- interior maxima (saddle mechanism), refined on the sign of dL/dxi
-    def dLA(rows, x):
+    def dLA(rows: NDArray[np.intp], x: FloatArray) -> FloatArray:
         om = Om[rows]
         hp = 1.0 - om / w.omega(x)
         num = x - om * w.J(x) - h0[rows]
-        return hp * (w.harmonic_amplitude(x) - G0 * c) - num * w.harmonic_amplitude_derivative(x)
+        out: FloatArray = hp * (w.harmonic_amplitude(x) - G0 * c) - num * w.harmonic_amplitude_derivative(x)
+        return out
 
-    def dLB(rows, x):
+    def dLB(rows: NDArray[np.intp], x: FloatArray) -> FloatArray:
         om = Om[rows]
         hp = 1.0 - om / w.omega(x)
         num = h0[rows] - (x - om * w.J(x))
-        return -hp * (w.harmonic_amplitude(x) + G0 * c) - num * w.harmonic_amplitude_derivative(x)
+        out: FloatArray = -hp * (w.harmonic_amplitude(x) + G0 * c) - num * w.harmonic_amplitude_derivative(x)
+        return out
 
-    def L_at(x, rows, which):
+    def L_at(x: FloatArray, rows: NDArray[np.intp], which: int) -> FloatArray:
         om = Om[rows]
         hh = x - om * w.J(x)
         Gx = w.harmonic_amplitude(x)
         if which == 0:
-            return (hh - h0[rows]) / (Gx - G0 * c)
-        return (h0[rows] - hh) / (Gx + G0 * c)
+            out: FloatArray = (hh - h0[rows]) / (Gx - G0 * c)
+            return out
+        out = (h0[rows] - hh) / (Gx + G0 * c)
+        return out
 
     xA, vA, eA = _interior_max(LA, posA[None, :] & np.ones((nO, 1), bool), xi, dLA)
     xB, vB, eB = _interior_max(LB, posB[None, :] & np.ones((nO, 1), bool), xi, dLB)
@@ -285,8 +299,9 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
             j = np.argmax(change[hit], axis=1)
             Fr = FA_end[rr]
 
-            def dap(x, rr=rr, Fr=Fr):
-                return 1.0 - Om[rr] / w.omega(x) - Fr * w.harmonic_amplitude_derivative(x)
+            def dap(x: FloatArray, rr: NDArray[np.intp] = rr, Fr: FloatArray = Fr) -> FloatArray:
+                out: FloatArray = 1.0 - Om[rr] / w.omega(x) - Fr * w.harmonic_amplitude_derivative(x)
+                return out
 
             xi_smm[rr] = _bisect(dap, up[j], up[j + 1])
             has_smm[rr] = True
@@ -303,7 +318,7 @@ def critical_forcing(Omega, xi_max, xi_ini=0.0, gamma_ini=0.0, fourier=None, n_g
     F_cr = np.where(ok, F_cr, np.nan)
     mech = np.where(ok, mech, NONE).astype(np.int8)
 
-    def var(values, long_name):
+    def var(values: ArrayLike, long_name: str) -> tuple[str, Any, dict[str, str]]:
         return ("Omega", values, {"units": "1", "long_name": long_name})
 
     ds = xr.Dataset(

@@ -20,14 +20,19 @@ from __future__ import annotations
 
 import warnings
 
+from typing import Any
+
 import numpy as np
 import xarray as xr
+from numpy.typing import ArrayLike, NDArray
 
 from safebasins.core import checks
 from safebasins.core.checks import check_finite, check_scalar
-from safebasins.theory.damped import forcing_and_level, slow_tables, to_tilde
+from safebasins.theory.damped import SlowTables, forcing_and_level, slow_tables, to_tilde
 from safebasins.theory.damped_flow import ESCAPED, SETTLED, STATUS, UNDECIDED, default_t_max, integrate_batch, pivots
+from safebasins.theory.types import BoolArray, FloatArray, WellArg
 from safebasins.wells import resolve_well
+from safebasins.wells.base import Well
 
 __all__ = ["slow_flow_outcomes", "damped_critical_forcing", "UndecidedWarning"]
 
@@ -37,7 +42,9 @@ class UndecidedWarning(RuntimeWarning):
     (counted as escaping, never as safe)."""
 
 
-def _decide(tab, X0, Y0, F, Om, beta, xm, pair, t_factor=1.0, retry=10.0):
+def _decide(tab: SlowTables, X0: FloatArray, Y0: FloatArray, F: FloatArray, Om: FloatArray, beta: float, xm: float,
+            pair: NDArray[np.intp], t_factor: float = 1.0,
+            retry: float = 10.0) -> tuple[NDArray[np.int8], FloatArray, FloatArray]:
     """Status codes (:data:`~safebasins.theory.damped_flow.STATUS`) of trajectories from (X0, Y0)
     (sheared frame) for parameter pairs (F, Om) (1-D; ``pair``: each lane's pair), with the lanes
     still undecided after the default horizon tried once more with ``retry`` times that horizon.
@@ -53,7 +60,8 @@ def _decide(tab, X0, Y0, F, Om, beta, xm, pair, t_factor=1.0, retry=10.0):
     return status, t_end, np.where(att >= 0, fp_xi, np.nan)
 
 
-def slow_flow_outcomes(q0, p0, F, Omega, Psi, xi_max, damping, fourier=None, well=None):
+def slow_flow_outcomes(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_max: float,
+                       damping: float, fourier: str | None = None, well: WellArg = None) -> NDArray[np.int8]:
     """Where the damped slow trajectory of each initial condition ``(q0, p0)`` (tau = 0) goes.
 
     The IC is mapped to ``(theta0, xi_ini)`` (eqs 7, 14), ``gamma_ini = theta0 - Psi``, and its
@@ -72,23 +80,24 @@ def slow_flow_outcomes(q0, p0, F, Omega, Psi, xi_max, damping, fourier=None, wel
     if beta <= 0:
         raise ValueError("damping must be > 0 here (damping = 0 is the conservative slow flow: "
                          "slow_flow_escapes)")
-    q0 = check_finite("q0", q0)
-    p0 = check_finite("p0", p0)
-    Psi = check_scalar("Psi", Psi, check_finite)
-    F, Om, xm, tab = forcing_and_level(w, F, Omega, xi_max)
-    q0, p0 = np.broadcast_arrays(q0, p0)
-    out = np.full(q0.shape, ESCAPED, np.int8)
-    inside = w.in_well(q0) & (w.H0(q0, p0) < xm)
+    qc = check_finite("q0", q0)
+    pc = check_finite("p0", p0)
+    psi = check_scalar("Psi", Psi, check_finite)
+    f, Om, xm, tab = forcing_and_level(w, F, Omega, xi_max)
+    q, p = np.broadcast_arrays(qc, pc)
+    out = np.full(q.shape, ESCAPED, np.int8)
+    inside = w.in_well(q) & (w.H0(q, p) < xm)
     if inside.any():
-        theta, xi = w.angle_energy(q0[inside], p0[inside])
-        X0, Y0 = to_tilde(w, theta - Psi, xi)
-        status, _, _ = _decide(tab, np.ravel(X0), np.ravel(Y0), np.array([F]), np.array([Om]), beta, xm,
+        theta, xi = w.angle_energy(q[inside], p[inside])
+        X0, Y0 = to_tilde(w, theta - psi, xi)
+        status, _, _ = _decide(tab, np.ravel(X0), np.ravel(Y0), np.array([f]), np.array([Om]), beta, xm,
                                np.zeros(np.size(X0), np.intp))
         out[inside] = status
     return out
 
 
-def damped_escapes(q0, p0, F, Omega, Psi, xi_max, damping, fourier=None, well=None):
+def damped_escapes(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_max: float, damping: float,
+                   fourier: str | None = None, well: WellArg = None) -> BoolArray:
     """:func:`slow_flow_outcomes` as the bool array of :func:`~safebasins.theory.slow_flow_escapes`
     (True = not settled); undecided ICs count as escaping, with an :class:`UndecidedWarning`."""
     status = slow_flow_outcomes(q0, p0, F, Omega, Psi, xi_max, damping, fourier=fourier, well=well)
@@ -97,15 +106,19 @@ def damped_escapes(q0, p0, F, Omega, Psi, xi_max, damping, fourier=None, well=No
         warnings.warn(f"{n} of {status.size} slow trajectories undecided (neither settled nor escaped within "
                       "the horizon): counted as escaping; slow_flow_outcomes reports them", UndecidedWarning,
                       stacklevel=3)
-    return status != SETTLED
+    out: BoolArray = status != SETTLED
+    return out
 
 
-def _escape_status(tab, X0, Y0, F, Om, beta, xm):
+def _escape_status(tab: SlowTables, X0: float, Y0: float, F: FloatArray, Om: FloatArray, beta: float,
+                   xm: float) -> tuple[NDArray[np.int8], FloatArray, FloatArray]:
     """Status of the trajectory from (X0, Y0) at each (F, Om) pair (1-D arrays), with attractors."""
     return _decide(tab, np.full(F.size, X0), np.full(F.size, Y0), F, Om, beta, xm, np.arange(F.size))
 
 
-def damped_critical_forcing(Omega, xi_max, xi_ini, gamma_ini, damping, well, n_scan=48, rtol=1e-7, F_undamped=None):
+def damped_critical_forcing(Omega: ArrayLike, xi_max: float, xi_ini: float, gamma_ini: float, damping: float,
+                            well: Well, n_scan: int = 48, rtol: float = 1e-7,
+                            F_undamped: FloatArray | None = None) -> xr.Dataset:
     """F_cr of the damped slow flow for validated arguments (``critical_forcing(..., damping > 0)``).
 
     For each Omega: a scan of ``n_scan`` geometric F values on ``[max(F_min, 0.3 F0), 2.5 F0 + F_min]``
@@ -117,6 +130,8 @@ def damped_critical_forcing(Omega, xi_max, xi_ini, gamma_ini, damping, well, n_s
     slow (cubic, xi_max = 1/6: 400 s for two Omega): near the separatrix omega ~ 1/log and dA/dxi
     diverge, and the trajectories that graze it need tens of thousands of steps.
     """
+    if F_undamped is None:
+        raise ValueError("F_undamped: the undamped F_cr per Omega seeds the scan (critical_forcing passes it)")
     w, beta = well, damping
     tab = slow_tables(w)
     xm = min(xi_max, tab.xi_top)
@@ -174,13 +189,14 @@ def damped_critical_forcing(Omega, xi_max, xi_ini, gamma_ini, damping, well, n_s
     # where the trajectory settles just below F_cr, and how long the escape at F_cr takes
     att = np.full(nO, np.nan)
     t_esc = np.full(nO, np.nan)
-    r = np.nonzero(ok)[0]
-    if r.size:
-        st, t_end, a = _escape_status(tab, X0, Y0, np.concatenate([F_lo[r], F_hi[r]]), np.tile(Om[r], 2), beta, xm)
-        att[r] = np.where(st[:r.size] == SETTLED, a[:r.size], np.nan)
-        t_esc[r] = np.where(st[r.size:] == ESCAPED, t_end[r.size:], np.nan)
+    done = np.nonzero(ok)[0]
+    if done.size:
+        st, t_end, a = _escape_status(tab, X0, Y0, np.concatenate([F_lo[done], F_hi[done]]), np.tile(Om[done], 2),
+                                      beta, xm)
+        att[done] = np.where(st[:done.size] == SETTLED, a[:done.size], np.nan)
+        t_esc[done] = np.where(st[done.size:] == ESCAPED, t_end[done.size:], np.nan)
 
-    def var(values, long_name, units="1"):
+    def var(values: ArrayLike, long_name: str, units: str = "1") -> tuple[str, Any, dict[str, str]]:
         return ("Omega", values, {"units": units, "long_name": long_name})
 
     return xr.Dataset(

@@ -27,9 +27,15 @@ with its own (F, Omega) and its own fixed points.  Times are slow-flow times in 
 """
 from __future__ import annotations
 
-import numpy as np
+from collections.abc import Callable
+from typing import Any
 
-from safebasins.theory.responses import fixed_points
+import numpy as np
+from numpy.typing import NDArray
+
+from safebasins.theory.damped import SlowTables
+from safebasins.theory.responses import FixedPoints, fixed_points
+from safebasins.theory.types import BoolArray, FloatArray
 
 __all__ = ["STATUS", "SETTLED", "ESCAPED", "UNDECIDED", "Pivots", "pivots", "integrate_batch", "default_t_max"]
 
@@ -51,8 +57,21 @@ class Pivots:
     (0: none); ``t_scale``: per pair, 2 pi over the slowest eigenvalue modulus of any fixed point
     below xi_max; ``fp``: the :class:`~safebasins.theory.responses.FixedPoints`."""
 
+    fp: FixedPoints
+    valid: BoolArray
+    x: FloatArray
+    y: FloatArray
+    index: NDArray[np.intp]
+    ux: FloatArray
+    uy: FloatArray
+    p11: FloatArray
+    p12: FloatArray
+    p22: FloatArray
+    c: FloatArray
+    t_scale: FloatArray
 
-def _lyapunov(M):
+
+def _lyapunov(M: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
     """P with ``M^T P + P M = -I`` for stacked 2x2 M: ``(p11, p12, p22)``."""
     m11, m12, m21, m22 = M[:, 0, 0], M[:, 0, 1], M[:, 1, 0], M[:, 1, 1]
     z = np.zeros_like(m11)
@@ -63,7 +82,9 @@ def _lyapunov(M):
     return p[:, 0], p[:, 1], p[:, 2]
 
 
-def _ellipse_levels(tab, x, y, M, F, Om, beta, r_max, n_ang=64, n_iter=14):
+def _ellipse_levels(tab: SlowTables, x: FloatArray, y: FloatArray, M: FloatArray, F: FloatArray, Om: FloatArray,
+                    beta: float, r_max: float, n_ang: int = 64,
+                    n_iter: int = 14) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Trapping-ellipse levels c (0 where none) and Lyapunov matrices for stable fixed points."""
     p11, p12, p22 = _lyapunov(M)
     l11 = np.sqrt(p11)
@@ -78,12 +99,13 @@ def _ellipse_levels(tab, x, y, M, F, Om, beta, r_max, n_ang=64, n_iter=14):
     t = np.linspace(0.0, 2 * np.pi, n_ang, endpoint=False)
     circ = np.stack([np.cos(t), np.sin(t)])
 
-    def inward(c):
+    def inward(c: FloatArray) -> BoolArray:
         d = np.sqrt(c)[:, None, None] * (B @ circ)              # (m, 2, n_ang)
         dx, dy = d[:, 0], d[:, 1]
         fx, fy = tab.rhs(x[:, None] + dx, y[:, None] + dy, F[:, None], Om[:, None], beta)
         dV = 2 * (dx * (p11[:, None] * fx + p12[:, None] * fy) + dy * (p12[:, None] * fx + p22[:, None] * fy))
-        return np.all(dV <= -0.5 * (dx * dx + dy * dy), axis=1)
+        out: BoolArray = np.all(dV <= -0.5 * (dx * dx + dy * dy), axis=1)
+        return out
 
     hi = np.log(np.maximum(c_max, 1e-300))
     lo = hi - 30.0
@@ -98,7 +120,7 @@ def _ellipse_levels(tab, x, y, M, F, Om, beta, r_max, n_ang=64, n_iter=14):
     return c, p11, p12, p22
 
 
-def pivots(tab, F, Om, beta, xi_max, n_grid=1200):
+def pivots(tab: SlowTables, F: FloatArray, Om: FloatArray, beta: float, xi_max: float, n_grid: int = 1200) -> Pivots:
     """:class:`Pivots` for parameter pairs (F, Omega) (1-D arrays) below xi_max."""
     fp = fixed_points(F, Om, beta, tab.well, xi_max, n_grid=n_grid)
     below = fp.converged & (fp.xi < xi_max)
@@ -108,7 +130,7 @@ def pivots(tab, F, Om, beta, xi_max, n_grid=1200):
     pv = Pivots()
     pv.fp = fp
     order = np.argsort(~att, axis=1, kind="stable")[:, :K]
-    take = lambda a: np.take_along_axis(a, order, axis=1)
+    take: Callable[[NDArray[Any]], NDArray[Any]] = lambda a: np.take_along_axis(a, order, axis=1)
     pv.valid = take(att)
     pv.x = np.where(pv.valid, take(fp.Xt), 0.0)
     pv.y = np.where(pv.valid, take(fp.Yt), 0.0)
@@ -117,8 +139,8 @@ def pivots(tab, F, Om, beta, xi_max, n_grid=1200):
     far = rad > 1e-12
     pv.ux = np.where(far, -pv.x / np.where(far, rad, 1.0), 1.0)
     pv.uy = np.where(far, -pv.y / np.where(far, rad, 1.0), 0.0)
-    for k in ("p11", "p12", "p22", "c"):
-        setattr(pv, k, np.zeros((P, K)))
+    for name in ("p11", "p12", "p22", "c"):
+        setattr(pv, name, np.zeros((P, K)))
     r_max = np.sqrt(2.0 * float(tab.well.J(np.asarray(xi_max))))
     if beta > 0:
         r, k = np.nonzero(pv.valid)
@@ -135,13 +157,13 @@ def pivots(tab, F, Om, beta, xi_max, n_grid=1200):
     return pv
 
 
-def default_t_max(pv, beta):
+def default_t_max(pv: Pivots, beta: float) -> FloatArray:
     """The generous slow-time horizon per pair: 200 slow periods (t_scale) and at least 60/beta,
     capped at 1e6."""
     return np.minimum(np.maximum(200.0 * pv.t_scale, 60.0 / beta), 1e6)
 
 
-def _hermite_max(J0, J1, m0, m1):
+def _hermite_max(J0: FloatArray, J1: FloatArray, m0: FloatArray, m1: FloatArray) -> FloatArray:
     """Maximum over the step of the cubic Hermite interpolant of J (values J0, J1, slopes*h m0, m1)."""
     a = 6 * J0 + 3 * m0 - 6 * J1 + 3 * m1
     b = -6 * J0 - 4 * m0 + 6 * J1 - 2 * m1
@@ -162,17 +184,19 @@ def _hermite_max(J0, J1, m0, m1):
     return best
 
 
-def _hermite_crossing(x0, y0, x1, y1, mx0, my0, mx1, my1, px, py, ux, uy, n_iter=40):
+def _hermite_crossing(x0: FloatArray, y0: FloatArray, x1: FloatArray, y1: FloatArray, mx0: FloatArray,
+                      my0: FloatArray, mx1: FloatArray, my1: FloatArray, px: FloatArray, py: FloatArray,
+                      ux: FloatArray, uy: FloatArray, n_iter: int = 40) -> tuple[FloatArray, FloatArray]:
     """Where the cubic Hermite interpolant of a step (ends (x0, y0), (x1, y1), slopes*h m) crosses the
     line through (px, py) along (ux, uy) (its cross product changes sign over the step): bisection on
     the interpolant (error O(h^5) instead of the chord's O(h^2), which could fake or hide the
     decrease of a slowly contracting spiral)."""
-    def point(s):
+    def point(s: FloatArray) -> tuple[FloatArray, FloatArray]:
         h00, h10 = 2 * s ** 3 - 3 * s ** 2 + 1, s ** 3 - 2 * s ** 2 + s
         h01, h11 = -2 * s ** 3 + 3 * s ** 2, s ** 3 - s ** 2
         return h00 * x0 + h10 * mx0 + h01 * x1 + h11 * mx1, h00 * y0 + h10 * my0 + h01 * y1 + h11 * my1
 
-    def cross(s):
+    def cross(s: FloatArray) -> FloatArray:
         x, y = point(s)
         return ux * (y - py) - uy * (x - px)
 
@@ -185,7 +209,9 @@ def _hermite_crossing(x0, y0, x1, y1, mx0, my0, mx1, my1, px, py, ux, uy, n_iter
     return point(0.5 * (lo + hi))
 
 
-def integrate_batch(tab, X0, Y0, F, Om, beta, xi_max, pv, pair, t_max, tol=1e-8, max_steps=200000):
+def integrate_batch(tab: SlowTables, X0: FloatArray, Y0: FloatArray, F: FloatArray, Om: FloatArray, beta: float,
+                    xi_max: float, pv: Pivots, pair: NDArray[np.intp], t_max: FloatArray, tol: float = 1e-8,
+                    max_steps: int = 200000) -> tuple[NDArray[np.int8], FloatArray, NDArray[np.int64], int]:
     """Decide trajectories of the damped slow flow (beta > 0) from (X0, Y0) (sheared frame).
 
     ``F``, ``Om``: per pair; ``pair``: each lane's pair index into F, Om and the :class:`Pivots`
@@ -226,7 +252,7 @@ def integrate_batch(tab, X0, Y0, F, Om, beta, xi_max, pv, pair, t_max, tol=1e-8,
         cap = 0.25 * np.minimum(np.maximum(dist, 1e-3 * r_max), r_max) / np.maximum(np.hypot(*k1), 1e-300)
         h = np.minimum(np.minimum(h, cap), np.maximum(Tl - t, 1e-12))
         ks = [k1]
-        for a_row, c in zip(_A[:5], _C):
+        for a_row, _c in zip(_A[:5], _C):
             xs = X + h * sum(a * k[0] for a, k in zip(a_row, ks))
             ys = Y + h * sum(a * k[1] for a, k in zip(a_row, ks))
             ks.append(tab.rhs(xs, ys, Fl, Ol, beta))

@@ -16,13 +16,19 @@ grid and polished by Newton's method in (xi, phi) with the well's exact function
 """
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 import xarray as xr
+from numpy.typing import ArrayLike, NDArray
 
 from safebasins.core import checks
 from safebasins.core.checks import check_1d, check_nonnegative, check_positive, check_positive_int, check_scalar
 from safebasins.theory.damped import TOP_GAP, coefficients, slow_tables
 from safebasins.theory.profile import unshear
+from safebasins.theory.types import BoolArray, FloatArray, WellArg
+from safebasins.wells.base import Well
 from safebasins.wells import resolve_well
 from safebasins.wells.provenance import api_provenance
 
@@ -33,7 +39,7 @@ KINDS = ("none", "stable_node", "stable_focus", "saddle", "center")
 NODE, FOCUS, SADDLE, CENTER = 1, 2, 3, 4
 
 
-def _grid(xi_hi, n):
+def _grid(xi_hi: float, n: int) -> FloatArray:
     """xi nodes on (0, xi_hi]: geometric below 1e-3 xi_hi (small-amplitude responses far from
     resonance), Chebyshev-Lobatto above."""
     t = np.linspace(0.0, 1.0, n)
@@ -42,22 +48,25 @@ def _grid(xi_hi, n):
     return np.concatenate([xi_hi * np.geomspace(1e-11, 1e-3, 48, endpoint=False), cheb])
 
 
-def _branches(c, F, Omega, beta):
+def _branches(c: dict[str, FloatArray], F: FloatArray, Omega: FloatArray,
+              beta: float) -> tuple[dict[int, FloatArray], dict[int, FloatArray], BoolArray]:
     """Omega_sigma(xi) - Omega and phi_sigma(xi) on a grid (rows: pairs (F, Omega)); NaN where s >= 1."""
-    F = F[:, None]
+    Fc = F[:, None]
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # s = inf or huge: outside
-        s = beta * c["J"][None, :] / (F * c["A"][None, :])
+        s = beta * c["J"][None, :] / (Fc * c["A"][None, :])
     inside = s < 1.0
     s_in = np.where(inside, s, 0.0)                  # 1 - s^2 only where s < 1 (no overflow outside)
     root = np.where(inside, np.sqrt(1.0 - s_in * s_in), np.nan)
     wt = (c["omega"] - beta * c["d"])[None, :]
-    k = F * (c["omega"] * c["A_xi"])[None, :]
+    k = Fc * (c["omega"] * c["A_xi"])[None, :]
     g = {1: wt - k * root - Omega[:, None], -1: wt + k * root - Omega[:, None]}
     phi = {1: np.arctan2(-s, root), -1: np.arctan2(-s, -root)}
     return g, phi, inside
 
 
-def _residuals(well, xi, phi, F, Omega, beta, xi_hi):
+def _residuals(well: Well, xi: FloatArray, phi: FloatArray, F: FloatArray, Omega: FloatArray, beta: float,
+               xi_hi: float) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray, FloatArray,
+                                      dict[str, FloatArray]]:
     """Newton residuals and Jacobian in (xi, phi), central differences in xi for the derivatives
     of omega - beta d and omega dA/dxi."""
     c = coefficients(well, xi)
@@ -86,37 +95,48 @@ class FixedPoints:
     the Jacobian in (Xt, Yt).
     """
 
-    def __init__(self, P, K):
-        self.xi = np.full((P, K), np.nan)
+    phi: FloatArray
+    gamma: FloatArray
+    J: FloatArray
+    Xt: FloatArray
+    Yt: FloatArray
+    det: FloatArray
+
+    def __init__(self, P: int, K: int) -> None:
+        self.xi: FloatArray = np.full((P, K), np.nan)
         for name in ("phi", "gamma", "J", "Xt", "Yt", "det"):
             setattr(self, name, np.full((P, K), np.nan))
-        self.kind = np.zeros((P, K), np.int8)
-        self.converged = np.zeros((P, K), bool)
-        self.eig = np.full((P, K, 2), np.nan + 0j)
-        self.M = np.full((P, K, 2, 2), np.nan)
+        self.kind: NDArray[np.int8] = np.zeros((P, K), np.int8)
+        self.converged: BoolArray = np.zeros((P, K), bool)
+        self.eig: NDArray[np.complex128] = np.full((P, K, 2), np.nan + 0j)
+        self.M: FloatArray = np.full((P, K, 2, 2), np.nan)
 
     @property
-    def attracting(self):
+    def attracting(self) -> BoolArray:
         """Stable nodes and foci (centres for beta = 0: the pivots of the trapping test)."""
-        return (self.kind == NODE) | (self.kind == FOCUS) | (self.kind == CENTER)
+        out: BoolArray = (self.kind == NODE) | (self.kind == FOCUS) | (self.kind == CENTER)
+        return out
 
 
-def fixed_points(F, Omega, beta, well, xi_hi, n_grid=1200, n_newton=30):
+def fixed_points(F: ArrayLike, Omega: ArrayLike, beta: float, well: Well, xi_hi: float, n_grid: int = 1200,
+                 n_newton: int = 30) -> FixedPoints:
     """All fixed points with ``0 < xi < xi_hi`` of the damped slow flow for pairs (F, Omega)
     (1-D arrays of equal length, F >= 0, Omega > 0; beta >= 0): a :class:`FixedPoints`.
 
     F = 0: the one fixed point is the well bottom (a stable focus for beta > 0, a centre at 0).
     """
-    F = np.asarray(F, float)
+    Fa = np.asarray(F, float)
     Om = np.asarray(Omega, float)
-    P = F.size
+    P = Fa.size
     grid = _grid(xi_hi, n_grid)
     c = coefficients(well, grid)
-    pos = F > 0
-    seeds_p, seeds_x, seeds_f = [], [], []
+    pos = Fa > 0
+    seeds_p: list[NDArray[np.intp]] = []
+    seeds_x: list[FloatArray] = []
+    seeds_f: list[FloatArray] = []
     if pos.any():
         rows = np.nonzero(pos)[0]
-        g, phi, inside = _branches(c, F[rows], Om[rows], beta)
+        g, phi, inside = _branches(c, Fa[rows], Om[rows], beta)
         for sg in (1, -1):
             gg = g[sg]
             link = inside[:, :-1] & inside[:, 1:] & ((gg[:, :-1] > 0) != (gg[:, 1:] > 0))
@@ -140,7 +160,7 @@ def fixed_points(F, Omega, beta, well, xi_hi, n_grid=1200, n_newton=30):
 
     ok = np.zeros(sp.size, bool)
     if sp.size:
-        Fs, Os = F[sp], Om[sp]
+        Fs, Os = Fa[sp], Om[sp]
         x, f = sx.copy(), sf.copy()
         for _ in range(n_newton):
             f1, f2, a11, a12, a21, a22, _ = _residuals(well, x, f, Fs, Os, beta, xi_hi)
@@ -215,17 +235,17 @@ def fixed_points(F, Omega, beta, well, xi_hi, n_grid=1200, n_newton=30):
     return out
 
 
-def _refine_junctions(well, grid, F, beta):
+def _refine_junctions(well: Well, grid: FloatArray, F: float, beta: float) -> FloatArray:
     """The grid with nodes clustered (geometrically, down to 1e-9 of the last cell) on the inside of
     each junction ``s(xi) = 1`` of the two branches, where xi is a poor parameter of the curve and
     the fold nearest the peak hides; the junction itself (both branches at Omega = w~) is a node."""
-    def s_of(x):
+    def s_of(x: FloatArray) -> FloatArray:
         c = coefficients(well, x)
         return beta * c["J"] / (F * c["A"])
 
     s = s_of(grid)
     flip = np.nonzero((s[:-1] < 1.0) != (s[1:] < 1.0))[0]
-    extra = []
+    extra: list[Any] = []
     for i in flip:
         lo, hi = grid[i], grid[i + 1]
         inside_lo = s[i] < 1.0
@@ -241,7 +261,8 @@ def _refine_junctions(well, grid, F, beta):
     return np.unique(np.concatenate([grid] + extra)) if extra else grid
 
 
-def _folds(well, c, grid, F, beta):
+def _folds(well: Well, c: dict[str, FloatArray], grid: FloatArray, F: float,
+           beta: float) -> list[tuple[float, float, float, int]]:
     """Extrema of Omega_sigma(xi) on each branch (grid sign changes of dOmega/dxi, refined by
     bisection on a central difference of the exact Omega_sigma)."""
     g, _, inside = _branches(c, np.array([F]), np.zeros(1), beta)
@@ -252,7 +273,7 @@ def _folds(well, c, grid, F, beta):
         ok = inside[0, 1:-1] & inside[0, :-2] & inside[0, 2:]
         idx = np.nonzero(ok & ((d[:-1] > 0) != (d[1:] > 0)))[0] + 1
 
-        def slope(x):
+        def slope(x: float) -> float:
             h = 1e-7 * x
             cp, cm = coefficients(well, x + h), coefficients(well, x - h)
             gp, _, _ = _branches({k: np.atleast_1d(v) for k, v in cp.items()}, np.array([F]), np.zeros(1), beta)
@@ -276,7 +297,8 @@ def _folds(well, c, grid, F, beta):
 
 
 @api_provenance
-def steady_responses(Omega, F, damping, well=None, xi_max=None, fourier=None, n_grid=4000):
+def steady_responses(Omega: ArrayLike, F: float, damping: float, well: WellArg = None, xi_max: float | None = None,
+                     fourier: str | None = None, n_grid: int = 4000) -> xr.Dataset:
     """Steady responses of ``q'' + beta q' + V'(q) = F sin(Omega tau + Psi)`` in the damped slow flow.
 
     The fixed points of the damped slow flow (docs/damping.md; module docstring) at each forcing
@@ -328,7 +350,7 @@ def steady_responses(Omega, F, damping, well=None, xi_max=None, fourier=None, n_
     xm = top if xi_max is None else min(check_scalar("xi_max", xi_max, w.check_threshold), top)
     fp = fixed_points(np.full(Om.size, F), Om, beta, w, xm, n_grid=n_grid)
     order = np.argsort(np.where(fp.converged, fp.xi, np.inf), axis=1, kind="stable")
-    take = lambda a: np.take_along_axis(a, order[..., None] if a.ndim == 3 else order, axis=1)
+    take: Callable[[NDArray[Any]], NDArray[Any]] = lambda a: np.take_along_axis(a, order[..., None] if a.ndim == 3 else order, axis=1)
     kind = take(fp.kind)
     eig = take(fp.eig)
 
@@ -370,15 +392,19 @@ def steady_responses(Omega, F, damping, well=None, xi_max=None, fourier=None, n_
                                                    "flag_meanings": " ".join(KINDS)}),
             "stable": (("Omega", "response"), (kind == NODE) | (kind == FOCUS),
                        {"long_name": "attracting steady response (stable node or focus)"}),
-            "eig_real": (("Omega", "response", "eig"), eig.real, {**one, "long_name": "Jacobian eigenvalue, real part"}),
-            "eig_imag": (("Omega", "response", "eig"), eig.imag, {**one, "long_name": "Jacobian eigenvalue, imaginary part"}),
-            "n_responses": ("Omega", (kind > 0).sum(axis=1).astype(np.int64), {"long_name": "number of fixed points"}),
+            "eig_real": (("Omega", "response", "eig"), eig.real,
+                         {**one, "long_name": "Jacobian eigenvalue, real part"}),
+            "eig_imag": (("Omega", "response", "eig"), eig.imag,
+                         {**one, "long_name": "Jacobian eigenvalue, imaginary part"}),
+            "n_responses": ("Omega", (kind > 0).sum(axis=1).astype(np.int64),
+                            {"long_name": "number of fixed points"}),
             "Omega_curve": ("curve_point", Oc, {**one, "long_name": "forcing frequency along the response curve"}),
             "xi_curve": ("curve_point", xc, {**one, "long_name": "averaged energy along the response curve"}),
             "gamma_curve": ("curve_point", gc, {"units": "rad", "long_name": "slow phase along the response curve"}),
             "branch": ("curve_point", bc, {"long_name": "branch: +1 where cos(gamma + delta) > 0, -1 where < 0"}),
             "stable_curve": ("curve_point", sc, {"long_name": "attracting part of the response curve"}),
-            "Omega_backbone": ("curve_point", backbone, {**one, "long_name": "backbone: free frequency omega(xi_curve)"}),
+            "Omega_backbone": ("curve_point", backbone,
+                               {**one, "long_name": "backbone: free frequency omega(xi_curve)"}),
             "Omega_fold": ("fold", fo[:, 0], {**one, "long_name": "forcing frequency of a fold (saddle-node)"}),
             "xi_fold": ("fold", fo[:, 1], {**one, "long_name": "averaged energy of a fold"}),
             "gamma_fold": ("fold", fo[:, 2], {"units": "rad", "long_name": "slow phase of a fold"}),

@@ -64,28 +64,29 @@ def first_integral(gamma: ArrayLike, xi: ArrayLike, F: ArrayLike, Omega: ArrayLi
     ("paper" | "exact") selects the quartic's G.
     """
     w = resolve_well(well, fourier)
-    gamma = check_finite("gamma", gamma)
-    xi = w.check_energy("xi", xi, allow_separatrix=True)
-    F = check_nonnegative("F", F)
-    Omega = check_positive("Omega", Omega)
-    return xi - Omega * w.J(xi) - F * w.harmonic_amplitude(xi) * np.cos(gamma + w.harmonic_shift(xi))
+    g = check_finite("gamma", gamma)
+    x = w.check_energy("xi", xi, allow_separatrix=True)
+    f = check_nonnegative("F", F)
+    om = check_positive("Omega", Omega)
+    out: FloatArray = x - om * w.J(x) - f * w.harmonic_amplitude(x) * np.cos(g + w.harmonic_shift(x))
+    return out
 
 
 # ----------------------------------------------------------------------------- profile
-def slow_flow_profile(F: ArrayLike, Omega: ArrayLike, xi_max: ArrayLike, fourier: str | None = None, n: int = 1500,
+def slow_flow_profile(F: float, Omega: float, xi_max: float, fourier: str | None = None, n: int = 1500,
                       well: WellArg = None) -> SlowFlowProfile:
     """Build the :class:`SlowFlowProfile` (a, b, suffix extrema, critical points) for one
     parameter set; see the module docstring."""
     w = resolve_well(well, fourier)
-    F = check_scalar("F", F, check_nonnegative)
-    Omega = check_scalar("Omega", Omega, check_positive)
-    xi_max = check_scalar("xi_max", xi_max, w.check_threshold)
+    f = check_scalar("F", F, check_nonnegative)
+    om = check_scalar("Omega", Omega, check_positive)
+    xm = check_scalar("xi_max", xi_max, w.check_threshold)
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 16:
         raise ValueError(f"n must be an integer >= 16 (nodes of the xi grid of the profile), got {n!r}")
-    return SlowFlowProfile(F, Omega, xi_max, w, n)
+    return SlowFlowProfile(f, om, xm, w, n)
 
 
-def saddles(F: ArrayLike, Omega: ArrayLike, xi_max: ArrayLike | None = None, fourier: str | None = None,
+def saddles(F: float, Omega: float, xi_max: float | None = None, fourier: str | None = None,
             well: WellArg = None) -> list[tuple[float, float]]:
     """Saddles of the slow flow below xi_max (eq 25), as a list of ``(gamma, xi)``.
 
@@ -96,10 +97,10 @@ def saddles(F: ArrayLike, Omega: ArrayLike, xi_max: ArrayLike | None = None, fou
     rays (the saddle's slow phase is gamma - delta(xi)).
     """
     w = resolve_well(well, fourier)
-    xi_max = w.barrier_energy if xi_max is None else xi_max
-    prof = slow_flow_profile(F, Omega, xi_max, n=1500, well=w)
-    out = [(0.0, float(x)) for x in prof.a_max if x < xi_max]
-    out += [(np.pi, float(x)) for x in prof.b_min if x < xi_max]
+    xm = w.barrier_energy if xi_max is None else xi_max
+    prof = slow_flow_profile(F, Omega, xm, n=1500, well=w)
+    out = [(0.0, float(x)) for x in prof.a_max if x < xm]
+    out += [(np.pi, float(x)) for x in prof.b_min if x < xm]
     return sorted(out, key=lambda t: t[1])
 
 
@@ -114,7 +115,7 @@ def _escapes_rm(gamma: FloatArray, xi: FloatArray, prof: SlowFlowProfile) -> Boo
     return out
 
 
-def escapes_on_manifold(gamma: ArrayLike, xi: ArrayLike, F: ArrayLike, Omega: ArrayLike, xi_max: ArrayLike,
+def escapes_on_manifold(gamma: ArrayLike, xi: ArrayLike, F: float, Omega: float, xi_max: float,
                         fourier: str | None = None, well: WellArg = None) -> BoolArray:
     """Does the slow-flow level curve (21) through ``(gamma, xi)`` reach ``xi = xi_max``?
 
@@ -123,15 +124,14 @@ def escapes_on_manifold(gamma: ArrayLike, xi: ArrayLike, F: ArrayLike, Omega: Ar
     (``max a <= C(gamma, xi) <= min b`` over ``[xi, xi_max]``).
     """
     w = resolve_well(well, fourier)
-    gamma = check_finite("gamma", gamma)
-    xi = w.check_energy("xi", xi, allow_separatrix=True)
+    g = check_finite("gamma", gamma)
+    x = w.check_energy("xi", xi, allow_separatrix=True)
     prof = slow_flow_profile(F, Omega, check_scalar("xi_max", xi_max, w.check_analytic_threshold), well=w)
-    return _escapes_rm(gamma, xi, prof)
+    return _escapes_rm(g, x, prof)
 
 
-def slow_flow_escapes(q0: ArrayLike, p0: ArrayLike, F: ArrayLike, Omega: ArrayLike, Psi: ArrayLike,
-                      xi_max: ArrayLike, fourier: str | None = None, well: WellArg = None,
-                      damping: ArrayLike = 0.0) -> BoolArray:
+def slow_flow_escapes(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_max: float,
+                      fourier: str | None = None, well: WellArg = None, damping: float = 0.0) -> BoolArray:
     """Analytic escape prediction for initial conditions ``(q0, p0)`` at tau = 0.
 
     Each IC is mapped to ``(theta0, xi_ini)`` (eqs 7, 14), ``gamma_ini = theta0 - Psi``, and
@@ -147,12 +147,12 @@ def slow_flow_escapes(q0: ArrayLike, p0: ArrayLike, F: ArrayLike, Omega: ArrayLi
     w = resolve_well(well, fourier)
     if check_scalar("damping", damping, check_nonnegative) > 0:
         return damped_escapes(q0, p0, F, Omega, Psi, xi_max, damping, well=w)
-    xi_max = check_scalar("xi_max", xi_max, w.check_analytic_threshold)
-    q0 = check_finite("q0", q0)
-    p0 = check_finite("p0", p0)
-    Psi = check_scalar("Psi", Psi, check_finite)
-    prof = slow_flow_profile(F, Omega, xi_max, well=w)
-    grid = GridSlowFlow(q0, p0, Psi, prof.xi_max, w, reuse=False)
+    xm = check_scalar("xi_max", xi_max, w.check_analytic_threshold)
+    q = check_finite("q0", q0)
+    p = check_finite("p0", p0)
+    psi = check_scalar("Psi", Psi, check_finite)
+    prof = slow_flow_profile(F, Omega, xm, well=w)
+    grid = GridSlowFlow(q, p, psi, prof.xi_max, w, reuse=False)
     return grid.escapes(grid.profile(prof.F, prof.Omega))
 
 
@@ -169,17 +169,17 @@ def _J_table() -> tuple[FloatArray, FloatArray]:
 
 def xi_from_J(Jv: ArrayLike) -> FloatArray:
     """Invert eq (19): energy xi with ``J(xi) = Jv`` (0 <= Jv <= 4/(3 pi)), Newton on dJ/dxi = 1/omega."""
-    Jv = check_nonnegative("Jv", Jv)
+    Jc = check_nonnegative("Jv", Jv)
     Jmax = float(QUARTIC.J(XI_SEPARATRIX))
-    if (Jv > Jmax).any():
+    if (Jc > Jmax).any():
         raise ValueError(f"Jv must be <= J(1/4) = {Jmax}")
     # initial guess from a monotone table, then Newton steps
     tab_x, tab_J = _J_table()
-    x = np.interp(Jv, tab_J, tab_x)
+    x: FloatArray = np.interp(Jc, tab_J, tab_x)
     for _ in range(3):
         inner = (x > 0) & (x < XI_SEPARATRIX)
         xs = np.where(inner, x, 0.1)
-        x = np.where(inner, x - (QUARTIC.J(xs) - Jv) * QUARTIC.omega(xs), x)
+        x = np.where(inner, x - (QUARTIC.J(xs) - Jc) * QUARTIC.omega(xs), x)
         x = np.clip(x, 0.0, XI_SEPARATRIX)
     return x
 
@@ -195,14 +195,14 @@ def slow_flow_rhs(X: ArrayLike, Y: ArrayLike, F: ArrayLike, Omega: ArrayLike,
     ``fourier`` "paper" | "exact", ``X^2 + Y^2 <= 2 J(1/4)``; a ValueError names the argument
     otherwise.  With damping see :func:`safebasins.theory.damped.rhs_gamma_frame`.
     """
-    check_nonnegative("F", F)
-    check_positive("Omega", Omega)
+    Fv = np.asarray(check_nonnegative("F", F), float)
+    Om = np.asarray(check_positive("Omega", Omega), float)
     check_fourier(fourier)
     check_finite("X", X)
     check_finite("Y", Y)
-    X = np.asarray(X, float)
-    Y = np.asarray(Y, float)
-    r2 = X * X + Y * Y
+    Xa = np.asarray(X, float)
+    Ya = np.asarray(Y, float)
+    r2 = Xa * Xa + Ya * Ya
     if (0.5 * r2 > float(QUARTIC.J(XI_SEPARATRIX))).any():
         raise ValueError("X, Y must lie inside the separatrix: X^2 + Y^2 <= 2 J(1/4) = "
                          f"{2 * float(QUARTIC.J(XI_SEPARATRIX))!r}")
@@ -211,16 +211,14 @@ def slow_flow_rhs(X: ArrayLike, Y: ArrayLike, F: ArrayLike, Omega: ArrayLike,
     small = r < 1e-12
     rs = np.where(small, 1.0, r)
     xs = np.where(small, 1e-30, xi)
-    c, s = np.where(small, 1.0, X / rs), np.where(small, 0.0, Y / rs)
+    c, s = np.where(small, 1.0, Xa / rs), np.where(small, 0.0, Ya / rs)
     well = resolve_well(None, fourier)
     w = well.omega(xs)
     dG = np.full(xs.shape, np.nan)            # no derivative on the separatrix (xi = 1/4)
     below = xs < XI_SEPARATRIX
     dG[below] = well.harmonic_amplitude_derivative(xs[below])
-    Jdot = -F * well.harmonic_amplitude(xs) * s
-    gdot = w - Omega - F * w * dG * c
-    dX = Jdot * c / rs - Y * gdot
-    dY = Jdot * s / rs + X * gdot
-    dX = np.where(small, 0.0, dX)
-    dY = np.where(small, -0.5 * F, dY)
+    Jdot = -Fv * well.harmonic_amplitude(xs) * s
+    gdot = w - Om - Fv * w * dG * c
+    dX: FloatArray = np.where(small, 0.0, Jdot * c / rs - Ya * gdot)
+    dY: FloatArray = np.where(small, -0.5 * Fv, Jdot * s / rs + Xa * gdot)
     return dX, dY

@@ -174,7 +174,7 @@ class GridSlowFlow:
             cosm = np.cos(gamma[:, None] + shift[None, :])
             if len(self._cos_cache) < 8:
                 self._cos_cache[key] = cosm
-        out: BoolArray = level_escapes(prof, xs, w.J(xs), w.harmonic_amplitude(xs), cosm).any(axis=0)
+        out: BoolArray = np.any(level_escapes(prof, xs, w.J(xs), w.harmonic_amplitude(xs), cosm), axis=0)
         return out
 
     def xi_true(self, prof: SlowFlowProfile, *, n_gamma: int = 512, n_xi: int = 400, levels: int = 3) -> float:

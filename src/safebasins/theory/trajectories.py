@@ -7,14 +7,19 @@ and event location for the escape, the ellipses and the pivots' rays.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 import xarray as xr
+from numpy.typing import NDArray
 from scipy import integrate
 
 from safebasins.core import checks
 from safebasins.core.checks import check_finite, check_positive, check_scalar
 from safebasins.theory.damped import forcing_and_level, from_tilde, rhs_exact, to_tilde
-from safebasins.theory.damped_flow import default_t_max, pivots
+from safebasins.theory.damped_flow import Pivots, default_t_max, pivots
+from safebasins.theory.types import FloatArray, WellArg
 from safebasins.wells import resolve_well
 from safebasins.wells.provenance import api_provenance
 
@@ -23,10 +28,14 @@ __all__ = ["slow_trajectory"]
 OUTCOMES = ("settled", "escaped", "undecided", "bounded")
 
 
-def _crossings(sol, pv, k_list, first, f):
+Flow = Callable[[float, Any], tuple[FloatArray, FloatArray]]
+Index = int | np.integer[Any]
+
+
+def _crossings(sol: Any, pv: Pivots, k_list: list[Index], first: int, f: Flow) -> list[tuple[float, Index, float, int]]:
     """Ray crossings (t, k, rho, direction) of one solve_ivp chunk, in time order (the rays'
     events are ``sol.t_events[first:]``)."""
-    out = []
+    out: list[tuple[float, Index, float, int]] = []
     for j, k in enumerate(k_list):
         te, ye = sol.t_events[first + j], sol.y_events[first + j]
         for t, y in zip(te, ye):
@@ -40,7 +49,7 @@ def _crossings(sol, pv, k_list, first, f):
     return sorted(out)
 
 
-def _transversal(pv, k, rho0, rho1, d, f):
+def _transversal(pv: Pivots, k: Index, rho0: float, rho1: float, d: int, f: Flow) -> bool:
     for s in np.linspace(0.0, 1.0, 9):
         r = rho0 + s * (rho1 - rho0)
         fx, fy = f(0.0, (pv.x[0, k] + r * pv.ux[0, k], pv.y[0, k] + r * pv.uy[0, k]))
@@ -50,8 +59,9 @@ def _transversal(pv, k, rho0, rho1, d, f):
 
 
 @api_provenance
-def slow_trajectory(xi_ini, gamma_ini, F, Omega, xi_max, damping=0.0, well=None, fourier=None,
-                    t_max=None, rtol=1e-10, atol=1e-12):
+def slow_trajectory(xi_ini: float, gamma_ini: float, F: float, Omega: float, xi_max: float, damping: float = 0.0,
+                    well: WellArg = None, fourier: str | None = None, t_max: float | None = None,
+                    rtol: float = 1e-10, atol: float = 1e-12) -> xr.Dataset:
     """Integrate the damped slow flow (docs/damping.md) from ``(gamma_ini, xi_ini)`` until it reaches
     ``xi_max`` or settles, with the well's exact functions (DOP853, events).
 
@@ -87,31 +97,37 @@ def slow_trajectory(xi_ini, gamma_ini, F, Omega, xi_max, damping=0.0, well=None,
         check_scalar("t_max", t_max, check_positive)
     J_max = float(w.J(np.asarray(xm)))
 
-    def f(t, y):
+    def f(t: float, y: Any) -> tuple[FloatArray, FloatArray]:
         return rhs_exact(w, np.asarray(y[0]), np.asarray(y[1]), F, Om, beta)
 
-    def esc(t, y):
-        return 0.5 * (y[0] * y[0] + y[1] * y[1]) - J_max
-    esc.terminal, esc.direction = True, 1
-    events, ell_k, ray_k = [esc], [], []
+    def esc(t: float, y: NDArray[np.float64]) -> float:
+        out: float = 0.5 * (y[0] * y[0] + y[1] * y[1]) - J_max
+        return out
+    esc.terminal, esc.direction = True, 1  # type: ignore[attr-defined]  # read by solve_ivp
+    events: list[Callable[..., float]] = [esc]
+    ell_k: list[Index] = []
+    ray_k: list[Index] = []
+    k: Index
     for k in np.nonzero(pv.valid[0])[0]:
         if pv.c[0, k] > 0:
-            def ell(t, y, k=k):
+            def ell(t: float, y: NDArray[np.float64], k: Index = k) -> float:
                 dx, dy = y[0] - pv.x[0, k], y[1] - pv.y[0, k]
-                return pv.p11[0, k] * dx * dx + 2 * pv.p12[0, k] * dx * dy + pv.p22[0, k] * dy * dy - pv.c[0, k]
-            ell.terminal, ell.direction = True, -1
+                out: float = pv.p11[0, k] * dx * dx + 2 * pv.p12[0, k] * dx * dy + pv.p22[0, k] * dy * dy - pv.c[0, k]
+                return out
+            ell.terminal, ell.direction = True, -1  # type: ignore[attr-defined]  # read by solve_ivp
             events.append(ell)
             ell_k.append(k)
     for k in np.nonzero(pv.valid[0])[0]:
-        def ray(t, y, k=k):
-            return pv.ux[0, k] * (y[1] - pv.y[0, k]) - pv.uy[0, k] * (y[0] - pv.x[0, k])
+        def ray(t: float, y: NDArray[np.float64], k: Index = k) -> float:
+            out: float = pv.ux[0, k] * (y[1] - pv.y[0, k]) - pv.uy[0, k] * (y[0] - pv.x[0, k])
+            return out
         events.append(ray)
         ray_k.append(k)
 
     y = np.array(to_tilde(w, g0, x0), float)
     ts, ys = [np.zeros(1)], [y[:, None]]
     t0, outcome, detection, t_end, att = 0.0, "undecided", f"neither within t_max = {T!r}", T, -1
-    last = {}
+    last: dict[Index, tuple[float, int]] = {}
     if 0.5 * float(y @ y) >= J_max:
         outcome, detection, t_end = "escaped", "starts at or above xi_max", 0.0
     for j, k in enumerate(ell_k):
@@ -150,10 +166,10 @@ def slow_trajectory(xi_ini, gamma_ini, F, Omega, xi_max, damping=0.0, well=None,
         if not sol.success:
             detection = f"solver failed: {sol.message}"
             break
-    t = np.concatenate(ts)
+    t_all = np.concatenate(ts)
     Y = np.concatenate(ys, axis=1)
     if outcome == "undecided":
-        t_end = float(t[-1])
+        t_end = float(t_all[-1])
     gam, xi = from_tilde(w, Y[0], Y[1])
     fp = pv.fp
     ax = float(fp.xi[0, att]) if att >= 0 else np.nan
@@ -162,7 +178,7 @@ def slow_trajectory(xi_ini, gamma_ini, F, Omega, xi_max, damping=0.0, well=None,
         {"gamma": ("t", gam, {"units": "rad", "long_name": "slow phase gamma = theta - Psi - Omega tau"}),
          "xi": ("t", xi, {"units": "1", "long_name": "averaged energy"}),
          "J": ("t", 0.5 * (Y[0] ** 2 + Y[1] ** 2), {"units": "1", "long_name": "averaged action"})},
-        coords={"t": ("t", t, {"units": "1", "long_name": "slow time (tau)"})},
+        coords={"t": ("t", t_all, {"units": "1", "long_name": "slow time (tau)"})},
         attrs={"outcome": outcome, "detection": detection, "t_end": float(t_end), "attractor_xi": ax,
                "attractor_gamma": ag, "xi_ini": x0, "gamma_ini": g0, "F": F, "Omega": Om, "xi_max": xm,
                "damping": beta, "t_max": T, "well": w.name, "fourier": w.fourier,
