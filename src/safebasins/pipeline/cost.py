@@ -15,6 +15,7 @@ from __future__ import annotations
 import functools
 import inspect
 import math
+import importlib
 
 from safebasins.pipeline.validation import fail
 
@@ -52,8 +53,6 @@ def costs(run, experiments=None) -> dict[str, int]:
 @functools.cache
 def _default(func, arg):
     """A library default (``"module:function"``), read from its signature, never restated."""
-    import importlib
-
     mod, _, name = func.partition(":")
     return inspect.signature(getattr(importlib.import_module(mod), name)).parameters[arg].default
 

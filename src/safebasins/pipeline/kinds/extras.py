@@ -8,6 +8,7 @@ it re-reads the numeric datasets of other experiments.
 from __future__ import annotations
 
 from functools import partial
+import math
 
 import numpy as np
 
@@ -235,10 +236,6 @@ class TrueBasin(GridChartKind):
         _check_grid_block(block, key, ctx)
 
     def resolve(self, block, ctx):
-        import math
-
-        import numpy as np
-
         xis = [float(x) for x in values.as_list(block["xi_max"])]
         n = int(block["n_psi"])
         psis = [float(np.round(2 * math.pi * k / n, 12)) for k in range(n)]

@@ -10,6 +10,7 @@ integrates its block of control points in one ensemble and keeps only the integr
 from __future__ import annotations
 
 import numpy as np
+import xarray as xr
 
 from safebasins.pipeline import values
 from safebasins.pipeline import well_defaults as WD
@@ -34,8 +35,6 @@ def build_analytic(params, data, job):
 
 def build_numeric(params, data, job):
     """Tiles (one Omega x a block of F each) gathered; numeric - analytic difference; fronts."""
-    import xarray as xr
-
     from safebasins.analysis.integrity_map import erosion_front
     from safebasins.io.gather import TILE_ATTRS
 
