@@ -428,20 +428,22 @@ def _tangency_gap(w: Well, forcing: tuple[float, float, float, float], pair: tup
 @api_provenance
 def manifold_tangency(Omega: float, damping: float, well: WellLike = None, Psi: float = 0.0, *,
                       F_bracket: tuple[float, float] | None = None, xtol: float = 1e-7, s0: float = 1e-7,
-                      ds_max: float = 0.01, angle_max: float = 0.05, max_points: int = 20000, rtol: float = 1e-10,
+                      ds_max: float = 0.01, angle_max: float = 0.05, max_points: int = 5000, rtol: float = 1e-10,
                       splitting: bool = True, n_phase: int = 48) -> xr.Dataset:
     """F of the first tangency of the hilltop saddle's stable and unstable manifolds (module docstring).
 
     The signed gap of the inner ``W^u`` from the inner ``W^s`` (grown with ``s0``, ``ds_max``,
     ``angle_max``, ``max_points``, ``rtol``, then refined three times around their closest approach)
     is negative while ``W^u`` lies inside ``W^s`` and changes sign at the tangency; its root in F by
-    Brent's method to ``xtol``, in ``F_bracket`` (default ``(0.5, 2) F_M``).  With ``splitting``
+    Brent's method to ``xtol``, in ``F_bracket`` (default ``(0.5, 1.25) F_M``: far past the tangency
+    the tangle makes every evaluation slow).  With ``splitting``
     also the root of the largest section energy gap of
     :func:`~safebasins.analysis.melnikov.manifold_splitting` (``n_phase`` start times), an
     independent numeric route.
 
     Returns a Dataset of scalars ``F_tangency``, ``F_melnikov``, ``F_splitting`` (NaN without
-    ``splitting``), ``tangency_ratio`` = F_tangency / F_M, ``splitting_ratio`` = F_splitting / F_M;
+    ``splitting`` or when the energy gap does not change sign in the bracket),
+    ``tangency_ratio`` = F_tangency / F_M, ``splitting_ratio`` = F_splitting / F_M;
     over ``evaluation``: ``F_evaluated``, ``gap`` (every F Brent tried and its signed gap).
     ValueError naming ``F_bracket`` when the gap does not change sign in it, naming ``damping`` for 0
     (the undamped manifolds intersect for every F > 0: the threshold is 0)."""
@@ -455,7 +457,7 @@ def manifold_tangency(Omega: float, damping: float, well: WellLike = None, Psi: 
     pair = (float(orbit.saddles[0]), float(orbit.saddles[-1]))
     FM = float(_threshold(Om, beta, w))
     if F_bracket is None:
-        lo, hi = 0.5 * FM, 2.0 * FM
+        lo, hi = 0.5 * FM, 1.25 * FM
     else:
         fb = checks.check_nonnegative("F_bracket", F_bracket).ravel()
         if fb.size != 2 or not fb[0] < fb[1]:
@@ -485,7 +487,9 @@ def manifold_tangency(Omega: float, damping: float, well: WellLike = None, Psi: 
     if splitting:
         def split(F: float) -> float:
             return float(_splitting(F, Om, beta, w, Psi, n_phase=n_phase).attrs["max_energy_gap"])
-        F_split = float(brentq(split, lo, hi, xtol=xtol))
+        s_lo, s_hi = split(lo), split(hi)
+        if s_lo < 0 < s_hi:                             # else its root is not in the bracket: NaN
+            F_split = float(brentq(split, lo, hi, xtol=xtol))
     seen.sort()
     E = ("evaluation",)
     ds = xr.Dataset(
