@@ -50,6 +50,13 @@ unlock: $(STAMP)
 test: $(STAMP)
 	$(BIN)/python -m pytest -n $(JOBS) --dist loadfile
 
+## Lint and types (pyproject's [tool.ruff] and [tool.mypy]; docs/contracts.md): ruff over src and
+## tests, mypy over src/safebasins (strict on wells, numerics, theory).
+.PHONY: lint
+lint: $(STAMP)
+	$(BIN)/ruff check src tests
+	$(BIN)/mypy
+
 ## The whole DAG at coarse resolution (a few minutes).
 quick: $(STAMP)
 	$(BIN)/snakemake -j$(JOBS) --configfile config/quick.yaml --rerun-incomplete all

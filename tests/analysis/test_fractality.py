@@ -18,7 +18,8 @@ def test_smooth_below_and_fractal_past_the_tangency():
     assert abs(a - 1.0) < 3 * da and da < 0.15                   # smooth: f(eps) ~ eps
     b, db = past.attrs["alpha"], past.attrs["alpha_err"]
     assert b < 0.85 and b + 3 * db < a and past.attrs["boundary_dimension"] > 1.15
-    assert past.attrs["safe_fraction"] > 0.2 and (past["n_uncertain"].values[:-1] >= past["n_uncertain"].values[1:]).all()
+    n_uncertain = past["n_uncertain"].values
+    assert past.attrs["safe_fraction"] > 0.2 and (n_uncertain[:-1] >= n_uncertain[1:]).all()
 
 
 @pytest.mark.parametrize("kw,name", [(dict(eps=(1e-3, 1e-3)), "eps"), (dict(eps=(-1e-3,)), "eps"), (dict(n=0), "n"),

@@ -16,7 +16,8 @@ OM, FF = [0.85, 1.0], [0.0, 0.02, 0.05]
 
 
 def test_batch_equals_single_charts_bitwise():
-    b = escape_chart_batch(Q, P, [0.01, 0.05, 0.0], [0.9, 1.0, 0.95], np.pi, xi_max=(0.18, 0.22), q_max=(0.8,), cycles=60)
+    b = escape_chart_batch(Q, P, [0.01, 0.05, 0.0], [0.9, 1.0, 0.95], np.pi, xi_max=(0.18, 0.22), q_max=(0.8,),
+                           cycles=60)
     for k, (F, Om) in enumerate([(0.01, 0.9), (0.05, 1.0), (0.0, 0.95)]):
         c = escape_chart(Q, P, F, Om, np.pi, xi_max=(0.18, 0.22), q_max=(0.8,), cycles=60)
         assert np.array_equal(c["escape_cycle_energy"].values, b["escape_cycle_energy"].values[k])

@@ -129,7 +129,8 @@ def test_info_reports_contents_provenance_and_agreement(chart_run):
         attrs = dict(ds.attrs)
         iou = ds["iou"].values
     out = res.stdout
-    for text in ("dimensions: xi_max=2, q0=12, p0=10, q_max=1", "q0 (q0): [-0.9, 0.9]", "escape_cycle_energy (xi_max, q0, p0) float64",
+    for text in ("dimensions: xi_max=2, q0=12, p0=10, q_max=1", "q0 (q0): [-0.9, 0.9]",
+                 "escape_cycle_energy (xi_max, q0, p0) float64",
                  "safebasins_version: " + attrs["safebasins_version"], "git_commit: " + attrs["git_commit"],
                  "config_hash: " + attrs["config_hash"], "date_created: " + attrs["date_created"],
                  "history: safebasins chart", '    command: "chart"', "headline numbers (agreement at t_eval = 20 EC):",

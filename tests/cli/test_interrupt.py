@@ -49,7 +49,8 @@ def test_sigint_during_a_chart_exits_130_and_writes_nothing(tmp_path):
     # F small: every IC inside the well survives all the cycles, so the run lasts (a minute or more)
     proc = subprocess.Popen(_cli("chart", "--F", "0.001", "--Omega", "0.9", "--xi-max", "0.2", "--n", "40",
                                  "--cycles", "200000", "--tiles", "40", "--threads", "1", "--allow-expensive",
-                                 "-o", str(tmp_path / "c")), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+                                 "-o", str(tmp_path / "c")), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True)
     out = _interrupt(proc, after=6)
     assert proc.returncode == EXIT_SIGINT == 130, out
     assert "interrupted (SIGINT)" in out

@@ -38,8 +38,8 @@ def test_every_public_function_returning_a_dataset_is_wrapped():
     import importlib
     import inspect
 
-    modules = ["safebasins.theory", "safebasins.numerics", "safebasins.analysis.melnikov", "safebasins.analysis.erosion",
-               "safebasins.analysis.phase_invariant", "safebasins.analysis.period_map",
+    modules = ["safebasins.theory", "safebasins.numerics", "safebasins.analysis.melnikov",
+               "safebasins.analysis.erosion", "safebasins.analysis.phase_invariant", "safebasins.analysis.period_map",
                "safebasins.analysis.fourier_compare", "safebasins.analysis.ic_basins",
                "safebasins.analysis.fcr_curves", "safebasins.analysis.tangency", "safebasins.analysis.fractality",
                "safebasins.analysis.integrity_map"]

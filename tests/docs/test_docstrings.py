@@ -33,7 +33,8 @@ def test_api_reference_builds_without_warnings(tmp_path):
         "              'sphinx.ext.mathjax', 'apipages']\n"
         "autodoc_typehints = 'none'\nautodoc_preserve_defaults = True\nnapoleon_google_docstring = False\n"
         "napoleon_use_rtype = False\nsuppress_warnings = ['toc.not_included']\n")
-    (src / "index.md").write_text("# API\n\n```{toctree}\n" + "".join(f"api/{p}\n" for p in apipages.PACKAGES) + "```\n")
+    (src / "index.md").write_text("# API\n\n```{toctree}\n" + "".join(f"api/{p}\n" for p in apipages.PACKAGES)
+                                  + "```\n")
     warnings = io.StringIO()
     app = Sphinx(str(src), str(src), str(tmp_path / "html"), str(tmp_path / "doctrees"), "html",
                  status=None, warning=warnings, freshenv=True, keep_going=True)

@@ -1,6 +1,7 @@
 """The built documentation site (make docs) in headless Debian Chromium: the index, the API
 reference and an executed tutorial render with their headings and images, without console
-errors; every page's images load; the equations are typeset by the bundled MathJax, offline.  Screenshots go to $SB_SCREENSHOTS or the test's tmp dir.
+errors; every page's images load; the equations are typeset by the bundled MathJax, offline.  Screenshots go to
+$SB_SCREENSHOTS or the test's tmp dir.
 
 The site must be built first (`make docs`); without it the tests skip, unless SB_REQUIRE_DOCS=1
 (.ci/run runs them after `make docs` that way).  Without Debian's chromium they skip, except in CI.

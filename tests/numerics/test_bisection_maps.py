@@ -105,7 +105,8 @@ def test_stroboscopic_map():
     safe = np.flatnonzero(~esc)[:3]
     S = m.attrs["steps_per_cycle"]
     for n in (1, 37, 200):
-        q, p = kernels.final_states(q0[safe], p0[safe], np.zeros(safe.size, np.int64), schemes.lane_coefficients(0.99, S),
+        q, p = kernels.final_states(q0[safe], p0[safe], np.zeros(safe.size, np.int64),
+                                    schemes.lane_coefficients(0.99, S),
                               np.array([0.0876]), schemes.sine_table(S, np.pi), n)
         np.testing.assert_array_equal(q, m["q"].values[safe, n])
         np.testing.assert_array_equal(p, m["p"].values[safe, n])

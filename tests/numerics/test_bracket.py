@@ -79,7 +79,8 @@ def test_widening_above_resonance_matches_dop853_and_the_final_bracket():
     assert ds["F_bracket_widenings"].values.tolist() == [0, 1]
     np.testing.assert_array_equal(ds["F_bracket_used_high"], [0.25, 0.5])
     assert np.isfinite(ds["F_cr"]).all()
-    wide = critical_forcing_numeric(Om[1:], 0.16, cycles=CYCLES, tol=1e-4, n_scan=51, well="cubic", F_bracket=(0.0, 0.5))
+    wide = critical_forcing_numeric(Om[1:], 0.16, cycles=CYCLES, tol=1e-4, n_scan=51, well="cubic",
+                                    F_bracket=(0.0, 0.5))
     for v in ("F_cr", "F_cr_low", "F_cr_high", "F_escape_low", "F_escape_all", "non_monotone"):
         np.testing.assert_array_equal(ds[v].values[1:], wide[v].values)
     f = float(ds["F_cr"][1])

@@ -12,7 +12,8 @@ trajectory reaches exactly, where a one-ulp difference in the state would move t
 step (this is what catches a multiply-add rounded twice).  Other wells: the cubic (kernel flag
 code: Horner from run-time coefficients, one barrier) with asymmetric displacement bounds, the
 quartic with asymmetric bounds (signed tracking), several parameter sets, and a rational well
-written as an expression (generated V, dV); the damped schemes (beta = 0.1, three parameter sets).  Subprocess: ~10-15 s.
+written as an expression (generated V, dV); the damped schemes (beta = 0.1, three parameter sets).  Subprocess:
+~10-15 s.
 """
 from __future__ import annotations
 
@@ -90,7 +91,8 @@ def _all_cases():
             args=[Q.tolist(), P.tolist(), zero, [0.95], [0.0876], np.pi],
             kw=dict(xi_max=[0.2, 0.12], q_max=[0.8], cycles=20, steps_per_cycle=16, integrator=integrator))
         yield f"{integrator}/multi_stop_any", dict(
-            args=[Q.tolist(), P.tolist(), (np.arange(Q.size) % 3).tolist(), [0.95, 0.8, 1.2], [0.0876, 0.05, 0.12], 0.7],
+            args=[Q.tolist(), P.tolist(), (np.arange(Q.size) % 3).tolist(), [0.95, 0.8, 1.2], [0.0876, 0.05, 0.12],
+                  0.7],
             kw=dict(xi_max=[0.2, 0.15], q_max=[0.75], cycles=15, steps_per_cycle=12, stop_any=True,
                     integrator=integrator),
             cuda=dict(block=8, grid=2), global_table=True)
@@ -111,7 +113,8 @@ def _all_cases():
                     steps_per_cycle=16, integrator=integrator),
             well=CUBIC)
         yield f"{integrator}/damped", dict(     # several parameter sets: the per-lane coefficient columns
-            args=[Qc.tolist(), Pc.tolist(), (np.arange(Q.size) % 3).tolist(), [0.85, 0.9, 0.8], [0.05, 0.06, 0.04], 0.3],
+            args=[Qc.tolist(), Pc.tolist(), (np.arange(Q.size) % 3).tolist(), [0.85, 0.9, 0.8], [0.05, 0.06, 0.04],
+                  0.3],
             kw=dict(xi_max=[0.12, 1.0 / 6.0], q_bounds=[[-0.43, 0.65]], cycles=25, steps_per_cycle=16,
                     integrator=integrator, damping=0.1),
             well=CUBIC)
@@ -142,7 +145,8 @@ def child():
     for name, c in json.load(sys.stdin).items():
         cuda_kernels.SHARED_TABLE_BYTES = 0 if c.get("global_table") else 16 * 1024
         t = time.perf_counter()
-        E, Q = engine.integrate(ensemble_problem(*c["args"], **c["kw"], well=c.get("well")), "cuda", **c.get("cuda", {}))
+        E, Q = engine.integrate(ensemble_problem(*c["args"], **c["kw"], well=c.get("well")), "cuda",
+                                **c.get("cuda", {}))
         out[name] = dict(E=E.tolist(), Q=Q.tolist(), dtype=[str(E.dtype), str(Q.dtype)],
                          seconds=round(time.perf_counter() - t, 2))
     print(json.dumps(out))

@@ -44,7 +44,8 @@ def test_damped_schemes_have_order_four(integrator):
     ref = np.array([_reference(a, b, F, Omega, beta, n * 2 * np.pi / Omega, w) for a, b in zip(q0, p0)])
     err = []
     for S in (16, 32, 64):
-        q, p = kernels.final_states(q0, p0, np.zeros(2, np.int64), schemes.lane_coefficients(Omega, S, integrator, beta),
+        q, p = kernels.final_states(q0, p0, np.zeros(2, np.int64),
+                                    schemes.lane_coefficients(Omega, S, integrator, beta),
                                     np.array([F]), schemes.sine_table(S, 0.0, integrator), n, well=code,
                                     scheme=scheme_code(integrator, beta > 0))
         err.append(np.max(np.abs(np.stack([q, p], 1) - ref)))

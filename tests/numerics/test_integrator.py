@@ -144,4 +144,5 @@ def test_bitwise_independent_of_threads_tasks_and_lanes(integrator):
     for oE, oQ in res[1:]:
         np.testing.assert_array_equal(oE, res[0][0])
         np.testing.assert_array_equal(oQ, res[0][1])
-    np.testing.assert_array_equal(engine.steps_to_cycles(res[0][0], S), a["escape_cycle_energy"].values.reshape(2, -1).T)
+    np.testing.assert_array_equal(engine.steps_to_cycles(res[0][0], S),
+                                  a["escape_cycle_energy"].values.reshape(2, -1).T)

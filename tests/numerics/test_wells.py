@@ -53,7 +53,8 @@ REF_MAP_STEPS = [31, 21, 69, 6]
 #: the iterates themselves (their sha256 is REF_MAP: the file holds the old engine's numbers)
 MAP_FILE = Path(__file__).with_name("quartic_map_reference.npz")
 # critical_forcing_numeric([0.85, 0.95], 0.2, cycles=100, n_scan=11, F_bracket=(0, 0.2), tol=1e-3, S=16)
-REF_FCR = {"srkn6b": (["0x1.899999999999ap-5", "0x1.e000000000000p-6"], ["0x1.899999999999ap-5", "0x1.1666666666667p-5"]),
+REF_FCR = {"srkn6b": (["0x1.899999999999ap-5", "0x1.e000000000000p-6"],
+                      ["0x1.899999999999ap-5", "0x1.1666666666667p-5"]),
            "rk4": (["0x1.899999999999ap-5", "0x1.e000000000000p-6"], ["0x1.899999999999ap-5", "0x1.2333333333334p-5"])}
 
 
@@ -155,7 +156,8 @@ def test_signed_tracking_equals_abs_tracking_bitwise(npar):
         oQ = np.full((N, 2), -1, np.int64)
         hi = np.array([0.8, 1.0])
         kernels.ensemble(Q, P, np.arange(N) % npar, np.repeat(schemes.lane_coefficients(0.95, S), npar, 0),
-                         np.repeat(schemes.step_sizes(0.95, S), npar), np.full(npar, 0.0876), schemes.sine_table(S, np.pi),
+                         np.repeat(schemes.step_sizes(0.95, S), npar), np.full(npar, 0.0876),
+                         schemes.sine_table(S, np.pi),
                          2 * np.array([0.12, 0.2]), hi, 40, False, 2, 64, oE, oQ, np.empty((0, 0, 2)), False,
                          well=flag, thrQlo=-hi)
         out.append((oE, oQ))

@@ -54,7 +54,8 @@ def test_quick_config_merges_and_is_small(base):
     run = plan(merged(base, load_yaml(ROOT / "config" / "quick.yaml")))
     res = run.params()
     assert res["fig05"]["F"] == base["figures"]["fig05"]["F"]  # paper values inherited from config.yaml
-    assert res["fig13"]["grid"]["n"] == [24, 24] and res["fig13"]["grid"]["q0"] == base["figures"]["fig13"]["grid"]["q0"]
+    assert (res["fig13"]["grid"]["n"] == [24, 24]
+            and res["fig13"]["grid"]["q0"] == base["figures"]["fig13"]["grid"]["q0"])
     assert res["fig21"]["cycles"] <= 300
 
 
@@ -150,7 +151,8 @@ BAD = [
     ({"extras": {"erosion": {"fourier": ["paper", "truncated"]}}}, "extras.erosion.fourier", ""),
     ({"extras": {"true_basin": {"n_psi": 0}}}, "extras.true_basin.n_psi", "minimum"),
     ({"extras": {"true_basin": {"grid": {"p0": [0.5, -0.5]}}}}, "extras.true_basin.grid.p0", "empty interval"),
-    ({"extras": {"fourier_compare": {"iou": ["fig13", "fig20"]}}}, "extras.fourier_compare.iou[1]", "'fig20' has no escape chart"),
+    ({"extras": {"fourier_compare": {"iou": ["fig13", "fig20"]}}}, "extras.fourier_compare.iou[1]",
+     "'fig20' has no escape chart"),
     ({"extras": {"fourier_compare": {"fcr": ["fig10", "fig10"]}}}, "extras.fourier_compare.fcr[1]", "twice"),
     ({"extras": {"fourier_compare": {"t_eval": 5000}}}, "extras.fourier_compare.t_eval", "horizon"),
     ({"extras": {"phase_map": {}}}, "extras.phase_map", "unknown key"),
@@ -169,9 +171,11 @@ BAD = [
     ({"experiments": {"toy": {"kind": "no_such_kind"}}}, "experiments.toy.kind", ""),
     ({"experiments": {"fig13": {"kind": "chart"}}}, "experiments.fig13", "already an experiment"),
     ({"experiments": {"zoom": {"kind": "chart", "F": 0.01, "Omega": 0.9, "Psi": 0, "xi_max": 0.3,
-                               "grid": {"q0": [-1, 1], "p0": [-1, 1], "n": 10}}}}, "experiments.zoom.xi_max", "barrier energy"),
+                               "grid": {"q0": [-1, 1], "p0": [-1, 1], "n": 10}}}}, "experiments.zoom.xi_max",
+     "barrier energy"),
     ({"extensions": ["no.such.module"]}, "extensions[0]", "cannot import"),
-    ({"figures": {"fig10": {"numeric": {"F_bracket": [0.3, 0.1]}}}}, "figures.fig10.numeric.F_bracket", "empty bracket"),
+    ({"figures": {"fig10": {"numeric": {"F_bracket": [0.3, 0.1]}}}}, "figures.fig10.numeric.F_bracket",
+     "empty bracket"),
     ({"figures": {"fig10": {"numeric": {"tol": 0}}}}, "figures.fig10.numeric.tol", ""),
     ({"seed": -3}, "seed", "minimum"),
     # non-finite numbers, degenerate grids, duplicates, ranges that stop short, num + step
@@ -195,9 +199,11 @@ BAD = [
     ({"figures": {"fig05": {"well": {"polynomial": [0, 0.1, 0.5, 0, -0.25]}}}}, "figures.fig05.well", "V'(0) = 0"),
     ({"figures": {"fig05": {"well": {"polynomial": [0, 0, -0.5, 0, 1]}}}}, "figures.fig05.well", "c_2"),
     ({"figures": {"fig05": {"well": {"polynomial": [0, 0, 0.5, 0, 0.25]}}}}, "figures.fig05.well", "no barrier"),
-    ({"figures": {"fig05": {"well": "cubic", "xi_max": 0.2}}}, "figures.fig05.xi_max", "barrier energy 0.166667 of the cubic"),
+    ({"figures": {"fig05": {"well": "cubic", "xi_max": 0.2}}}, "figures.fig05.xi_max",
+     "barrier energy 0.166667 of the cubic"),
     ({"figures": {"fig01": {"well": "cubic", "xi_max": [0.1, 0.15, 0.17]}}}, "figures.fig01.xi_max[2]", "cubic"),
-    ({"figures": {"fig04": {"well": "cubic", "xi_max": [0.1, wells.cubic().barrier_energy]}}}, "figures.fig04.xi_max[1]", "separatrix"),
+    ({"figures": {"fig04": {"well": "cubic", "xi_max": [0.1, wells.cubic().barrier_energy]}}},
+     "figures.fig04.xi_max[1]", "separatrix"),
     ({"figures": {"fig19": {"well": "cubic"}}}, "figures.fig19.well", "quartic only"),
     ({"figures": {"fig18": {"well": "cubic", "xi_max": 0.1}}}, "figures.fig18.well", "quartic only"),
     ({"extras": {"erosion": {"well": "cubic", "xi_max": [0.1]}}}, "extras.erosion.fourier", "exact first harmonic"),

@@ -25,7 +25,8 @@ def refused(cfg, key):
 # ------------------------------------------------------------------ values past the separatrix
 def test_manifold_top_above_or_at_the_separatrix(base):
     for top in (0.26, 0.25):
-        msg = refused(merged(base, {"figures": {"fig05": {"manifold": {"xi_top": top}}}}), "figures.fig05.manifold.xi_top")
+        msg = refused(merged(base, {"figures": {"fig05": {"manifold": {"xi_top": top}}}}),
+                      "figures.fig05.manifold.xi_top")
         assert "below the barrier energy 0.25 of the quartic well" in msg
 
 
@@ -75,7 +76,8 @@ def test_yaml_syntax_error_names_file_and_line(tmp_path):
 
 # ------------------------------------------------------------------ analytic cost guard
 @pytest.mark.parametrize("override, largest", [
-    ({"figures": {"fig01": {"Omega": {"start": 0.5, "stop": 1.2, "num": 250_000}}}}, "fig01"),   # x 6 curves x 2001 nodes
+    # 250,000 values of Omega x 6 curves x 2001 nodes
+    ({"figures": {"fig01": {"Omega": {"start": 0.5, "stop": 1.2, "num": 250_000}}}}, "fig01"),
     ({"figures": {"fig05": {"manifold": {"n_gamma": 100_000, "n_xi": 100_000}}}}, "fig05"),
 ])
 def test_analytic_cost_guard(base, override, largest):

@@ -22,7 +22,8 @@ def test_every_kind_has_the_damping_key_with_default_zero(base):
     run = plan(base)
     for name, exp in run.experiments.items():
         if exp.key.startswith("damped."):
-            assert min(exp.params["damping"] if isinstance(exp.params["damping"], list) else [exp.params["damping"]]) > 0
+            beta = exp.params["damping"]
+            assert min(beta if isinstance(beta, list) else [beta]) > 0
         else:
             assert "damping" not in exp.params, name          # beta = 0: no parameter, files unchanged
 

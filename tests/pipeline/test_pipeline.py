@@ -122,7 +122,8 @@ def test_extras_datasets_and_figures(quick):
     # numerics.tiles = 0: the numeric dataset integrated its F tasks itself (no tile jobs, no tile files)
     assert not (wd / "results/data/numeric/parts").exists()
     ta, tn = L("extra_true_basin_analytic.nc"), L("extra_true_basin_numeric.nc")
-    assert tn["safe"].dims == ("Psi", "xi_max", "t_eval", "q0", "p0") and tn.sizes["Psi"] == len(RES["extra_true_basin"]["Psi"])
+    assert tn["safe"].dims == ("Psi", "xi_max", "t_eval", "q0", "p0")
+    assert tn.sizes["Psi"] == len(RES["extra_true_basin"]["Psi"])
     for ds in (ta, tn):
         assert bool(ds["contained"].all())
         assert (ds["GIM_true"] <= ds["GIM"].min("Psi") + 1e-12).all()

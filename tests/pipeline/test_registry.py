@@ -29,7 +29,8 @@ def test_toy_kind_resolves_and_joins_the_catalog():
     exp = run.experiments["toybox"]
     assert exp.kind is KINDS["toy_energy"] and exp.key == "experiments.toybox"
     assert exp.params == {"experiment": "toybox", "kind": "toy_energy", "title": "Toy: unforced safe set",
-                          "well": {"name": "quartic"}, "xi_max": 0.2, "grid": {"q0": [-1.0, 1.0], "p0": [-0.75, 0.75], "n": [41, 41]}}
+                          "well": {"name": "quartic"}, "xi_max": 0.2,
+                          "grid": {"q0": [-1.0, 1.0], "p0": [-0.75, 0.75], "n": [41, 41]}}
     assert run.datasets("analytic")[-1] == "results/data/analytic/toy_toybox.nc"
     fig = run.figures()[-1]
     assert fig.name == "toybox" and fig.category == "Experiments" and not fig.packaged

@@ -26,7 +26,8 @@ def test_bad_config_stops_before_any_job(sandbox):
     bad.write_text("figures:\n  fig13:\n    xi_max: [0.1, 0.3]\n")
     r = run_snakemake(sandbox, "-n", configfiles=("config/quick.yaml", bad))
     assert r.returncode != 0
-    assert "config key figures.fig13.xi_max[1]: 0.3 must be at most the barrier energy 0.25 of the quartic well" in r.stderr + r.stdout
+    assert ("config key figures.fig13.xi_max[1]: 0.3 must be at most the barrier energy 0.25 of the quartic well"
+            in r.stderr + r.stdout)
     bad.write_text("figures:\n  fig23:\n    F: 0.1\n")
     r = run_snakemake(sandbox, "-j1", configfiles=("config/quick.yaml", bad))
     assert r.returncode != 0 and "unknown figure name 'fig23'" in r.stderr + r.stdout

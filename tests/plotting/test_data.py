@@ -33,7 +33,8 @@ def test_missing_variable_names_file_and_name(stored):
     msg = str(info.value)
     assert msg.startswith(f"{stored}: no variable 'escape_cycle_energy'") and "'iou'" in msg and not msg.startswith('"')
     assert isinstance(info.value, KeyError) and isinstance(info.value, ValueError)
-    with pytest.raises(MissingData, match=f"{re.escape(str(stored))}: no attribute or single-valued coordinate 'Omega'"):
+    with pytest.raises(MissingData, match=f"{re.escape(str(stored))}: no attribute or single-valued coordinate "
+                                          "'Omega'"):
         param(ds, "Omega")
     assert param(ds, "F") == 0.01 and param(ds, "xi_max") == 0.2
 

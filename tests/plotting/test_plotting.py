@@ -122,8 +122,8 @@ def strobe():
              escape_cycle_displacement=("sample", [np.inf] * 6),
              chain_period=("chain", [3]), chain_n_orbits=("chain", [1]), chain_trace=("chain", [1.2]),
              chain_q=(("chain", "island"), chain_pts.real[None]), chain_p=(("chain", "island"), chain_pts.imag[None])),
-        attrs=dict(F=0.0876, Omega=0.99, Psi=np.pi, xi_max=0.24, q_max=0.894, criterion="displacement", seed=1, well="quartic",
-                   center_q=0.0, center_p=0.0, center_rotation=0.06, n_iter=it - 1, min_digits=5.0,
+        attrs=dict(F=0.0876, Omega=0.99, Psi=np.pi, xi_max=0.24, q_max=0.894, criterion="displacement", seed=1,
+                   well="quartic", center_q=0.0, center_p=0.0, center_rotation=0.06, n_iter=it - 1, min_digits=5.0,
                    n_candidates=40, n_non_escaping=10, n_line=3))
 
 

@@ -95,7 +95,8 @@ def test_integrity_map_scales_labels_and_line_styles():
     assert lo == -hi and 0.03 < hi < 0.05
     dashed = [ln for ax in panels for ln in ax.lines if ln.get_linestyle() == "--"]
     assert dashed and all(ln.axes in panels[:2] for ln in dashed)  # the all-phase front: dashed, top row
-    legend = {t.get_text(): h.get_linestyle() for t, h in zip(fig.legends[0].get_texts(), fig.legends[0].legend_handles)}
+    legend = {t.get_text(): h.get_linestyle() for t, h in zip(fig.legends[0].get_texts(),
+                                                              fig.legends[0].legend_handles)}
     assert [ls for lab, ls in legend.items() if "every phase" in lab] == ["--"]
     text = " ".join(notes(fig))
     assert "Ψ = π" in text and "3.14" not in text and "all-phase slow flow dashed" in text

@@ -41,7 +41,8 @@ def test_detected_where_v_cancels(cos_pendulum, sin2_pendulum):
     q = np.concatenate([-np.geomspace(1e-9, 0.3, 30), np.geomspace(1e-9, 1.0, 30)])
     assert rel(morse.V(q), np.expm1(-q) ** 2) <= 1e-15
     # a V' off by a constant factor is a wrong V', not cancellation: left alone
-    assert cancellation_fix(lambda q: 2 * np.sin(0.5 * q) ** 2, lambda q: (1 + 1e-8) * np.sin(q), (np.pi, np.pi)) is None
+    assert cancellation_fix(lambda q: 2 * np.sin(0.5 * q) ** 2, lambda q: (1 + 1e-8) * np.sin(q),
+                            (np.pi, np.pi)) is None
     assert cancellation_fix(lambda q: 1 - np.cos(q), np.sin, (np.pi, np.pi)) is not None
 
 
@@ -53,14 +54,16 @@ def test_v_accurate_at_the_bottom(cos_pendulum):
 
 def test_cos_pendulum_agrees_with_sin2_pendulum(cos_pendulum, sin2_pendulum):
     assert cos_pendulum.barriers == sin2_pendulum.barriers
-    E = np.concatenate([np.geomspace(1e-12, 1e-2, 20), np.linspace(0.01, 1.998, 200), 2 - np.geomspace(1e-3, 1e-15, 20)])
+    E = np.concatenate([np.geomspace(1e-12, 1e-2, 20), np.linspace(0.01, 1.998, 200),
+                        2 - np.geomspace(1e-3, 1e-15, 20)])
     for f in ("J", "omega", "harmonic_amplitude", "harmonic_phase"):
         a, b = getattr(cos_pendulum, f)(E), getattr(sin2_pendulum, f)(E)
         assert np.max(np.abs(a - b) / np.abs(b)) <= 1e-14, f
 
 
 def test_cos_pendulum_against_closed_forms(cos_pendulum):
-    E = np.concatenate([np.geomspace(1e-12, 1e-2, 20), np.linspace(0.01, 1.998, 200), 2 - np.geomspace(1e-3, 1e-15, 20)])
+    E = np.concatenate([np.geomspace(1e-12, 1e-2, 20), np.linspace(0.01, 1.998, 200),
+                        2 - np.geomspace(1e-3, 1e-15, 20)])
     m, mc = E / 2, (2 - E) / 2                      # 2 - E exact near E_b
     K = np.where(m < 0.5, special.ellipk(m), special.ellipkm1(mc))
     J = 8 / np.pi * m * (K - special.elliprd(0.0, mc, 1.0) / 3)

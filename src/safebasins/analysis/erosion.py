@@ -259,7 +259,8 @@ def level_crossing(profile, level=0.5, dim="F"):
                           if k in profile})
         return out.assign_attrs(level=float(level), dim=dim)
     if not isinstance(profile, xr.DataArray):
-        raise ValueError(f"profile must be a DataArray or Dataset of measures over {dim!r}, got {type(profile).__name__}")
+        raise ValueError(f"profile must be a DataArray or Dataset of measures over {dim!r}, got "
+                         f"{type(profile).__name__}")
     if dim not in profile.dims:
         raise ValueError(f"dim {dim!r} is not a dimension of the profile (dims: {profile.dims})")
     if profile.sizes[dim] == 0:

@@ -1,8 +1,8 @@
 """Critical-forcing curves F_cr(Omega), analytic and numeric, stacked over ``curve`` (Figs 1-4, 10-12).
 
 A curve is a dict with ``label``, ``xi_max``, ``xi_ini``, ``gamma_ini``, optionally ``damping``
-(beta > 0: the damped theory and numerics) and, for the numerics, ``Psi`` (safebasins.pipeline.values.curves makes them from a config block); the pipeline's
-``fcr_theory`` / ``fcr_compare`` kinds and ``safebasins fcr`` call these functions.
+(beta > 0: the damped theory and numerics) and, for the numerics, ``Psi`` (safebasins.pipeline.values.curves makes them
+from a config block); the pipeline's ``fcr_theory`` / ``fcr_compare`` kinds and ``safebasins fcr`` call these functions.
 """
 from __future__ import annotations
 
@@ -51,7 +51,8 @@ def numeric_fcr_curves(Omega, curves, *, well=None, cycles, tol, F_bracket, crit
         p0s.append(p0)
         print(f"{label}: {c['label']}: IC (q0, p0) = ({q0:.6f}, {p0:.6f})", flush=True)
         parts.append(critical_forcing_numeric(
-            Omega, c["xi_max"], q0=q0, p0=p0, Psi=c["Psi"], cycles=cycles, tol=tol, F_bracket=None if F_bracket is None else tuple(F_bracket),
+            Omega, c["xi_max"], q0=q0, p0=p0, Psi=c["Psi"], cycles=cycles, tol=tol,
+            F_bracket=None if F_bracket is None else tuple(F_bracket),
             criterion=criterion, n_scan=n_scan, steps_per_cycle=steps_per_cycle, threads=threads, backend=backend,
             well=well, damping=c.get("damping", 0.0)))
     coords = _curve_coords(curves, ("xi_max", "xi_ini", "gamma_ini", "Psi", "label"), ("damping",))

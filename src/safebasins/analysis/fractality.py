@@ -123,5 +123,6 @@ def uncertainty_exponent(F, Omega, Psi, xi_max, box, *, eps=(1e-2, 3e-3, 1e-3, 3
     ds.attrs.update(n=n, seed=int(seed), safe_fraction=float(base.mean()), F=float(F), Omega=float(Omega),
                     Psi=float(Psi), xi_max=float(xi_max), cycles=int(cycles), t_eval=t_eval,
                     **{k: ch.attrs[k] for k in ("damping",) if k in ch.attrs},
-                    method="f(eps) ~ eps^alpha, x and x +- eps e with e along q0 or p0 at random; weighted fit of log f")
+                    method="f(eps) ~ eps^alpha, x and x +- eps e with e along q0 or p0 at random; weighted fit of log "
+                           "f")
     return ds

@@ -105,8 +105,8 @@ def analytic_basin(F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, l
     """Boundaries + per-IC analytic escape mask on the (q0, p0) grid of 1-D axes ``q0``, ``p0``.
 
     ``well``: any form :func:`safebasins.wells.resolve_well` reads (its first harmonic included);
-    ``label``: the name of a progress line printed for a job's log (None: nothing printed).  ``damping`` (beta >= 0, default 0: the paper's
-    conservative slow flow, output as before damping existed): for beta > 0 ``escapes`` is the
+    ``label``: the name of a progress line printed for a job's log (None: nothing printed).  ``damping`` (beta >= 0,
+    default 0: the paper's conservative slow flow, output as before damping existed): for beta > 0 ``escapes`` is the
     classification of the damped slow flow (``slow_flow_escapes(..., damping=beta)``,
     docs/damping.md; undecided trajectories count as escaping) and the boundary curves are the
     outline of its safe mask (:func:`mask_outline`, attribute ``boundary = "mask_outline"``;

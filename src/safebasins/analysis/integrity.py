@@ -276,7 +276,8 @@ def _measures_numpy(safe, q0, p0, xi_max, bottom, well=None):
         try:
             xi_b = np.broadcast_to(xi, lead)
         except ValueError as exc:
-            raise ValueError(f"xi_max with shape {xi.shape} does not broadcast to the leading mask shape {lead}") from exc
+            raise ValueError(f"xi_max with shape {xi.shape} does not broadcast to the leading mask shape "
+                             f"{lead}") from exc
         uniq, inv = np.unique(xi_b, return_inverse=True)
         ref = _raw_measures(unforced_safe_mask(q, p, uniq, well), q, p, dq, dp, bottom)
         inv = inv.reshape(lead)

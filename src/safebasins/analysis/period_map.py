@@ -462,14 +462,16 @@ def portrait_with_criteria(q0, p0, origin, F, Omega, Psi, *, criterion, xi_max, 
     out = period_map_portrait(q0, p0, F, Omega, Psi, n_keep=n_keep, n_iter=n_iter, steps_per_cycle=steps_per_cycle,
                               threads=threads, min_digits=min_digits, max_period=max_period, **thresholds)
     cand = np.asarray(out["candidate"].values)
-    out["origin"] = ("sample", np.array([origin[i] for i in cand]), {"long_name": "where the IC comes from (line | random)"})
+    out["origin"] = ("sample", np.array([origin[i] for i in cand]),
+                     {"long_name": "where the IC comes from (line | random)"})
     other = escape_chart(np.asarray(out["q0"].values, float), np.asarray(out["p0"].values, float), F, Omega, Psi,
                          xi_max=(xi_max,), q_max=(q_max,), cycles=n_iter, steps_per_cycle=steps_per_cycle,
                          threads=threads, grid=False)
     out["escape_cycle_energy"] = ("sample", np.asarray(other["escape_cycle_energy"].isel(xi_max=0).values, float),
                                   {"units": "1", "long_name": "escape time in forcing cycles, energy criterion "
                                                               "H0 > xi_max (inf: no escape)"})
-    out["escape_cycle_displacement"] = ("sample", np.asarray(other["escape_cycle_displacement"].isel(q_max=0).values, float),
+    out["escape_cycle_displacement"] = ("sample", np.asarray(other["escape_cycle_displacement"].isel(q_max=0).values,
+                                                             float),
                                         {"units": "1", "long_name": "escape time in forcing cycles, displacement "
                                                                     "criterion |q| > q_max (inf: no escape)"})
     return out

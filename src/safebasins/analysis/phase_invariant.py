@@ -75,7 +75,8 @@ def default_phases(n_psi=16):
 def _first_escaping_circle(lo, hi, n_xi, F, Omega, xi_max, well, gamma):
     """Grid search on [lo, hi]: (last all-safe xi, first xi with an escaping point) or None."""
     xs = np.linspace(lo, hi, n_xi)
-    e = np.asarray(escapes_on_manifold(gamma[:, None], xs[None, :], F, Omega, xi_max, well=well), dtype=bool).any(axis=0)
+    e = np.asarray(escapes_on_manifold(gamma[:, None], xs[None, :], F, Omega, xi_max, well=well),
+                   dtype=bool).any(axis=0)
     k = np.flatnonzero(e)
     if k.size == 0:
         return None

@@ -15,8 +15,8 @@ from safebasins.core import checks
 from safebasins.core import cf
 from safebasins.wells import from_attrs, QuarticWell
 
-__all__ = ["is_safe", "check_t_eval", "check_chart", "safe_mask", "safe_area", "safe_stack", "escape_variable", "chart_well",
-           "displacement_energy", "q_max_energy"]
+__all__ = ["is_safe", "check_t_eval", "check_chart", "safe_mask", "safe_area", "safe_stack", "escape_variable",
+           "chart_well", "displacement_energy", "q_max_energy"]
 
 #: escape-time variable and threshold dimension of each criterion
 CRITERIA = {"energy": ("escape_cycle_energy", "xi_max"),
@@ -131,7 +131,8 @@ def safe_mask(chart, t_eval):
         out = out.transpose("t_eval", ...)
     for c in CRITERIA:
         out[f"safe_{c}"].attrs = {"long_name": f"safe (no {c} escape up to t_eval)"}
-    out.attrs.update({k: chart.attrs[k] for k in ("F", "Omega", "Psi", "cycles", "steps_per_cycle") if k in chart.attrs})
+    out.attrs.update({k: chart.attrs[k] for k in ("F", "Omega", "Psi", "cycles",
+                                                  "steps_per_cycle") if k in chart.attrs})
     return out
 
 

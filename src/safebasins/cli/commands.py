@@ -366,8 +366,8 @@ def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, dampi
         raise click.BadParameter(f"must be > 0, got {xi_top}", param_hint="'--xi-top'")
     name = Path(out).name
     fourier = fourier_of(ctx, fourier)
-    params = dict(command="basin", kind="basin_rm", experiment=name, fourier=fourier, well=well, F=F, Omega=Omega, Psi=Psi,
-                  xi_max=xi_max, grid=grid_params(grid, n), n_points=n_points,
+    params = dict(command="basin", kind="basin_rm", experiment=name, fourier=fourier, well=well, F=F, Omega=Omega,
+                  Psi=Psi, xi_max=xi_max, grid=grid_params(grid, n), n_points=n_points,
                   manifold={"n_gamma": n_gamma, "n_xi": n_xi, "xi_top": xi_top}, **damping_param(damping))
     damped, beta = damping_text(damping)
     params["title"] = (f"Analytic {damped}safe basin, {well_label(well)} well, F = {fmt(F)}, Omega = {fmt(Omega)}, "

@@ -478,7 +478,8 @@ def engine_check(name, module="engine"):
 
 def out_option(default):
     return click.option("--out", "-o", "out", metavar="PREFIX", default=default, show_default=True,
-                        callback=out_prefix, help="Output prefix: writes PREFIX.nc and PREFIX.png (folders are created).")
+                        callback=out_prefix, help="Output prefix: writes PREFIX.nc and PREFIX.png (folders are "
+                                                  "created).")
 
 
 def grid_params(grid, n, ctx=None):

@@ -48,7 +48,8 @@ VARIABLES = {
     "escapes": ("1", "analytic (slow-flow) escape: True = the IC escapes"),
     "escapes_rm": ("1", "analytic escape of the resonance-manifold point: True = escapes"),
     "escape_cycle_energy": ("1", "escape time in forcing cycles, energy criterion H0 > xi_max (inf: no escape)"),
-    "escape_cycle_displacement": ("1", "escape time in forcing cycles, displacement criterion |q| > q_max (inf: no escape)"),
+    "escape_cycle_displacement": ("1", "escape time in forcing cycles, displacement criterion |q| > q_max (inf: no "
+                                       "escape)"),
     "escape_cycle_bounds": ("1", "escape time in forcing cycles, displacement criterion q < q_lower or q > q_upper "
                                  "(inf: no escape)"),
     "escape_cycle": ("1", "escape time in forcing cycles (inf: no escape)"),

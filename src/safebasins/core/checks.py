@@ -5,7 +5,14 @@ are methods of the well (:mod:`safebasins.wells`); the ones here are well-indepe
 """
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
+import numpy.typing as npt
+
+#: a check of a named value (``check_finite``, ``check_positive``, ...): the value as a float array
+Check = Callable[[str, Any], np.ndarray]
 
 
 #: relative distance below an escape energy within which a value counts as at it: the computed
@@ -14,12 +21,12 @@ import numpy as np
 BARRIER_RTOL = 1e-12
 
 
-def as_array(name, value):
+def as_array(name: str, value: Any) -> np.ndarray:
     """``value`` as a float ndarray; ValueError naming ``name`` if not numeric, complex or NaN."""
     try:
         raw = np.asarray(value)
         complex_ = np.iscomplexobj(raw)
-        a = None if complex_ else raw.astype(float, copy=False)
+        a = raw if complex_ else raw.astype(float, copy=False)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{name} must be numeric, got {value!r}") from exc
     if complex_:    # (a float conversion would drop the imaginary part with only a warning)
@@ -29,27 +36,27 @@ def as_array(name, value):
     return a
 
 
-def reaches(values, level):
+def reaches(values: npt.ArrayLike, level: float) -> np.ndarray:
     """Where ``values`` lie at or above ``level`` (an escape energy), counting values within a
     relative :data:`BARRIER_RTOL` below it as at it."""
     return np.asarray(values, dtype=float) >= level - BARRIER_RTOL * abs(level)
 
 
-def check_nonempty(name, a):
+def check_nonempty(name: str, a: np.ndarray) -> np.ndarray:
     """``a`` (an array) with at least one element."""
     if np.size(a) == 0:
         raise ValueError(f"{name} must not be empty")
     return a
 
 
-def check_finite(name, value):
+def check_finite(name: str, value: Any) -> np.ndarray:
     a = as_array(name, value)
     if not np.isfinite(a).all():
         raise ValueError(f"{name} must be finite")
     return a
 
 
-def check_nonnegative(name, value):
+def check_nonnegative(name: str, value: Any) -> np.ndarray:
     """Finite and >= 0 (an amplitude, a time)."""
     a = check_finite(name, value)
     if (a < 0).any():
@@ -57,7 +64,7 @@ def check_nonnegative(name, value):
     return a
 
 
-def check_positive(name, value):
+def check_positive(name: str, value: Any) -> np.ndarray:
     """Finite and > 0 (a frequency, a tolerance)."""
     a = check_finite(name, value)
     if (a <= 0).any():
@@ -65,19 +72,19 @@ def check_positive(name, value):
     return a
 
 
-def check_positive_int(name, value):
+def check_positive_int(name: str, value: Any) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
         raise ValueError(f"{name} must be a positive integer, got {value!r}")
     return int(value)
 
 
-def check_damping(damping):
+def check_damping(damping: Any) -> float:
     """The damping beta of ``q'' + beta q' + V'(q) = F sin(Omega t + Psi)``: a finite scalar >= 0
     (ValueError naming ``damping`` otherwise)."""
     return check_scalar("damping", damping, check_nonnegative)
 
 
-def check_scalar(name, value, check):
+def check_scalar(name: str, value: Any, check: Check) -> float:
     """``check(name, value)`` and a 0-d result, returned as float."""
     a = check(name, value)
     if a.ndim != 0:
@@ -85,7 +92,7 @@ def check_scalar(name, value, check):
     return float(a)
 
 
-def check_1d(name, value, check):
+def check_1d(name: str, value: Any, check: Check) -> np.ndarray:
     """``check(name, value)`` as a 1-D float array (a scalar becomes length 1)."""
     a = np.atleast_1d(check(name, value)).astype(float)
     if a.ndim != 1:
@@ -93,6 +100,7 @@ def check_1d(name, value, check):
     return check_nonempty(name, a)
 
 
-def value_repr(a):
+def value_repr(a: Any) -> str:
     a = np.asarray(a)
-    return repr(a.item()) if a.ndim == 0 else repr(a.tolist() if a.size <= 6 else f"array with range [{a.min()}, {a.max()}]")
+    return repr(a.item()) if a.ndim == 0 else repr(a.tolist() if a.size <= 6 else f"array with range [{a.min()}, "
+                                                                                  f"{a.max()}]")

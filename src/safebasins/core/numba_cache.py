@@ -13,6 +13,7 @@ import os
 import sys
 import tempfile
 from pathlib import Path
+from typing import Any
 
 __all__ = ["fallback_cache_dir", "configure"]
 
@@ -44,7 +45,7 @@ def _private_dir(base: Path, uid: int) -> Path:
     return Path(tempfile.mkdtemp(prefix="safebasins-numba-", dir=base))
 
 
-def fallback_cache_dir(package_dir: Path, environ) -> Path | None:
+def fallback_cache_dir(package_dir: Path, environ: Any) -> Path | None:
     """The directory numba must cache in when it can use neither ``package_dir`` (the source's
     ``__pycache__``) nor the user's cache directory; None when one of them works, when
     ``NUMBA_CACHE_DIR`` is set or off Linux (numba's own choice stands)."""

@@ -20,12 +20,14 @@ import json
 import subprocess
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar, overload
 
 import numpy as np
 import xarray as xr
 
 from safebasins.core.version import __version__
+
+F = TypeVar("F", bound=Callable[..., Any])
 
 __all__ = ["api_provenance", "call_parameters", "git_commit", "PROVENANCE_ATTRS"]
 
@@ -55,7 +57,7 @@ def git_commit() -> str:
 FULL_ARRAY = 16
 
 
-def _value(v):
+def _value(v: Any) -> Any:
     if isinstance(v, (str, bool, int, float, type(None))):
         return v
     if isinstance(v, (np.integer, np.floating, np.bool_)):
@@ -75,7 +77,7 @@ def _value(v):
     return repr(v)
 
 
-def call_parameters(fn, args, kwargs) -> dict:
+def call_parameters(fn: Any, args: Any, kwargs: Any) -> dict:
     """The bound arguments of a call (defaults applied) as JSON-ready values; a well object by
     its spec."""
     bound = inspect.signature(fn).bind(*args, **kwargs)
@@ -89,7 +91,17 @@ def call_parameters(fn, args, kwargs) -> dict:
     return out
 
 
-def api_provenance(fn: Callable | None = None, *, well_attrs: Callable[[Any], dict] | None = None):
+@overload
+def api_provenance(fn: F, *, well_attrs: Callable[[Any], dict[str, Any]] | None = None) -> F: ...
+
+
+@overload
+def api_provenance(fn: None = None, *, well_attrs: Callable[[Any], dict[str, Any]] | None = None
+                   ) -> Callable[[F], F]: ...
+
+
+def api_provenance(fn: Callable[..., Any] | None = None, *,
+                   well_attrs: Callable[[Any], dict[str, Any]] | None = None) -> Any:
     """Decorator: the returned Dataset carries version, commit, date, parameters, history and,
     where the call has a ``well`` argument and ``well_attrs`` is given, ``well_attrs(well)`` (see
     the module docstring); anything else is returned as it is.  ``@api_provenance`` or
@@ -98,7 +110,7 @@ def api_provenance(fn: Callable | None = None, *, well_attrs: Callable[[Any], di
         return functools.partial(api_provenance, well_attrs=well_attrs)
 
     @functools.wraps(fn)
-    def wrapper(*args, **kwargs):
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
         out = fn(*args, **kwargs)
         if not isinstance(out, xr.Dataset):
             return out

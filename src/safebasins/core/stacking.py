@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 import xarray as xr
+from typing import Any
 
 from safebasins.core.provenance import PROVENANCE_ATTRS
 
 __all__ = ["stack", "pad_dim"]
 
 
-def _fill_value(dtype):
+def _fill_value(dtype: Any) -> Any:
     k = np.dtype(dtype).kind
     if k == "f":
         return np.nan
@@ -60,7 +61,7 @@ def pad_dim(ds: xr.Dataset, dim: str, n: int) -> xr.Dataset:
     return out
 
 
-def _same(a, b):
+def _same(a: Any, b: Any) -> Any:
     try:
         a, b = np.asarray(a), np.asarray(b)
         if a.dtype.kind in "fc" and b.dtype.kind in "fc":
@@ -70,7 +71,7 @@ def _same(a, b):
         return a == b
 
 
-def stack(datasets, dim: str, values=None, *, coords: dict | None = None,
+def stack(datasets: Any, dim: str, values: Any = None, *, coords: dict | None = None,
           pad: tuple[str, ...] = ("vertex", "curve")) -> xr.Dataset:
     """Concatenate datasets along a new dimension `dim`.
 

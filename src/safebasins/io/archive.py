@@ -35,6 +35,7 @@ import time
 import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import xarray as xr
 import yaml
@@ -123,7 +124,7 @@ def _config_values(config: Mapping) -> dict[str, object]:
     return out
 
 
-def _value_type(value) -> str:
+def _value_type(value: Any) -> str:
     if isinstance(value, bool):
         return "Boolean"
     if isinstance(value, int):
@@ -136,13 +137,13 @@ def _value_type(value) -> str:
 class _Builder:
     """Adds entities to one ROCrate (contextual entities, files with size + sha256, parameters)."""
 
-    def __init__(self, crate: ROCrate):
+    def __init__(self, crate: ROCrate) -> None:
         self.crate = crate
 
-    def entity(self, id_: str, type_, /, **props):
+    def entity(self, id_: str, type_: Any, /, **props: Any) -> Any:
         return self.crate.add(ContextEntity(self.crate, id_, properties={"@type": type_, **props}))
 
-    def file(self, source, dest: str, *, name: str, description: str, encoding, **props):
+    def file(self, source: Any, dest: str, *, name: str, description: str, encoding: Any, **props: Any) -> Any:
         """A File data entity; `source` is a path, or the file's content (str/bytes)."""
         if isinstance(source, (bytes, str)):
             data = source.encode() if isinstance(source, str) else source
@@ -153,7 +154,8 @@ class _Builder:
                  "contentSize": str(size), "sha256": digest, **props}
         return self.crate.add_file(src, dest, properties=props)
 
-    def parameter(self, identifier: str, name: str, additional_type: str, example, description: str, **props):
+    def parameter(self, identifier: str, name: str, additional_type: str, example: Any, description: str,
+                  **props: Any) -> Any:
         """A FormalParameter (an input/output slot of the workflow) linked with its value `example`
         both ways (workExample / exampleOfWork), as the Workflow Run Crate profile asks."""
         fp = self.crate.add_formal_parameter(name, additional_type, identifier=identifier, description=description,
@@ -199,7 +201,7 @@ def _software(b: _Builder, packages: Sequence[str]) -> list:
     return apps
 
 
-def _paper(b: _Builder, cff: Mapping):
+def _paper(b: _Builder, cff: Mapping) -> Any:
     """The paper (CITATION.cff preferred-citation) as a ScholarlyArticle with Person authors."""
     ref = cff.get("preferred-citation") or {}
     if not ref.get("title") or not ref.get("authors"):

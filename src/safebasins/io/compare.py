@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -29,7 +30,7 @@ def same_array(a: np.ndarray, b: np.ndarray) -> bool:
     return bool(np.array_equal(a, b))
 
 
-def same_attr(a, b) -> bool:
+def same_attr(a: Any, b: Any) -> bool:
     """Equal attribute values: numbers and arrays by value (NaN == NaN; a netCDF round trip turns
     Python scalars into numpy ones), everything else by equality."""
     numeric = (int, float, np.number, np.ndarray, list, tuple)
@@ -39,12 +40,13 @@ def same_attr(a, b) -> bool:
         except (TypeError, ValueError):
             return a == b
         if x.dtype.kind in "fciub" and y.dtype.kind in "fciub":
-            return x.shape == y.shape and bool(np.array_equal(x, y, equal_nan=x.dtype.kind in "fc" and y.dtype.kind in "fc"))
+            nan_equal = x.dtype.kind in "fc" and y.dtype.kind in "fc"
+            return x.shape == y.shape and bool(np.array_equal(x, y, equal_nan=nan_equal))
         return x.shape == y.shape and bool(np.array_equal(x, y))
     return type(a) is type(b) and a == b
 
 
-def _attr_diffs(where: str, a: dict, b: dict, ignore=()) -> list[str]:
+def _attr_diffs(where: str, a: dict, b: dict, ignore: Any = ()) -> list[str]:
     out = []
     for k in sorted(set(a) | set(b)):
         if k in ignore:
@@ -56,7 +58,7 @@ def _attr_diffs(where: str, a: dict, b: dict, ignore=()) -> list[str]:
     return out
 
 
-def dataset_differences(old: xr.Dataset, new: xr.Dataset, *, ignore_attrs=PROVENANCE_ATTRS) -> list[str]:
+def dataset_differences(old: xr.Dataset, new: xr.Dataset, *, ignore_attrs: Any = PROVENANCE_ATTRS) -> list[str]:
     """Every difference between two datasets except the ignored global attributes."""
     out = []
     names_old, names_new = set(map(str, old.variables)), set(map(str, new.variables))
@@ -75,7 +77,8 @@ def dataset_differences(old: xr.Dataset, new: xr.Dataset, *, ignore_attrs=PROVEN
             continue
         va, vb = np.asarray(a.values), np.asarray(b.values)
         if not same_array(va, vb):
-            if va.shape != vb.shape or (va.dtype != vb.dtype and not (va.dtype.kind in "OUS" and vb.dtype.kind in "OUS")):
+            if va.shape != vb.shape or (va.dtype != vb.dtype
+                                        and not (va.dtype.kind in "OUS" and vb.dtype.kind in "OUS")):
                 out.append(f"{n}: shape/dtype {va.shape} {va.dtype} vs {vb.shape} {vb.dtype}")
             else:
                 neq = ~((va == vb) | ((va != va) & (vb != vb))) if va.dtype.kind in "fc" else (va != vb)
@@ -85,7 +88,7 @@ def dataset_differences(old: xr.Dataset, new: xr.Dataset, *, ignore_attrs=PROVEN
     return out
 
 
-def assert_same_content(old: xr.Dataset, new: xr.Dataset, *, ignore_attrs=PROVENANCE_ATTRS):
+def assert_same_content(old: xr.Dataset, new: xr.Dataset, *, ignore_attrs: Any = PROVENANCE_ATTRS) -> None:
     """AssertionError listing every difference (provenance attributes aside)."""
     diffs = dataset_differences(old, new, ignore_attrs=ignore_attrs)
     if diffs:
@@ -104,7 +107,7 @@ class TreeReport:
     def identical(self) -> bool:
         return not (self.only_old or self.only_new or self.differences)
 
-    def lines(self, verbose=True):
+    def lines(self, verbose: bool = True) -> Any:
         for f in self.only_old:
             yield f"MISSING in new: {f}"
         for f in self.only_new:
@@ -122,14 +125,14 @@ class TreeReport:
                + ("IDENTICAL" if self.identical else "DIFFERENT"))
 
 
-def dataset_files(root, parts: bool = False) -> set[str]:
+def dataset_files(root: Any, parts: bool = False) -> set[str]:
     """The ``*.nc`` files below ``root`` (relative paths; tile parts under ``parts/`` only with ``parts``)."""
     root = Path(root)
     return {p.relative_to(root).as_posix() for p in root.rglob("*.nc")
             if parts or "parts" not in p.relative_to(root).parts}
 
 
-def compare_trees(old_root, new_root, *, parts=False) -> TreeReport:
+def compare_trees(old_root: Any, new_root: Any, *, parts: bool = False) -> TreeReport:
     """Compare every dataset of two ``results/data`` trees (see the module docstring)."""
     old_root, new_root = Path(old_root), Path(new_root)
     a, b = dataset_files(old_root, parts), dataset_files(new_root, parts)

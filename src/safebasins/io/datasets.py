@@ -21,6 +21,7 @@ import datetime as _dt
 import hashlib
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -32,7 +33,7 @@ from safebasins.io import netcdf
 from safebasins.wells import spec_attrs
 
 
-def _attr_value(v):
+def _attr_value(v: Any) -> Any:
     """A netCDF-storable attribute value."""
     if isinstance(v, (bool, np.bool_)):
         return int(v)
@@ -44,8 +45,8 @@ def _attr_value(v):
         if all(isinstance(x, str) for x in v):
             return list(v) if v else ""
         try:
-            return np.asarray(v, dtype=float) if not all(isinstance(x, (int, np.integer)) and
-                                                      not isinstance(x, bool) for x in v) else np.asarray(v, dtype=np.int64)
+            ints = all(isinstance(x, (int, np.integer)) and not isinstance(x, bool) for x in v)
+            return np.asarray(v, dtype=np.int64) if ints else np.asarray(v, dtype=float)
         except (TypeError, ValueError):
             return json.dumps(v)
     if isinstance(v, np.ndarray) and v.dtype.kind == "b":
@@ -53,7 +54,7 @@ def _attr_value(v):
     return v
 
 
-def _collect_seeds(params):
+def _collect_seeds(params: Any) -> Any:
     seeds = []
     if isinstance(params, dict):
         for k, v in params.items():
@@ -65,7 +66,7 @@ def _collect_seeds(params):
 
 
 def finalize(ds: xr.Dataset, *, title: str, params: dict | None = None, config_hash: str | None = None,
-             source: str | None = None, history: str | None = None, **extra) -> xr.Dataset:
+             source: str | None = None, history: str | None = None, **extra: Any) -> xr.Dataset:
     """Add CF globals and provenance (returns `ds`, modified in place)."""
     annotate(ds)
     params = params or {}
@@ -110,7 +111,7 @@ def _encoding(ds: xr.Dataset) -> dict:
     return enc
 
 
-def write_netcdf(ds: xr.Dataset, path) -> Path:
+def write_netcdf(ds: xr.Dataset, path: Any) -> Path:
     """Write `ds` to netCDF4 (zlib) atomically (:func:`safebasins.io.netcdf.write`: no half file
     survives a failure; a full disk is a :class:`~safebasins.io.netcdf.NetCDFFileError` naming the file)."""
     return netcdf.write(ds, path, format="NETCDF4", engine="netcdf4", encoding=_encoding(ds))
@@ -121,7 +122,7 @@ def params_hash(params: dict) -> str:
     return hashlib.sha256(json.dumps(params, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
 
 
-def load(path) -> xr.Dataset:
+def load(path: Any) -> xr.Dataset:
     """Read a dataset fully into memory and close the file (:func:`safebasins.io.netcdf.read`: a
     corrupted or truncated file is a :class:`~safebasins.io.netcdf.NetCDFFileError` naming it)."""
     return netcdf.read(path)

@@ -11,18 +11,19 @@ import contextlib
 import os
 import tempfile
 from pathlib import Path
+from typing import Any
 
 __all__ = ["atomic_path", "stale_temporaries"]
 
 
-def stale_temporaries(path) -> list[Path]:
+def stale_temporaries(path: Any) -> list[Path]:
     """Temporaries of earlier, interrupted writes of ``path``."""
     path = Path(path)
     return sorted(path.parent.glob(f".{path.name}.*.tmp"))
 
 
 @contextlib.contextmanager
-def atomic_path(path, mode=0o644):
+def atomic_path(path: Any, mode: int = 0o644) -> Any:
     """Yield a temporary path beside ``path``; on success it replaces ``path`` atomically.
 
     On any exception (including KeyboardInterrupt) the temporary file is removed and the

@@ -7,13 +7,15 @@ the tile files (:func:`load_blocks`); the functions here take Datasets.
 from __future__ import annotations
 
 import xarray as xr
+from typing import Any
 
+from safebasins.core.stacking import stack
 from safebasins.io.datasets import load
 
 TILE_ATTRS = ("task", "tile", "tiles")
 
 
-def gather_tiles(parts) -> xr.Dataset:
+def gather_tiles(parts: Any) -> xr.Dataset:
     """Concatenate the tiles (Datasets) of one chart task (rule `chart_tile`) in order.
 
     Grid tiles are blocks of q0 rows; random-IC tiles are blocks of ``sample``. The tile
@@ -28,7 +30,7 @@ def gather_tiles(parts) -> xr.Dataset:
     return ds
 
 
-def task_blocks(paths, ntasks: int) -> list[list]:
+def task_blocks(paths: Any, ntasks: int) -> list[list]:
     """The flat tile list (tasks x tiles, task-major) split into the tiles of each task (any
     items: paths or Datasets)."""
     paths = list(paths)
@@ -38,21 +40,19 @@ def task_blocks(paths, ntasks: int) -> list[list]:
     return [paths[i * per_task:(i + 1) * per_task] for i in range(ntasks)]
 
 
-def load_blocks(paths, ntasks: int) -> list[list[xr.Dataset]]:
+def load_blocks(paths: Any, ntasks: int) -> list[list[xr.Dataset]]:
     """The tile files (tasks x tiles, task-major) loaded, as one list of tiles per task."""
     return [[load(f) for f in block] for block in task_blocks(paths, ntasks)]
 
 
-def task_charts(blocks) -> list[xr.Dataset]:
+def task_charts(blocks: Any) -> list[xr.Dataset]:
     """The gathered chart of every task from its tiles (one list of tile Datasets per task)."""
     return [gather_tiles(block) for block in blocks]
 
 
-def gather_chart(charts, *, cycles, scan=None, F=None, t_eval=None) -> xr.Dataset:
+def gather_chart(charts: Any, *, cycles: Any, scan: Any = None, F: Any = None, t_eval: Any = None) -> xr.Dataset:
     """One dataset of the gathered task charts: stacked over ``F`` (values ``F``) for an F scan,
     else the single chart; attributes ``scan``, ``t_eval`` (if given) and ``cycles``."""
-    from safebasins.core.stacking import stack
-
     if scan == "F":
         out = stack(charts, "F", list(F), pad=())
         out.attrs["scan"] = "F"

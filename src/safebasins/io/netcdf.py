@@ -19,6 +19,7 @@ import errno
 import os
 import shutil
 from pathlib import Path
+from typing import Any
 
 import xarray as xr
 
@@ -32,22 +33,22 @@ _NO_SPACE = (errno.ENOSPC, errno.EDQUOT)
 class NetCDFFileError(OSError):
     """A netCDF file could not be read or written (the message names the file and the likely cause)."""
 
-    def __init__(self, message, path, err=None):
+    def __init__(self, message: Any, path: Any, err: Any = None) -> None:
         super().__init__(message)
         self.filename = os.fspath(path)
         self.errno = err
 
-    def __str__(self):
+    def __str__(self) -> str:
         return self.args[0]
 
 
-def _netcdf_error(exc) -> bool:
+def _netcdf_error(exc: Any) -> bool:
     """An error of the netCDF/HDF5 library (``NetCDF: ...``, ``HDF error``)."""
     text = str(exc)
     return "NetCDF:" in text or "HDF" in text
 
 
-def read(path, *, engine="netcdf4") -> xr.Dataset:
+def read(path: Any, *, engine: str = "netcdf4") -> xr.Dataset:
     """Read the dataset at ``path`` fully into memory and close the file.
 
     A file the netCDF library cannot read (truncated, a corrupted chunk, not netCDF at all)
@@ -72,7 +73,7 @@ def _free_bytes(directory: Path) -> int | None:
         return None
 
 
-def write(ds: xr.Dataset, path, **to_netcdf) -> Path:
+def write(ds: xr.Dataset, path: Any, **to_netcdf: Any) -> Path:
     """Write ``ds`` to ``path`` atomically (``ds.to_netcdf(tmp, **to_netcdf)``, then rename).
 
     A failure leaves no file behind; a full disk (or a netCDF/HDF error while the target's file

@@ -46,10 +46,11 @@ import re
 import sys
 import tarfile
 import tempfile
+from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from collections.abc import Iterator
+from typing import Any
 
 import numpy as np
 import xarray as xr
@@ -218,15 +219,15 @@ class Verdict:
 class _Check:
     """Collects the worst in-tolerance difference and the problems of one dataset."""
 
-    def __init__(self):
+    def __init__(self) -> None:
         self.worst: Difference | None = None
         self.problems: list[str] = []
 
-    def within(self, d: Difference):
+    def within(self, d: Difference) -> None:
         if self.worst is None or d.ratio > self.worst.ratio:
             self.worst = d
 
-    def fail(self, text: str):
+    def fail(self, text: str) -> None:
         self.problems.append(text)
 
 
@@ -249,7 +250,7 @@ def _mixed_neighbourhood(cls: np.ndarray) -> np.ndarray:
         return np.nanmin(shifted, axis=0) != np.nanmax(shifted, axis=0)
 
 
-def _check_field(name, kind, tol: Tolerance, a, b, chk: _Check):
+def _check_field(name: str, kind: Any, tol: Tolerance, a: Any, b: Any, chk: _Check) -> None:
     """Masks and escape times: equal but for a share of the entries; an entry may change class
     (escaped or not, safe or not, region label) only on a boundary (:func:`_mixed_neighbourhood`
     in either run), an escape time anywhere both runs escape."""
@@ -280,8 +281,8 @@ def _check_field(name, kind, tol: Tolerance, a, b, chk: _Check):
     chk.within(Difference(name, kind, share, tol.fraction, "of entries"))
 
 
-def _check_values(name, kind, tol: Tolerance, a, b, units, chk: _Check, *, absolute: float | None = None,
-                  allowed: np.ndarray | None = None):
+def _check_values(name: str, kind: Any, tol: Tolerance, a: Any, b: Any, units: Any, chk: _Check, *,
+                  absolute: float | None = None, allowed: np.ndarray | None = None) -> None:
     """Continuous values: the same NaN/inf pattern (but at ``allowed`` entries) and finite values within
     tolerance (``absolute``: an absolute tolerance instead of the relative one)."""
     a, b = np.asarray(a, float), np.asarray(b, float)
@@ -338,7 +339,7 @@ def _degenerate(old: xr.Dataset, new: xr.Dataset, da: xr.DataArray) -> np.ndarra
     return close | (np.isnan(fa) & np.isnan(fb))
 
 
-def _compare_variable(name, old: xr.Dataset, new: xr.Dataset, chk: _Check):
+def _compare_variable(name: str, old: xr.Dataset, new: xr.Dataset, chk: _Check) -> None:
     a_da, b_da = old[name], new[name]
     if a_da.dims != b_da.dims or a_da.shape != b_da.shape:
         chk.fail(f"{name}: dims {dict(a_da.sizes)} vs {dict(b_da.sizes)}")
@@ -382,7 +383,7 @@ def _compare_variable(name, old: xr.Dataset, new: xr.Dataset, chk: _Check):
         _check_values(name, kind, tol, a, b, units, chk)
 
 
-def _compare_attrs(where: str, a: dict, b: dict, ds_attrs: dict, chk: _Check, ignore=()):
+def _compare_attrs(where: str, a: dict, b: dict, ds_attrs: dict, chk: _Check, ignore: Any = ()) -> None:
     for k in sorted(set(a) | set(b)):
         if k in ignore:
             continue
@@ -463,7 +464,7 @@ def _data_root(path: Path, argument: str) -> Path:
 
 
 @contextmanager
-def reference_tree(path, argument: str = "REFERENCE") -> Iterator[tuple[Path, list[str]]]:
+def reference_tree(path: Any, argument: str = "REFERENCE") -> Iterator[tuple[Path, list[str]]]:
     """``(data root, archive problems)`` of a reference: an archive ``.tar.gz`` (its datasets
     extracted to a temporary directory, removed afterwards), an extracted crate or a results
     directory.  A missing path or a file that is no results archive raises
@@ -497,7 +498,7 @@ def reference_tree(path, argument: str = "REFERENCE") -> Iterator[tuple[Path, li
         yield root, check_archive(path)
 
 
-def verify_reproduction(reference, new, *, parts: bool = False) -> ReproductionReport:
+def verify_reproduction(reference: Any, new: Any, *, parts: bool = False) -> ReproductionReport:
     """Verdict on every dataset of ``new`` (a ``results`` or ``results/data`` directory) against
     ``reference`` (an archive, an extracted crate or a results directory)."""
     new = Path(new)
@@ -519,7 +520,7 @@ def verify_reproduction(reference, new, *, parts: bool = False) -> ReproductionR
     return report
 
 
-def main(argv=None) -> int:
+def main(argv: Any = None) -> int:
     """``python -m safebasins.io.reproduction REFERENCE NEW``: 0 when reproduced, 1 when not, 2 on bad input."""
     argv = sys.argv[1:] if argv is None else argv
     if len(argv) != 2 or argv[0] in ("-h", "--help"):

@@ -23,6 +23,7 @@ import os
 import sys
 import tarfile
 from pathlib import Path
+from typing import Any
 
 from safebasins.io.archive import MANIFEST, METADATA
 
@@ -33,7 +34,7 @@ class ArchiveError(ValueError):
     """A results archive whose files disagree with its manifest or metadata (the message lists each)."""
 
 
-def _digest(fh) -> tuple[str, int]:
+def _digest(fh: Any) -> tuple[str, int]:
     h, n = hashlib.sha256(), 0
     for block in iter(lambda: fh.read(1 << 20), b""):
         h.update(block)
@@ -95,7 +96,7 @@ def _described(text: bytes) -> dict[str, dict]:
     return out
 
 
-def check_archive(path) -> list[str]:
+def check_archive(path: Any) -> list[str]:
     """The problems of the results archive ``path`` (a ``.tar.gz`` or an extracted crate
     directory), one line each; an empty list: every file is listed, described and intact."""
     path = Path(path)
@@ -126,7 +127,7 @@ def check_archive(path) -> list[str]:
     return problems
 
 
-def verify_archive(path) -> Path:
+def verify_archive(path: Any) -> Path:
     """:func:`check_archive`, raising :class:`ArchiveError` (naming the archive and each
     problem) unless the archive is intact; returns ``path``."""
     problems = check_archive(path)
@@ -135,7 +136,7 @@ def verify_archive(path) -> Path:
     return Path(path)
 
 
-def main(argv=None) -> int:
+def main(argv: Any = None) -> int:
     """``python -m safebasins.io.verify ARCHIVE...``: 0 when every archive is intact, else 1."""
     argv = sys.argv[1:] if argv is None else argv
     if not argv or argv[0] in ("-h", "--help"):

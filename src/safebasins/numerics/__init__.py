@@ -18,5 +18,5 @@ from safebasins.numerics.initial_conditions import random_initial_conditions
 from safebasins.numerics.maps import stroboscopic_map
 from safebasins.numerics.schemes import SCHEMES
 
-__all__ = ["escape_chart", "escape_chart_batch", "critical_forcing_numeric", "stroboscopic_map", "random_initial_conditions",
-           "displacement_bounds", "DEFAULT_STEPS_PER_CYCLE", "SCHEMES"]
+__all__ = ["escape_chart", "escape_chart_batch", "critical_forcing_numeric", "stroboscopic_map",
+           "random_initial_conditions", "displacement_bounds", "DEFAULT_STEPS_PER_CYCLE", "SCHEMES"]

@@ -16,15 +16,18 @@ from __future__ import annotations
 
 import math
 import warnings
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import xarray as xr
 
 from safebasins.core import checks
 from safebasins.wells.provenance import api_provenance
 from safebasins.numerics import criteria, engine, schemes
 from safebasins.numerics.problem import check_cycles, ensemble_problem
-from safebasins.wells import QuarticWell, resolve_well
+from safebasins.wells import QuarticWell, Well, resolve_well
+from safebasins.wells.base import WellLike
 
 DEFAULT_N_SCAN = 301
 #: how often the bracket's top may be doubled where it does not escape (up to 2**3 = 8 F_hi)
@@ -35,7 +38,7 @@ class BracketWarning(RuntimeWarning):
     """F_bracket did not contain the escape threshold at some Omega (their F_cr is NaN)."""
 
 
-def default_bracket(well) -> tuple[float, float]:
+def default_bracket(well: WellLike) -> tuple[float, float]:
     """``(0, F_static)``: the default F bracket of :func:`critical_forcing_numeric` for a well,
     ``F_static`` (:attr:`~safebasins.wells.base.Well.static_escape_force`) rounded up to two
     significant digits (the quartic 0.39, the cubic 0.25, the pendulum 1, sech^2 0.77)."""
@@ -45,7 +48,8 @@ def default_bracket(well) -> tuple[float, float]:
     return 0.0, float(round(math.ceil(f / unit * (1.0 - 1e-9)) * unit, 12))
 
 
-def _warn_bracket(Om, br, top, low_escapes, high_safe, cycles, widenings):
+def _warn_bracket(Om: np.ndarray, br: np.ndarray, top: np.ndarray, low_escapes: np.ndarray, high_safe: np.ndarray,
+                  cycles: int, widenings: int) -> None:
     """Name the Omega whose F_cr is NaN because the bracket ``br`` (its top widened to ``top``) misses
     the threshold, and a bracket to try."""
     n = Om.size
@@ -66,27 +70,30 @@ def _warn_bracket(Om, br, top, low_escapes, high_safe, cycles, widenings):
                   BracketWarning, stacklevel=4)  # the caller of critical_forcing_numeric (api_provenance)
 
 
-def _list(values, most=6):
+def _list(values: np.ndarray, most: int = 6) -> str:
     text = ", ".join(f"{v:g}" for v in values[:most])
     return text + (f", ... ({values.size - most} more)" if values.size > most else "")
 
 
-def _escapes(q0, p0, Omega, F, Psi, thr_kw, cycles, spc, threads, integrator, backend, w, damping):
+def _escapes(q0: float, p0: float, Omega: np.ndarray, F: np.ndarray, Psi: float, thr_kw: dict[str, Any], cycles: int,
+             spc: int, threads: int | None, integrator: str, backend: str, w: Well, damping: float) -> np.ndarray:
     """One compiled ensemble: trajectory k with (Omega[k], F[k]); True where it escapes."""
     n = Omega.size
     problem = ensemble_problem(np.full(n, q0), np.full(n, p0), np.arange(n), Omega, F, Psi, cycles=cycles,
                                steps_per_cycle=spc, stop_any=True, integrator=integrator, well=w, damping=damping,
                                **thr_kw)
     sE, sQ = engine.integrate(problem, backend, threads=threads)
-    return ((sE >= 0).any(axis=1)) | ((sQ >= 0).any(axis=1))
+    return np.asarray(((sE >= 0).any(axis=1)) | ((sQ >= 0).any(axis=1)))
 
 
 @api_provenance
-def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3000, tol=5e-5,
-                             F_bracket=None, criterion="energy", n_scan=DEFAULT_N_SCAN,
-                             steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None,
-                             integrator=engine.DEFAULT_INTEGRATOR, backend="cpu", well=None, damping=0.0,
-                             max_widenings=MAX_WIDENINGS):
+def critical_forcing_numeric(Omega: npt.ArrayLike, xi_max: float, *, q0: float = 0.0, p0: float = 0.0,
+                             Psi: float = 0.0, cycles: int = 3000, tol: float = 5e-5,
+                             F_bracket: tuple[float, float] | None = None, criterion: str = "energy",
+                             n_scan: int = DEFAULT_N_SCAN, steps_per_cycle: int = engine.DEFAULT_STEPS_PER_CYCLE,
+                             threads: int | None = None, integrator: str = engine.DEFAULT_INTEGRATOR,
+                             backend: str = "cpu", well: WellLike = None, damping: float = 0.0,
+                             max_widenings: int = MAX_WIDENINGS) -> xr.Dataset:
     """Numeric escape threshold F_cr(Omega) for the IC (q0, p0) (Section 3.1, Figs 10-12).
 
     Bisection: all Omega points advance together, one compiled ensemble per bisection level,
@@ -132,7 +139,8 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     if br.shape != (2,) or not np.isfinite(br).all() or not br[1] > br[0]:
         raise ValueError(f"F_bracket must be (F_lo, F_hi) with 0 <= F_lo < F_hi, or None (the well's own), "
                          f"got {F_bracket!r}")
-    if isinstance(max_widenings, bool) or not isinstance(max_widenings, (int, np.integer)) or not 0 <= max_widenings <= 20:
+    if (isinstance(max_widenings, bool) or not isinstance(max_widenings, (int, np.integer))
+            or not 0 <= max_widenings <= 20):
         raise ValueError(f"max_widenings must be an integer in [0, 20], got {max_widenings!r}")
     if criterion not in ("energy", "displacement"):
         raise ValueError(f"criterion must be 'energy' or 'displacement', got {criterion!r}")
@@ -141,7 +149,8 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
     schemes.check_integrator(integrator)
     spc = engine.check_step(Om, engine.check_steps_per_cycle(steps_per_cycle), w, integrator)
     threads = engine.check_threads(threads)
-    bounds = {}
+    bounds: dict[str, float] = {}
+    thr_kw: dict[str, Any]
     if criterion == "energy":
         thr_kw = {"xi_max": (xi,), "q_max": ()}
     elif isinstance(w, QuarticWell):
@@ -155,7 +164,7 @@ def critical_forcing_numeric(Omega, xi_max, *, q0=0.0, p0=0.0, Psi=0.0, cycles=3
 
     nO = Om.size
 
-    def run(Om_, F_):
+    def run(Om_: np.ndarray, F_: np.ndarray) -> np.ndarray:
         return _escapes(q0, p0, Om_, F_, Psi, thr_kw, cycles, spc, threads, integrator, backend, w, damping)
 
     # ---- bracket ends (one ensemble), then the top doubled where it does not escape

@@ -1,7 +1,10 @@
 """Escape charts: escape time of every initial condition for many thresholds in one pass."""
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+import numpy.typing as npt
 import xarray as xr
 
 from safebasins.core import checks
@@ -9,14 +12,17 @@ from safebasins.core import cf
 from safebasins.wells.provenance import api_provenance
 from safebasins.numerics import criteria, engine, schemes
 from safebasins.numerics.problem import check_cycles, displacement_pairs, ensemble_problem
-from safebasins.wells import resolve_well
+from safebasins.wells import Well, resolve_well
+from safebasins.wells.base import WellLike
 
-def _monotone(a):
+
+def _monotone(a: np.ndarray) -> bool:
     d = np.diff(a)
     return bool(np.all(d > 0) or np.all(d < 0))
 
 
-def _ic_arrays(q0, p0, grid):
+def _ic_arrays(q0: npt.ArrayLike, p0: npt.ArrayLike, grid: bool | None
+               ) -> tuple[bool, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     qa = checks.check_finite("q0", q0)
     pa = checks.check_finite("p0", p0)
     if grid is None:
@@ -34,7 +40,8 @@ def _ic_arrays(q0, p0, grid):
     return False, qa, pa, qa.ravel(), pa.ravel()
 
 
-def _thresholds(w, xi_max, q_max, q_bounds):
+def _thresholds(w: Well, xi_max: npt.ArrayLike, q_max: npt.ArrayLike, q_bounds: npt.ArrayLike
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Checked thresholds of a chart in the well w: (xi, q_max, q_bounds (n, 2))."""
     xi = engine.thresholds("xi_max", xi_max, w.check_threshold)
     qm = engine.thresholds("q_max", q_max, w.check_displacement)
@@ -46,9 +53,11 @@ def _thresholds(w, xi_max, q_max, q_bounds):
 
 
 @api_provenance
-def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=(), well=None, cycles=3000,
-                 steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None, grid=None,
-                 integrator=engine.DEFAULT_INTEGRATOR, backend="cpu", damping=0.0):
+def escape_chart(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: float, Psi: float, *,
+                 xi_max: npt.ArrayLike = (0.25,), q_max: npt.ArrayLike = (), q_bounds: npt.ArrayLike = (),
+                 well: WellLike = None, cycles: int = 3000, steps_per_cycle: int = engine.DEFAULT_STEPS_PER_CYCLE,
+                 threads: int | None = None, grid: bool | None = None, integrator: str = engine.DEFAULT_INTEGRATOR,
+                 backend: str = "cpu", damping: float = 0.0) -> xr.Dataset:
     """Escape time (forcing cycles) of every initial condition, for every threshold.
 
     Parameters
@@ -115,6 +124,8 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=()
     sE, sQ = engine.integrate(problem, backend, threads=threads)
     tE = engine.steps_to_cycles(sE, spc).T   # (nE, N)
     tQ = engine.steps_to_cycles(sQ, spc).T   # (nQ + nB, N)
+    shape: tuple[int, ...]
+    dims: tuple[str, ...]
     if is_grid:
         shape, dims = (qa.size, pa.size), ("q0", "p0")
         coords = {"q0": ("q0", qa, cf.attrs("q0")), "p0": ("p0", pa, cf.attrs("p0"))}
@@ -135,23 +146,27 @@ def escape_chart(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=()
                                        cf.attrs("escape_cycle_bounds"))
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(
-        F=F, Omega=Omega, Psi=Psi, cycles=cycles, steps_per_cycle=spc, integrator=engine.integrator_text(integrator, damping),
+        F=F, Omega=Omega, Psi=Psi, cycles=cycles, steps_per_cycle=spc,
+        integrator=engine.integrator_text(integrator, damping),
         grid=int(is_grid), escape_criteria=criteria.criteria_text(w),
         safe_basin="escape_cycle > t_eval (t_eval <= cycles)", **w.numerics_attrs(), **engine.damping_attrs(damping),
     )
     return ds
 
 
-def _bounds_coords(qb):
+def _bounds_coords(qb: np.ndarray) -> dict[str, Any]:
     return {"q_bounds": ("q_bounds", np.arange(qb.shape[0]), cf.attrs("q_bounds")),
             "q_lower": ("q_bounds", qb[:, 0], cf.attrs("q_lower")),
             "q_upper": ("q_bounds", qb[:, 1], cf.attrs("q_upper"))}
 
 
 @api_provenance
-def escape_chart_batch(q0, p0, F, Omega, Psi, *, xi_max=(0.25,), q_max=(), q_bounds=(), well=None, cycles=3000,
-                       steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None,
-                       integrator=engine.DEFAULT_INTEGRATOR, backend="cpu", damping=0.0):
+def escape_chart_batch(q0: npt.ArrayLike, p0: npt.ArrayLike, F: npt.ArrayLike, Omega: npt.ArrayLike, Psi: float, *,
+                       xi_max: npt.ArrayLike = (0.25,), q_max: npt.ArrayLike = (), q_bounds: npt.ArrayLike = (),
+                       well: WellLike = None, cycles: int = 3000,
+                       steps_per_cycle: int = engine.DEFAULT_STEPS_PER_CYCLE, threads: int | None = None,
+                       integrator: str = engine.DEFAULT_INTEGRATOR, backend: str = "cpu",
+                       damping: float = 0.0) -> xr.Dataset:
     """Escape charts of one IC grid for several control points ``(F[k], Omega[k])`` in ONE ensemble.
 
     Every trajectory carries its control point (the lanes refill across charts, so a control

@@ -14,13 +14,15 @@ displacement ``|q| > q_max`` (symmetric, ``q_max``) or ``q < lo`` or ``q > hi`` 
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
-from safebasins.wells import resolve_well
+from safebasins.wells import Well, resolve_well
+from safebasins.wells.base import WellLike
 
 __all__ = ["displacement_bounds", "criteria_text"]
 
 
-def displacement_bounds(xi_max, well=None):
+def displacement_bounds(xi_max: npt.ArrayLike, well: WellLike = None) -> np.ndarray:
     """Displacement bound pairs from energy levels: ``(q_minus(xi), q_plus(xi))``, the turning
     points of the unforced orbit of energy xi (``well.turning_points``; eq (4) for the quartic,
     where they are ``-+q_max(xi)``), as an (n, 2) array for ``q_bounds``."""
@@ -30,7 +32,7 @@ def displacement_bounds(xi_max, well=None):
     return np.stack([np.asarray(lo, float).ravel(), np.asarray(hi, float).ravel()], axis=-1)
 
 
-def criteria_text(well, displacement="|q| > q_max, or q < q_lower or q > q_upper (q_bounds)"):
+def criteria_text(well: Well, displacement: str = "|q| > q_max, or q < q_lower or q > q_upper (q_bounds)") -> str:
     """The escape criteria of a numeric dataset in words."""
     return (f"energy ({well.energy_criterion()}); displacement: {displacement}; a NaN or inf state counts as "
             "escaped; checked after every step; escape_cycle = step / steps_per_cycle")

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import time
+from typing import Any
 
 import numpy as np
 from numba import cuda
@@ -28,14 +29,14 @@ SIMULATOR_WARP = 8        # compaction granularity under the simulator: small, s
 GOLDEN = 0.6180339887498949
 
 
-def cuda_available():
+def cuda_available() -> bool:
     """True when run_cuda can run: a usable CUDA GPU (driver and NVVM), or the simulator."""
     if cuda_kernels.SIMULATOR:
         return True
     return bool(cuda.is_available())
 
 
-def require_cuda():
+def require_cuda() -> None:
     if not cuda_available():
         raise RuntimeError(
             "the CUDA backend needs a CUDA GPU (driver and NVVM found by numba-cuda) or numba's CUDA "
@@ -43,7 +44,7 @@ def require_cuda():
             "here: use the CPU backend")
 
 
-def scramble_multiplier(n):
+def scramble_multiplier(n: int) -> int:
     """A multiplier coprime to n near n / golden ratio: c -> c * A mod n is a permutation of
     range(n) that spreads neighbouring indices (clustered escape times in an IC grid) evenly
     over the grid's blocks.  c * A < n^2 must fit in int64: n < 3e9."""
@@ -55,17 +56,18 @@ def scramble_multiplier(n):
     return a
 
 
-def launch_grid(kernel, n, block, smem):
+def launch_grid(kernel: Any, n: int, block: int, smem: int) -> int:
     """Blocks to launch: no more than the GPU keeps resident (persistent threads take the
     remaining trajectories from the queue), no more than the work needs."""
     need = max(1, math.ceil(n / block))
     if cuda_kernels.SIMULATOR:
         return min(need, SIMULATOR_GRID)
     overload = next(iter(kernel.overloads.values()))
-    return max(1, min(need, overload.max_cooperative_grid_blocks(block, smem)))
+    return max(1, min(need, int(overload.max_cooperative_grid_blocks(block, smem))))
 
 
-def run_cuda(problem: EnsembleProblem, *, block=None, grid=None, timing=None):
+def run_cuda(problem: EnsembleProblem, *, block: int | None = None, grid: int | None = None,
+             timing: dict[str, Any] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Integrate an ensemble problem (problem.ensemble_problem) on the GPU.
 
     Returns (steps_E (N, nE), steps_Q (N, nQ)): int64 step of first crossing of each threshold in

@@ -8,17 +8,22 @@ engine's checks that depend on the scheme and the machine (steps per cycle, thre
 from __future__ import annotations
 
 import contextlib
+from collections.abc import Callable, Iterator
+from types import ModuleType
+from typing import Any
 import importlib
 import importlib.util
 import math
 
 import numba
 import numpy as np
+import numpy.typing as npt
 
 from safebasins.core import checks
 from safebasins.numerics import kernels, schemes
 from safebasins.numerics.problem import EnsembleProblem
 from safebasins.wells import resolve_well
+from safebasins.wells.base import WellLike
 
 DEFAULT_STEPS_PER_CYCLE = 32
 DEFAULT_INTEGRATOR = schemes.DEFAULT_SCHEME
@@ -29,7 +34,7 @@ LANES = 128          # trajectories in flight per task (4 chains x up to 32-lane
 
 
 @contextlib.contextmanager
-def thread_count(threads):
+def thread_count(threads: int | None) -> Iterator[int]:
     """Temporarily run numba parallel regions on `threads` threads (None: leave as is)."""
     if threads is None:
         yield numba.get_num_threads()
@@ -42,16 +47,17 @@ def thread_count(threads):
         numba.set_num_threads(old)
 
 
-def check_threads(threads):
+def check_threads(threads: Any) -> int | None:
     if threads is None:
         return None
     n = checks.check_positive_int("threads", threads)
-    if n > numba.config.NUMBA_NUM_THREADS:
-        raise ValueError(f"threads must be <= {numba.config.NUMBA_NUM_THREADS} (numba's thread pool), got {n}")
+    pool: int = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # (set at import from the environment)
+    if n > pool:
+        raise ValueError(f"threads must be <= {pool} (numba's thread pool), got {n}")
     return n
 
 
-def check_steps_per_cycle(steps_per_cycle):
+def check_steps_per_cycle(steps_per_cycle: Any) -> int:
     n = checks.check_positive_int("steps_per_cycle", steps_per_cycle)
     if n < 4:
         raise ValueError(f"steps_per_cycle must be >= 4, got {n}")
@@ -63,7 +69,8 @@ def check_steps_per_cycle(steps_per_cycle):
 MAX_STEPS_PER_CYCLE = 10 ** 7
 
 
-def check_step(Omega, steps_per_cycle, well=None, integrator=DEFAULT_INTEGRATOR):
+def check_step(Omega: npt.ArrayLike, steps_per_cycle: int, well: WellLike = None,
+               integrator: str = DEFAULT_INTEGRATOR) -> int:
     """Refuse a step ``h = 2 pi / (Omega steps_per_cycle)`` the scheme cannot integrate: ValueError
     (naming steps_per_cycle) when ``h * max(omega_max, Omega)`` exceeds the scheme's step limit
     (schemes.step_limit: half its stability limit on the harmonic oscillator; SRKN6b 1.58, RK4
@@ -83,7 +90,8 @@ def check_step(Omega, steps_per_cycle, well=None, integrator=DEFAULT_INTEGRATOR)
         if need > MAX_STEPS_PER_CYCLE:
             raise ValueError(
                 f"steps_per_cycle: Omega = {om_min:.6g} is too small to integrate: the step limit h * {fastest:.4g} <= "
-                f"{limit:.4g} of {integrator} in the {w.name} well would need {need:.3g} steps per forcing cycle (more than "
+                f"{limit:.4g} of {integrator} in the {w.name} well would need {need:.3g} steps per forcing cycle (more "
+                "than "
                 f"{MAX_STEPS_PER_CYCLE:.0e}); use a larger Omega")
         need = math.ceil(need)
         raise ValueError(
@@ -95,7 +103,7 @@ def check_step(Omega, steps_per_cycle, well=None, integrator=DEFAULT_INTEGRATOR)
     return steps_per_cycle
 
 
-def damping_attrs(damping):
+def damping_attrs(damping: float) -> dict[str, float]:
     """``{"damping": beta}`` for a damped run; nothing for the undamped equation (datasets of the
     paper's equation keep their attributes: no damping attribute means beta = 0)."""
     return {"damping": damping} if damping > 0 else {}
@@ -104,14 +112,15 @@ def damping_attrs(damping):
 integrator_text = schemes.integrator_text
 
 
-def thresholds(name, values, check):
+def thresholds(name: str, values: npt.ArrayLike, check: Callable[[str, Any], np.ndarray]) -> np.ndarray:
     a = np.atleast_1d(check(name, values) if np.size(values) else np.asarray(values, dtype=float)).astype(float)
     if a.ndim != 1:
         raise ValueError(f"{name} must be a scalar or a 1-D sequence, got shape {a.shape}")
     return a
 
 
-def run_cpu(problem: EnsembleProblem, *, threads=None, store: bool = False):
+def run_cpu(problem: EnsembleProblem, *, threads: int | None = None, store: bool = False
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """Integrate a problem on the CPU lanes (kernels.ensemble).
 
     Returns (steps_E (N, nE), steps_Q (N, nQ), store or None): int64 first-crossing steps in the
@@ -133,14 +142,14 @@ def run_cpu(problem: EnsembleProblem, *, threads=None, store: bool = False):
     return outE, outQ, (st if store else None)
 
 
-def steps_to_cycles(steps, steps_per_cycle):
+def steps_to_cycles(steps: np.ndarray, steps_per_cycle: int) -> np.ndarray:
     """int64 step counts (-1: none) -> float64 forcing cycles (+inf: none)."""
     out = steps.astype(float) / steps_per_cycle
     out[steps < 0] = np.inf
     return out
 
 
-def resolve_backend(backend):
+def resolve_backend(backend: str) -> str:
     """"cpu" or "cuda" for a requested backend ("auto": the GPU when numba-cuda sees one)."""
     if backend not in BACKENDS:
         raise ValueError(f"backend must be one of {BACKENDS}, got {backend!r}")
@@ -149,7 +158,7 @@ def resolve_backend(backend):
     return backend
 
 
-def cuda_engine():
+def cuda_engine() -> ModuleType:
     """The CUDA backend's module (safebasins.numerics.cuda_engine), imported on first use: importing
     numba.cuda costs ~1 s and the simulator must be chosen (NUMBA_ENABLE_CUDASIM) before it;
     ImportError naming the extra to install when numba-cuda, the numba CUDA target it is written
@@ -160,7 +169,8 @@ def cuda_engine():
     return importlib.import_module("safebasins.numerics.cuda_engine")
 
 
-def integrate(problem: EnsembleProblem, backend: str = "cpu", *, threads=None, **options):
+def integrate(problem: EnsembleProblem, backend: str = "cpu", *, threads: int | None = None,
+              **options: Any) -> tuple[np.ndarray, np.ndarray]:
     """Integrate an ensemble problem (problem.ensemble_problem) on a backend: "cpu" (the CPU lanes,
     the reference; ``threads``), "cuda" (cuda_engine.run_cuda; ``block``, ``grid``, ``timing``) or
     "auto" (the GPU when one is visible).  Returns (steps_E, steps_Q) in the caller's threshold

@@ -2,11 +2,13 @@
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 from safebasins.core import checks
 
 
-def random_initial_conditions(n, seed, box=((-1, 1), (-1, 1))):
+def random_initial_conditions(n: int, seed: int, box: npt.ArrayLike = ((-1, 1), (-1, 1))
+                              ) -> tuple[np.ndarray, np.ndarray]:
     """n ICs uniform in box = ((q_lo, q_hi), (p_lo, p_hi)) from numpy.random.default_rng(seed).
 
     Returns (q0, p0), 1-D arrays of length n (q0 drawn first, then p0).  Pass them to

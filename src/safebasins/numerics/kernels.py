@@ -23,8 +23,8 @@ Escape criteria
 energy: 2 H0 = p^2 + 2 V(q) > 2 xi_max, or q beyond a barrier (|q| tracking, the quartic: |q| > 1; signed
 tracking: q > q_right or q < q_left, a side without barrier has q_left = -inf / q_right = +inf
 and never escapes that way); displacement: q outside the bound pair (lo, hi), q < lo or
-q > hi (|q| tracking: |q| > q_max, lo = -hi).  A NaN or inf state is beyond every threshold.  The thresholds are sorted: 2 xi_max ascending, the
-bound pairs nested from the inside out (lo non-increasing, hi non-decreasing), so crossing a
+q > hi (|q| tracking: |q| > q_max, lo = -hi).  A NaN or inf state is beyond every threshold.  The thresholds are sorted:
+2 xi_max ascending, the bound pairs nested from the inside out (lo non-increasing, hi non-decreasing), so crossing a
 threshold crosses every inner one and each lane only watches its next uncrossed one.
 
 Escape detection
@@ -44,9 +44,12 @@ the vector loop only runs over live trajectories.
 """
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 from numba import literally, njit, typeof, types
 from numba.core import errors
 from numba.extending import overload
@@ -294,7 +297,8 @@ def _run_task(well, scheme, shared, wpar, task, n_tasks, lanes, q0, p0, pidx, co
             iQ = lQ[l]
             if hit[l]:
                 for g in range(G):
-                    if not SME[g, l] <= tE[l] or not SMQ[g, l] <= tQ[l] or (not abs_tracking(well) and not SMN[g, l] <= tN[l]):
+                    if (not SME[g, l] <= tE[l] or not SMQ[g, l] <= tQ[l]
+                            or (not abs_tracking(well) and not SMN[g, l] <= tN[l])):
                         k = pidx[i]
                         iE, iQ = _replay(scheme, well, wpar, i, SQ[g, l], SP[g, l], per[l] - 1, seg[g], seg[g + 1],
                                          sintab, coef[k], Fpar[k], thrE2, thrLo, thrHi, iE, iQ, outE, outQ,
@@ -334,11 +338,11 @@ def _ol_period(shared, scheme, well, wpar, M, Q, P, ME, MQ, MN, coef, FS, HL, CL
     return impl
 
 
-def specialised(dispatcher, args, n_literal=2):
+def specialised(dispatcher: Any, args: Sequence[Any], n_literal: int = 2) -> Callable[..., Any]:
     """The compiled entry point of ``dispatcher`` for ``args``, whose first ``n_literal`` arguments
     (the kernel key, the scheme key; for _run_task also the shared flag) are taken as numba
-    literals (compiled, or loaded from the on-disk cache, on first use).  Calling it skips numba's dispatch, which would first try the
-    non-literal signature at every call."""
+    literals (compiled, or loaded from the on-disk cache, on first use).  Calling it skips numba's dispatch, which would
+    first try the non-literal signature at every call."""
     sig = tuple(types.literal(a) for a in args[:n_literal]) + tuple(typeof(a) for a in args[n_literal:])
     entry = _ENTRIES.get((dispatcher, sig))
     if entry is None:
@@ -347,10 +351,10 @@ def specialised(dispatcher, args, n_literal=2):
     return entry
 
 
-_ENTRIES = {}
+_ENTRIES: dict[tuple[Any, tuple[Any, ...]], Callable[..., Any]] = {}
 
 
-def run_tasks(fn, n_tasks):
+def run_tasks(fn: Callable[[int], object], n_tasks: int) -> None:
     """fn(task) for task in range(n_tasks), on n_tasks threads (the compiled task functions release
     the GIL); exceptions propagate."""
     if n_tasks == 1:
@@ -361,15 +365,18 @@ def run_tasks(fn, n_tasks):
             f.result()
 
 
-def _check_code(well):
+def _check_code(well: object) -> WellCode:
     if not isinstance(well, WellCode):
         raise ValueError(f"well must be a compiled well (safebasins.wells.compiled.WellCode: Well.compiled), "
                          f"got {well!r}")
     return well
 
 
-def ensemble(q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQ, cycles, stop_any, n_tasks, lanes,
-             outE, outQ, store, do_store, well=None, thrQlo=None, scheme=None):
+def ensemble(q0: np.ndarray, p0: np.ndarray, pidx: np.ndarray, coef: np.ndarray, hpar: np.ndarray, Fpar: np.ndarray,
+             sintab: np.ndarray, thrE2: np.ndarray, thrQ: npt.ArrayLike, cycles: int, stop_any: bool, n_tasks: int,
+             lanes: int, outE: np.ndarray, outQ: np.ndarray, store: np.ndarray, do_store: bool,
+             well: WellCode | None = None, thrQlo: npt.ArrayLike | None = None,
+             scheme: SchemeCode | None = None) -> None:
     """Integrate every trajectory i from (q0[i], p0[i]) with parameter set pidx[i]
     (coef[pidx[i]] = step coefficients from schemes.lane_coefficients, hpar[pidx[i]] = the step h
     from schemes.step_sizes, Fpar[pidx[i]] = F) for at most
@@ -390,16 +397,16 @@ def ensemble(q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrQ, cycles, stop_a
     n_tasks, lanes or the thread count (each trajectory is the same sequence of IEEE operations).
     """
     code = quartic_code() if well is None else _check_code(well)
-    thrQ = np.ascontiguousarray(thrQ, dtype=float)
-    thrQlo = -thrQ if thrQlo is None else np.ascontiguousarray(thrQlo, dtype=float)
+    hi = np.ascontiguousarray(thrQ, dtype=float)
+    lo = -hi if thrQlo is None else np.ascontiguousarray(thrQlo, dtype=float)
     sc = _scheme(scheme, sintab, coef)
     args = [code.key, sc.key, bool(coef.shape[0] == 1), code.wpar, 0, int(n_tasks), int(lanes), q0, p0, pidx, coef,
-            hpar, Fpar, sintab, thrE2, thrQlo, thrQ, int(cycles), bool(stop_any), outE, outQ, store, bool(do_store)]
+            hpar, Fpar, sintab, thrE2, lo, hi, int(cycles), bool(stop_any), outE, outQ, store, bool(do_store)]
     entry = specialised(_run_task, args, n_literal=3)
     run_tasks(lambda task: entry(*args[:4], task, *args[5:]), n_tasks)
 
 
-def _scheme(scheme, sintab, coef) -> SchemeCode:
+def _scheme(scheme: SchemeCode | None, sintab: np.ndarray, coef: np.ndarray) -> SchemeCode:
     """The scheme code (None: SRKN6b), checked against the forcing table and the coefficient table."""
     sc = scheme_code("srkn6b") if scheme is None else scheme
     if not isinstance(sc, SchemeCode):
@@ -432,16 +439,18 @@ def _final_states(well, scheme, wpar, q0, p0, pidx, coef, Fpar, sintab, n_period
         po[i] = p
 
 
-def final_states(q0, p0, pidx, coef, Fpar, sintab, n_periods, well=None, n_tasks=2, scheme=None):
+def final_states(q0: npt.ArrayLike, p0: npt.ArrayLike, pidx: np.ndarray, coef: np.ndarray, Fpar: np.ndarray,
+                 sintab: np.ndarray, n_periods: int, well: WellCode | None = None, n_tasks: int = 2,
+                 scheme: SchemeCode | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Plain integration (no escape checks) for n_periods periods; returns (q, p).
     Scalar per trajectory; used by tests (convergence order, energy drift).  well: a compiled
     well (None: the quartic); scheme: as ensemble."""
     code = quartic_code() if well is None else _check_code(well)
-    q0 = np.ascontiguousarray(q0, dtype=float)
-    qo, po = np.empty(q0.shape), np.empty(q0.shape)
-    n_tasks = max(1, min(int(n_tasks), q0.size))
+    q = np.ascontiguousarray(q0, dtype=float)
+    qo, po = np.empty(q.shape), np.empty(q.shape)
+    n_tasks = max(1, min(int(n_tasks), q.size))
     sc = _scheme(scheme, sintab, coef)
-    args = [code.key, sc.key, code.wpar, q0, np.ascontiguousarray(p0, dtype=float), pidx, coef, Fpar, sintab,
+    args = [code.key, sc.key, code.wpar, q, np.ascontiguousarray(p0, dtype=float), pidx, coef, Fpar, sintab,
             int(n_periods), 0, n_tasks, qo, po]
     entry = specialised(_final_states, args)
     run_tasks(lambda t: entry(*args[:10], t, *args[11:]), n_tasks)

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 import xarray as xr
 
 from safebasins.core import checks
@@ -10,12 +11,15 @@ from safebasins.wells.provenance import api_provenance
 from safebasins.numerics import engine, schemes
 from safebasins.numerics.problem import check_cycles, displacement_pairs, ensemble_problem
 from safebasins.wells import resolve_well
+from safebasins.wells.base import WellLike
 
 
 @api_provenance
-def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=None, q_bounds=None, well=None,
-                     steps_per_cycle=engine.DEFAULT_STEPS_PER_CYCLE, threads=None, integrator=engine.DEFAULT_INTEGRATOR,
-                     damping=0.0):
+def stroboscopic_map(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: float, Psi: float, *, n_iter: int = 3000,
+                     xi_max: float | None = 0.25, q_max: float | None = None, q_bounds: npt.ArrayLike | None = None,
+                     well: WellLike = None, steps_per_cycle: int = engine.DEFAULT_STEPS_PER_CYCLE,
+                     threads: int | None = None, integrator: str = engine.DEFAULT_INTEGRATOR,
+                     damping: float = 0.0) -> xr.Dataset:
     """Period-map iterates (q(nT), p(nT)), T = 2 pi / Omega, n = 0..n_iter, of paired ICs.
 
     Parameters
@@ -69,6 +73,7 @@ def stroboscopic_map(q0, p0, F, Omega, Psi, *, n_iter=3000, xi_max=0.25, q_max=N
                                cycles=n_iter, steps_per_cycle=spc, stop_any=True, integrator=integrator, well=w,
                                damping=damping)
     sE, sQ, st = engine.run_cpu(problem, threads=threads, store=True)
+    assert st is not None  # (store=True)
     steps = np.concatenate([sE, sQ], axis=1).astype(float)
     steps[steps < 0] = np.inf
     first = steps.min(axis=1)

@@ -17,24 +17,27 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from safebasins.core import checks
 from safebasins.numerics import schemes
 from safebasins.numerics.scheme_code import SchemeCode, scheme_code
 from safebasins.wells.compiled import WellCode
 from safebasins.wells import resolve_well
+from safebasins.wells.base import WellLike
 
 __all__ = ["EnsembleProblem", "ensemble_problem", "displacement_pairs", "engine_code", "check_cycles"]
 
 
-def check_cycles(name: str, cycles) -> int:
+def check_cycles(name: str, cycles: float) -> int:
     """A positive integer number of forcing cycles (an integral float is accepted)."""
     if isinstance(cycles, (float, np.floating)) and float(cycles).is_integer() and cycles >= 1:
         cycles = int(cycles)
     return checks.check_positive_int(name, cycles)
 
 
-def displacement_pairs(q_max=(), q_bounds=()) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
+def displacement_pairs(q_max: npt.ArrayLike = (), q_bounds: npt.ArrayLike = ()
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
     """The displacement thresholds as bound pairs (lo, hi): q_max -> (-q_max, q_max), then the
     q_bounds pairs; returns (lo, hi, order, signed): `order` sorts them nested from the inside
     out (hi ascending, lo descending; stable), `signed` = some pair is not symmetric.
@@ -53,7 +56,7 @@ def displacement_pairs(q_max=(), q_bounds=()) -> tuple[np.ndarray, np.ndarray, n
     return lo, hi, order, bool((lo != -hi).any())
 
 
-def engine_code(well, q_max=(), q_bounds=()) -> WellCode:
+def engine_code(well: WellLike, q_max: npt.ArrayLike = (), q_bounds: npt.ArrayLike = ()) -> WellCode:
     """The compiled form the engines integrate ``well`` in: its abs(q)-tracking form only when every
     displacement bound is symmetric (displacement_pairs)."""
     code = resolve_well(well).compiled
@@ -114,8 +117,10 @@ class EnsembleProblem:
         return out_E, out_Q
 
 
-def ensemble_problem(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_bounds=(), cycles, steps_per_cycle,
-                     stop_any: bool = False, integrator: str = schemes.DEFAULT_SCHEME, well=None,
+def ensemble_problem(q0: npt.ArrayLike, p0: npt.ArrayLike, pidx: npt.ArrayLike, Omega: npt.ArrayLike,
+                     F: npt.ArrayLike, Psi: float, *, xi_max: npt.ArrayLike = (), q_max: npt.ArrayLike = (),
+                     q_bounds: npt.ArrayLike = (), cycles: float, steps_per_cycle: int,
+                     stop_any: bool = False, integrator: str = schemes.DEFAULT_SCHEME, well: WellLike = None,
                      damping: float = 0.0) -> EnsembleProblem:
     """The checked description of an ensemble run (EnsembleProblem); ValueError naming the argument.
 
@@ -146,5 +151,6 @@ def ensemble_problem(q0, p0, pidx, Omega, F, Psi, *, xi_max=(), q_max=(), q_boun
         thrE2=np.ascontiguousarray(2.0 * xi[order_E]), lo=np.ascontiguousarray(lo[order_Q]),
         hi=np.ascontiguousarray(hi[order_Q]), order_E=order_E, order_Q=order_Q,
         code=engine_code(well, q_max, q_bounds), scheme=scheme_code(name, damping > 0.0), damping=damping,
-        cycles=check_cycles("cycles", cycles), steps_per_cycle=checks.check_positive_int("steps_per_cycle", steps_per_cycle),
+        cycles=check_cycles("cycles", cycles),
+        steps_per_cycle=checks.check_positive_int("steps_per_cycle", steps_per_cycle),
         stop_any=bool(stop_any))

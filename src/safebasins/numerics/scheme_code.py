@@ -29,8 +29,8 @@ import functools
 import hashlib
 from dataclasses import dataclass, field
 from pathlib import Path
+from collections.abc import Callable, Iterable
 from typing import Any
-from collections.abc import Callable
 
 import numpy as np
 
@@ -45,7 +45,7 @@ ENGINE_FILES = (compiled.__file__, *(str(Path(__file__).with_name(name)) for nam
                 ("schemes.py", "scheme_code.py", "steps.py", "periods.py", "kernels.py")))
 
 
-def fingerprint(paths) -> str:
+def fingerprint(paths: Iterable[str | Path]) -> str:
     """Hash of the bytes of the files ``paths``, in order."""
     h = hashlib.blake2b(digest_size=16)
     for path in paths:
@@ -196,16 +196,16 @@ class SchemeCode:
         """Forcing values per step (the forcing table's width)."""
         return len(self.scheme.times)
 
-    def _namespace(self, force: Callable | None, primitives: dict[str, Any]) -> dict[str, Any]:
+    def _namespace(self, force: Callable[..., Any] | None, primitives: dict[str, Any]) -> dict[str, Any]:
         ns: dict[str, Any] = {"force": force, **primitives, **_constants(self.scheme)}
         exec(compile(self.source, f"<scheme {self.name}{' damped' if self.damped else ''}>", "exec"), ns)
         return ns
 
-    def make(self, jit: Callable, force: Callable) -> Callable:
+    def make(self, jit: Callable[..., Any], force: Callable[..., Any]) -> Any:
         """The step compiled with ``jit`` around ``force`` (already compiled for the target)."""
         return jit(self._namespace(force, {"fma": compiled.fma, "mul": compiled.mul})["step"])
 
-    def helpers(self, jit: Callable) -> dict[str, Callable]:
+    def helpers(self, jit: Callable[..., Any]) -> dict[str, Any]:
         """The tuple helpers (row, scaled, coefs, column, from_h, flat_row, flat_coefs) compiled with jit."""
         ns = self._namespace(None, {})
         return {k: jit(ns[k]) for k in ("row", "scaled", "coefs", "column", "from_h", "flat_row", "flat_coefs")}

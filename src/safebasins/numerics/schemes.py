@@ -26,6 +26,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+import numpy.typing as npt
 
 __all__ = ["Splitting", "RungeKutta", "Scheme", "SRKN6B", "RK4", "FOREST_RUTH", "SCHEMES", "DEFAULT_SCHEME",
            "STABILITY_FRACTION", "scheme_of", "check_integrator", "integrator_text", "lane_coefficients",
@@ -212,13 +213,14 @@ def integrator_text(integrator: str, damping: float = 0.0) -> str:
     return s.damped_title if damping > 0 else s.title
 
 
-def step_sizes(Omega, steps_per_cycle: int) -> np.ndarray:
+def step_sizes(Omega: npt.ArrayLike, steps_per_cycle: int) -> np.ndarray:
     """h = T / S per parameter set."""
-    Omega = np.atleast_1d(np.asarray(Omega, dtype=float))
-    return 2.0 * np.pi / (Omega * steps_per_cycle)
+    Om = np.atleast_1d(np.asarray(Omega, dtype=float))
+    h: np.ndarray = 2.0 * np.pi / (Om * steps_per_cycle)
+    return h
 
 
-def lane_coefficients(Omega, steps_per_cycle: int, integrator: str | Scheme = DEFAULT_SCHEME,
+def lane_coefficients(Omega: npt.ArrayLike, steps_per_cycle: int, integrator: str | Scheme = DEFAULT_SCHEME,
                       damping: float = 0.0) -> np.ndarray:
     """Per-parameter-set step coefficients (n, scheme.n_coef(damped)), the products the step uses:
 

@@ -21,7 +21,8 @@ function.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Callable, ClassVar, Mapping
+from collections.abc import Callable, Mapping
+from typing import ClassVar
 
 from safebasins.pipeline.well_defaults import WellDefault
 

@@ -291,7 +291,8 @@ def _rm_notes(fig, ds, kinds, refuted, chk, widened):
         esc = int(np.asarray(chk.escaping).sum())
         add_note(fig, f"Numeric check: every analytic-safe IC of the grid integrated {cyc} EC (energy criterion); one "
                       f"rule for Figs 5-9: a connected part of the basin is confirmed when at least "
-                      f"{100 * CONFIRMED_FROM:.0f}% of its ICs stay, otherwise its boundary is drawn dotted dark orange and "
+                      f"{100 * CONFIRMED_FROM:.0f}% of its ICs stay, otherwise its boundary is drawn dotted dark "
+                      "orange and "
                       f"it is left out of the classification; the ICs that escape are hatched orange. "
                       + "; ".join(_parts_text(chk)) + f". In all {esc:,} of {safe:,} analytic-safe ICs "
                       f"({100 * esc / max(safe, 1):.1f}%) escape within {cyc} EC.")

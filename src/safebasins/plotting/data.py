@@ -98,7 +98,8 @@ def provenance(*datasets, fig=None) -> dict:
     out, sources = {}, []
     for d in items:
         attrs = _attrs_of(d)
-        src = source(d) if isinstance(d, xr.Dataset) else "<data array>" if isinstance(d, xr.DataArray) else os.fspath(d)
+        src = (source(d) if isinstance(d, xr.Dataset) else "<data array>" if isinstance(d, xr.DataArray)
+               else os.fspath(d))
         if src not in sources:
             sources.append(src)
         for k in PROVENANCE:
@@ -189,7 +190,8 @@ def describe(**datasets):
                     da = ds[v]
                     dims = ", ".join(f"{d}={np.array2string(np.asarray(da[d].values), precision=4)}" for d in da.dims)
                     vals = np.array2string(np.asarray(da.values), precision=4, suppress_small=True)
-                    lines.append(f"  {v}" + (f" over ({dims})" if dims else "") + ":\n    " + vals.replace("\n", "\n    "))
+                    lines.append(f"  {v}" + (f" over ({dims})" if dims else "") + ":\n    "
+                                 + vals.replace("\n", "\n    "))
     text = "\n".join(lines)
     print(text)
     return text

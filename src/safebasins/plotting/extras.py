@@ -162,8 +162,8 @@ def _erosion_notes(fig, analytic, numeric, measures):
     if numeric is not None and "F_GIM" in numeric.variables:
         for x in _values(numeric, "xi_max"):
             add_note(fig, f"Numeric, ξ_max = {fmt_value(x)}: " + "; ".join(
-                f"t_eval = {fmt_value(t)} EC: {crossings(numeric, xi_max=x, t_eval=t)}" for t in _values(numeric, "t_eval"))
-                + ".")
+                f"t_eval = {fmt_value(t)} EC: {crossings(numeric, xi_max=x, t_eval=t)}"
+                for t in _values(numeric, "t_eval")) + ".")
 
 
 def _draw_basin_panel(ax, ds, sel, label):
@@ -271,7 +271,8 @@ def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, 
         m = {k: float(_sel(var(ds, f"{k}_true"), **sel)) for k in ("GIM", "LIM", "IF")}
         per = np.asarray(_sel(var(ds, "GIM"), **sel), float) if "GIM" in ds.variables else np.array([np.nan])
         txt = (f"{lab}" + (f" (t_eval = {fmt_value(sel['t_eval'])} EC)" if "t_eval" in sel else f" ({fourier} G)")
-               + f", {ds.sizes['Psi']} phases: true basin GIM = {m['GIM']:.3f}, LIM = {m['LIM']:.3f}, IF = {m['IF']:.3f}"
+               + f", {ds.sizes['Psi']} phases: true basin GIM = {m['GIM']:.3f}, LIM = {m['LIM']:.3f}, IF = "
+                 f"{m['IF']:.3f}"
                + (f"; single-phase GIM {fmt_range(per, '{:.3f}')}" if np.isfinite(per).any() else "")
                + (f"; contained in every per-phase basin: {bool(_sel(var(ds, 'contained'), **sel))}"
                   if "contained" in ds.variables else ""))
@@ -279,7 +280,8 @@ def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, 
     if analytic is not None:
         x = xi_max if xi_max is not None else float(analytic["xi_max"][0])
         xt = float(_sel(var(analytic, "xi_true"), xi_max=x, fourier=fourier))
-        add_note(fig, f"All phases (continuous Ψ), analytic: the basin is the energy disk H0 < ξ_true = {xt:.4g}, GIM = "
+        add_note(fig, f"All phases (continuous Ψ), analytic: the basin is the energy disk H0 < ξ_true = {xt:.4g}, GIM "
+                      "= "
                       f"{float(_sel(var(analytic, 'GIM_closed'), xi_max=x, fourier=fourier)):.3f}, LIM = IF = "
                       f"{float(_sel(var(analytic, 'LIM_closed'), xi_max=x, fourier=fourier)):.3f} (closed forms); "
                       "the analytic per-phase outlines are the slow flow's boundary curves, the numeric ones outline "
@@ -331,7 +333,8 @@ def _grouped_bars(ax, groups, ylabel, *, ymax, fmt="{:.2f}"):
         for s, f, i in ((-1, "paper", 1), (1, "exact", 2)):
             v = [b[i] for b in bars]
             allv[f] += v
-            ax.bar(x + s * w / 2, v, width=w, color=FOURIER_COLOR[f], label=FOURIER_STYLE[f]["label"] if g == 0 else None)
+            ax.bar(x + s * w / 2, v, width=w, color=FOURIER_COLOR[f],
+                   label=FOURIER_STYLE[f]["label"] if g == 0 else None)
         ticks += list(x)
         labels += [b[0] for b in bars]
         ax.text(x.mean(), 0.985, head, transform=ax.get_xaxis_transform(), ha="center", va="top", fontsize=7.5)
@@ -394,8 +397,8 @@ def figure_fourier(fcr=None, iou=None, *, title=None):
                 ax.set_ylabel(r"rel. $F_{cr}$ error vs numeric (%)")
             else:
                 ax.tick_params(labelleft=False)
-            ax.legend(loc="upper center", bbox_to_anchor=(0.56, 1.0), fontsize=6.5, ncol=2 if len(labs) > 3 else 1, handlelength=1.4,
-                      columnspacing=0.8, labelspacing=0.25, framealpha=0.9)
+            ax.legend(loc="upper center", bbox_to_anchor=(0.56, 1.0), fontsize=6.5, ncol=2 if len(labs) > 3 else 1,
+                      handlelength=1.4, columnspacing=0.8, labelspacing=0.25, framealpha=0.9)
         style_h = [Line2D([], [], color="0.25", ls=FOURIER_STYLE[f]["ls"], label=FOURIER_STYLE[f]["label"])
                    for f in ("paper", "exact")]
         fig.legend(handles=style_h, loc="center", bbox_to_anchor=(0.5, 0.925), ncol=2, fontsize=8,

@@ -176,7 +176,8 @@ def draw_fcr(ax, ds, *, color_by="curve", show_branches=False, colors=None, lw=1
     ax.set_ylabel(LABELS["F_cr"])
     ax.set_xlim(Omega.min(), Omega.max())
     ax.set_ylim(bottom=0)
-    branches = {m for m, v in BRANCHES.items() if np.isfinite(np.asarray(ds[v], float)).any()} if show_branches else set()
+    branches = ({m for m, v in BRANCHES.items() if np.isfinite(np.asarray(ds[v], float)).any()}
+                if show_branches else set())
     if legend:
         by_color = color_by == "mechanism"
         if show_branches:
@@ -534,7 +535,8 @@ def _side_notes(fig, sides):
         if not e:                  # no mechanism (damped theory): no sides
             continue
         txt.append(f"{lab}: " + ", ".join(f"{side} side median {100 * e[side][0]:.0f}%, max {100 * e[side][1]:.0f}% "
-                                          f"(Ω = {e[side][2]:.3g}, numeric F_cr = {e[side][3]:.3g})" for side in SIDES if side in e))
+                                          f"(Ω = {e[side][2]:.3g}, numeric F_cr = "
+                                          f"{e[side][3]:.3g})" for side in SIDES if side in e))
     if not txt:
         return
     add_note(fig, "Error by the mechanism of the theory (SM side: SM or SMM sets the theoretical F_cr, below the "

@@ -107,7 +107,8 @@ def figure_period_map(analytic, numeric, *, title=None, figsize=(8.2, 7.4), s=0.
                               label=f"{count(unconfirmed.sum(), 'chain orbit')} without a Newton-confirmed centre"))
     ax.plot(*center, "x", color="k", ms=7, mew=1.5, zorder=8)
     handles.append(Line2D([], [], marker="x", ls="none", color="k", ms=7, mew=1.5,
-                          label=rf"centre: elliptic fixed point, $\rho_0$ = {float(param(strobe, 'center_rotation')):.4f}"))
+                          label=r"centre: elliptic fixed point, $\rho_0$ = "
+                                rf"{float(param(strobe, 'center_rotation')):.4f}"))
     line = origin == "line"
     if line.any():
         ax.plot(np.asarray(var(strobe, "q0"))[line], np.asarray(var(strobe, "p0"))[line], "o", mfc="none",
@@ -133,8 +134,8 @@ def figure_period_map(analytic, numeric, *, title=None, figsize=(8.2, 7.4), s=0.
         for c, tag, col, pts in labels:
             order = np.argsort(pts[:, 1] + 1e-3 * pts[:, 0])
             j = int(order[min(1 + c, len(order) - 1)])
-            ax.annotate(tag, pts[j], xytext=(pts[j, 0], ys.min() - (1.2 + 0.9 * c) * pad), textcoords="data", ha="center",
-                        va="center", fontsize=9, color=col, fontweight="bold", zorder=8,
+            ax.annotate(tag, pts[j], xytext=(pts[j, 0], ys.min() - (1.2 + 0.9 * c) * pad), textcoords="data",
+                        ha="center", va="center", fontsize=9, color=col, fontweight="bold", zorder=8,
                         arrowprops=dict(arrowstyle="-", color=col, lw=0.9, shrinkA=2, shrinkB=4))
     ax.set_aspect("equal")
     ax.set_xlabel(LABELS["q"] + r" at $t = nT$")
@@ -160,9 +161,11 @@ def figure_period_map(analytic, numeric, *, title=None, figsize=(8.2, 7.4), s=0.
                       f"numbers {fmt_range(r_main)} (rotation numbers converge to "
                       f"{fmt_range(digits[main], '{:.0f}')} digits).")
     if k_chain.size:
-        per = ", ".join(f"chain {chr(65 + c)} (labelled {chain_tag(float(np.nanmedian(rho[chain == c])), int(k_chain[c]))}"
+        per = ", ".join(f"chain {chr(65 + c)} (labelled "
+                        f"{chain_tag(float(np.nanmedian(rho[chain == c])), int(k_chain[c]))}"
                         f"): period {int(k_chain[c])}, {count(n_chain_orbits[c], 'orbit')}, "
-                        f"rotation {_fraction(float(np.nanmedian(rho[chain == c])), int(k_chain[c]))} about the centre, "
+                        f"rotation {_fraction(float(np.nanmedian(rho[chain == c])), int(k_chain[c]))} about the "
+                        "centre, "
                         f"monodromy trace {float(var(strobe, 'chain_trace')[c]):.3f}"
                         for c in range(k_chain.size))
         add_note(fig, f"{count(k_chain.size, 'island chain')} (each confirmed by an elliptic periodic orbit of the "
@@ -187,7 +190,8 @@ def figure_period_map(analytic, numeric, *, title=None, figsize=(8.2, 7.4), s=0.
                       f"|q| > q_max(ξ_max) (eq 4) drawn here. Under the energy criterion H0 > ξ_max only "
                       f"{int(surv.sum())} of these {n} orbits survive {n_iter:,} cycles ({by})"
                       + (f": {' and '.join(lost)} cross H0 = ξ_max" if lost else "")
-                      + (f", an energy-criterion portrait would show {' and '.join(kept)} only." if kept and lost else "."))
+                      + (f", an energy-criterion portrait would show {' and '.join(kept)} "
+                         "only." if kept and lost else "."))
     else:
         surv = np.isinf(d_esc)
         add_note(fig, f"{int(surv.sum())} of these {n} orbits also survive the displacement criterion "

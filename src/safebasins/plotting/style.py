@@ -178,8 +178,8 @@ def plain_text(txt):
     """Mathtext of titles and legends (``$\\xi_{max}$ = 0.18, $\\Psi$ = $\\pi$``) as plain text for
     captions (``ξ_max = 0.18, Ψ = π``)."""
     for a, b in (("$\\xi_{max}$", "ξ_max"), ("$\\xi_{ini}$", "ξ_ini"), ("$\\gamma_{ini}$", "γ_ini"),
-                 ("$\\Psi$", "Ψ"), ("$\\beta$", "β"), ("$\\Omega$", "Ω"), ("$q_{max}$", "q_max"), ("$t_{eval}$", "t_eval"),
-                 ("\\pi", "π"), ("$", "")):
+                 ("$\\Psi$", "Ψ"), ("$\\beta$", "β"), ("$\\Omega$", "Ω"), ("$q_{max}$", "q_max"),
+                 ("$t_{eval}$", "t_eval"), ("\\pi", "π"), ("$", "")):
         txt = txt.replace(a, b)
     return txt
 

@@ -23,9 +23,12 @@ from __future__ import annotations
 
 import functools
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 
-from safebasins.wells.base import Well
+from safebasins.wells.base import Well, WellLike
 from safebasins.wells.quartic import FOURIER_VARIANTS, QUARTIC, QuarticWell
 # (bound here, after the submodule import, so the package attribute is the function)
 from safebasins.wells.polynomial import cubic, polynomial
@@ -38,7 +41,7 @@ __all__ = ["Well", "QuarticWell", "QUARTIC", "NAMED_WELLS", "resolve_well", "fro
 #: named wells: name -> (builder, one-line description).  Adding a named well is one line here: the
 #: config schema, the command line and the docs read this table; an expression compiles for the
 #: CPU and the GPU engines by itself (wells.expression).
-NAMED_WELLS = {
+NAMED_WELLS: dict[str, tuple[Callable[[], Well], str]] = {
     "quartic": (lambda: QUARTIC, "the paper's truncated quartic V = q^2/2 - q^4/4 (closed forms), barriers q = +-1"),
     "cubic": (cubic, "the escape equation V = q^2/2 - q^3/3, one barrier at q = 1 (E_b = 1/6)"),
     "pendulum": (lambda: expression("1 - cos(q)", name="pendulum"),
@@ -59,7 +62,7 @@ def describe_forms() -> str:
             "{'expression': '<formula in q>'} (either optionally with 'tol': 1e-11) or a safebasins.wells.Well")
 
 
-def _tol_of(spec) -> dict:
+def _tol_of(spec: Any) -> dict[str, Any]:
     """``{"tol": float}`` of a spec mapping that has the key, checked (ValueError naming ``well``), else ``{}``."""
     if TOL_KEY not in spec:
         return {}
@@ -70,7 +73,7 @@ def _tol_of(spec) -> dict:
     return {TOL_KEY: tol}
 
 
-def spec_of(config_value) -> dict:
+def spec_of(config_value: Any) -> dict[str, Any]:
     """Resolved spec of a well form: ``{"name": "cubic"}``, ``{"name": "polynomial",
     "coefficients": [...]}`` or ``{"name": "expression", "expression": "..."}`` (the last two with
     ``"tol"`` when given); ValueError naming ``well`` for anything else."""
@@ -97,7 +100,8 @@ def spec_of(config_value) -> dict:
                 try:
                     coefficients = [float(c) for c in value]
                 except (TypeError, ValueError):
-                    raise ValueError(f"well: polynomial coefficients must be a list of numbers, got {value!r}") from None
+                    raise ValueError("well: polynomial coefficients must be a list of numbers, got "
+                                     f"{value!r}") from None
                 return {"name": "polynomial", "coefficients": coefficients, **_tol_of(config_value)}
             if key == "expression":
                 if not isinstance(value, str):
@@ -107,7 +111,7 @@ def spec_of(config_value) -> dict:
 
 
 @functools.lru_cache(maxsize=64)
-def _build(name, payload, tol=None):
+def _build(name: str, payload: Any, tol: Any = None) -> Any:
     extra = {} if tol is None else {"tol": tol}
     if name == "polynomial":
         return polynomial(list(payload), **extra)
@@ -116,7 +120,7 @@ def _build(name, payload, tol=None):
     return NAMED_WELLS[name][0]()
 
 
-def from_spec(spec, fourier=None) -> Well:
+def from_spec(spec: Any, fourier: str | None = None) -> Well:
     """The well of a spec (resolved, or any form :func:`spec_of` reads); ``fourier`` selects the
     quartic's first harmonic ("paper" is an error with any other well).  Built once per spec and kept."""
     s = spec_of(spec)
@@ -127,7 +131,7 @@ def from_spec(spec, fourier=None) -> Well:
     return resolve_well(_build(name, payload, s.get(TOL_KEY)), fourier)
 
 
-def resolve_well(well=None, fourier=None) -> Well:
+def resolve_well(well: WellLike = None, fourier: str | None = None) -> Well:
     """The one resolver of a ``well=`` argument: None (the paper's quartic), a name, a spec dict
     or a :class:`Well` object (module docstring).  ``fourier`` ("paper" | "exact") selects the
     quartic's G (eq 20 as printed or exact); every other well carries its exact first harmonic
@@ -148,7 +152,7 @@ def resolve_well(well=None, fourier=None) -> Well:
     return well
 
 
-def spec_attrs(spec) -> dict:
+def spec_attrs(spec: Any) -> dict[str, Any]:
     """Dataset attributes naming a well spec: ``well`` and, for a polynomial, ``well_coefficients``,
     for an expression, ``well_expression``; ``well_tol`` where the spec gives ``tol``."""
     s = spec_of(spec)
@@ -162,7 +166,7 @@ def spec_attrs(spec) -> dict:
     return out
 
 
-def well_attrs(well: Well) -> dict:
+def well_attrs(well: Well) -> dict[str, Any]:
     """Dataset attributes naming a well object (:func:`spec_attrs` of its spec)."""
     spec = well.spec()
     if spec["name"] not in NAMED_WELLS and spec["name"] not in SPEC_KEYS:
@@ -170,7 +174,7 @@ def well_attrs(well: Well) -> dict:
     return spec_attrs(spec)
 
 
-def from_attrs(attrs) -> Well:
+def from_attrs(attrs: Any) -> Well:
     """The well a dataset was made with (its :func:`spec_attrs` attributes)."""
     if not hasattr(attrs, "get"):
         raise ValueError(f"attrs must be a dataset's attributes (a mapping), got {type(attrs).__name__}")
@@ -189,5 +193,6 @@ def from_attrs(attrs) -> Well:
     if name == "expression":
         return from_spec({"expression": str(attrs["well_expression"]), **tol})
     if name not in NAMED_WELLS:
-        raise ValueError(f"the dataset was made with the well {name!r}, which is not a named well: pass well= explicitly")
+        raise ValueError(f"the dataset was made with the well {name!r}, which is not a named well: pass well= "
+                         "explicitly")
     return from_spec(name)

@@ -22,7 +22,10 @@ untouched.
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+import numpy.typing as npt
 from numpy.polynomial import chebyshev as _cheb
 from numpy.polynomial import legendre as _leg
 from scipy.fft import dct
@@ -35,7 +38,7 @@ N_NODES, N_CHECK = 12, 20
 DETECT = 64e3 * EPS
 
 
-def _rule(n):
+def _rule(n: Any) -> Any:
     x, w = _leg.leggauss(n)
     return 0.5 * (x + 1.0), 0.5 * w
 
@@ -43,7 +46,7 @@ def _rule(n):
 _RULES = {n: _rule(n) for n in (N_NODES, N_CHECK)}
 
 
-def bottom_integral(dV, q, n=N_NODES):
+def bottom_integral(dV: Any, q: npt.ArrayLike, n: Any = N_NODES) -> Any:
     """``int_0^q V'(s) ds`` for a 1-D array q (Gauss-Legendre with n nodes on [0, q])."""
     t, w = _RULES[n]
     q = np.asarray(q, dtype=float)
@@ -58,7 +61,7 @@ class BottomIntegralV:
     coefficients are below ``8 eps`` of the largest), so an evaluation costs a polynomial, not
     ``N_NODES`` calls of ``V'``."""
 
-    def __init__(self, V, dV, q_left, q_right):
+    def __init__(self, V: Any, dV: Any, q_left: Any, q_right: Any) -> None:
         self.V, self.dV = V, dV
         self.q_left, self.q_right = float(q_left), float(q_right)
         for n in (24, 48, 96, 192):
@@ -73,10 +76,10 @@ class BottomIntegralV:
                              "(V' not analytic at the well bottom)")
         self.coefficients = c
 
-    def _q(self, t):
+    def _q(self, t: Any) -> Any:
         return 0.5 * (self.q_right - self.q_left) + 0.5 * (self.q_right + self.q_left) * t
 
-    def __call__(self, q):
+    def __call__(self, q: Any) -> Any:
         q = np.asarray(q, dtype=float)
         out = np.array(self.V(q), dtype=float)
         near = (q > -self.q_left) & (q < self.q_right)
@@ -87,7 +90,7 @@ class BottomIntegralV:
         return out
 
 
-def cancellation_fix(V, dV, scales):
+def cancellation_fix(V: Any, dV: Any, scales: Any) -> Any:
     """A :class:`BottomIntegralV` if ``V`` loses relative accuracy at the bottom, else None.
 
     ``scales`` = ``(L_left, L_right)``: the extent of the well on each side (distance to the

@@ -20,6 +20,8 @@ differentiated series and the chain rule of the panel variable.
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from numba import njit
 from numpy.polynomial import chebyshev as _cheb
@@ -41,8 +43,8 @@ class EnergyInterpolant:
     (``kind`` BOTTOM/SEPARATRIX, ``[a, b]`` in that panel's variable).
     """
 
-    def __init__(self, func, E_b, *, E_split=None, n=20, tol=DEFAULT_TOL, noise=None,
-                 bottom_panels=2, separatrix_step=2.5, max_rounds=12):
+    def __init__(self, func: Any, E_b: Any, *, E_split: Any = None, n: int = 20, tol: Any = DEFAULT_TOL,
+                 noise: Any = None, bottom_panels: int = 2, separatrix_step: float = 2.5, max_rounds: int = 12) -> None:
         self.E_b = float(E_b)
         self.E_split = 0.5 * self.E_b if E_split is None else float(E_split)
         self.n = int(n)
@@ -85,7 +87,8 @@ class EnergyInterpolant:
             todo = nxt
         if todo:
             where = ", ".join(f"E in [{min(e):.6g}, {max(e):.6g}]" for e in (self._energies(p) for p in todo[:3]))
-            raise ValueError(f"tol: the energy interpolation did not reach tol = {self.tol!r} after {max_rounds} rounds "
+            raise ValueError(f"tol: the energy interpolation did not reach tol = {self.tol!r} after {max_rounds} "
+                             "rounds "
                              f"({len(todo)} panels, {where}, ...): the orbit data are not smooth in E there, or V, dV "
                              "are not accurate to tol; give a larger tol (a well spec's key, e.g. {expression: '...', "
                              "tol: 1e-11}) or a smoother, more accurate V")
@@ -94,12 +97,12 @@ class EnergyInterpolant:
         self._build(done)
 
     # ------------------------------------------------------------------ construction
-    def _energies(self, panel):
+    def _energies(self, panel: Any) -> Any:
         kind, a, b = panel
         var = 0.5 * (a + b) + 0.5 * (b - a) * self._t
         return var * var if kind == BOTTOM else self.E_b - np.exp(var)
 
-    def _coefficients(self, panels, E_nodes, vals):
+    def _coefficients(self, panels: Any, E_nodes: Any, vals: Any) -> Any:
         """Chebyshev coefficients (Q, P, n) interpolating the values at the energies actually
         sampled: a node energy is rounded to a float, which near E_b moves ``u = log(E_b - E)``
         visibly (only multiples of the float spacing of E_b exist there), so the series is
@@ -118,7 +121,7 @@ class EnergyInterpolant:
             coefs[:, i, :deg + 1] = sol.T
         return coefs
 
-    def _build(self, done):
+    def _build(self, done: Any) -> None:
         self.breaks, self.coef, self.dcoef = {}, {}, {}
         for kind in (BOTTOM, SEPARATRIX):
             items = sorted([(p[1], p[2], c) for p, c, _ in done if p[0] == kind])
@@ -134,11 +137,11 @@ class EnergyInterpolant:
             self.dcoef[kind] = np.ascontiguousarray(D)
 
     @property
-    def n_panels(self):
+    def n_panels(self) -> Any:
         return sum(len(b) - 1 for b in self.breaks.values())
 
     # ------------------------------------------------------------------ evaluation
-    def _run(self, E, quantities, derivative):
+    def _run(self, E: Any, quantities: Any, derivative: Any) -> Any:
         E = np.ascontiguousarray(E, dtype=float).ravel()
         q = np.asarray(quantities, dtype=np.int64)
         out = np.empty((q.size, E.size))
@@ -150,12 +153,12 @@ class EnergyInterpolant:
                      C[SEPARATRIX], q, out, var, scale, bottom)
         return out, var, scale, bottom
 
-    def evaluate_many(self, E, quantities):
+    def evaluate_many(self, E: Any, quantities: Any) -> Any:
         """Values of several quantities (one panel search): array (len(quantities), len(E)).
         ``E`` is a validated 1-D array in ``[0, E_b)``."""
         return self._run(E, quantities, False)[0]
 
-    def evaluate(self, E, quantity, derivative=False):
+    def evaluate(self, E: Any, quantity: Any, derivative: bool = False) -> Any:
         """``(value, dvalue/dE)`` of one quantity (the derivative None unless requested)."""
         val = self._run(E, (quantity,), False)[0][0]
         if not derivative:
@@ -167,7 +170,7 @@ class EnergyInterpolant:
             der = np.where(bottom, dv / (2.0 * var), -dv / (self.E_b - E))
         return val, der
 
-    def evaluate_var(self, E, quantity):
+    def evaluate_var(self, E: Any, quantity: Any) -> Any:
         """Values, derivatives with respect to the panel variable (``x = sqrt(E)`` or
         ``u = log(E_b - E)``) and the mask of bottom panels, for callers that combine factors
         analytically."""
@@ -177,7 +180,8 @@ class EnergyInterpolant:
 
 
 @njit(cache=True)
-def _eval_kernel(E, E_split, E_b, br0, C0, br1, C1, quantities, out, var_out, scale_out, bottom_out):
+def _eval_kernel(E: Any, E_split: float, E_b: float, br0: Any, C0: Any, br1: Any, C1: Any, quantities: Any, out: Any,
+                 var_out: Any, scale_out: Any, bottom_out: Any) -> None:
     """Piecewise Chebyshev series (Clenshaw) at energies E: for each point the panel variable
     (``sqrt(E)`` below ``E_split``, ``log(E_b - E)`` above), its panel (binary search in the
     breaks), the local ``t`` in [-1, 1] and the series ``C[q, :, panel]`` for every q."""

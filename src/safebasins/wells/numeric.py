@@ -46,14 +46,16 @@ Wells open at infinity (docs/wells.md; closed forms of Morse ``D (1 - e^{-a q})^
 ``tanh^2 q``): omega, J, ``q_1``, ``arg q_1`` within 1.2e-13 relative for every float
 ``E < E_b`` (the last one included; J of tanh^2 within 2.1e-13, the interpolation tolerance),
 ``phase_point`` within 1.2e-13 for ``E <= 0.99 E_b`` and 1.7e-13 as an angle up to
-``E_b - E = 1e-12 E_b``; DOP853 orbits agree to their own accuracy (~1e-12).  Such wells need ``V'`` accurate to relative
-precision in the tail (``2 tanh(q) / cosh(q)^2``, not ``2 tanh(q) (1 - tanh(q)^2)``: ValueError
+``E_b - E = 1e-12 E_b``; DOP853 orbits agree to their own accuracy (~1e-12).  Such wells need ``V'`` accurate to
+relative precision in the tail (``2 tanh(q) / cosh(q)^2``, not ``2 tanh(q) (1 - tanh(q)^2)``: ValueError
 naming dV).  ``V`` may lose relative accuracy at the bottom (``1 - cos q``, ``(1 - exp(-q))^2``):
 this is detected and V is evaluated there as ``int_0^q V'`` (:mod:`safebasins.wells.bottom`).
 """
 from __future__ import annotations
 
 from functools import partial
+
+from typing import Any
 
 import numpy as np
 
@@ -71,7 +73,7 @@ __all__ = ["NumericWell", "check_options"]
 _T, _JE, _H, _THM, _TL, _QM, _QP = range(7)
 
 
-def _minus(f, c, q):
+def _minus(f: Any, c: Any, q: Any) -> Any:
     """``f(q) - c``."""
     return f(q) - c
 
@@ -133,8 +135,8 @@ class NumericWell(WellShape, Well):
 
     name = "numeric"
 
-    def __init__(self, V, dV, *, barriers=None, search_bound=10.0, name=None, n_scan=20001, tol=DEFAULT_TOL,
-                 asymptotes=None):
+    def __init__(self, V: Any, dV: Any, *, barriers: Any = None, search_bound: float = 10.0, name: str | None = None,
+                 n_scan: int = 20001, tol: Any = DEFAULT_TOL, asymptotes: Any = None) -> None:
         if not callable(V):
             raise ValueError(f"V must be a callable V(q), got {V!r}")
         if not callable(dV):
@@ -149,7 +151,7 @@ class NumericWell(WellShape, Well):
             raise ValueError(f"search_bound must be finite and > 0, got {search_bound!r}")
         self.search_bound = B
         self._check_bottom()
-        self.walls = {}              # side -> position of a wall (a pole of V' where V -> +inf)
+        self.walls: dict[float, float] = {}              # side -> position of a wall (a pole of V' where V -> +inf)
         found = self._locate_barriers(B, n_scan)
         if barriers is not None:
             self._check_given_barriers(barriers, found)
@@ -188,23 +190,23 @@ class NumericWell(WellShape, Well):
         self.interpolation_error = self._interp.error_estimate
 
     # ------------------------------------------------------------------ construction
-    def _tol_spec(self) -> dict:
+    def _tol_spec(self) -> dict[str, Any]:
         """``{"tol": tol}`` when it is not the default (the ``tol`` key of a well spec), else ``{}``."""
         return {} if self.tol == DEFAULT_TOL else {"tol": self.tol}
 
-    def _noise(self, kind, a, b):
+    def _noise(self, kind: Any, a: Any, b: Any) -> Any:
         """Relative accuracy floor of the tabulated data on a panel (conditioning near E_b)."""
         if kind == BOTTOM:
             return 0.0
         return 64 * EPS * np.sqrt(self._E_b / np.exp(a))
 
-    def _orbit_table(self, E):
+    def _orbit_table(self, E: Any) -> Any:
         d = self._quad.orbit_data(E)
         return np.stack([d["T"], d["J"] / E, d["q1_abs"] / np.sqrt(E), d["theta_minus"],
                          d["t_left"] / d["T"], d["q_minus"], d["q_plus"]])
 
     # ------------------------------------------------------------------ checks
-    def check_energy(self, name, E, *, allow_separatrix=False):
+    def check_energy(self, name: str, E: Any, *, allow_separatrix: bool = False) -> Any:
         """Energy in ``[0, E_b)`` (or ``[0, E_b]`` with ``allow_separatrix``), as float array."""
         a = as_array(name, E)
         if (a < 0).any():
@@ -217,13 +219,13 @@ class NumericWell(WellShape, Well):
                              f"above the separatrix), got max {float(a.max())!r}")
         return a
 
-    def _check_positive_energy(self, name, E):
+    def _check_positive_energy(self, name: str, E: Any) -> Any:
         a = self.check_energy(name, E)
         if (a <= 0).any():
             raise ValueError(f"{name} must be > 0 for this derivative (|q_1| ~ sqrt(E) at the well bottom)")
         return a
 
-    def check_point(self, q, p):
+    def check_point(self, q: Any, p: Any) -> Any:
         """Validated, broadcast ``(q, p)`` inside the well: between the limits, ``H0 < E_b``."""
         q, p = np.broadcast_arrays(as_array("q", q), as_array("p", p))
         lo, hi = self.limits
@@ -236,37 +238,37 @@ class NumericWell(WellShape, Well):
         return q, p
 
     # ------------------------------------------------------------------ the potential
-    def V(self, q):
+    def V(self, q: Any) -> Any:
         """``V(q)``; near the bottom ``int_0^q V'`` where the given V loses relative accuracy
         (:mod:`safebasins.wells.bottom`, e.g. ``1 - cos q``)."""
         q = as_array("q", q)
         return _call(self._V, q) if self._V_bottom is None else self._V_bottom(q)
 
-    def dV(self, q):
+    def dV(self, q: Any) -> Any:
         q = as_array("q", q)
         return _call(self._dV, q)
 
     @property
-    def barriers(self):
+    def barriers(self) -> Any:
         return self._barriers
 
     @property
-    def barrier_energy(self):
+    def barrier_energy(self) -> Any:
         return self._E_b
 
     @property
-    def asymptotes(self):
+    def asymptotes(self) -> Any:
         return self._asymptotes
 
     @property
-    def bottom_integral(self):
+    def bottom_integral(self) -> Any:
         """``(q_left, q_right)`` where the given V loses relative accuracy at the bottom and
         :meth:`V` is ``int_0^q V'`` for ``-q_left < q < q_right`` (:mod:`safebasins.wells.bottom`),
         else None."""
         b = self._V_bottom
         return None if b is None else (b.q_left, b.q_right)
 
-    def turning_points(self, E):
+    def turning_points(self, E: Any) -> Any:
         E = self.check_energy("E", E, allow_separatrix=True)
         shape = E.shape
         e = E.ravel()
@@ -278,33 +280,33 @@ class NumericWell(WellShape, Well):
         return qm.reshape(shape), qp.reshape(shape)
 
     # ------------------------------------------------------------------ action-angle
-    def _eval(self, name, E, k):
+    def _eval(self, name: str, E: Any, k: Any) -> Any:
         E = self.check_energy(name, E)
         return self._interp.evaluate(E.ravel(), k)[0].reshape(E.shape), E
 
-    def period(self, E):
+    def period(self, E: Any) -> Any:
         """Period ``T(E) = 2 pi / omega`` of the free orbit."""
         return self._eval("E", E, _T)[0]
 
-    def omega(self, E):
+    def omega(self, E: Any) -> Any:
         """Frequency ``omega(E) = dE/dJ = 2 pi / T`` (eq 16)."""
         return 2.0 * np.pi / self.period(E)
 
-    def dJ_dE(self, E):
+    def dJ_dE(self, E: Any) -> Any:
         """``dJ/dE = 1/omega = T / (2 pi)`` (eq 16)."""
         return self.period(E) / (2.0 * np.pi)
 
-    def J(self, E):
+    def J(self, E: Any) -> Any:
         """Action ``J(E) = (1/2pi) oint p dq`` (eqs 8, 13, 19)."""
         je, E = self._eval("E", E, _JE)
         return je * E
 
-    def harmonic_amplitude(self, E):
+    def harmonic_amplitude(self, E: Any) -> Any:
         """``|q_1(E)|``, half the amplitude of the first harmonic of ``q(theta)`` (eq 20's G)."""
         h, E = self._eval("E", E, _H)
         return h * np.sqrt(E)
 
-    def harmonic_amplitude_derivative(self, E):
+    def harmonic_amplitude_derivative(self, E: Any) -> Any:
         """``d|q_1|/dE`` (derivative of the interpolant), ``0 < E < E_b`` (eq 20's dG/dxi)."""
         E = self._check_positive_energy("E", E)
         e = E.ravel()
@@ -315,19 +317,19 @@ class NumericWell(WellShape, Well):
                        h / (2.0 * x) - x * dh / np.where(bottom, 1.0, self._E_b - e))
         return out.reshape(E.shape)
 
-    def harmonic_phase(self, E):
+    def harmonic_phase(self, E: Any) -> Any:
         """``arg q_1(E)`` in ``(-pi, 0)``, continuous: ``-theta_plus`` with ``theta_plus`` the
         angle of the right turning point (``-pi/2`` for a symmetric well)."""
         thm, _ = self._eval("E", E, _THM)
         return -(thm + np.pi)
 
-    def harmonic_phase_derivative(self, E):
+    def harmonic_phase_derivative(self, E: Any) -> Any:
         """``d arg q_1 / dE``, ``0 < E < E_b``."""
         E = self._check_positive_energy("E", E)
         _, d = self._interp.evaluate(E.ravel(), _THM, derivative=True)
         return -d.reshape(E.shape)
 
-    def first_harmonic(self, E):
+    def first_harmonic(self, E: Any) -> Any:
         """Complex ``q_1(E) = |q_1| exp(i arg q_1)`` (eq 12); ``-i G_exact`` for the quartic."""
         E = self.check_energy("E", E)
         e = E.ravel()
@@ -336,7 +338,7 @@ class NumericWell(WellShape, Well):
         return ((h * np.sqrt(e)) * (np.cos(phase) + 1j * np.sin(phase))).reshape(E.shape)
 
     # ------------------------------------------------------------------ angles
-    def _orbits(self, E):
+    def _orbits(self, E: Any) -> Any:
         """Per-item orbit data for 1-D energies ``0 < E < E_b``: interpolated period, angle of
         q_minus, time to the middle, and Newton-polished turning points with geometry."""
         T, thm, tl, qm0, qp0 = self._interp.evaluate_many(E, (_T, _THM, _TL, _QM, _QP))
@@ -347,7 +349,7 @@ class NumericWell(WellShape, Well):
         return {"T": T, "omega": 2.0 * np.pi / T, "theta_minus": thm, "t_left": tl,
                 "q_minus": qm, "q_plus": qp, "m": m, "d": d, "alpha_left": aL, "alpha_right": aR}
 
-    def angle_energy(self, q, p):
+    def angle_energy(self, q: Any, p: Any) -> Any:
         """``(theta, E)`` of phase points inside the well (eqs 7, 14), ``theta in [0, 2 pi)``;
         ``theta = 0`` at the well bottom."""
         q, p = self.check_point(q, p)
@@ -388,7 +390,7 @@ class NumericWell(WellShape, Well):
             theta[k] = np.where(th >= 2.0 * np.pi, 0.0, th)
         return theta.reshape(shape), E.reshape(shape)
 
-    def phase_point(self, theta, E):
+    def phase_point(self, theta: Any, E: Any) -> Any:
         """``(q, p)`` at angle theta on the orbit of energy E (eqs 15, 17); inverse of
         :meth:`angle_energy`.  ``0 <= E < E_b``; theta any finite real."""
         theta = as_array("theta", theta)
@@ -418,7 +420,7 @@ class NumericWell(WellShape, Well):
             v_end = np.arcsinh(0.5 * np.pi / alpha)
             quad = self._quad
 
-            def fdf(v, idx):
+            def fdf(v: Any, idx: Any) -> Any:
                 psi = alpha[idx] * np.sinh(v)
                 tau = quad.side_time(Ek[idx], q_end[idx], d[idx], alpha[idx], sigma[idx], psi)
                 rate = quad.rate(Ek[idx], q_end[idx], d[idx], alpha[idx], sigma[idx], v)[0]
@@ -435,8 +437,8 @@ class NumericWell(WellShape, Well):
     #: a user's Python V, dV may call anything: the bound of a code calling libm functions
     step_cost = STEP_COST_TRANSCENDENTAL
 
-    def _compiled_form(self):
+    def _compiled_form(self) -> Any:
         return user_code(self._V, self._dV, self.barriers, self.name)
 
-    def potential_text(self):
+    def potential_text(self) -> str:
         return f"user function {getattr(self._V, '__qualname__', type(self._V).__name__)}"

@@ -22,6 +22,9 @@ end) and evaluated as ``G_j + int_x^{x_j} side V'``: relative accuracy ~1e-15 do
 """
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 from numpy.polynomial import legendre as _leg
 from scipy import optimize
@@ -46,7 +49,7 @@ _X, _W = _leg.leggauss(20)
 _T, _W = 0.5 * (_X + 1.0), 0.5 * _W
 
 
-def geometric_values(V, side, start):
+def geometric_values(V: Any, side: Any, start: Any) -> Any:
     """``x_k = start 2^k`` (all finite ones) and ``V(side x_k)`` (``V`` vectorised, quiet)."""
     with np.errstate(over="ignore"):
         x = np.ldexp(float(start), np.arange(1100))
@@ -54,7 +57,7 @@ def geometric_values(V, side, start):
     return x, V(side * x)
 
 
-def converged_limit(v):
+def converged_limit(v: Any) -> Any:
     """``(A, k)``: the value ``V`` settles to along the sequence ``v``: the first run of ``RUN``
     consecutive finite values within ``CONVERGED`` of each other starts at ``k``, ``A`` its last
     value; ``(None, None)`` if there is none.  (Values beyond the run are not looked at: near
@@ -82,10 +85,10 @@ class Tail:
     (``G/f`` there).
     """
 
-    def __init__(self, f, V, side, A, x_hint, where):
+    def __init__(self, f: Any, V: Any, side: Any, A: Any, x_hint: Any, where: Any) -> None:
         self.f, self.side, self.A, self.where, self._V = f, float(side), float(A), where, V
         level = (1.0 - TAIL_START) * self.A
-        g = lambda x: float(V(np.array([side * x]))[0]) - level
+        g: Callable[[Any], Any] = lambda x: float(V(np.array([side * x]))[0]) - level
         lo = x_hint
         while lo > 1e-300 and g(lo) >= 0:
             lo *= 0.5
@@ -97,15 +100,15 @@ class Tail:
         self.G0 = float(self.G_knots[0])
         self.ell0 = self.G0 / float(f(np.array([self.x0]))[0])
 
-    def _integrals(self, a, b):
+    def _integrals(self, a: Any, b: Any) -> Any:
         """Gauss-Legendre integrals of f over the panels ``[a_i, b_i]`` and the least f at the nodes."""
         a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
         r = a[..., None] + (b - a)[..., None] * _T
         fr = self.f(r)
         return (fr @ _W) * (b - a), fr.min(axis=-1)
 
-    def _table(self):
-        V_at = lambda x: self._V(np.array([self.side * x]))[0]
+    def _table(self) -> None:
+        V_at: Callable[[Any], Any] = lambda x: self._V(np.array([self.side * x]))[0]
         x, h = self.x0, 0.25 * self.x0
         knots, parts = [x], []
         while True:
@@ -121,7 +124,8 @@ class Tail:
                 if h < 1e-13 * x:
                     raise ValueError(
                         f"dV: V' has lost its relative precision at |q| ~ {x!r} on the {self.where} side, where V is "
-                        f"within {self.A - float(V_at(x)):.3g} of its limit {self.A!r}: the orbits near the escape energy "
+                        f"within {self.A - float(V_at(x)):.3g} of its limit {self.A!r}: the orbits near the escape "
+                        "energy "
                         "reach that far and cannot be computed.  Write V' without terms that cancel as V tends to "
                         "its limit (2 tanh(q) / cosh(q)^2, not 2 tanh(q) (1 - tanh(q)^2); 2 q / (1 + q^2)^2, not "
                         "2 q / (1 + q^2) - 2 q^3 / (1 + q^2)^2)")
@@ -142,7 +146,7 @@ class Tail:
         # the last knot has G = 0 (the negligible rest): carry the previous length
         self.ell_knots = np.where(np.isfinite(ell) & (ell > 0), ell, np.append(ell[:-1], ell[-2]))
 
-    def G(self, x):
+    def G(self, x: Any) -> Any:
         """``A - V(side x)`` for ``x >= x0`` (0 beyond the table, where it is below ``NEGLIGIBLE A``)."""
         x = np.asarray(x, dtype=float)
         j = np.searchsorted(self.knots, x, side="right")
@@ -154,7 +158,7 @@ class Tail:
             out[inside] = self.G_knots[ji] + I
         return out
 
-    def bracket(self, s):
+    def bracket(self, s: Any) -> Any:
         """``(lo, hi)`` with ``G(lo) >= s > G(hi)`` for ``0 < s`` (the turning point of ``A - E = s``):
         ``(0, x0)`` where ``s >= G0`` (the turning point is not in the tail)."""
         s = np.asarray(s, dtype=float)
@@ -165,10 +169,10 @@ class Tail:
         hi = np.where(core, self.x0, self.knots[j])
         return lo, hi
 
-    def length_at(self, x):
+    def length_at(self, x: Any) -> Any:
         """Decay length ``G / f`` at ``x0 <= x`` interpolated between the knots (a panel-count estimate)."""
         return np.interp(x, self.knots, self.ell_knots)
 
-    def length(self, x, G):
+    def length(self, x: Any, G: Any) -> Any:
         """Decay length ``G / f`` of the tail at ``x`` (``G = G(x)``): e-folding length of ``A - V``."""
         return np.asarray(G, dtype=float) / self.f(np.asarray(x, dtype=float))

@@ -34,6 +34,9 @@ Quantities of one orbit (``tau_side(psi)`` = time from the side's turning point)
 """
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 from numpy.polynomial import chebyshev as _cheb
 from numpy.polynomial import legendre as _leg
@@ -50,7 +53,7 @@ MEAN_NODES = (4, 6, 8, 12, 16)
 NOISE = 16 * EPS
 
 
-def clenshaw_curtis(n):
+def clenshaw_curtis(n: Any) -> Any:
     """Clenshaw-Curtis rule on [-1, 1]: ascending nodes ``x``, weights ``w`` and the matrix
     ``S`` of the indefinite integral, ``int_{-1}^{x_i} f ~ sum_j S[i, j] f(x_j)``."""
     x = -np.cos(np.pi * np.arange(n) / (n - 1))
@@ -65,7 +68,8 @@ def clenshaw_curtis(n):
     return x, S[-1].copy(), S
 
 
-def solve_increasing(fdf, lo, hi, x0, *, xtol=4 * EPS, atol=0.0, maxiter=200):
+def solve_increasing(fdf: Any, lo: Any, hi: Any, x0: Any, *, xtol: Any = 4 * EPS, atol: float = 0.0,
+                     maxiter: int = 200) -> Any:
     """Vectorised safeguarded Newton (rtsafe) for increasing ``F`` with ``F(lo) <= 0 <= F(hi)``.
 
     ``fdf(x, idx)`` returns ``F(x), F'(x)`` for the items ``idx``.  Newton steps that leave the
@@ -112,13 +116,13 @@ def solve_increasing(fdf, lo, hi, x0, *, xtol=4 * EPS, atol=0.0, maxiter=200):
     raise RuntimeError(f"turning-point / angle solver did not converge for {active.size} items")
 
 
-def _reference_mean(dV, a, b, rtol, floor, panels=16, n=20):
+def _reference_mean(dV: Any, a: Any, b: Any, rtol: Any, floor: Any, panels: int = 16, n: int = 20) -> Any:
     """Mean of ``V'`` over ``[a, b]`` (arrays) by composite Gauss-Legendre (``panels`` x ``n`` nodes),
     and where it agrees with half as many panels to ``rtol`` (relative) plus ``floor`` (absolute):
     converged."""
     x, w = _leg.leggauss(n)
 
-    def composite(m):
+    def composite(m: Any) -> Any:
         edges = np.linspace(0.0, 1.0, m + 1)
         total = 0.0
         for lo, hi in zip(edges[:-1], edges[1:]):
@@ -160,9 +164,10 @@ class OrbitQuadrature:
     graded (:meth:`breaks`).
     """
 
-    def __init__(self, V, dV, limits, barriers, kappa, *, tails=(None, None), core=None, n_nodes=20, n_point=12,
-                 panel_length=1.5, alpha_max=3.0, gap_switch=0.02, n_mean=4, barrier_zone=0.1, span=4.0,
-                 mean_rtol=DEFAULT_TOL):
+    def __init__(self, V: Any, dV: Any, limits: Any, barriers: Any, kappa: Any, *, tails: Any = (None, None),
+                 core: Any = None, n_nodes: int = 20, n_point: int = 12,
+                 panel_length: float = 1.5, alpha_max: float = 3.0, gap_switch: float = 0.02, n_mean: int = 4,
+                 barrier_zone: float = 0.1, span: float = 4.0, mean_rtol: Any = DEFAULT_TOL) -> None:
         self.V, self.dV = V, dV
         self.tails = tuple(tails)
         self.open = any(t is not None for t in self.tails)
@@ -184,7 +189,7 @@ class OrbitQuadrature:
         self.mean_w = 0.5 * gw
         self.n_mean = n_mean
 
-    def _mean_segments(self):
+    def _mean_segments(self) -> Any:
         """Per side, the segments ``(q_end, length)`` over which :meth:`mean_dV` is taken: at the
         barrier (``barrier_zone |q_b|``, turning points) and at turning points near the limit and
         inside the well (``gap_switch`` times the orbit's width, the integrand's ``near`` form);
@@ -192,7 +197,7 @@ class OrbitQuadrature:
         finite = all(np.isfinite(self.limits))
         width = abs(self.limits[0]) + abs(self.limits[1]) if finite else self.core
         near = self.gap_switch * width
-        out = []
+        out: list[Any] = []
         for k, lim in enumerate(self.limits):
             if self.tails[k] is not None or not np.isfinite(lim):
                 out.append([])
@@ -204,7 +209,7 @@ class OrbitQuadrature:
             out.append(segs)
         return out
 
-    def _calibrate_mean(self, n_first, rtol):
+    def _calibrate_mean(self, n_first: Any, rtol: Any) -> Any:
         """``(n, (length_left, length_right))``: the Gauss rule of :meth:`mean_dV` and, per side, the
         longest segment it may span.  ``<V'>`` must reach ``rtol`` (relative, plus the rounding
         floor :data:`NOISE` of V') against a composite reference on the segments of
@@ -224,7 +229,7 @@ class OrbitQuadrature:
         scan = np.linspace(min(min(ends), 0.0), max(max(ends), 0.0), 401)
         floor = NOISE * float(np.max(np.abs(self.dV(scan))))
 
-        def passes(n, segs, cap=np.inf):
+        def passes(n: Any, segs: Any, cap: Any = np.inf) -> Any:
             if not segs:
                 return True
             q_end = np.array([s[0] for s in segs])
@@ -254,13 +259,13 @@ class OrbitQuadrature:
             lengths.append(cap)
         return n, tuple(lengths)
 
-    def mean_cap(self, sigma):
+    def mean_cap(self, sigma: Any) -> Any:
         """Longest segment of :meth:`mean_dV` at a turning point of the side ``sigma`` (-1 left, +1
         right; arrays broadcast): ``inf`` unless V' has a singularity near that side."""
         return np.where(np.asarray(sigma) < 0, self.mean_length[0], self.mean_length[1])
 
     # ------------------------------------------------------------------ turning points
-    def turning_points(self, E, guess=None):
+    def turning_points(self, E: Any, guess: Any = None) -> Any:
         """``(q_minus, q_plus)`` with ``V = E`` for ``0 <= E <= E_b`` (validated, 1-D)."""
         E_all = np.asarray(E, dtype=float)
         pos = np.nonzero(E_all > 0)[0]              # E = 0: both turning points at the bottom
@@ -279,7 +284,7 @@ class OrbitQuadrature:
             # F(s) = V(side s) - E is increasing in s = side q on [0, |lim|]; near a barrier
             # V(q) - E = (V_b - E) - (q_b - q) <V'>_[q, q_b]: only V' and the exact difference
             # V_b - E enter, so q is found to ~eps (the energy to ~eps sqrt(V_b - E)).
-            def fdf(s, idx, side=side, qb=qb, Vb=Vb, k=k):
+            def fdf(s: Any, idx: Any, side: Any = side, qb: Any = qb, Vb: Any = Vb, k: Any = k) -> Any:
                 q = side * s
                 F = self.V(q) - E[idx]
                 if np.isfinite(qb):
@@ -295,7 +300,7 @@ class OrbitQuadrature:
             out.append(q)
         return out[0], out[1]
 
-    def _tail_turning_point(self, tail, E, guess):
+    def _tail_turning_point(self, tail: Any, E: Any, guess: Any) -> Any:
         """Distance ``x`` of the turning point on an open side: ``V(side x) = E`` (``inf`` at
         ``E >= A``); in the tail as ``(A - E) - G(x) = 0`` (both terms exact or accurate)."""
         side = tail.side
@@ -306,7 +311,7 @@ class OrbitQuadrature:
         lo, hi = tail.bracket(si)
         x0 = 0.5 * (lo + hi) if guess is None else np.clip(guess[i], lo, hi)
 
-        def fdf(s, idx):
+        def fdf(s: Any, idx: Any) -> Any:
             F = self.V(side * s) - Ei[idx]
             far = s >= tail.x0
             if far.any():
@@ -315,7 +320,7 @@ class OrbitQuadrature:
         x[i] = solve_increasing(fdf, lo, hi, x0)
         return x
 
-    def _tail_gap(self, E, q, gap):
+    def _tail_gap(self, E: Any, q: Any, gap: Any) -> Any:
         """``E - V(q)`` (``gap``, computed directly) replaced beyond each open side's ``x0`` by
         ``G(|q|) - (A - E)``."""
         for tail in self.tails:
@@ -325,7 +330,7 @@ class OrbitQuadrature:
                     gap[far] = tail.G(tail.side * q[far]) - (tail.A - E[far])
         return gap
 
-    def _tail_length(self, q):
+    def _tail_length(self, q: Any) -> Any:
         """Decay length ``l = (A - V) / |V'|`` at the points ``q`` (``inf`` outside the tails)."""
         ell = np.full(np.shape(q), np.inf)
         for tail in self.tails:
@@ -335,14 +340,14 @@ class OrbitQuadrature:
                 ell[far] = tail.length_at(x[far])
         return ell
 
-    def end_length(self, q_end):
+    def end_length(self, q_end: Any) -> Any:
         """Length scale of V' at a turning point of a well open at infinity: the decay length
         ``l`` of the tail beyond ``x0``, else the extent ``core`` of the well proper (with a far
         turning point on an open side the half width ``d`` is far larger than either)."""
         ell = self._tail_length(np.asarray(q_end, dtype=float))
         return np.where(np.isfinite(ell), ell, self.core)
 
-    def breaks(self, v_end, d, alpha, q_end, sigma, max_panels=4000):
+    def breaks(self, v_end: Any, d: Any, alpha: Any, q_end: Any, sigma: Any, max_panels: int = 4000) -> Any:
         """Panel breaks ``(N, M + 1)`` on ``[0, v_end]`` for a well open at infinity, marching from
         the turning point: a panel spans at most ``panel_length`` in ``v`` and, in ``q``, at most
         ``span`` decay lengths ``l = (A - V) / |V'|`` of a tail (``sqrt(A - V)`` changes by
@@ -368,20 +373,20 @@ class OrbitQuadrature:
         raise RuntimeError(f"panel breaks of the open well did not reach the end in {max_panels} panels")
 
     @staticmethod
-    def _nodes_between(b, x):
+    def _nodes_between(b: Any, x: Any) -> Any:
         """Nodes ``(N, M, n)`` (reference nodes ``x`` on [-1, 1]) on the panels between the breaks
         ``b`` ``(N, M + 1)``, and the panel half-lengths ``(N, M, 1)``."""
         half = 0.5 * (b[:, 1:, None] - b[:, :-1, None])
         return b[:, :-1, None] + half * (x[None, None, :] + 1.0), half
 
-    def mean_dV(self, q, q_end):
+    def mean_dV(self, q: Any, q_end: Any) -> Any:
         """Mean of ``V'`` over the segment ``[q, q_end]`` (Gauss-Legendre, ``n_mean`` nodes)."""
         mean = np.zeros(np.broadcast_shapes(np.shape(q), np.shape(q_end)))
         for t, wt in zip(self.mean_t, self.mean_w):
             mean = mean + wt * self.dV(q + (q_end - q) * t)
         return mean
 
-    def geometry(self, E, q_minus, q_plus):
+    def geometry(self, E: Any, q_minus: Any, q_plus: Any) -> Any:
         """Centre ``m``, half-width ``d`` and peak widths ``alpha`` of each side."""
         m = 0.5 * (q_plus + q_minus)
         d = 0.5 * (q_plus - q_minus)
@@ -407,7 +412,7 @@ class OrbitQuadrature:
         return m, d, alphas[0], alphas[1]
 
     # ------------------------------------------------------------------ integrand
-    def integrand(self, E, q_end, d, alpha, sigma, v):
+    def integrand(self, E: Any, q_end: Any, d: Any, alpha: Any, sigma: Any, v: Any) -> Any:
         """At nodes ``v`` (items along axis 0, per-item arrays of shape (N, 1)): ``psi``, ``q``,
         ``R`` and ``dpsi/dv``."""
         psi = alpha * np.sinh(v)
@@ -444,7 +449,7 @@ class OrbitQuadrature:
 
     # ------------------------------------------------------------------ composite rules
     @staticmethod
-    def _nodes(v_end, m, x):
+    def _nodes(v_end: Any, m: Any, x: Any) -> Any:
         """Composite nodes (reference nodes ``x`` on [-1, 1]) on ``[0, v_end]`` (per item) with
         ``m`` equal panels: shape (N, m, n) and the panel half-lengths (N, 1, 1)."""
         h = (v_end / m)[:, None, None]
@@ -452,7 +457,7 @@ class OrbitQuadrature:
         v = a + h * 0.5 * (x[None, None, :] + 1.0)
         return v, 0.5 * h
 
-    def side_profile(self, E, q_end, d, alpha, sigma, m=None):
+    def side_profile(self, E: Any, q_end: Any, d: Any, alpha: Any, sigma: Any, m: Any | None = None) -> Any:
         """Half orbit from one turning point to ``q = m`` (``psi`` in [0, pi/2]), all nodes.
 
         Returns dict with per-node ``psi``, ``q``, ``R``, ``dpsi`` (N, K), the cumulative time
@@ -466,7 +471,7 @@ class OrbitQuadrature:
                 m = max(int(np.ceil(np.max(v_end) / self.panel_length)), 1)
             v, half = self._nodes(v_end, m, self.x)
         N = v.shape[0]
-        col = lambda a: np.asarray(a, dtype=float).reshape(N, 1, 1)
+        col: Callable[[Any], Any] = lambda a: np.asarray(a, dtype=float).reshape(N, 1, 1)
         psi, q, R, dpsi = self.integrand(col(E), col(q_end), col(d), col(alpha), sigma, v)
         f = col(d) / R * dpsi
         cum = half * (f @ self.S.T)
@@ -474,11 +479,11 @@ class OrbitQuadrature:
         off = np.concatenate([np.zeros((N, 1)), np.cumsum(tot, axis=1)[:, :-1]], axis=1)
         tau = cum + off[..., None]
         wts = np.broadcast_to(half * self.w, v.shape)
-        flat = lambda a: np.broadcast_to(a, v.shape).reshape(N, -1)
+        flat: Callable[[Any], Any] = lambda a: np.broadcast_to(a, v.shape).reshape(N, -1)
         return {"psi": flat(psi), "q": flat(q), "R": flat(R), "dpsi": flat(dpsi),
                 "tau": flat(tau), "w": flat(wts), "total": tau[:, -1, -1]}
 
-    def side_time(self, E, q_end, d, alpha, sigma, psi):
+    def side_time(self, E: Any, q_end: Any, d: Any, alpha: Any, sigma: Any, psi: Any) -> Any:
         """Time from the turning point ``q_end`` to the point at ``psi`` (1-D arrays), by
         composite Gauss-Legendre in ``v = asinh(psi/alpha)``, items grouped by their number of
         panels."""
@@ -487,7 +492,7 @@ class OrbitQuadrature:
         v_end = np.arcsinh(psi / alpha)
         if self.open:
             v, half = self._nodes_between(self.breaks(v_end, d, alpha, q_end, sigma), self.gx)
-            col = lambda a: a.reshape(-1, 1, 1)
+            col: Callable[[Any], Any] = lambda a: a.reshape(-1, 1, 1)
             _, _, R, dpsi = self.integrand(col(E), col(q_end), col(d), col(alpha), col(sigma), v)
             return np.sum(half[:, :, 0] * ((col(d) / R * dpsi) @ self.gw), axis=1)
         m = np.maximum(np.ceil(v_end / self.panel_length), 1).astype(int)
@@ -501,13 +506,13 @@ class OrbitQuadrature:
             out[idx] = np.sum(half[:, :, 0] * (f @ self.gw), axis=1)
         return out
 
-    def rate(self, E, q_end, d, alpha, sigma, v):
+    def rate(self, E: Any, q_end: Any, d: Any, alpha: Any, sigma: Any, v: Any) -> Any:
         """``dtau/dv`` and ``(psi, q, R)`` at single nodes ``v`` (1-D arrays)."""
         psi, q, R, dpsi = self.integrand(E, q_end, d, alpha, sigma, v)
         return d / R * dpsi, psi, q, R
 
     # ------------------------------------------------------------------ one orbit
-    def orbit_data(self, E, guess=None):
+    def orbit_data(self, E: Any, guess: Any = None) -> Any:
         """Period, action, first harmonic and angle data of the orbits of energies ``E``
         (1-D, ``0 < E < E_b``): dict of 1-D arrays ``q_minus, q_plus, T, J, q1_abs,
         theta_minus, t_left`` (``t_left``: time from ``q_minus`` to ``m``)."""

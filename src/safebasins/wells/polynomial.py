@@ -20,7 +20,10 @@ multiplicity >= 3, ``V''(q_b) = 0``).
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+import numpy.typing as npt
 from numpy.polynomial import polynomial as P
 
 from safebasins.core.checks import as_array
@@ -31,7 +34,7 @@ from safebasins.wells.compiled import POLY_DEGREES, polynomial_code
 __all__ = ["PolynomialWell", "polynomial", "cubic", "quartic_polynomial"]
 
 
-def _check_coefficients(coefficients):
+def _check_coefficients(coefficients: Any) -> Any:
     try:
         c = np.array(coefficients, dtype=float)
     except (TypeError, ValueError) as exc:
@@ -62,7 +65,7 @@ class PolynomialWell(NumericWell):
 
     name = "polynomial"
 
-    def __init__(self, coefficients, *, name=None, **kwargs):
+    def __init__(self, coefficients: Any, *, name: str | None = None, **kwargs: Any) -> None:
         check_options(**{k: kwargs[k] for k in ("tol", "n_scan", "asymptotes") if k in kwargs})
         c = _check_coefficients(coefficients)
         self.coefficients = c
@@ -75,12 +78,12 @@ class PolynomialWell(NumericWell):
         dc = self.dV_coefficients
         super().__init__(lambda q: P.polyval(q, c), lambda q: P.polyval(q, dc), name=name, **kwargs)
 
-    def _default_search_bound(self):
+    def _default_search_bound(self) -> Any:
         cauchy = self._cauchy_bound()
         roots = self._root_bound()
         return cauchy if not (roots > 0 and cauchy > 1e3 * roots) else roots
 
-    def _root_bound(self):
+    def _root_bound(self) -> Any:
         """4 x the largest real root of ``V'`` and of ``V - E_b`` (0 without a barrier)."""
         barriers = self._locate_barriers(None, None)
         Vb = [float(P.polyval(b, self.coefficients)) for b in barriers if np.isfinite(b)]
@@ -92,7 +95,7 @@ class PolynomialWell(NumericWell):
         real = r[np.abs(r.imag) <= 1e-7 * max(1.0, float(np.max(np.abs(r))))].real
         return 4.0 * float(np.max(np.abs(np.concatenate([real, self._real_roots]))))
 
-    def _cauchy_bound(self):
+    def _cauchy_bound(self) -> Any:
         """Search bound (x4 margin) from Cauchy's root bound ``1 + max |a_k / a_n|``: it contains
         every real root of ``V'`` (the barriers) and of ``V - E`` for every E up to a bound of
         ``|V|`` on the roots' range, so the no-barrier side rises above the escape energy within it."""
@@ -105,7 +108,7 @@ class PolynomialWell(NumericWell):
         b2 = 1.0 + np.max(np.abs(cc[:-1] / cc[-1]))
         return float(4.0 * max(b1, b2))
 
-    def _locate_barriers(self, B, n):
+    def _locate_barriers(self, B: Any, n: Any) -> Any:
         """Nearest sign-changing real roots of V' on each side of 0 (Newton-polished)."""
         dc = self.dV_coefficients
         if dc.size <= 2:           # V' = 2 c_2 q: harmonic, no barrier
@@ -128,15 +131,16 @@ class PolynomialWell(NumericWell):
         self._real_roots = real
         return tuple(out)
 
-    def _check_monotone(self, side, lim):
+    def _check_monotone(self, side: Any, lim: Any) -> None:
         """No root of V' strictly between 0 and the limit (a root of even multiplicity there is
         an equilibrium with V' = 0 whose orbit is not periodic)."""
         inner = [r for r in self._real_roots if 0 < side * r < abs(lim) * (1 - 1e-12)]
         if inner:
-            raise ValueError(f"coefficients: V' vanishes at q = {float(inner[0])!r} inside the well without changing sign "
+            raise ValueError(f"coefficients: V' vanishes at q = {float(inner[0])!r} inside the well without changing "
+                             "sign "
                              "(an inflection point with V' = 0): the orbit through it is not periodic")
 
-    def _polish(self, x):
+    def _polish(self, x: Any) -> Any:
         dc, d2 = self.dV_coefficients, self._d2
         for _ in range(8):
             f, g = P.polyval(x, dc), P.polyval(x, d2)
@@ -148,53 +152,53 @@ class PolynomialWell(NumericWell):
                 break
         return float(x)
 
-    def _curvature(self, qb):
+    def _curvature(self, qb: Any) -> Any:
         return float(-P.polyval(qb, self._d2))
 
-    def V(self, q):
+    def V(self, q: npt.ArrayLike) -> Any:
         return P.polyval(as_array("q", q), self.coefficients)
 
-    def dV(self, q):
+    def dV(self, q: npt.ArrayLike) -> Any:
         return P.polyval(as_array("q", q), self.dV_coefficients)
 
 
     # ------------------------------------------------------------------ the numerics
     @property
-    def step_cost(self) -> float:
+    def step_cost(self) -> float:  # type: ignore[override]  # (Well's class attribute, computed here)
         """Step cost of its degree class (``STEP_COST_POLY4`` / ``STEP_COST_POLY8`` of
         safebasins.wells.base)."""
         return STEP_COST_POLY4 if self.coefficients.size - 1 <= POLY_DEGREES[0] else STEP_COST_POLY8
 
-    def _compiled_form(self):
+    def _compiled_form(self) -> Any:
         return polynomial_code(self.coefficients, self.barriers, self.name)
 
-    def potential_text(self):
+    def potential_text(self) -> str:
         terms = [f"{'-' if c < 0 else '+'} {abs(c)!r} q^{k}" for k, c in enumerate(self.coefficients.tolist())
                  if c != 0.0]
         return " ".join(terms).removeprefix("+ ")
 
-    def numerics_attrs(self):
+    def numerics_attrs(self) -> Any:
         return {**super().numerics_attrs(), "well_coefficients": np.array(self.coefficients, dtype=float)}
 
-    def spec(self):
+    def spec(self) -> Any:
         if self.name != "polynomial":          # a named polynomial well (cubic)
             return super().spec()
         return {"name": "polynomial", "coefficients": [float(c) for c in self.coefficients], **self._tol_spec()}
 
 
-def polynomial(coefficients, **kwargs):
+def polynomial(coefficients: Any, **kwargs: Any) -> Any:
     """The well ``V = sum_k c_k q^k`` (see :class:`PolynomialWell`)."""
     return PolynomialWell(coefficients, **kwargs)
 
 
-def cubic(**kwargs):
+def cubic(**kwargs: Any) -> Any:
     """Helmholtz-Thompson escape well ``V = q^2/2 - q^3/3`` (``q'' + q - q^2 = F sin(...)``):
     barrier at ``q = 1`` with energy 1/6, none on the left (``V -> inf`` as ``q -> -inf``)."""
     kwargs.setdefault("name", "cubic")
     return PolynomialWell([0.0, 0.0, 0.5, -1.0 / 3.0], **kwargs)
 
 
-def quartic_polynomial(**kwargs):
+def quartic_polynomial(**kwargs: Any) -> Any:
     """The paper's well, eq (2), ``V = q^2/2 - q^4/4`` by quadrature (closed form:
     :mod:`safebasins.wells.quartic`)."""
     kwargs.setdefault("name", "quartic-numeric")

@@ -4,18 +4,23 @@ argument; None is the quartic).  The public functions of theory, numerics and an
 one decorator."""
 from __future__ import annotations
 
-import functools
+from collections.abc import Callable
+from typing import Any, TypeVar
 
 from safebasins.core import provenance
 from safebasins.wells import resolve_well, well_attrs
+from safebasins.wells.base import WellLike
 
 __all__ = ["api_provenance", "call_well_attrs"]
 
+F = TypeVar("F", bound=Callable[..., Any])
 
-def call_well_attrs(well) -> dict:
+
+def call_well_attrs(well: WellLike) -> dict[str, Any]:
     """Dataset attributes of a call's ``well`` argument (any form :func:`resolve_well` reads)."""
     return well_attrs(resolve_well(well))
 
 
-#: ``@api_provenance``: the core's decorator with :func:`call_well_attrs`
-api_provenance = functools.partial(provenance.api_provenance, well_attrs=call_well_attrs)
+def api_provenance(fn: F) -> F:
+    """``@api_provenance``: the core's decorator with :func:`call_well_attrs`."""
+    return provenance.api_provenance(fn, well_attrs=call_well_attrs)

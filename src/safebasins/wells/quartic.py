@@ -26,12 +26,15 @@ their own grids; the public, checked API is :mod:`safebasins.theory.action_angle
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+import numpy.typing as npt
 from scipy import special
 
 from safebasins.core.checks import as_array, check_finite, value_repr
 from safebasins.wells.base import Well
-from safebasins.wells.compiled import quartic_code
+from safebasins.wells.compiled import WellCode, quartic_code
 
 __all__ = ["QuarticWell", "QUARTIC", "XI_SEPARATRIX", "FOURIER_VARIANTS", "check_fourier"]
 
@@ -42,7 +45,7 @@ FOURIER_VARIANTS = ("paper", "exact")
 _C_J = 2.0 * np.sqrt(2.0) / (3.0 * np.pi)
 
 
-def check_fourier(fourier):
+def check_fourier(fourier: str) -> str:
     """Validate the ``fourier`` keyword ("paper" = eq (20) as printed, "exact" = true harmonic)."""
     if fourier not in FOURIER_VARIANTS:
         raise ValueError(f"fourier must be one of {FOURIER_VARIANTS}, got {fourier!r}")
@@ -50,23 +53,23 @@ def check_fourier(fourier):
 
 
 # ----------------------------------------------------------------------------- potential
-def _V(q):
+def _V(q: Any) -> Any:
     return 0.5 * q * q - 0.25 * q ** 4
 
 
-def _H0(q, p):
+def _H0(q: Any, p: Any) -> Any:
     """Eq (7), untruncated: ``p^2/2 + q^2/2 - q^4/4`` (validated arrays)."""
     return 0.5 * p * p + 0.5 * q * q - 0.25 * q ** 4
 
 
-def _q_max(xi):
+def _q_max(xi: Any) -> Any:
     """Eq (4), ``sqrt(1 - sqrt(1 - 4 xi))``, evaluated as ``sqrt(4 xi / (1 + sqrt(1 - 4 xi)))``
     (no cancellation at small xi)."""
     return np.sqrt(4.0 * xi / (1.0 + np.sqrt(1.0 - 4.0 * xi)))
 
 
 # ----------------------------------------------------------------------------- elliptic
-def _ell(xi):
+def _ell(xi: Any) -> dict[str, Any]:
     """Elliptic quantities for validated energies ``0 <= xi <= 1/4`` (no checks).
 
     Returns dict with mu, m, m1 (= 1 - m), K, Kp (= K(1-m)), E.  At xi = 1/4 K = inf.
@@ -84,7 +87,7 @@ def _ell(xi):
     return {"mu": mu, "m": m, "m1": m1, "K": K, "Kp": Kp, "E": E, "RD3": RD3}
 
 
-def _J(xi, e=None):
+def _J(xi: Any, e: Any = None) -> Any:
     """Eqs (13)/(19): ``J = 2 sqrt(2) / (3 pi) sqrt(1 + mu) (E(k) - mu K(k))``."""
     e = _ell(xi) if e is None else e
     # E - mu K = (1 - mu) K - m (K - E)/m ; both terms O(xi) at the well bottom (no cancellation)
@@ -98,14 +101,14 @@ def _J(xi, e=None):
     return _C_J * np.sqrt(1.0 + mu) * d
 
 
-def _omega(xi, e=None):
+def _omega(xi: Any, e: Any = None) -> Any:
     """Eq (16): ``pi sqrt(1 + mu) / (2 sqrt(2) K)``."""
     e = _ell(xi) if e is None else e
     with np.errstate(divide="ignore"):
         return np.pi * np.sqrt(1.0 + e["mu"]) / (2.0 * np.sqrt(2.0) * e["K"])
 
 
-def _G(xi, fourier="paper", e=None):
+def _G(xi: Any, fourier: str = "paper", e: Any = None) -> Any:
     """Eq (20) (``fourier="paper"``) or the exact first harmonic (divided by 1 - nome)."""
     e = _ell(xi) if e is None else e
     K, Kp = e["K"], e["Kp"]
@@ -119,12 +122,12 @@ def _G(xi, fourier="paper", e=None):
     return g
 
 
-def _dK_dm(K, E, m, m1, RD3):
+def _dK_dm(K: Any, E: Any, m: Any, m1: Any, RD3: Any) -> Any:
     # (E - (1-m) K) / (2 m (1-m)) with E = K - m RD3  ->  (K - RD3) / (2 (1-m))
     return (K - RD3) / (2.0 * m1)
 
 
-def _dG_dxi(xi, fourier="paper", e=None):
+def _dG_dxi(xi: Any, fourier: str = "paper", e: Any = None) -> Any:
     """dG/dxi for 0 < xi < 1/4 (validated)."""
     e = _ell(xi) if e is None else e
     mu, m, m1, K, Kp, E, RD3 = e["mu"], e["m"], e["m1"], e["K"], e["Kp"], e["E"], e["RD3"]
@@ -141,17 +144,17 @@ def _dG_dxi(xi, fourier="paper", e=None):
         return g * dlog
 
 
-def _nome(xi):
+def _nome(xi: Any) -> Any:
     e = _ell(xi)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(np.isfinite(e["K"]), np.exp(-np.pi * e["Kp"] / e["K"]), 1.0)
 
 
-def _amplitudes(mu):
+def _amplitudes(mu: Any) -> tuple[Any, Any]:
     return np.sqrt(1.0 - mu), np.sqrt(0.5 * (1.0 - mu * mu))
 
 
-def _angle_energy(q, p):
+def _angle_energy(q: Any, p: Any) -> tuple[Any, Any]:
     """Eq (14) extended to the whole orbit (validated points inside the well)."""
     xi = _H0(q, p)
     xi = np.clip(xi, 0.0, None)
@@ -175,7 +178,7 @@ def _angle_energy(q, p):
     return theta, xi
 
 
-def _phase_point(theta, xi):
+def _phase_point(theta: Any, xi: Any) -> tuple[Any, Any]:
     """Eqs (15), (17) (validated)."""
     e = _ell(xi)
     A, B = _amplitudes(e["mu"])
@@ -194,11 +197,11 @@ class QuarticWell(Well):
 
     name = "quartic"
 
-    def __init__(self, fourier="paper"):
+    def __init__(self, fourier: str = "paper") -> None:
         self.fourier = check_fourier(fourier)
 
     # -- checks
-    def check_energy(self, name, xi, *, allow_separatrix=False):
+    def check_energy(self, name: str, xi: npt.ArrayLike, *, allow_separatrix: bool = False) -> np.ndarray:
         """Energy in [0, 1/4) (or [0, 1/4] with allow_separatrix)."""
         a = as_array(name, xi)
         if (a < 0).any():
@@ -211,7 +214,7 @@ class QuarticWell(Well):
                 f"{name} must be < 1/4: the action-angle map is singular on the separatrix, got max {float(a.max())!r}")
         return a
 
-    def check_threshold(self, name, xi_max):
+    def check_threshold(self, name: str, xi_max: npt.ArrayLike) -> np.ndarray:
         """Energy truncation level in (0, 1/4]."""
         a = as_array(name, xi_max)
         if ((a <= 0) | (a > XI_SEPARATRIX)).any():
@@ -219,10 +222,10 @@ class QuarticWell(Well):
         return a
 
     @property
-    def barrier_energy_text(self):
+    def barrier_energy_text(self) -> str:
         return "1/4"
 
-    def check_displacement(self, name, q_max):
+    def check_displacement(self, name: str, q_max: npt.ArrayLike) -> np.ndarray:
         """Displacement threshold in (0, 1] (the barrier at ``|q| = 1``)."""
         a = as_array(name, q_max)
         if ((a <= 0) | (a > 1)).any():
@@ -230,67 +233,67 @@ class QuarticWell(Well):
         return a
 
     # -- the numerics
-    def _compiled_form(self):
+    def _compiled_form(self) -> WellCode:
         return quartic_code()
 
-    def potential_text(self):
+    def potential_text(self) -> str:
         return "q^2/2 - q^4/4"
 
     @property
-    def omega_max(self):
+    def omega_max(self) -> float:
         """``sqrt(max |V''|)`` on ``|q| <= 1``: ``V'' = 1 - 3 q^2`` is -2 at the barriers."""
         return float(np.sqrt(2.0))
 
-    def barrier_text(self):
+    def barrier_text(self) -> str:
         return "|q| > 1"
 
     # -- potential (plain arithmetic: numpy arrays, DataArrays and scalars alike, no checks)
-    def V(self, q):
+    def V(self, q: Any) -> Any:
         return _V(q)
 
-    def dV(self, q):
+    def dV(self, q: Any) -> Any:
         return q - q * q * q
 
     @property
-    def barriers(self):
+    def barriers(self) -> tuple[float, float]:
         return (-1.0, 1.0)
 
     @property
-    def barrier_energy(self):
+    def barrier_energy(self) -> float:
         return XI_SEPARATRIX
 
-    def H0(self, q, p):
+    def H0(self, q: npt.ArrayLike, p: npt.ArrayLike) -> Any:
         """Eq (7), untruncated: ``p^2/2 + q^2/2 - q^4/4``."""
         return _H0(q, p)
 
-    def q_max(self, xi_max):
+    def q_max(self, xi_max: npt.ArrayLike) -> Any:
         """Displacement threshold of an energy threshold, eq (4) (``xi_max`` in (0, 1/4]: else
         ValueError naming it)."""
         self.check_threshold("xi_max", xi_max)
         return _q_max(xi_max)
 
-    def xi_from_q_max(self, q_max):
+    def xi_from_q_max(self, q_max: npt.ArrayLike) -> Any:
         """Energy ``V(q_max)`` equivalent to a displacement threshold ``q_max`` in (0, 1] (else
         ValueError naming it)."""
         self.check_displacement("q_max", q_max)
         return _V(q_max)
 
-    def turning_points(self, E):
+    def turning_points(self, E: npt.ArrayLike) -> tuple[Any, Any]:
         qm = _q_max(self.check_energy("E", E, allow_separatrix=True))
         return -qm, qm
 
-    def unforced_safe(self, q, p, xi_max):
+    def unforced_safe(self, q: Any, p: Any, xi_max: Any) -> Any:
         """The unforced safe set of a threshold, ``S0 = {H0 < xi_max, |q| < q_max(xi_max)}``."""
         return (_H0(q, p) < xi_max) & (abs(q) < _q_max(xi_max))
 
     # -- action-angle
-    def J(self, E):
+    def J(self, E: npt.ArrayLike) -> Any:
         return _J(self.check_energy("E", E, allow_separatrix=True))
 
-    def omega(self, E):
+    def omega(self, E: npt.ArrayLike) -> Any:
         return _omega(self.check_energy("E", E, allow_separatrix=True))
 
-    def angle_energy(self, q, p):
+    def angle_energy(self, q: npt.ArrayLike, p: npt.ArrayLike) -> tuple[Any, Any]:
         q, p = np.broadcast_arrays(check_finite("q", q), check_finite("p", p))
         if (np.abs(q) >= 1.0).any():
             raise ValueError("q must satisfy |q| < 1 (inside the potential well)")
@@ -298,30 +301,30 @@ class QuarticWell(Well):
             raise ValueError("p: phase point has H0(q, p) >= 1/4 (outside the well)")
         return _angle_energy(q, p)
 
-    def phase_point(self, theta, E):
+    def phase_point(self, theta: npt.ArrayLike, E: npt.ArrayLike) -> tuple[Any, Any]:
         theta = check_finite("theta", theta)
         xi = self.check_energy("E", E)
         theta, xi = np.broadcast_arrays(theta, xi)
         return _phase_point(theta, xi)
 
-    def first_harmonic(self, E):
+    def first_harmonic(self, E: npt.ArrayLike) -> Any:
         """``q_1 = -i G`` (``q(theta) = 2 G sin(theta) + ...``), G of this well's ``fourier``."""
         return -1j * _G(self.check_energy("E", E, allow_separatrix=True), self.fourier)
 
-    def harmonic_amplitude(self, E):
+    def harmonic_amplitude(self, E: npt.ArrayLike) -> Any:
         """G of eq (20) (this well's ``fourier``): ``|q_1|``."""
         return _G(self.check_energy("E", E, allow_separatrix=True), self.fourier)
 
-    def harmonic_amplitude_derivative(self, E):
+    def harmonic_amplitude_derivative(self, E: npt.ArrayLike) -> Any:
         xi = self.check_energy("E", E)
         if (xi <= 0).any():
             raise ValueError("E must be > 0 for dG/dxi (G ~ sqrt(xi/2) at the well bottom)")
         return _dG_dxi(xi, self.fourier)
 
-    def harmonic_phase(self, E):
+    def harmonic_phase(self, E: npt.ArrayLike) -> Any:
         return np.full(np.shape(self.check_energy("E", E, allow_separatrix=True)), -0.5 * np.pi)
 
-    def harmonic_shift(self, E):
+    def harmonic_shift(self, E: npt.ArrayLike) -> Any:
         """Exactly 0: the quartic is symmetric, ``q(theta)`` is odd."""
         return np.zeros(np.shape(self.check_energy("E", E, allow_separatrix=True)))
 

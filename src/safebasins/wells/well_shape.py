@@ -14,6 +14,9 @@ from __future__ import annotations
 
 from functools import partial
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
 from scipy import optimize
 
@@ -28,7 +31,7 @@ EPS = np.finfo(float).eps
 BOTTOM_ATOL = 1e-12
 
 
-def check_options(*, tol=DEFAULT_TOL, n_scan=20001, asymptotes=None):
+def check_options(*, tol: Any = DEFAULT_TOL, n_scan: int = 20001, asymptotes: Any = None) -> Any:
     """Validated ``(tol, n_scan, asymptotes)`` of :class:`NumericWell` (ValueError naming the argument),
     checked before anything is computed.  ``asymptotes``: None or a pair of float-or-None."""
     t = as_array("tol", tol)
@@ -44,7 +47,8 @@ def check_options(*, tol=DEFAULT_TOL, n_scan=20001, asymptotes=None):
     except TypeError:
         pair = None
     if pair is None or len(pair) != 2:
-        raise ValueError(f"asymptotes must be a pair (left, right) of limits of V at -inf / +inf, each a float or None, "
+        raise ValueError("asymptotes must be a pair (left, right) of limits of V at -inf / +inf, each a float or "
+                         "None, "
                          f"got {asymptotes!r}")
     out = []
     for side, a in zip(("left", "right"), pair):
@@ -58,7 +62,7 @@ def check_options(*, tol=DEFAULT_TOL, n_scan=20001, asymptotes=None):
     return float(t), int(n_scan), tuple(out)
 
 
-def _call(f, q):
+def _call(f: Any, q: Any) -> Any:
     """``f(q)`` as a float array of q's shape (a callable returning a constant is broadcast)."""
     with np.errstate(over="ignore", invalid="ignore"):
         out = np.asarray(f(q), dtype=float)
@@ -68,7 +72,16 @@ def _call(f, q):
 class WellShape:
     """Construction-time analysis of ``V``, ``V'`` (``self._V``, ``self._dV``, ``self.search_bound``)."""
 
-    def _check_bottom(self):
+    # set by the well that uses this analysis (NumericWell.__init__)
+    _V: Callable[[Any], Any]
+    _dV: Callable[[Any], Any]
+    search_bound: float
+    walls: dict[float, float]
+    _E_b: float
+    _tails: tuple[Any, Any]
+    limits: tuple[float, float]
+
+    def _check_bottom(self) -> None:
         z = np.zeros(1)
         v0, d0 = float(_call(self._V, z)[0]), float(_call(self._dV, z)[0])
         if not (np.isfinite(v0) and abs(v0) <= BOTTOM_ATOL):
@@ -82,19 +95,20 @@ class WellShape:
         k0 = float(np.mean(g))
         if not (np.isfinite(g).all() and (g > 0).all() and g.min() > 0.5 * g.max()):
             raise ValueError(f"V: V''(0) = {float(g.min())!r} (V'(q)/q at |q| = 1e-8 and 1e-7 search_bound = "
-                             f"{self.search_bound!r}), must be > 0: q = 0 must be a non-degenerate minimum (a well much "
+                             f"{self.search_bound!r}), must be > 0: q = 0 must be a non-degenerate minimum (a well "
+                             "much "
                              "smaller than search_bound needs a smaller search_bound)")
         self.omega0 = float(np.sqrt(k0))
 
-    def _locate_barriers(self, B, n):
+    def _locate_barriers(self, B: Any, n: Any) -> Any:
         """``(q_left, q_right)``: nearest local maxima of V on each side (``+-inf`` if none)."""
         return tuple(self._find_barrier(side, B, n) for side in (-1.0, 1.0))
 
-    def _scan(self, side, B, n):
+    def _scan(self, side: Any, B: Any, n: Any) -> Any:
         s = np.geomspace(1e-9 * B, B, n)
         return s, side * _call(self._dV, side * s)
 
-    def _find_barrier(self, side, B, n):
+    def _find_barrier(self, side: Any, B: Any, n: Any) -> Any:
         """The barrier on one side: the first sign change of V' on the scan, polished by Brent's
         method; ``side * inf`` where there is none, or where the sign changes through a pole of V'
         at which V rises without bound (a wall, e.g. the repulsive core of a Lennard-Jones well:
@@ -117,7 +131,7 @@ class WellShape:
             raise ValueError(f"dV: V'({float(side * s[i])!r}) is not finite, {where} of 0 before any barrier")
         if f[i - 1] == 0:
             return side * a
-        g = lambda x: side * float(_call(self._dV, np.array([side * x]))[0])
+        g: Callable[[Any], Any] = lambda x: side * float(_call(self._dV, np.array([side * x]))[0])
         r = optimize.brentq(g, a, b, xtol=1e-300, rtol=4 * EPS, maxiter=500)
         # a root of V' has |V'| at rounding level there; a pole (V' -> +inf, then -inf beyond) does not
         if not abs(g(r)) <= 1e-6 * max(abs(f[i - 1]), abs(f[i])):
@@ -128,14 +142,14 @@ class WellShape:
                              "and V does not rise without bound towards it: neither a barrier nor a wall")
         return side * r
 
-    def _rises_to_wall(self, side, s):
+    def _rises_to_wall(self, side: Any, s: Any) -> Any:
         """Whether V grows without bound along the scan points ``s`` (towards a pole of V'): its last
         values exceed 1e6 times its largest value over the first half of the scan's extent."""
         v = _call(self._V, side * s)
         inner = v[s <= 0.5 * s[-1]]
         return bool(np.isfinite(v[-1]) and inner.size and v[-1] > 1e6 * max(float(np.max(np.abs(inner))), EPS))
 
-    def _check_monotone(self, side, lim):
+    def _check_monotone(self, side: Any, lim: Any) -> None:
         """V' must not vanish between 0 and the limit (an interior equilibrium, e.g. an
         inflection point with V' = 0, carries a non-periodic orbit): interior local minima of
         ``V'(q)/q`` on the scan are polished and rejected if they reach ~0."""
@@ -145,15 +159,16 @@ class WellShape:
         if g.size < 3:
             return
         j = np.nonzero((g[1:-1] <= g[:-2]) & (g[1:-1] <= g[2:]) & (g[1:-1] < 1e-3 * g[0]))[0] + 1
-        h = lambda x: side * float(_call(self._dV, np.array([side * x]))[0]) / x
+        h: Callable[[Any], Any] = lambda x: side * float(_call(self._dV, np.array([side * x]))[0]) / x
         for k in j:
             res = optimize.minimize_scalar(h, bounds=(s[k - 1], s[k + 1]), method="bounded",
                                            options={"xatol": 1e-12 * s[k]})
             if res.fun <= 1e-9 * g[0]:
-                raise ValueError(f"V: V' vanishes at q ~ {float(side * res.x)!r} inside the well (an equilibrium that is "
+                raise ValueError(f"V: V' vanishes at q ~ {float(side * res.x)!r} inside the well (an equilibrium that "
+                                 "is "
                                  "not a barrier): the orbit through it is not periodic")
 
-    def _check_given_barriers(self, barriers, found):
+    def _check_given_barriers(self, barriers: Any, found: Any) -> None:
         try:
             given = tuple(float(b) for b in barriers)
         except (TypeError, ValueError) as exc:
@@ -168,10 +183,10 @@ class WellShape:
                 raise ValueError(f"barriers: the {side} barrier is given as {g!r} but the nearest local maximum "
                                  f"of V on that side (within search_bound) is at {f!r}")
 
-    def _find_asymptotes(self, found, declared, B):
+    def _find_asymptotes(self, found: Any, declared: Any, B: Any) -> Any:
         """Per side without a barrier, the finite limit of V at infinity or None (V -> inf); None on a
         side with a barrier.  Declared limits (``asymptotes``) are checked against V at large |q|."""
-        out = []
+        out: list[float | None] = []
         self._sequences = {}
         for k, side in enumerate((-1.0, 1.0)):
             where, sign = ("left", "-") if side < 0 else ("right", "+")
@@ -200,7 +215,7 @@ class WellShape:
             out.append(given if given is not None else A)
         return tuple(out)
 
-    def _open_tail(self, side, A):
+    def _open_tail(self, side: Any, A: Any) -> Any:
         """The :class:`~safebasins.wells.open_sides.Tail` of a side open at infinity (its limit is
         the escape energy), else None."""
         if A is None or A > self._E_b:
@@ -208,7 +223,7 @@ class WellShape:
         where = "left" if side < 0 else "right"
         x, v = self._sequences[side]
         hint = float(x[np.nonzero(v >= (1.0 - TAIL_START) * A)[0][0]])
-        f = lambda s: side * _call(self._dV, side * s)
+        f: Callable[[Any], Any] = lambda s: side * _call(self._dV, side * s)
         tail = Tail(f, partial(_call, self._V), side, A, hint, where)
         # V(x0) + int_x0^inf V' must be the limit: a wrong declared limit, or V' not the derivative of V
         rest = A - float(_call(self._V, np.array([side * tail.x0]))[0])
@@ -217,7 +232,7 @@ class WellShape:
                              f"{A - rest + tail.G0!r} (q = {side * tail.x0!r}): a wrong limit, or dV is not V'")
         return tail
 
-    def _limit(self, side, barrier, B, n):
+    def _limit(self, side: Any, barrier: Any, B: Any, n: Any) -> Any:
         if np.isfinite(barrier):
             return float(barrier)
         if self._tails[0 if side < 0 else 1] is not None:
@@ -237,17 +252,18 @@ class WellShape:
         above = np.nonzero(v > self._E_b)[0]
         if above.size == 0:
             raise ValueError(f"V: on the {'left' if side < 0 else 'right'} side V' keeps its sign up to search_bound = "
-                             f"{B}, but V neither rises above the escape energy {self._E_b!r} nor converges to a finite "
+                             f"{B}, but V neither rises above the escape energy {self._E_b!r} nor converges to a "
+                             "finite "
                              f"limit (|q| up to {float(x[-1])!r}): the side neither closes nor is open at infinity")
         return float(side * x[above[0]])
 
-    def _bottom_scales(self):
+    def _bottom_scales(self) -> Any:
         """Per side the extent of the well proper: the limit, where the tail of an open side begins, or
         on a side closed by a wall the distance to the wall (V' is analytic up to it)."""
         return tuple(abs(self.walls[side]) if side in self.walls else abs(lim) if t is None else t.x0
                      for side, lim, t in zip((-1.0, 1.0), self.limits, self._tails))
 
-    def _check_derivative(self):
+    def _check_derivative(self) -> None:
         lo, hi = (side * s for side, s in zip((-1.0, 1.0), self._bottom_scales()))
         q = np.linspace(lo, hi, 13)[1:-1]
         q = q[q != 0]
@@ -259,6 +275,6 @@ class WellShape:
             raise ValueError(f"dV does not match the derivative of V (max |dV - dV_fd| = {np.max(np.abs(fd - d))!r} "
                              f"relative to max |dV| = {scale!r})")
 
-    def _curvature(self, qb):
+    def _curvature(self, qb: Any) -> Any:
         h = 1e-5 * max(1.0, abs(qb))
         return float(-(_call(self._dV, np.array([qb + h]))[0] - _call(self._dV, np.array([qb - h]))[0]) / (2 * h))

@@ -6,8 +6,8 @@ classification ``escapes(q0, p0)`` of :func:`safebasins.theory.slow_flow_escapes
 experiment's grid; ``basin_rm`` adds the first integral ``C`` and ``escapes_rm`` on the
 resonance-manifold grid ``(gamma_rm, xi_rm)``; ``basin_chart`` stacks the basins over the
 scanned parameter (``xi_max`` or ``F``; with damping: the damped slow flow's
-classification and the outline of its safe mask, ``kind = "mask_outline"``).  ``basin_chart``'s numeric product is the escape chart
-gathered from its tiles with the analytic/numeric agreement stored in it; ``strobe``'s is the
+classification and the outline of its safe mask, ``kind = "mask_outline"``).  ``basin_chart``'s numeric product is the
+escape chart gathered from its tiles with the analytic/numeric agreement stored in it; ``strobe``'s is the
 classified period map (:func:`safebasins.analysis.period_map.period_map_portrait`).
 """
 from __future__ import annotations
@@ -101,7 +101,8 @@ def strobe_candidates(params):
     seeded random ones in ``box``; and their origin labels."""
     from safebasins.numerics import random_initial_conditions
 
-    qr, pr = random_initial_conditions(params["n_candidates"], params["seed"], box=tuple(tuple(b) for b in params["box"]))
+    qr, pr = random_initial_conditions(params["n_candidates"], params["seed"],
+                                       box=tuple(tuple(b) for b in params["box"]))
     line = params.get("line")
     if line:
         ql = np.linspace(line["q0"][0], line["q0"][1], line["n"])
@@ -184,8 +185,8 @@ class BasinRM(Kind):
 
     def check(self, block, key, ctx):
         ctx.check_grid(f"{key}.grid", block["grid"])
-        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key),
-                                              block.get("damping", 0.0))
+        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin",
+                                              ctx.well_at(key), block.get("damping", 0.0))
         if block["manifold"]["xi_top"] is not None and block["manifold"]["xi_top"] <= 0:
             ctx.fail(f"{key}.manifold.xi_top", "must be > 0")
 
@@ -238,8 +239,8 @@ class BasinChart(GridChartKind):
 
     def check(self, block, key, ctx):
         ctx.check_grid(f"{key}.grid", block["grid"])
-        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key),
-                                              block.get("damping", 0.0))
+        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin",
+                                              ctx.well_at(key), block.get("damping", 0.0))
         if isinstance(block["F"], list) and isinstance(block["xi_max"], list):
             ctx.fail(f"{key}.F", "only one of F and xi_max may be a list (the scanned parameter)")
         ctx.check_unique(f"{key}.F", block["F"])
@@ -316,8 +317,8 @@ class Strobe(Kind):
 
     def check(self, block, key, ctx):
         ctx.check_grid(f"{key}.grid", block["grid"])
-        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin", ctx.well_at(key),
-                                              block.get("damping", 0.0))
+        ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin",
+                                              ctx.well_at(key), block.get("damping", 0.0))
         if "box" in block:
             ctx.check_interval(f"{key}.box[0]", block["box"][0])
             ctx.check_interval(f"{key}.box[1]", block["box"][1])

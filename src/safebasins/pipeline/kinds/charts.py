@@ -148,7 +148,8 @@ class Chart(GridChartKind):
 
     def products(self, experiment, params):
         return [Product(dataset_path("numeric", f"chart_{experiment}"), "numeric", build_chart, tiles=True,
-                        title=params["title"], contract=chart_contract(), history=f"safebasins.numerics.escape_chart tiles gathered ({experiment})")]
+                        title=params["title"], contract=chart_contract(),
+                        history=f"safebasins.numerics.escape_chart tiles gathered ({experiment})")]
 
     def figure_inputs(self, experiment, params):
         return {"numeric": dataset_path("numeric", f"chart_{experiment}"), "params": params_path(experiment)}

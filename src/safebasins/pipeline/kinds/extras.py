@@ -1,9 +1,9 @@
 """Beyond-the-paper kinds (docs/extras.md): ``erosion`` (integrity versus F), ``true_basin``
 (phase-invariant safe basin) and ``fourier_compare`` (paper versus exact first harmonic).
 
-Their datasets are ``results/data/extras/<experiment>_<product>.nc``.  Their numerics reuse the chart tiles (one escape chart per F, per Psi); every threshold and
-evaluation time is read from the same integration.  ``fourier_compare`` integrates nothing:
-it re-reads the numeric datasets of other experiments.
+Their datasets are ``results/data/extras/<experiment>_<product>.nc``.  Their numerics reuse the chart tiles (one escape
+chart per F, per Psi); every threshold and evaluation time is read from the same integration.  ``fourier_compare``
+integrates nothing: it re-reads the numeric datasets of other experiments.
 """
 from __future__ import annotations
 
@@ -108,7 +108,8 @@ def build_fourier(params, data, job, *, what, source):
     if what == "fcr":
         ds = fc.fcr_fourier_comparison_from_numeric(src)
         if "curve" in ds.dims:  # per-curve parameters of the source (attributes would conflict across curves)
-            ds = ds.assign_coords({c: ("curve", src[c].values) for c in ("label", "xi_max", "xi_ini", "gamma_ini", "Psi")
+            names = ("label", "xi_max", "xi_ini", "gamma_ini", "Psi")
+            ds = ds.assign_coords({c: ("curve", src[c].values) for c in names
                                    if c in src.coords and src[c].dims == ("curve",)})
     else:
         ds = fc.iou_fourier_comparison(src, params["t_eval"])
@@ -213,7 +214,8 @@ class TrueBasin(GridChartKind):
         "description": description,
         "type": "object", "additionalProperties": False, "default": {},
         "properties": {
-            "F": WD.nullable({"$ref": "#/$defs/forcing"}, "0.026 of the well's static escape force (the quartic: 0.01)"),
+            "F": WD.nullable({"$ref": "#/$defs/forcing"}, "0.026 of the well's static escape force (the quartic: "
+                                                          "0.01)"),
             "Omega": WD.nullable({"$ref": "#/$defs/frequency"}, "0.9 of the well's linear frequency"),
             "xi_max": WD.nullable({"$ref": "#/$defs/threshold_list"}, "0.72 of the barrier energy"),
             "n_psi": {"type": "integer", "minimum": 1, "default": 16},

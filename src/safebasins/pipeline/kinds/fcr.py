@@ -176,7 +176,8 @@ class FcrCompare(Kind):
     def products(self, experiment, params):
         return [
             Product(dataset_path("analytic", f"fcr_{experiment}"), "analytic", build_fcr_analytic,
-                    title=params["title"], contract={**analytic_contract(params), "Psi": ("curve",)}, history=f"safebasins.theory.critical_forcing per curve ({experiment})"),
+                    title=params["title"], contract={**analytic_contract(params), "Psi": ("curve",)},
+                    history=f"safebasins.theory.critical_forcing per curve ({experiment})"),
             Product(dataset_path("numeric", f"fcr_{experiment}"), "numeric", build_fcr_numeric, heavy=True,
                     title=params["title"],
                     contract={**NUMERIC_CONTRACT, **({"damping": ("curve",)} if "damping" in params else {})},

@@ -146,8 +146,9 @@ class IntegrityMap(Kind):
                 "numeric": dataset_path("extras", f"{experiment}_numeric")}
 
     def default_figure_text(self, experiment, params):
-        caption = (f"Integrity over the control plane: GIM and LIM of the safe basin for xi_max = {params['xi_max']:g}, "
-                   f"Psi = {values.fmt(params['Psi'], angle=True)}, on a {len(params['Omega'])} x {len(params['F'])} grid of (Omega, F), "
+        caption = ("Integrity over the control plane: GIM and LIM of the safe basin for xi_max = "
+                   f"{params['xi_max']:g}, Psi = {values.fmt(params['Psi'], angle=True)}, on a "
+                   f"{len(params['Omega'])} x {len(params['F'])} grid of (Omega, F), "
                    f"{params['grid']['n'][0]} x {params['grid']['n'][1]} ICs per point, {params['cycles']} cycles.")
         look = ("Top: slow-flow (analytic) maps and, dashed, the all-phase basin's erosion front; middle: numeric maps "
                 "at the last evaluation time; bottom: numeric minus analytic. Lines: the erosion fronts (F at which "
