@@ -50,12 +50,14 @@ unlock: $(STAMP)
 test: $(STAMP)
 	$(BIN)/python -m pytest -n $(JOBS) --dist loadfile
 
-## Lint and types (pyproject's [tool.ruff] and [tool.mypy]; docs/contracts.md): ruff over src and
-## tests, mypy over src/safebasins (strict on wells, numerics, theory).
+## Lint, types and layers (pyproject's [tool.ruff], [tool.mypy], [tool.importlinter];
+## docs/contracts.md): ruff over src and tests, mypy over src/safebasins (strict on wells,
+## numerics, theory), the layer contract.
 .PHONY: lint
 lint: $(STAMP)
 	$(BIN)/ruff check src tests
 	$(BIN)/mypy
+	$(BIN)/lint-imports
 
 ## The whole DAG at coarse resolution (a few minutes).
 quick: $(STAMP)
