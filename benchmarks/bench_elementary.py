@@ -21,6 +21,7 @@ import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -58,7 +59,7 @@ def accuracy(names: list[str], n: int) -> None:
         print(f"{name:9s} {elementary.ULP_BOUNDS[name]:6.2f} {worst[0]:8.4f}  ({arg})  [{took:.0f} s]", flush=True)
 
 
-def _loops(f: Callable[..., float], two: bool) -> Callable[..., None]:
+def _loops(f: Callable[..., float], two: bool) -> Any:
     if two:
         @njit
         def run2(x: np.ndarray, y: np.ndarray, out: np.ndarray) -> None:
@@ -73,7 +74,7 @@ def _loops(f: Callable[..., float], two: bool) -> Callable[..., None]:
     return run1
 
 
-def _libm(name: str) -> Callable[..., float] | None:
+def _libm(name: str) -> Any:
     if name == "pow":
         return njit(lambda x, y: x ** y)
     g = getattr(math, name, None)

@@ -1,7 +1,8 @@
-"""Every named well and an electrostatic expression well: the CUDA backend under numba's simulator
-gives the CPU backend's escape steps bitwise (their forces call wells.elementary, compiled for
-each target from one source).  The GPU side runs in a subprocess with NUMBA_ENABLE_CUDASIM=1, the
-child of tests/numerics/test_cuda_simulator.py (cases as JSON on stdin)."""
+"""Every named well that is not a polynomial, and an electrostatic expression well: the CUDA
+backend under numba's simulator gives the CPU backend's escape steps bitwise (their forces call
+wells.elementary, compiled for each target from one source).  The GPU side runs in a subprocess
+with NUMBA_ENABLE_CUDASIM=1, the child of tests/numerics/test_cuda_simulator.py (cases as JSON
+on stdin)."""
 from __future__ import annotations
 
 import json
@@ -25,7 +26,8 @@ def _cases() -> dict[str, dict[str, object]]:
     """(well spec -> ensemble_problem arguments): a grid of ICs inside the well, two energy
     thresholds below the barrier (some ICs escape at once, some later, some never)."""
     cases: dict[str, dict[str, object]] = {}
-    for spec in [*(n for n in wells.NAMED_WELLS if n != "quartic"), MEMS]:
+    # the polynomial named wells (quartic, cubic) are cases of test_cuda_simulator.py
+    for spec in [*(n for n in wells.NAMED_WELLS if n not in ("quartic", "cubic")), MEMS]:
         w = wells.resolve_well(spec)
         Eb = w.barrier_energy
         lo, hi = w.barriers

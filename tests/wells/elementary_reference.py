@@ -147,7 +147,7 @@ def _map2(f: Callable[[float, float], float], x: np.ndarray, y: np.ndarray, out:
 
 
 @njit(cache=False)
-def _map_powi(f: Callable[[float, int], float], x: np.ndarray, n: np.ndarray, out: np.ndarray) -> None:
+def _map_powi(f: Callable[[float, np.int64], float], x: np.ndarray, n: np.ndarray, out: np.ndarray) -> None:
     for i in range(x.size):
         out[i] = f(x[i], np.int64(n[i]))
 
@@ -157,6 +157,7 @@ def cpu_values(name: str, x: np.ndarray, y: np.ndarray | None = None) -> np.ndar
     f = getattr(elementary.cpu(), name)
     out = np.empty(x.size)
     if name == "powi":
+        assert y is not None, "powi takes an exponent"
         _map_powi(f, x, y, out)
     elif y is not None:
         _map2(f, x, y, out)

@@ -13,6 +13,7 @@ import os
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -146,15 +147,15 @@ def _simulator_child() -> None:
         if "y" in c:
             y = np.array(c["y"]) if name == "pow" else np.array(c["y"]).astype(np.int64)
 
-            @cuda.jit
-            def k2(x: np.ndarray, y: np.ndarray, res: np.ndarray, f: object = f) -> None:
+            @cuda.jit  # type: ignore[untyped-decorator]  # numba's decorators are unannotated
+            def k2(x: np.ndarray, y: np.ndarray, res: np.ndarray, f: Any = f) -> None:
                 i = cuda.grid(1)  # type: ignore[attr-defined]  # numba.cuda's attributes are set at import
                 if i < x.size:
                     res[i] = f(x[i], y[i])
             k2[(x.size + 31) // 32, 32](x, y, res)
         else:
-            @cuda.jit
-            def k1(x: np.ndarray, res: np.ndarray, f: object = f) -> None:
+            @cuda.jit  # type: ignore[untyped-decorator]  # as k2
+            def k1(x: np.ndarray, res: np.ndarray, f: Any = f) -> None:
                 i = cuda.grid(1)  # type: ignore[attr-defined]  # numba.cuda's attributes are set at import
                 if i < x.size:
                     res[i] = f(x[i])
