@@ -130,7 +130,8 @@ DECLARATIONS = (
         title='Coexisting safe basins of both types (F = 0.0478, Omega = 0.76, xi_max = 0.235)',
         caption=('Co-existence of two types of SB with parameters F = 0.0478, Ω = 0.76. Thick '
                  'dashed line corresponds to truncation level ξ_max = 0.235.'),
-        look=_SB_LEFT_RIGHT + " " + ('Both a maximum-type and a saddle-type region exist, so the slow-flow safe basin on '
+        look=_SB_LEFT_RIGHT + " " + ('Both a maximum-type and a saddle-type region exist, so the slow-flow safe basin '
+                                     'on '
               '(q0, p0) is made of two disjoint parts; the numeric check judges each part on its own.')),
     Declaration(
         name="fig10", kind="fcr_compare", key=("figures", "fig10"), stem="fig10_fcr_numeric_zero_ic",
@@ -262,7 +263,8 @@ DECLARATIONS = (
               'final value. Whether the paper\'s shrinking over about 2000 EC is reproduced is said below.')),
     Declaration(
         name="extra_erosion", kind="erosion", key=("extras", "erosion"), stem="extra_erosion",
-        label='Erosion profiles: integrity measures versus forcing amplitude', category="Beyond the paper", options={'measures': ['GIM', 'LIM', 'IF'], 'xi_max': None, 't_eval': None},
+        label='Erosion profiles: integrity measures versus forcing amplitude', category="Beyond the paper",
+        options={'measures': ['GIM', 'LIM', 'IF'], 'xi_max': None, 't_eval': None},
         title=('Erosion profiles: GIM, LIM and IF versus F, analytic (paper and exact G) and '
                'numeric'),
         caption=('Global (GIM), local (LIM) and integrity-factor (IF) measures of the safe basin '
@@ -276,7 +278,8 @@ DECLARATIONS = (
               'level whose first crossing F_GIM, F_LIM, F_IF is stored in both datasets.')),
     Declaration(
         name="extra_true_basin", kind="true_basin", key=("extras", "true_basin"), stem="extra_true_basin",
-        label='Phase-invariant (true) safe basin', category="Beyond the paper", options={'xi_max': None, 't_eval': None, 'fourier': 'paper'},
+        label='Phase-invariant (true) safe basin', category="Beyond the paper",
+        options={'xi_max': None, 't_eval': None, 'fourier': 'paper'},
         title='Phase-invariant (true) safe basin: intersection over the forcing phase Psi',
         caption=('Initial conditions that are safe whatever the forcing phase Ψ: intersection of '
                  'the safe basins over equispaced phases, slow flow (left) and numerics (right), F '
@@ -430,7 +433,8 @@ DECLARATIONS += (
         title="Damped escape equation: integrity, boundary fractality and basins across the Melnikov tangency",
         caption=("Thompson's escape equation with damping, q'' + β q' + q - q² = F sin(Ωt + Ψ) (β, Ω, Ψ in the "
                  "title), the classic benchmark of basin erosion: the safe basin (energy criterion, H0 above the "
-                 "hilltop's energy) of the long-time response versus the forcing amplitude F. The Melnikov threshold F_M (first order in "
+                 "hilltop's energy) of the long-time response versus the forcing amplitude F. The Melnikov threshold "
+                 "F_M (first order in "
                  "F and β, docs/melnikov.md) is where the hilltop saddle's stable and unstable manifolds first "
                  "touch; past it the basin boundary becomes fractal and the basin erodes."),
         look=("(a) GIM, LIM and IF versus F (faint: the early evaluation time, solid: the long-time basin) with "
@@ -444,7 +448,8 @@ DECLARATIONS += (
         options={'layout': 'overlay', 'bracket': True, 'F_max': None},
         title="Paper's quartic with small damping: analytic versus numeric F_cr(Omega) for several beta",
         caption=("The paper's benchmark with linear damping, q'' + β q' + q - q³ = F sin(Ωt + Ψ), one initial "
-                 "condition and truncation level (in the title), one curve per small damping coefficient β. Theory: F_cr is the smallest F for which the damped slow flow "
+                 "condition and truncation level (in the title), one curve per small damping coefficient β. Theory: "
+                 "F_cr is the smallest F for which the damped slow flow "
                  "J' = -∂C/∂γ - βJ, γ' = ∂C/∂J (docs/damping.md) carries the zero IC to ξ_max before it settles "
                  "on an attractor."),
         look=("Lines: damped slow-flow theory, one colour per β; markers: numeric bisection of the damped "
