@@ -14,16 +14,19 @@ interrupt Ctrl-C (SIGINT) exits 130, never 0 (the group class of ``main``)
 check_config  the ``check-config`` command: a pipeline configuration checked as snakemake would
 reproduction  the ``verify-reproduction`` command: a new run checked against a results archive
 basin_measures  the ``basin-measures`` command: fractal boundary measures of a damped well's basins
+saddle    the ``hilltop-saddle`` command: the hilltop saddle's manifolds over escape charts, their tangency
 """
 from safebasins.cli.commands import main
 from safebasins.cli.explore import explore
 from safebasins.cli.check_config import check_config
 from safebasins.cli.reproduction import verify_reproduction
 from safebasins.cli.basin_measures import basin_measures
+from safebasins.cli.saddle import hilltop_saddle
 
 main.add_command(explore)
 main.add_command(check_config)
 main.add_command(verify_reproduction)
 main.add_command(basin_measures)
+main.add_command(hilltop_saddle)
 
 __all__ = ["main"]
