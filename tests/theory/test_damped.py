@@ -13,7 +13,6 @@ Measured (quartic unless named; the bounds below leave a margin):
   undamped errors there are -1.9 %, -1.0 %, +12 %, +13 %;
 * beta = 1e-4: F_cr within 0.35 % of the undamped F_cr; safe-mask IoU 0.993 with the undamped one.
 """
-import warnings
 
 import numpy as np
 import pytest

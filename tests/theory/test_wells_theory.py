@@ -86,7 +86,8 @@ def test_fcr_theory_against_numerics_near_resonance(well):
     xm = 0.6 * well.barrier_energy
     Om = np.array([0.8, 0.86, 0.9, 1.02, 1.1])
     a = critical_forcing(Om, xm, well=well)["F_cr"].values
-    n = critical_forcing_numeric(Om, xm, cycles=1000, tol=1e-4, F_bracket=(0.0, 0.2), n_scan=41, well=well)["F_cr"].values
+    n = critical_forcing_numeric(Om, xm, cycles=1000, tol=1e-4, F_bracket=(0.0, 0.2), n_scan=41,
+                                 well=well)["F_cr"].values
     rel = np.abs(a - n) / n
     assert np.all(rel[:3] < FCR_BOUND_BELOW) and np.all(rel[3:] < FCR_BOUND_ABOVE), (well.name, rel)
 

@@ -33,11 +33,13 @@ SCHEMA_PATH = Path(__file__).resolve().parent / "schemas" / "config.schema.yaml"
 REPO_ROOT = Path(__file__).resolve().parents[3]
 #: the kind modules of the package (importing them registers the kinds)
 KIND_MODULES = ("safebasins.pipeline.kinds.fcr", "safebasins.pipeline.kinds.basins",
-                "safebasins.pipeline.kinds.charts", "safebasins.pipeline.kinds.extras", "safebasins.pipeline.kinds.maps",
-                "safebasins.pipeline.kinds.damped", "safebasins.pipeline.kinds.basin_measures",
+                "safebasins.pipeline.kinds.charts", "safebasins.pipeline.kinds.extras",
+                "safebasins.pipeline.kinds.maps", "safebasins.pipeline.kinds.damped",
+                "safebasins.pipeline.kinds.basin_measures",
                 "safebasins.pipeline.kinds.saddle")
 
-__all__ = ["ConfigError", "load_yaml", "merge_config", "build_schema", "validate_config", "experiment_blocks", "SCHEMA_PATH"]
+__all__ = ["ConfigError", "load_yaml", "merge_config", "build_schema", "validate_config", "experiment_blocks",
+           "SCHEMA_PATH"]
 
 
 def load_yaml(path):
@@ -117,7 +119,8 @@ def well_schema() -> dict:
                         f"({names}), {{polynomial: [c0, c1, c2, ...]}} for V = sum c_k q^k (c0 = c1 = 0, c2 > 0), or "
                         "{expression: '<formula in q>'} (sympy; e.g. '1 - cos(q)'); V(0) = V'(0) = 0, V''(0) > 0, "
                         "escape over a barrier or to an asymptote on at least one side. A polynomial or expression "
-                        f"may add tol: the relative accuracy of its action-angle interpolants (default {DEFAULT_TOL:g}), "
+                        "may add tol: the relative accuracy of its action-angle interpolants (default "
+                        f"{DEFAULT_TOL:g}), "
                         "for a formula whose own rounding does not reach it"),
         "oneOf": [{"enum": list(NAMED_WELLS)},
                   {"type": "object", "additionalProperties": False, "required": ["polynomial"],

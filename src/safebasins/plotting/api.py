@@ -12,6 +12,8 @@ with :func:`safebasins.plotting.style.save_figure` to keep the datasets' provena
 from __future__ import annotations
 
 import matplotlib.pyplot as plt
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
 import numpy as np
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
@@ -20,7 +22,7 @@ from matplotlib.legend_handler import HandlerTuple
 from safebasins.plotting import data
 from safebasins.plotting.charts import CRITERIA, agreement_time, chart_scan, draw_nested_chart, draw_nested_safe
 from safebasins.plotting.curves import IC_LINE, boundary_polylines, draw_well, plot_curve
-from safebasins.plotting.data import MissingData, open_dataset, param, source, var
+from safebasins.plotting.data import DataSource, MissingData, open_dataset, param, source, var
 from safebasins.plotting.integrity_maps import plot_integrity_map
 from safebasins.plotting.style import (LABELS, SB_EDGE, SB_FACE, SYMBOLS, add_footnote, fmt_value, new_axes,
                                        param_text)
@@ -39,7 +41,8 @@ def _attrs_text(ds, names):
     return param_text({k: ds.attrs[k] for k in names if k in ds.attrs})
 
 
-def plot_escape_chart(chart, *, t_eval=None, xi_max=None, basin=None, ax=None):
+def plot_escape_chart(chart: DataSource, *, t_eval: float | None = None, xi_max: float | None = None,
+                      basin: DataSource | None = None, ax: Axes | None = None) -> Figure:
     """Draw the numeric safe basins of an escape chart, optionally with analytic boundaries.
 
     Parameters
@@ -136,7 +139,7 @@ def _draw_basin_slice(ax, b, *, color=SB_EDGE, ls="-"):
     return lines
 
 
-def plot_basin(basin, *, ax=None):
+def plot_basin(basin: DataSource, *, ax: Axes | None = None) -> Figure:
     """Draw the analytic (slow-flow) safe basin on the plane of initial conditions.
 
     Parameters
@@ -225,7 +228,8 @@ def _curves(ds):
     return [ds.isel(curve=i) for i in range(ds.sizes["curve"])] if "curve" in ds.dims else [ds]
 
 
-def plot_fcr(analytic=None, numeric=None, *, ax=None):
+def plot_fcr(analytic: DataSource | None = None, numeric: DataSource | None = None, *,
+             ax: Axes | None = None) -> Figure:
     """Draw the critical forcing F_cr(Omega): theory as lines, numerics as markers.
 
     Parameters

@@ -9,6 +9,7 @@ figure: what the public plotting functions document).
 from __future__ import annotations
 
 import os
+from typing import TypeAlias
 
 import numpy as np
 import xarray as xr
@@ -16,6 +17,9 @@ import yaml
 
 from safebasins.io.netcdf import read
 from safebasins.wells import NAMED_WELLS, from_attrs
+
+#: what the figure functions read: a dataset, or the path of its netCDF file
+DataSource: TypeAlias = "xr.Dataset | str | os.PathLike[str]"
 
 
 def open_dataset(src):

@@ -4,12 +4,14 @@ the erosion fronts (datasets of the ``integrity_map`` kind and of
 from __future__ import annotations
 
 import matplotlib.pyplot as plt
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
 import numpy as np
 from matplotlib.lines import Line2D
 
 from safebasins.plotting import data
 from safebasins.plotting.captions import add_note, count
-from safebasins.plotting.data import open_dataset, param, var
+from safebasins.plotting.data import DataSource, open_dataset, param, var
 from safebasins.plotting.style import LABELS, fmt_value, new_axes, param_text, plain_text
 
 MEASURES = ("GIM", "LIM")
@@ -131,7 +133,7 @@ def _map_notes(fig, an, nu, nu_t, t, level, shown):
         add_note(fig, txt + ".")
 
 
-def plot_integrity_map(ds, *, measure="GIM", ax=None):
+def plot_integrity_map(ds: DataSource, *, measure: str = "GIM", ax: Axes | None = None) -> Figure:
     """Draw one integrity measure over the control plane (Omega, F).
 
     Parameters

@@ -3,9 +3,11 @@ from __future__ import annotations
 
 import os
 from contextlib import contextmanager
+from typing import Any
 import textwrap
 
 import matplotlib.pyplot as plt
+from matplotlib.figure import Figure
 import numpy as np
 
 from safebasins.plotting.data import provenance, well_texts
@@ -88,7 +90,8 @@ def new_axes(ax, figsize):
     return ax.figure, ax
 
 
-def save_figure(fig, png=None, pdf=None, *, dpi=DEFAULT_DPI, datasets=(), heading=None):
+def save_figure(fig: Figure, png: str | os.PathLike[str] | None = None, pdf: str | os.PathLike[str] | None = None, *,
+                dpi: float = DEFAULT_DPI, datasets: Any = (), heading: str | None = None) -> Figure:
     """Write ``fig`` to PNG (``dpi``) and/or PDF, creating parent folders.
 
     The provenance of the datasets drawn (``datasets``: paths or Datasets, and those the

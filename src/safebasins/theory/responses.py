@@ -350,7 +350,8 @@ def steady_responses(Omega: ArrayLike, F: float, damping: float, well: WellArg =
     xm = top if xi_max is None else min(check_scalar("xi_max", xi_max, w.check_threshold), top)
     fp = fixed_points(np.full(Om.size, F), Om, beta, w, xm, n_grid=n_grid)
     order = np.argsort(np.where(fp.converged, fp.xi, np.inf), axis=1, kind="stable")
-    take: Callable[[NDArray[Any]], NDArray[Any]] = lambda a: np.take_along_axis(a, order[..., None] if a.ndim == 3 else order, axis=1)
+    take: Callable[[NDArray[Any]], NDArray[Any]] = (
+        lambda a: np.take_along_axis(a, order[..., None] if a.ndim == 3 else order, axis=1))
     kind = take(fp.kind)
     eig = take(fp.eig)
 
@@ -385,7 +386,8 @@ def steady_responses(Omega: ArrayLike, F: float, damping: float, well: WellArg =
         {
             "xi": (("Omega", "response"), take(fp.xi), {**one, "long_name": "averaged energy of the steady response"}),
             "gamma": (("Omega", "response"), take(fp.gamma),
-                      {"units": "rad", "long_name": "slow phase gamma = theta - Psi - Omega tau of the steady response"}),
+                      {"units": "rad", "long_name": "slow phase gamma = theta - Psi - Omega tau of the steady "
+                                                    "response"}),
             "J": (("Omega", "response"), take(fp.J), {**one, "long_name": "averaged action of the steady response"}),
             "kind": (("Omega", "response"), kind, {"long_name": "fixed point of the damped slow flow",
                                                    "flag_values": np.arange(len(KINDS), dtype=np.int8),
