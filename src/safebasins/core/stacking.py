@@ -36,7 +36,7 @@ def pad_dim(ds: xr.Dataset, dim: str, n: int) -> xr.Dataset:
     if dim in ds.indexes:
         ds = ds.drop_vars(dim)
     out = ds.copy()
-    new_vars = {}
+    new_vars: dict[Any, xr.Variable] = {}
     for name, var in ds.variables.items():
         if dim not in var.dims:
             continue

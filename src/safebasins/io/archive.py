@@ -115,7 +115,7 @@ def _config_values(config: Mapping) -> dict[str, object]:
     """The configuration's scalar settings (top level, and plain tables of scalars such as
     `numerics`) as 'a.b' -> value; the per-figure blocks are described by the parameter files."""
     scalar = (str, int, float, bool)
-    out = {}
+    out: dict[str, object] = {}
     for key, value in config.items():
         if isinstance(value, scalar):
             out[str(key)] = value
@@ -145,6 +145,7 @@ class _Builder:
 
     def file(self, source: Any, dest: str, *, name: str, description: str, encoding: Any, **props: Any) -> Any:
         """A File data entity; `source` is a path, or the file's content (str/bytes)."""
+        src: io.BytesIO | str
         if isinstance(source, (bytes, str)):
             data = source.encode() if isinstance(source, str) else source
             size, digest, src = len(data), hashlib.sha256(data).hexdigest(), io.BytesIO(data)
@@ -206,7 +207,8 @@ def _paper(b: _Builder, cff: Mapping) -> Any:
     ref = cff.get("preferred-citation") or {}
     if not ref.get("title") or not ref.get("authors"):
         raise ValueError("CITATION.cff has no preferred-citation with title and authors")
-    authors, orgs = [], {}
+    authors: list[Any] = []
+    orgs: dict[str, Any] = {}
     for i, a in enumerate(ref["authors"]):
         given, family = a.get("given-names"), a.get("family-names")
         props = {"name": " ".join(x for x in (given, family) if x) or a["name"]}

@@ -55,7 +55,7 @@ def _attr_value(v: Any) -> Any:
 
 
 def _collect_seeds(params: Any) -> Any:
-    seeds = []
+    seeds: list[Any] = []
     if isinstance(params, dict):
         for k, v in params.items():
             if k in ("seed", "seeds"):

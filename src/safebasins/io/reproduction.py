@@ -50,7 +50,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import IO, Any, cast
 
 import numpy as np
 import xarray as xr
@@ -493,7 +493,7 @@ def reference_tree(path: Any, argument: str = "REFERENCE") -> Iterator[tuple[Pat
             if ".." in Path(m.name).parts:
                 raise ReproductionInputError(f"{argument} {os.fspath(path)}: member {m.name!r} leaves the archive")
             target.parent.mkdir(parents=True, exist_ok=True)
-            with tar.extractfile(m) as src, open(target, "wb") as dst:
+            with cast(IO[bytes], tar.extractfile(m)) as src, open(target, "wb") as dst:
                 dst.write(src.read())
         yield root, check_archive(path)
 

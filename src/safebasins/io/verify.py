@@ -23,7 +23,7 @@ import os
 import sys
 import tarfile
 from pathlib import Path
-from typing import Any
+from typing import IO, Any, cast
 
 from safebasins.io.archive import MANIFEST, METADATA
 
@@ -68,10 +68,10 @@ def _files(path: Path) -> tuple[dict[str, tuple[str, int]], dict[str, bytes], li
             if not m.isfile():
                 problems.append(f"{name}: not a regular file")
                 continue
-            fh = tar.extractfile(m)
-            files[name] = _digest(fh)
+            member = cast(IO[bytes], tar.extractfile(m))      # (a regular file: never None)
+            files[name] = _digest(member)
             if name in (MANIFEST, METADATA):
-                texts[name] = tar.extractfile(m).read()
+                texts[name] = cast(IO[bytes], tar.extractfile(m)).read()
     return files, texts, problems
 
 
