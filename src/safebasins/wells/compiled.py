@@ -60,7 +60,8 @@ from numba.extending import intrinsic, overload
 
 __all__ = ["WellCode", "fma", "mul", "fma_cpu", "mul_cpu", "N_WPAR", "quartic_code", "polynomial_code", "callable_code",
            "target_code",
-           "well_force", "well_energy2", "abs_tracking", "code_of", "literal_code", "cpu_jit", "cpu_functions",
+           "well_force", "well_energy2", "abs_tracking", "code_of", "literal_code", "cpu_jit", "cpu_leaf_jit",
+           "cpu_functions",
            "POLY_DEGREES"]
 
 #: a target's decorator (njit-like, cuda.jit(device=True)): a plain function -> its compiled form
@@ -292,7 +293,8 @@ def target_code(functions: Callable[[Jit], tuple[Callable[[float], float], Calla
     compiled kernels."""
     def make(jit: Jit) -> tuple[Any, Any]:
         V, dV = functions(jit)
-        force, energy2 = _template(jit(V), jit(dV))
+        leaf = cpu_leaf_jit if jit is cpu_jit else jit
+        force, energy2 = _template(leaf(V), leaf(dV))
         return jit(force), jit(energy2)
 
     return WellCode(name, make, _wpar(barriers), False, f"{_TEMPLATE_SOURCE}\0{source}")
@@ -333,11 +335,24 @@ def cpu_jit(fn: Callable[..., Any]) -> Any:
     module's) bound to the CPU primitives: the same operations, typed once per signature; through
     the generic functions' inline overloads numba reruns its front end at every call site and
     type-inference round (~2.5 ms each, ~2 s of a kernel's first compile)."""
+    return njit(inline="always")(_cpu_globals(fn))
+
+
+def cpu_leaf_jit(fn: Callable[..., Any]) -> Any:
+    """A well's ``V`` or ``dV`` for the CPU lanes: compiled on its own with numpy's error model (a
+    division never raises, x/0 is inf as on the GPU: a raising division would give the lane loop
+    an exit and keep it scalar) and inlined by LLVM; globals bound as by :func:`cpu_jit`."""
+    return njit(error_model="numpy", forceinline=True)(_cpu_globals(fn))
+
+
+def _cpu_globals(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """``fn`` with its globals ``fma`` and ``mul`` (when they are this module's) bound to the CPU
+    primitives."""
     g = fn.__globals__
     cpu = {k: c for k, (generic, c) in _CPU_PRIMITIVES.items() if g.get(k) is generic}
     if cpu:
         fn = types_module.FunctionType(fn.__code__, {**g, **cpu}, fn.__name__, fn.__defaults__, fn.__closure__)
-    return njit(inline="always")(fn)
+    return fn
 
 
 @functools.cache
