@@ -13,7 +13,8 @@ from numpy.typing import ArrayLike
 from safebasins.core.checks import check_finite
 from safebasins.theory.types import FloatArray, WellArg
 from safebasins.wells import resolve_well
-from safebasins.wells.quartic import QUARTIC, _nome, check_fourier
+from safebasins.wells.quartic import QUARTIC, check_fourier
+from safebasins.wells.quartic import nome as quartic_nome
 
 __all__ = ["H0", "q_max_from_xi", "J", "omega", "G", "dJ_dxi", "dG_dxi", "nome",
            "angle_energy", "phase_point", "initial_condition", "check_fourier"]
@@ -87,7 +88,7 @@ def dG_dxi(xi: ArrayLike, fourier: str = "paper") -> FloatArray:
 
 def nome(xi: ArrayLike) -> FloatArray:
     """Jacobi nome ``exp(-pi K'/K)`` of the free orbit with energy xi (0 at xi = 0, 1 at 1/4)."""
-    out: FloatArray = _nome(QUARTIC.check_energy("xi", xi, allow_separatrix=True))
+    out: FloatArray = quartic_nome(QUARTIC.check_energy("xi", xi, allow_separatrix=True))
     return out
 
 

@@ -136,6 +136,11 @@ class Well(abc.ABC):
         """``(q_minus(E), q_plus(E))``: the orbit's turning points, ``q_minus <= 0 <= q_plus``,
         for ``0 <= E <= barrier_energy``."""
 
+    @abc.abstractmethod
+    def check_energy(self, name: str, E: npt.ArrayLike, *, allow_separatrix: bool = False) -> Any:
+        """``E`` as a float array after checking it is an energy of the well's orbits, ``0 <= E <
+        barrier_energy`` (``<=`` with ``allow_separatrix``); a ValueError naming ``name`` otherwise."""
+
     # ------------------------------------------------------------------ action-angle
     @abc.abstractmethod
     def J(self, E: npt.ArrayLike) -> Any:

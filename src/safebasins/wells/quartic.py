@@ -36,7 +36,7 @@ from safebasins.core.checks import as_array, check_finite, value_repr
 from safebasins.wells.base import Well
 from safebasins.wells.compiled import WellCode, quartic_code
 
-__all__ = ["QuarticWell", "QUARTIC", "XI_SEPARATRIX", "FOURIER_VARIANTS", "check_fourier"]
+__all__ = ["QuarticWell", "QUARTIC", "XI_SEPARATRIX", "FOURIER_VARIANTS", "check_fourier", "nome"]
 
 #: energy of the hilltops q = +-1 of V(q) = q^2/2 - q^4/4
 XI_SEPARATRIX = 0.25
@@ -144,7 +144,9 @@ def _dG_dxi(xi: Any, fourier: str = "paper", e: Any = None) -> Any:
         return g * dlog
 
 
-def _nome(xi: Any) -> Any:
+def nome(xi: Any) -> Any:
+    """The elliptic nome ``q = exp(-pi K'(m) / K(m))`` of the quartic's orbit of energy ``xi``
+    (1 at the separatrix, where K diverges): its powers set the Fourier coefficients of the orbit."""
     e = _ell(xi)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(np.isfinite(e["K"]), np.exp(-np.pi * e["Kp"] / e["K"]), 1.0)
