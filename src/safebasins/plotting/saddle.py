@@ -77,8 +77,9 @@ def _notes(fig: Figure, ds: xr.Dataset, F_M: float) -> None:
     nq, np_ = ds.sizes["q0"], ds.sizes["p0"]
     text = f"Melnikov threshold F_M = {F_M:.5f}"
     if np.isfinite(F_T):
-        text += (f"; the manifolds grown on the stroboscopic map first touch at F = {F_T:.5f} ({F_T / F_M:.3f} F_M)"
-                 + (f", the root of the section energy gap is {F_S:.5f} ({F_S / F_M:.3f} F_M)" if np.isfinite(F_S)
+        text += (f"; the manifolds grown on the stroboscopic map first touch at F = {F_T:.7f} (F / F_M - 1 = "
+                 f"{F_T / F_M - 1:.2g})"
+                 + (f", the root of the section energy gap is {F_S:.7f} ({F_S / F_M - 1:.2g})" if np.isfinite(F_S)
                     else ""))
     else:
         text += " (the numeric tangency was not computed)"
