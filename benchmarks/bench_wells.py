@@ -22,12 +22,15 @@ form (before and after; its signed variant: the same arithmetic with signed maxi
 asymmetric displacement bounds), the polynomial codes (the cubic V = q^2/2 - q^3/3 and the
 quartic written as coefficients [0, 0, 0.5, 0, -0.25] in the degree-4 class; the cubic in the
 degree-8 class, i.e. a degree 5-8 well) and the generic V, dV code of an expression well (the
-cubic as an expression, and the pendulum 1 - cos q: transcendental, the lane loop stays scalar).
+cubic as an expression; the pendulum 1 - cos q, sech^2 tanh(q)^2, Morse (1 - exp(-q))^2, whose
+forces call wells.elementary in the vectorised lanes, and the electrostatic q^2/2 - a/(1 - q) + a
++ a q, a = 0.05).  Ratios to the quartic: from the best times, and the median of the ratios paired
+within each interleaved round (robust to a loaded machine).
 
 Measured (docs/numerics.md, "Wells"), AMD EPYC (AVX-512), 1 thread, SRKN6b, with one compiled form per well:
 quartic after / before 1.020 dense, 0.957 chart (escape steps equal); time per step vs the quartic:
 signed 1.12, cubic (degree 4) 1.29, quartic coefficients 1.29, degree-8 class 3.07, cubic as an
-expression 1.19, pendulum (sin, cos: scalar lanes) 68.
+expression 1.19, pendulum (sin, cos: scalar lanes) 68.  With wells.elementary: docs/elementary.md.
 """
 from __future__ import annotations
 
@@ -40,7 +43,13 @@ import tempfile
 import time
 from pathlib import Path
 
+import numba
 import numpy as np
+
+from safebasins import wells
+from safebasins.numerics import engine, kernels, schemes
+from safebasins.numerics.scheme_code import scheme_code
+from safebasins.wells import compiled
 
 ROOT = Path(__file__).resolve().parents[1]
 QUARTIC_COEFS = [0.0, 0.0, 0.5, 0.0, -0.25]
@@ -112,7 +121,7 @@ def H_quartic(q, p):
     return 0.5 * p * p + 0.5 * q * q - 0.25 * q ** 4
 
 
-def H_cubic(q, p):  # noqa: D103
+def H_cubic(q, p):
     return 0.5 * p * p + 0.5 * q * q - q ** 3 / 3.0
 
 
@@ -120,8 +129,6 @@ class Job:
     """One kernels.ensemble call with fixed arrays; run() returns the escape steps."""
 
     def __init__(self, name, mod, Q, P, F, Omega, Psi, xi_max, cycles, S, integrator, threads, code=None):
-        from safebasins.numerics import engine, kernels, schemes
-        from safebasins.numerics.scheme_code import scheme_code
         self.name, self.mod, self.cycles, self.S = name, mod, cycles, S
         self.Q, self.P = Q, P
         N = Q.size
@@ -147,7 +154,9 @@ class Job:
         return float(np.where(e < 0, self.cycles * self.S, e).sum())
 
 
-def bench(jobs, repeat):
+def bench(jobs, repeat, rounds=None):
+    """(best wall time, its CPU time) per job over ``repeat`` interleaved rounds; ``rounds``, when
+    given, collects every round's wall time per job (paired ratios: median over rounds)."""
     for j in jobs:                      # compile / cache load outside the timings
         j.run()
     best = {j.name: np.inf for j in jobs}
@@ -157,9 +166,28 @@ def bench(jobs, repeat):
             t, c = time.perf_counter(), time.process_time()
             j.run()
             w = time.perf_counter() - t
+            if rounds is not None:
+                rounds.setdefault(j.name, []).append(w)
             if w < best[j.name]:
                 best[j.name], cpu[j.name] = w, time.process_time() - c
     return best, cpu
+
+
+#: the non-polynomial wells of the per-step comparison (name -> well spec): their forces call
+#: wells.elementary (vectorised lanes); the electrostatic (MEMS) well is arithmetic with a pole
+TRANSCENDENTAL = {"pendulum": "pendulum", "sech2": "sech2", "morse": "morse",
+                  "electrostatic": {"expression": "q**2/2 - 0.05/(1 - q) + 0.05 + 0.05*q"}}
+
+
+def well_ics(well, n, seed):
+    """n ICs with H0 below half the barrier energy, between the well's barriers."""
+    lo, hi = well.barriers
+    Eb = well.barrier_energy
+
+    def H(q, p):
+        with np.errstate(all="ignore"):
+            return np.where((q > lo) & (q < hi), 0.5 * p * p + well.V(q), np.inf)
+    return disc_ics(n, H, 0.5 * Eb, seed=seed)
 
 
 def main(argv=None):
@@ -175,11 +203,7 @@ def main(argv=None):
     ap.add_argument("--steps-per-cycle", type=int, default=32)
     args = ap.parse_args(argv)
 
-    import numba
     numba.set_num_threads(args.threads)
-    from safebasins import wells
-    from safebasins.numerics import kernels
-    from safebasins.wells import compiled
     print("machine:", machine())
     print(f"numba {numba.__version__}, threads {args.threads}, steps_per_cycle {args.steps_per_cycle}, "
           f"best of {args.repeat} interleaved runs, kernel only (kernels.ensemble)")
@@ -198,8 +222,8 @@ def main(argv=None):
     cubic = wells.cubic().compiled
     cubic8 = compiled.polynomial_code(CUBIC_COEFS, (-np.inf, 1.0), "cubic", degree_class=8)
     cubic_expr = wells.expression("q**2/2 - q**3/3").compiled
-    pendulum = wells.resolve_well("pendulum")
-    qp, pp = disc_ics(args.dense_n, lambda q, p: 0.5 * p * p + pendulum.V(q), 1.0, seed=2)
+    others = {k: wells.resolve_well(v) for k, v in TRANSCENDENTAL.items()}
+    other_ics = {k: well_ics(w, args.dense_n, seed=2 + i) for i, (k, w) in enumerate(others.items())}
     for integ in args.integrators:
         dense = dict(F=0.0, Omega=1.0, Psi=0.0, xi_max=0.25, cycles=args.dense_cycles, S=S, integrator=integ,
                      threads=args.threads)
@@ -213,13 +237,15 @@ def main(argv=None):
             Job("cubic dense, degree-4 class", kernels, cd_q, cd_p, **dense_c, code=cubic),
             Job("cubic dense, degree-8 class", kernels, cd_q, cd_p, **dense_c, code=cubic8),
             Job("cubic dense, expression", kernels, cd_q, cd_p, **dense_c, code=cubic_expr),
-            Job("pendulum dense, expression", kernels, qp, pp, **dict(dense, xi_max=2.0), code=pendulum.compiled),
+            *(Job(f"{k} dense, expression", kernels, *other_ics[k], **dict(dense, xi_max=w.barrier_energy),
+                  code=w.compiled) for k, w in others.items()),
             Job("quartic chart, before", before, qc, pc, **cq_, **chart),
             Job("quartic chart, after", kernels, qc, pc, **cq_, **chart, code=quartic),
             Job("cubic chart, degree-4 class", kernels, cq, cp, **cc_, **chart, code=cubic),
         ]
         t = time.perf_counter()
-        best, cpu = bench(jobs, args.repeat)
+        rounds = {}
+        best, cpu = bench(jobs, args.repeat, rounds)
         print(f"\n=== {integ} (compile or cache load + runs: {time.perf_counter() - t:.0f} s) ===")
         by = {j.name: j for j in jobs}
         for a, b in (("quartic dense, before", "quartic dense, after"),
@@ -240,9 +266,12 @@ def main(argv=None):
             b, a = by[f"quartic {kind}, before"], by[f"quartic {kind}, after"]
             print(f"quartic {kind}: after / before = {best[b.name] / best[a.name]:.3f} (steps/s ratio; 1 = same speed)")
         for name in ("cubic dense, degree-4 class", "quartic dense, coefficients", "cubic dense, degree-8 class",
-                     "quartic dense, signed", "cubic dense, expression", "pendulum dense, expression"):
+                     "quartic dense, signed", "cubic dense, expression", *(f"{k} dense, expression" for k in others)):
             j = by[name]
-            print(f"{name}: time per step / quartic's = {ref_rate / (j.steps() / best[name]):.3f}")
+            paired = np.array(rounds[name]) / j.steps() / (np.array(rounds[ref.name]) / ref.steps())
+            print(f"{name}: time per step / quartic's = {ref_rate / (j.steps() / best[name]):.3f} (best times), "
+                  f"{np.median(paired):.3f} (median of {paired.size} paired rounds, "
+                  f"{paired.min():.3f}-{paired.max():.3f})")
     print("\nmachine after:", machine())
 
 
