@@ -31,9 +31,10 @@ Primitives (one name each, an implementation per target):
   (expression wells) writes every product with it, so CPU and GPU round the same operations.
 
 Bitwise CPU = GPU holds for arithmetic wells (quartic, polynomials, rational expressions: IEEE
-+, -, *, /, sqrt and fma are correctly rounded on both).  Transcendental functions (sin, exp,
-...) come from each target's math library (glibc on the CPU, libdevice on the GPU), which may
-differ in the last bit.
++, -, *, /, sqrt and fma are correctly rounded on both) and for the functions of
+wells.elementary (sin, exp, tanh, ...: written once over fma and mul, compiled per target by
+:func:`target_code`'s ``functions(jit)``); a libm function (glibc on the CPU, libdevice on the
+GPU) may differ in the last bit.
 
 Adding a compiled well family with run-time parameters is one :class:`WellCode` builder here
 (see docs/adding-a-well.md); a well written as an expression needs none (wells.expression).

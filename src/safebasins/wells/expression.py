@@ -5,12 +5,15 @@ The text is parsed by sympy; ``V'`` is its symbolic derivative.  One generated P
 
 * the theory (action-angle variables by quadrature, :class:`~safebasins.wells.numeric.NumericWell`)
   runs it vectorised on numpy arrays;
-* the compiled engines run it through the well's compiled form (wells.compiled.callable_code),
+* the compiled engines run it through the well's compiled form (wells.compiled.target_code),
   compiled by numba for the CPU and by numba-cuda for the GPU; every product is written with
-  ``mul`` (never contracted into an fma by the GPU compiler).
+  ``mul`` (never contracted into an fma by the GPU compiler) and the functions are those of
+  wells.elementary compiled for the target (the same bits on both; ``atan`` and ``asinh``: the
+  target's libm).
 
-The generated source is what a user would write by hand (``1.0 - math.cos(q)``, ``math.sin(q)``):
-the same well given as a :class:`NumericWell` with the same arithmetic integrates bitwise alike.
+The generated source is what a user would write by hand (``1.0 - cos(q)``, ``sin(q)``), the
+functions named without a module; numpy's run it for the theory, wells.elementary's in the
+engines.
 A side where ``V`` tends to a finite limit (sympy's ``limit``) is declared open at infinity with
 that limit as its escape energy (sech^2, Morse).
 
