@@ -4,14 +4,17 @@ Independent routes: the orbit's period mean against the second-order closed form
 quartic saddles against the symmetry q -> -q, t -> t + T/2; the manifolds' invariance (points
 between the vertices of W^u mapped one period forward by a separate scipy DOP853 integration
 land on W^u, W^s backward likewise); at F = 0 without damping both inner branches lie on the
-separatrix (energy E_b) and reach its turning point; the signed gap on curves of known geometry.
+separatrix (energy E_b) and reach its turning point; the signed gap on curves of known geometry;
+the manifolds' first tangency within 2% of the Melnikov threshold at beta = 0.1 (the full Brent
+root, 2.4e-4 above F_M, takes minutes: docs/melnikov.md).
 """
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
 from safebasins.analysis import hilltop_orbit, saddle_manifolds
-from safebasins.analysis.saddle import manifold_tangency, signed_gap
+from safebasins.analysis.melnikov import melnikov_threshold
+from safebasins.analysis.saddle import _tangency_gap, manifold_tangency, signed_gap
 from safebasins.wells import resolve_well
 
 CUBIC = resolve_well("cubic")
@@ -104,3 +107,11 @@ def test_signed_gap_on_known_curves():
     assert (gap, i) == (-0.05, -1)
     with pytest.raises(ValueError, match="damping"):
         manifold_tangency(OMEGA, 0.0, "cubic")
+
+
+def test_manifolds_touch_at_the_melnikov_threshold():
+    F_M = float(melnikov_threshold(OMEGA, 0.1, "cubic"))
+    opts = dict(iterations=None, s0=1e-7, ds_max=0.05, angle_max=0.2, max_points=2000, rtol=1e-8)
+    below = _tangency_gap(CUBIC, (0.98 * F_M, OMEGA, 0.1, 0.0), (1.0, 1.0), opts, rounds=2)
+    past = _tangency_gap(CUBIC, (1.02 * F_M, OMEGA, 0.1, 0.0), (1.0, 1.0), opts, rounds=2)
+    assert below < 0 < past and past > 1e-3            # W^u inside W^s, then across it by ~ 0.16 (F / F_M - 1)
