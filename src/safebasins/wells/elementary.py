@@ -1,6 +1,6 @@
 """Elementary functions written once in the wells' code language: the same bits on every target.
 
-The functions are plain Python over +, -, *, /, comparisons, the wells' two primitives
+The functions are plain Python over ``+``, ``-``, ``*``, ``/``, comparisons, the wells' two primitives
 (:func:`~safebasins.wells.compiled.fma`; :func:`~safebasins.wells.compiled.mul` for every
 product that feeds an add, which the GPU compiler may then not contract), ``math.sqrt`` (IEEE,
 correctly rounded: llvm.sqrt on the CPU, sqrt.rn.f64 on CUDA) and two bit casts,
@@ -9,7 +9,7 @@ differently; these functions round identically wherever they are compiled.  They
 with selects rather than branches, so that a loop calling them vectorises on the CPU.
 
 * sin, cos, sincos: x = n pi/2 + r, Cody-Waite in three parts (r as a double-double, exact for
-  |x| <= 2^30), exact Payne-Hanek reduction beyond (elementary_reduction: a branch that on the
+  ``|x| <= 2^30``), exact Payne-Hanek reduction beyond (elementary_reduction: a branch that on the
   CPU is a vector-masked call, taken only by the lanes that need it); minimax kernels on
   [-pi/4, pi/4] with their r^3/6 and r^2/2 terms in double-double.
 * exp, expm1: x = n ln2 + r (r a double-double), e^r - 1 by a minimax polynomial with r^2/2
@@ -67,7 +67,7 @@ ULP_BOUNDS = {"sin": 0.55, "cos": 0.55, "sincos": 0.55, "tan": 2.7, "exp": 0.55,
 #: of every compiled well that calls them (an edit never reuses a kernel cached before it)
 MODULE_HASH = hashlib.blake2b(b"".join(Path(str(m.__file__)).read_bytes() for m in (
     sys.modules[__name__], elementary_reduction, elementary_targets)), digest_size=16).hexdigest()
-#: |x| up to which sin and cos reduce by Cody-Waite (beyond: Payne-Hanek)
+#: ``|x|`` up to which sin and cos reduce by Cody-Waite (beyond: Payne-Hanek)
 SIN_COS_FAST_LIMIT = 2.0 ** 30
 
 

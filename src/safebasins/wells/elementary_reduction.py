@@ -1,8 +1,8 @@
 """Exact reduction of huge arguments by pi/2 (Payne-Hanek), in 64-bit integer arithmetic.
 
 For x = m 2^(e-52) (m the 53-bit integer significand, 30 <= e <= 1023), :func:`reduce_pio2`
-returns n mod 4 and the fraction of x (2/pi) nearest to zero, x (2/pi) = n + F, |F| <= 1/2, as
-three exact doubles (F = a0 + a1 + a2 to 2^-144, 82 bits below the smallest |F| of any double,
+returns n mod 4 and the fraction of x (2/pi) nearest to zero, x (2/pi) = n + F, ``|F| <= 1/2``, as
+three exact doubles (F = a0 + a1 + a2 to 2^-144, 82 bits below the smallest ``|F|`` of any double,
 2^-61.4).  The product m 2^(e-52) (2/pi) is formed column by column in base 2^24 from the
 24-bit digits of 2/pi: every partial product is below 2^48 and every column sum below 2^51,
 so no intermediate leaves int64 (and the same Python, run by numba's CUDA simulator with
@@ -38,7 +38,7 @@ def _column(c: int, a: int, l0: int, l1: int, l2: int, l3: int) -> int:
 
 def reduce_pio2(m: int, e: int) -> tuple[int, float, float, float]:
     """(n mod 4, a0, a1, a2): x (2/pi) = n + a0 + a1 + a2 for x = m 2^(e-52), 2^52 <= m < 2^53,
-    e >= 30; |a0 + a1 + a2| <= 1/2, a0 a multiple of 2^-48, |a1| < 2^-48, |a2| < 2^-96."""
+    e >= 30; ``|a0 + a1 + a2| <= 1/2``, a0 a multiple of 2^-48, ``|a1| < 2^-48``, ``|a2| < 2^-96``."""
     ex = e - 52
     a = ex // 24
     b = ex - 24 * a                                  # x = (m 2^b) 2^(24 a), 0 <= b < 24

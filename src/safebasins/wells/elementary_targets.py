@@ -10,7 +10,7 @@
 * :func:`cold_call_cpu`: a CPU call that a vectorised loop makes only for the lanes that need it.
   The call carries LLVM's vector-function-ABI attribute naming masked variants (2, 4 and 8
   lanes) which test the mask lane by lane and call the scalar function only where it is set:
-  the loop vectoriser keeps the loop vectorised and a rare slow path (sin/cos of |x| > 2^30)
+  the loop vectoriser keeps the loop vectorised and a rare slow path (sin/cos of ``|x| > 2^30``)
   costs one well-predicted branch per vector.
 * :func:`register_cpu_overload`: lets ``@njit`` code call a code function by its Python name.
 """
