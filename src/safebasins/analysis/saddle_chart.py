@@ -73,6 +73,7 @@ def saddle_chart(F_values: float | Sequence[float], Omega: float, Psi: float, xi
                                  {**_ONE, "long_name": f"fraction of the chart safe over {cycles} cycles"})
         for name in ("q_fixed", "p_fixed", "multiplier_unstable", "multiplier_stable"):
             part[name] = orb[name].drop_vars(["q_barrier"])
+        manifold_rtol = float(man.attrs["rtol"])
         part.attrs = {}
         parts.append(part)
     ds = stack(parts, "F", F)
@@ -87,6 +88,9 @@ def saddle_chart(F_values: float | Sequence[float], Omega: float, Psi: float, xi
                                                          "(melnikov.manifold_splitting)"})
     ds.attrs = {"title": "hilltop saddle's manifolds over escape charts", **well_attrs(w), "Omega": Om, "Psi": Psi,
                 "damping": beta, "xi_max": float(xi_max), "cycles": cycles,
+                # the manifolds' vertices are integrated orbits, known to this tolerance (amplified
+                # along the unstable direction): safebasins.io.reproduction compares them as such
+                "manifold_rtol": manifold_rtol,
                 "method": "escape charts: safebasins.numerics.escape_chart; manifolds, orbit and tangency: "
                           "safebasins.analysis.saddle"}
     return annotate(ds)

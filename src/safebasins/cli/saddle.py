@@ -13,9 +13,7 @@ from safebasins.cli.options import (FINITE, NONNEG, POSITIVE, THRESHOLD, Deferre
                                     checked, common_options, cost_guard, engine_check, from_library, from_schema,
                                     grid_params, joined, library_errors, out_option)
 from safebasins.cli.output import chatter, draw, finish, job, write_outputs
-from safebasins.pipeline.kinds.saddle import build_saddle
 from safebasins.pipeline.values import fmt
-from safebasins.plotting.saddle import figure_hilltop_saddle
 
 __all__ = ["hilltop_saddle"]
 
@@ -75,6 +73,11 @@ def hilltop_saddle(F: tuple[float, ...], Omega: float, Psi: float, xi_max: float
                        f"Omega = {fmt(Omega)}, Psi = {fmt(Psi, angle=True)}, beta = {fmt(damping)} "
                        f"(safebasins hilltop-saddle {name})")
     cost_guard("hilltop_saddle", params, allow_expensive)
+    # the computation and its figure load the engine and matplotlib: imported when the command runs,
+    # so that `safebasins --help` and the other commands start without them
+    from safebasins.pipeline.kinds.saddle import build_saddle
+    from safebasins.plotting.saddle import figure_hilltop_saddle
+
     with library_errors(), chatter(verbose):
         ds = build_saddle(params, {}, job(threads, "cpu"))
         ds = finish(ds, title=params["title"], params=params)
