@@ -601,7 +601,7 @@ def cuda_device() -> SimpleNamespace:
     if not cuda_config.ENABLE_CUDASIM:
         from numba.cuda import libdevice  # noqa: PLC0415  (as numba.cuda; not there under the simulator)
 
-        prims = {"fma": cuda.fma,  # type: ignore[attr-defined]  # numba.cuda's attributes are set at import "mul": libdevice.dmul_rn, "as_bits": libdevice.double_as_longlong,
+        prims = {"fma": cuda.fma, "mul": libdevice.dmul_rn, "as_bits": libdevice.double_as_longlong,
                  "from_bits": libdevice.longlong_as_double}
     return compile_code(_MODULES, cuda.jit(device=True), prims)
 
