@@ -12,11 +12,13 @@ PY=.venv/bin/python
 KERNELS=${KERNELS:-"Haswell Sandybridge"}
 read -r -a DIRS <<< "${KERNEL_TEST_PATHS:-tests/wells tests/theory tests/numerics tests/analysis}"
 # Left out here (run by make test under the native kernel): the slowest tests that compare two
-# code paths on the same inputs in one process (the CUDA simulator against the CPU engine, a
-# numeric well against its expression twin) or the compiled engine against scipy's DOP853 on the
-# quartic, whose arithmetic calls no BLAS/LAPACK: a kernel changes neither side of them.
+# code paths on the same inputs in one process (the CUDA simulator against the CPU engine, for the
+# polynomial and the named wells; a numeric well against its expression twin) or the compiled
+# engine against scipy's DOP853 on the quartic, whose arithmetic calls no BLAS/LAPACK: a kernel
+# changes neither side of them.
 DESELECT=(
     tests/numerics/test_cuda_simulator.py::test_cuda_simulator_matches_cpu_engine_bitwise
+    tests/numerics/test_cuda_simulator_wells.py::test_named_wells_cuda_simulator_matches_cpu_bitwise
     tests/numerics/test_damping.py::test_damped_chart_matches_dop853_pixel_for_pixel
     tests/numerics/test_other_wells.py::test_numeric_well_equals_expression_bitwise
     tests/theory/test_damped.py::test_batch_decisions_match_per_ic_reference
