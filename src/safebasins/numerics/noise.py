@@ -1,0 +1,223 @@
+"""Escape under noise: escape probabilities of the Langevin equation from ensembles of paths.
+
+    dq = p dt,    dp = (-beta p - V'(q) + F sin(Omega t + Psi)) dt + sigma dW
+
+(additive white noise: Ito and Stratonovich agree; thermal noise at temperature T is
+sigma^2 = 2 beta T).  :func:`escape_probability` integrates ``paths`` paths from every initial
+condition with the compiled lanes of numerics.noise_kernels (the Strang splitting of the noise
+around the engine's deterministic step: weak order 2; counter-based Philox streams keyed by
+(seed, initial condition, path, step)) and escapes by the criteria of
+:func:`~safebasins.numerics.escape_chart` (energy H0 > xi_max or q beyond a barrier; a NaN state
+counts as escaped), checked after every step.  At sigma = 0 every path is the engine's
+trajectory, bitwise: the escape times are escape_chart's.  docs/noise.md: the model, the scheme
+and its measured weak order, the boundary correction and the Kramers check.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import numpy.typing as npt
+import xarray as xr
+
+from safebasins.core import cf, checks
+from safebasins.numerics import criteria, engine, noise_kernels, schemes
+from safebasins.numerics.charts import _ic_arrays
+from safebasins.numerics.problem import check_cycles, ensemble_problem
+from safebasins.wells import resolve_well
+from safebasins.wells.base import WellLike
+from safebasins.wells.provenance import api_provenance
+
+__all__ = ["escape_probability", "wilson_interval", "CORRECTIONS", "GOBET_SHIFT", "WILSON_Z", "noise_amplitude",
+           "energy_shift"]
+
+#: beta_1 = -zeta(1/2) / sqrt(2 pi): the boundary shift, in units of the local volatility times
+#: sqrt(h), that removes the O(sqrt(h)) bias of a discretely monitored killed diffusion
+#: (Broadie, Glasserman & Kou 1997; Gobet & Menozzi 2010)
+GOBET_SHIFT = 0.5825971579390106
+#: the discrete-monitoring corrections: "shift" (the energy threshold moved inwards by
+#: GOBET_SHIFT sigma |p| sqrt(h), the local volatility of H0 being sigma |p|) or "none"
+CORRECTIONS = ("shift", "none")
+#: the normal quantile of the 95% Wilson interval
+WILSON_Z = 1.959963984540054
+#: the backends of the noisy ensemble (the CPU lanes; the CUDA kernels are not written)
+NOISE_BACKENDS = ("cpu",)
+#: paths in flight per task
+LANES = 256
+#: at most this many points on the survival curve's time axis
+SURVIVAL_POINTS = 256
+
+SCHEME_TEXT = ("Strang splitting p += a Z_1, deterministic step, p += a Z_2 with a = sigma sqrt(h/2), Z_i "
+               "standard normal (the exact flow of the noise over h/2 around the deterministic scheme's step; "
+               "weak order 2)")
+RNG_TEXT = ("Philox4x32-10 with counter (step, path, initial condition, 0) and key (seed mod 2^32, seed div 2^32); "
+            "Box-Muller pair from its two 53-bit uniforms (wells.elementary log, sqrt, sincos)")
+
+
+def noise_amplitude(sigma: float, h: float) -> float:
+    """a = sigma sqrt(h/2): the noise kick of each half step."""
+    return sigma * math.sqrt(0.5 * h)
+
+
+def energy_shift(sigma: float, h: float, correction: str) -> float:
+    """The shift of 2 xi_max per |p| (noise_kernels): 2 GOBET_SHIFT sigma sqrt(h) for "shift", 0 for "none"."""
+    return 2.0 * GOBET_SHIFT * sigma * math.sqrt(h) if correction == "shift" else 0.0
+
+
+def wilson_interval(k: npt.ArrayLike, n: int, z: float = WILSON_Z) -> tuple[np.ndarray, np.ndarray]:
+    """The Wilson score interval (low, high) of a binomial proportion k / n (95% for the default z)."""
+    kk = np.asarray(k, dtype=float)
+    p = kk / n
+    z2 = z * z
+    centre = (p + z2 / (2 * n)) / (1 + z2 / n)
+    half = z / (1 + z2 / n) * np.sqrt(p * (1 - p) / n + z2 / (4 * n * n))
+    return np.clip(centre - half, 0.0, 1.0), np.clip(centre + half, 0.0, 1.0)
+
+
+def _check_seed(seed: object) -> int:
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) < 2 ** 63:
+        raise ValueError(f"seed must be an integer in [0, 2^63), got {seed!r}")
+    return int(seed)
+
+
+def _check_choice(name: str, value: object, allowed: tuple[str, ...]) -> str:
+    if not isinstance(value, str) or value not in allowed:
+        raise ValueError(f"{name} must be one of {allowed}, got {value!r}")
+    return value
+
+
+def _survival_axis(cycles: int) -> np.ndarray:
+    if cycles <= SURVIVAL_POINTS:
+        return np.arange(cycles + 1, dtype=float)
+    return np.linspace(0.0, float(cycles), SURVIVAL_POINTS + 1)
+
+
+def _counts_within(tc: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """(n_ic, len(times)): how many paths of each initial condition escaped at or before each time."""
+    srt = np.sort(tc, axis=1)
+    return np.stack([np.searchsorted(row, times, side="right") for row in srt]) if srt.shape[0] else (
+        np.zeros((0, times.size), np.int64))
+
+
+@api_provenance
+def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: float, Psi: float, *, noise: float,
+                       paths: int, xi_max: float, t_eval: npt.ArrayLike, damping: float = 0.0, well: WellLike = None,
+                       seed: int = 0, cycles: int | None = None,
+                       steps_per_cycle: int = engine.DEFAULT_STEPS_PER_CYCLE, grid: bool | None = None,
+                       correction: str = "shift", integrator: str = engine.DEFAULT_INTEGRATOR,
+                       threads: int | None = None, backend: str = "cpu") -> xr.Dataset:
+    """Probability of escape within each ``t_eval`` under noise, from ``paths`` paths per initial condition.
+
+    Parameters
+    ----------
+    q0, p0, grid : initial conditions as :func:`~safebasins.numerics.escape_chart` (a grid of
+        1-D axes -> dims (q0, p0); paired -> dim sample).
+    F, Omega, Psi, damping, well, integrator, steps_per_cycle : the equation and the deterministic
+        scheme, as escape_chart (its damped variant for damping > 0).
+    noise : sigma >= 0, the amplitude of the white noise dp = ... + sigma dW (thermal noise at
+        temperature T: sigma^2 = 2 damping T).  0: every path is escape_chart's trajectory.
+    paths : paths per initial condition (positive integer).
+    xi_max : the energy threshold (a scalar in (0, barrier energy]): escape when H0 > xi_max or q
+        beyond a barrier, checked after every step.
+    t_eval : evaluation times in forcing cycles (>= 0, up to ``cycles``).
+    seed : integer in [0, 2^63): the key of the Philox streams; path m of initial condition i
+        draws the same numbers for any threads, lanes or order (numerics.noise_kernels).
+    cycles : the horizon in forcing cycles (None: the largest t_eval rounded up); the first-passage
+        mean is restricted to it.
+    correction : "shift" (default: the energy threshold moved inwards by GOBET_SHIFT sigma |p|
+        sqrt(h), removing the O(sqrt(h)) bias of checking the threshold only at the steps) or
+        "none".
+    threads : numba threads (None: the current setting); the result does not depend on it.
+    backend : "cpu" (the only backend of the noisy ensemble).
+
+    Returns
+    -------
+    xr.Dataset with P_escape (ic dims, t_eval): the fraction of paths escaped at or before t_eval,
+    its 95% Wilson interval P_escape_low, P_escape_high; survival (ic dims, t_survival), the
+    fraction not escaped by t_survival (every forcing cycle up to 256 cycles, else 257 points);
+    first_passage_mean (ic dims): the restricted mean first-passage time E[min(tau, cycles)]
+    in forcing cycles with its standard error first_passage_sem and censored_fraction, the
+    fraction of paths not escaped within cycles (where it is 0 the restricted mean is the mean
+    first-passage time; otherwise a lower bound of it).  Attributes: the equation, noise, paths,
+    seed, the scheme, the random numbers, the correction, the escape criteria and the well.
+    """
+    is_grid, qa, pa, Q, P = _ic_arrays(q0, p0, grid)
+    F = checks.check_scalar("F", F, checks.check_nonnegative)
+    Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
+    Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
+    damping = checks.check_damping(damping)
+    sigma = checks.check_scalar("noise", noise, checks.check_nonnegative)
+    paths = checks.check_positive_int("paths", paths)
+    w = resolve_well(well)
+    xi = checks.check_scalar("xi_max", w.check_threshold("xi_max", xi_max), checks.check_finite)
+    te = checks.check_1d("t_eval", t_eval, checks.check_nonnegative)
+    cycles = check_cycles("cycles", max(1, math.ceil(float(te.max()))) if cycles is None else cycles)
+    if te.max() > cycles:
+        raise ValueError(f"t_eval must be <= cycles = {cycles}, got max {float(te.max())!r}")
+    seed = _check_seed(seed)
+    correction = _check_choice("correction", correction, CORRECTIONS)
+    _check_choice("backend", backend, NOISE_BACKENDS)
+    schemes.check_integrator(integrator)
+    spc = engine.check_step(Omega, engine.check_steps_per_cycle(steps_per_cycle), w, integrator)
+    threads = engine.check_threads(threads)
+    if cycles * spc > noise_kernels.MAX_STEPS:
+        raise ValueError(f"cycles: {cycles} cycles of {spc} steps exceed {noise_kernels.MAX_STEPS} steps per path")
+    if Q.size * paths >= 2 ** 62:
+        raise ValueError(f"paths: {paths} paths from {Q.size} initial conditions are too many")
+
+    problem = ensemble_problem(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=[xi], cycles=cycles,
+                               steps_per_cycle=spc, integrator=integrator, well=w, damping=damping)
+    h = float(problem.step_sizes()[0])
+    with engine.thread_count(threads) as nthreads:
+        n_tasks = max(1, min(math.ceil(Q.size * paths / LANES), nthreads))
+        steps = noise_kernels.escape_steps(problem.code, problem.scheme, Q, P, paths, problem.coefficients(),
+                                           problem.sine_table(), F, float(problem.thrE2[0]), cycles,
+                                           noise_amplitude(sigma, h), seed,
+                                           shift=energy_shift(sigma, h, correction), n_tasks=n_tasks, lanes=LANES)
+    tc = engine.steps_to_cycles(steps, spc)                       # (n_ic, paths), inf: not within cycles
+    ts = _survival_axis(cycles)
+    k_eval = _counts_within(tc, te)
+    k_surv = _counts_within(tc, ts)
+    low, high = wilson_interval(k_eval, paths)
+    restricted = np.minimum(tc, float(cycles))
+    sem = restricted.std(axis=1, ddof=1) / math.sqrt(paths) if paths > 1 else np.full(Q.size, np.inf)
+
+    shape: tuple[int, ...]
+    dims: tuple[str, ...]
+    if is_grid:
+        shape, dims = (qa.size, pa.size), ("q0", "p0")
+        coords = {"q0": ("q0", qa, cf.attrs("q0")), "p0": ("p0", pa, cf.attrs("p0"))}
+    else:
+        shape, dims = (Q.size,), ("sample",)
+        coords = {"sample": ("sample", np.arange(Q.size), cf.attrs("sample")), "q0": ("sample", Q, cf.attrs("q0")),
+                  "p0": ("sample", P, cf.attrs("p0"))}
+    coords["t_eval"] = ("t_eval", te, cf.attrs("t_eval"))
+    coords["t_survival"] = ("t_survival", ts, cf.attrs("t_survival"))
+
+    def field(a: np.ndarray, name: str, last: tuple[str, ...] = ()
+              ) -> tuple[tuple[str, ...], np.ndarray, dict[str, str]]:
+        return dims + last, a.reshape(shape + a.shape[1:]), cf.attrs(name)
+
+    data = {
+        "P_escape": field(k_eval / paths, "P_escape", ("t_eval",)),
+        "P_escape_low": field(low, "P_escape_low", ("t_eval",)),
+        "P_escape_high": field(high, "P_escape_high", ("t_eval",)),
+        "survival": field(1.0 - k_surv / paths, "survival", ("t_survival",)),
+        "first_passage_mean": field(restricted.mean(axis=1), "first_passage_mean"),
+        "first_passage_sem": field(sem, "first_passage_sem"),
+        "censored_fraction": field(np.isinf(tc).mean(axis=1), "censored_fraction"),
+    }
+    ds = xr.Dataset(data, coords=coords)
+    ds.attrs.update(
+        F=F, Omega=Omega, Psi=Psi, xi_max=xi, noise=sigma, paths=paths, seed=seed, cycles=cycles, steps_per_cycle=spc,
+        noise_model="dp = (-beta p - V'(q) + F sin(Omega t + Psi)) dt + sigma dW (white, additive; sigma = noise)",
+        integrator=engine.integrator_text(integrator, damping), noise_scheme=SCHEME_TEXT, random_numbers=RNG_TEXT,
+        boundary_correction=(f"energy threshold shifted inwards by {GOBET_SHIFT} sigma |p| sqrt(h) (Gobet-Menozzi)"
+                             if correction == "shift" else "none: checked after every step only"),
+        first_passage=("restricted mean E[min(tau, cycles)] in forcing cycles; censored_fraction of the paths had "
+                       "not escaped within cycles (the mean first-passage time where it is 0, a lower bound "
+                       "otherwise)"),
+        grid=int(is_grid), escape_criteria=criteria.criteria_text(w), **w.numerics_attrs(),
+        **engine.damping_attrs(damping))
+    return ds
+

@@ -1,0 +1,260 @@
+"""Compiled ensembles of the Langevin equation: the CPU lanes of numerics.noise.
+
+Equation: dq = p dt, dp = (-beta p - V'(q) + F sin(Omega t + Psi)) dt + sigma dW.
+
+Scheme (weak order 2): the Strang splitting of the generator into the deterministic part
+(drift, damping, force; the engine's scheme, schemes.py, with its damped variant for beta > 0)
+and the noise ``(sigma^2/2) d^2/dp^2``, whose exact flow over h/2 is ``p += sigma sqrt(h/2) N``:
+
+    p += a Z_1;   (q, p) = step(q, p);   p += a Z_2,        a = sigma sqrt(h/2)
+
+with ``step`` the deterministic scheme's step (the same compiled step as the engine's: at
+sigma = 0 the two half kicks add exact zeros and every state is bitwise the engine's).
+
+Gaussian variates: (Z_1, Z_2) of step k of path m from initial condition i are the Box-Muller pair of
+one Philox4x32-10 block (numerics.philox) with counter (k, m, i, 0) and key (seed mod 2^32,
+seed div 2^32): ``Z_1 = r cos(2 pi u_2)``, ``Z_2 = r sin(2 pi u_2)``, ``r = sqrt(-2 log u_1)``,
+u_1, u_2 the two 53-bit uniforms in (0, 1] of the block (numerics.philox.uniform53), log, sqrt
+and sincos from wells.elementary (the same bits on every target).  A path's numbers are a pure
+function of (seed, i, m, k): lanes, tasks, threads and the order of the paths cannot change them.
+
+Escape: after every step, by the engine's criteria (2 H0 > 2 xi_max or q beyond a barrier, a
+NaN state beyond every threshold; and, for the kernels' own callers, a displacement pair
+(lo, hi)); ``shift`` > 0 moves the energy threshold inwards by ``shift |p|``: the boundary
+shift of Gobet and Menozzi for a discretely monitored diffusion, here the energy H0 whose
+local volatility is sigma |p| (numerics.noise sets shift = 2 * 0.5826 sigma sqrt(h) for 2 H0).
+
+The kernels are specialised on three numba literals: the well's and the scheme's keys (as the
+engine's, kernels.py) and :data:`RNG_KEY`, a hash of the files inlined from outside the
+engine's fingerprint (this module, numerics/philox.py, wells.elementary), so a kernel cached
+on disk is never reused after an edit of any of them.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numba import literally, njit
+
+from safebasins.numerics import philox
+from safebasins.numerics.kernels import run_tasks, specialised
+from safebasins.numerics.scheme_code import SchemeCode, fingerprint
+from safebasins.numerics.steps import coefs, row, step, wtuple
+from safebasins.wells import elementary
+from safebasins.wells.compiled import WellCode, abs_tracking, cpu_jit, fma, well_energy2
+
+__all__ = ["RNG_KEY", "MAX_STEPS", "escape_steps", "final_states", "gaussian_pairs"]
+
+#: the numba literal of the random-number and noise code (module docstring)
+RNG_KEY = int(fingerprint([__file__, philox.__file__])[:15], 16) ^ int(elementary.MODULE_HASH[:15], 16)
+#: a path's step index is the counter's first 32-bit word
+MAX_STEPS = 2 ** 32 - 1
+_TWO_PI = 2.0 * math.pi
+_ZERO = np.uint64(0)
+_MASK32 = philox.MASK32
+_philox = cpu_jit(philox.philox4x32)
+_uniform53 = cpu_jit(philox.uniform53)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _gauss2(k0: Any, k1: Any, k: Any, m: Any, i: Any) -> tuple[float, float]:
+    """The Box-Muller pair of step k of path m from initial condition i (module docstring)."""
+    w0, w1, w2, w3 = _philox(np.uint64(k) & _MASK32, np.uint64(m) & _MASK32, np.uint64(i) & _MASK32, _ZERO, k0, k1)
+    r = elementary.sqrt(-2.0 * elementary.log(_uniform53(w0, w1)))
+    s, c = elementary.sincos(_TWO_PI * _uniform53(w2, w3))
+    return r * c, r * s
+
+
+@njit(cache=True, error_model="numpy")
+def _pairs(rng: Any, k0: Any, k1: Any, k: Any, m: Any, i: Any) -> Any:
+    literally(rng)
+    n = k.shape[0]
+    z = np.zeros((n, 2))
+    for j in range(n):
+        z[j, 0], z[j, 1] = _gauss2(k0, k1, k[j], m[j], i[j])
+    return z
+
+
+def gaussian_pairs(seed: int, step: np.ndarray, path: np.ndarray, ic: np.ndarray) -> np.ndarray:
+    """The Gaussian pairs (Z_1, Z_2) the kernels use at (step, path, ic) (arrays of equal size,
+    ints < 2^32) for ``seed``: shape (n, 2) (tests, documentation)."""
+    k0, k1 = _key(seed)
+    arrays = [np.ascontiguousarray(a, dtype=np.int64).ravel() for a in (step, path, ic)]
+    return _pairs(RNG_KEY, k0, k1, *arrays)  # type: ignore[no-any-return]  # (a numba dispatcher)
+
+
+def _key(seed: int) -> tuple[np.uint64, np.uint64]:
+    return np.uint64(seed & 0xFFFFFFFF), np.uint64(seed >> 32)
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _beyond(well: Any, wpar: Any, q: Any, e: Any, thrE2: Any, lo: Any, hi: Any) -> bool:
+    """The engine's criteria (kernels._check_state) for one energy threshold and one bound pair:
+    written ``not x <= t`` so that a NaN state is beyond."""
+    if abs_tracking(well):
+        barrier = not abs(q) <= wpar[1]
+    else:
+        barrier = (not q <= wpar[1]) | (not q >= wpar[0])
+    return (not e <= thrE2) | barrier | (not q <= hi) | (not q >= lo)
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _escape_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks: Any, lanes: Any, q0: Any, p0: Any,
+                 n_paths: Any, coef: Any, FS: Any, thrE2: Any, lo: Any, hi: Any, cycles: Any, amp: Any, shift: Any,
+                 k0: Any, k1: Any, out: Any) -> None:
+    """Trajectories j = task, task + n_tasks, ... (path j % n_paths of initial condition
+    j // n_paths): out[j] = the step after which it is first beyond (0: the initial condition,
+    -1: not within cycles periods).  Lanes run one forcing period at a time; at the period
+    boundary finished lanes are written out and compacted and empty lanes take the next
+    trajectories (every lane is at the same sub-step of the period)."""
+    literally(well)
+    literally(scheme)
+    literally(rng)
+    S = FS.shape[0]
+    w = wtuple(wpar)
+    c = coefs(scheme, coef[0])  # type: ignore[no-untyped-call]  # (numba overloads: untyped)
+    N = q0.shape[0] * n_paths
+    total = np.int64(cycles) * S
+    L = np.int64(lanes)
+    Q = np.zeros(L)
+    P = np.zeros(L)
+    IC = np.zeros(L, np.int64)
+    PATH = np.zeros(L, np.int64)
+    J = np.zeros(L, np.int64)
+    BASE = np.zeros(L, np.int64)         # the lane's steps done at the start of this period
+    FIRST = np.zeros(L, np.int64)        # its first step beyond the thresholds (-1: none yet)
+    nxt = np.int64(task)
+    nact = np.int64(0)
+    while True:
+        k = np.int64(0)
+        for l in range(nact):
+            if FIRST[l] >= 0 or BASE[l] >= total:
+                out[J[l]] = FIRST[l]
+            else:
+                Q[k] = Q[l]
+                P[k] = P[l]
+                IC[k] = IC[l]
+                PATH[k] = PATH[l]
+                J[k] = J[l]
+                BASE[k] = BASE[l]
+                FIRST[k] = FIRST[l]
+                k += 1
+        nact = k
+        while nact < L and nxt < N:
+            j = nxt
+            nxt += n_tasks
+            i = j // n_paths
+            q = q0[i]
+            p = p0[i]
+            if _beyond(well, wpar, q, well_energy2(well, w, q, p), thrE2, lo, hi):
+                out[j] = 0
+                continue
+            if total == 0:
+                out[j] = -1
+                continue
+            Q[nact] = q
+            P[nact] = p
+            IC[nact] = i
+            PATH[nact] = j - i * n_paths
+            J[nact] = j
+            BASE[nact] = 0
+            FIRST[nact] = -1
+            nact += 1
+        if nact == 0:
+            break
+        for s in range(S):
+            f = row(scheme, FS, s)  # type: ignore[no-untyped-call]  # (as coefs)
+            for l in range(nact):
+                n = BASE[l] + s
+                z1, z2 = _gauss2(k0, k1, n, PATH[l], IC[l])
+                q, p = step(scheme, well, w, Q[l], fma(amp, z1, P[l]), c, f)  # type: ignore[no-untyped-call]
+                p = fma(amp, z2, p)
+                Q[l] = q
+                P[l] = p
+                e = fma(shift, abs(p), well_energy2(well, w, q, p))
+                hit = _beyond(well, wpar, q, e, thrE2, lo, hi) & (FIRST[l] < 0)
+                FIRST[l] = n + 1 if hit else FIRST[l]
+        for l in range(nact):
+            BASE[l] += S
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def _final_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks: Any, q0: Any, p0: Any, n_paths: Any,
+                coef: Any, FS: Any, n_steps: Any, amp: Any, k0: Any, k1: Any, qo: Any, po: Any) -> None:
+    """Plain integration (no escape) of trajectories j = task, task + n_tasks, ... for n_steps
+    steps; the same step as _escape_task."""
+    literally(well)
+    literally(scheme)
+    literally(rng)
+    S = FS.shape[0]
+    w = wtuple(wpar)
+    c = coefs(scheme, coef[0])  # type: ignore[no-untyped-call]  # (numba overloads: untyped)
+    N = q0.shape[0] * n_paths
+    for j in range(task, N, n_tasks):
+        i = j // n_paths
+        m = j - i * n_paths
+        q = q0[i]
+        p = p0[i]
+        for n in range(n_steps):
+            z1, z2 = _gauss2(k0, k1, n, m, i)
+            f = row(scheme, FS, n % S)  # type: ignore[no-untyped-call]  # (as coefs)
+            q, p = step(scheme, well, w, q, fma(amp, z1, p), c, f)  # type: ignore[no-untyped-call]
+            p = fma(amp, z2, p)
+        qo[j] = q
+        po[j] = p
+
+
+def _common(code: WellCode, scheme: SchemeCode, q0: np.ndarray, coef: np.ndarray, sintab: np.ndarray, F: float,
+            seed: int) -> tuple[np.ndarray, np.ndarray, np.uint64, np.uint64]:
+    if coef.ndim != 2 or coef.shape != (1, scheme.n_coef):
+        raise ValueError(f"coef must be one row of lane_coefficients of {scheme.name}, got shape {coef.shape}")
+    if sintab.ndim != 2 or sintab.shape[1] != scheme.width:
+        raise ValueError(f"the forcing table of {scheme.name} has {scheme.width} columns, got shape {sintab.shape}")
+    if not 0 <= seed < 2 ** 64:
+        raise ValueError(f"seed must be an integer in [0, 2^64), got {seed}")
+    k0, k1 = _key(int(seed))
+    return np.ascontiguousarray(q0, dtype=float), np.ascontiguousarray(F * sintab), k0, k1
+
+
+def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndarray, n_paths: int, coef: np.ndarray,
+                 sintab: np.ndarray, F: float, thrE2: float, cycles: int, amp: float, seed: int, *,
+                 shift: float = 0.0, bounds: tuple[float, float] = (-math.inf, math.inf),
+                 wpar: np.ndarray | None = None, n_tasks: int = 1, lanes: int = 256) -> np.ndarray:
+    """First steps beyond the thresholds of ``n_paths`` paths from every initial condition,
+    shape (len(q0), n_paths), int64 (0: the initial condition is beyond, -1: not within
+    ``cycles`` periods of ``sintab.shape[0]`` steps).  code, scheme: the compiled well and scheme
+    (damped variant for beta > 0); coef: their lane_coefficients (one row); sintab: the forcing
+    table (schemes.sine_table), times F; thrE2 = 2 xi_max; amp = sigma sqrt(h/2); shift: the
+    energy boundary shift per |p| (module docstring); bounds: a displacement pair (lo, hi);
+    wpar: the well's wpar (None: code.wpar; the barriers are its first two entries).  The
+    result does not depend on n_tasks or lanes."""
+    q, FS, k0, k1 = _common(code, scheme, q0, coef, sintab, F, seed)
+    p = np.ascontiguousarray(p0, dtype=float)
+    if int(cycles) * sintab.shape[0] > MAX_STEPS:
+        raise ValueError(f"cycles: {cycles} periods of {sintab.shape[0]} steps exceed {MAX_STEPS} steps per path "
+                         "(the random counter's range)")
+    out = np.full(q.size * int(n_paths), -1, np.int64)
+    wp = code.wpar if wpar is None else np.ascontiguousarray(wpar, dtype=float)
+    args = [code.key, scheme.key, RNG_KEY, wp, 0, int(n_tasks), int(lanes), q, p, int(n_paths),
+            np.ascontiguousarray(coef), FS, float(thrE2), float(bounds[0]), float(bounds[1]), int(cycles),
+            float(amp), float(shift), k0, k1, out]
+    entry = specialised(_escape_task, args, n_literal=3)
+    run_tasks(lambda task: entry(*args[:4], task, *args[5:]), int(n_tasks))
+    return out.reshape(q.size, int(n_paths))
+
+
+def final_states(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndarray, n_paths: int, coef: np.ndarray,
+                 sintab: np.ndarray, F: float, n_steps: int, amp: float, seed: int, n_tasks: int = 1
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """(q, p) of every path after ``n_steps`` steps, shape (len(q0), n_paths) each, no escape
+    checks (weak-order tests, benchmarks); arguments as :func:`escape_steps`."""
+    q, FS, k0, k1 = _common(code, scheme, q0, coef, sintab, F, seed)
+    p = np.ascontiguousarray(p0, dtype=float)
+    qo = np.empty(q.size * int(n_paths))
+    po = np.empty_like(qo)
+    args = [code.key, scheme.key, RNG_KEY, code.wpar, 0, int(n_tasks), q, p, int(n_paths), np.ascontiguousarray(coef),
+            FS, int(n_steps), float(amp), k0, k1, qo, po]
+    entry = specialised(_final_task, args, n_literal=3)
+    run_tasks(lambda task: entry(*args[:4], task, *args[5:]), int(n_tasks))
+    return qo.reshape(q.size, int(n_paths)), po.reshape(q.size, int(n_paths))
