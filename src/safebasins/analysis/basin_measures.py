@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 import xarray as xr
-from scipy import integrate, stats  # type: ignore[import-untyped]
+from scipy import integrate, stats
 
 from safebasins.analysis.basin_labels import Axis, LabelsLike, check_labels
 from safebasins.analysis.fractality import exponent_dataset

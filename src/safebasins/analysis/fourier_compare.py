@@ -112,8 +112,8 @@ def fcr_fourier_comparison(Omega, xi_max, *, xi_ini=0.0, gamma_ini=0.0, Psi=0.0,
     gamma_ini = float(checks.check_finite("gamma_ini", gamma_ini))
     Psi = float(checks.check_finite("Psi", Psi))
     if xi_ini > 0:
-        q0, p0 = initial_condition(xi_ini, gamma_ini, Psi)
-        q0, p0 = float(q0), float(p0)
+        qa, pa = initial_condition(xi_ini, gamma_ini, Psi)
+        q0, p0 = float(qa), float(pa)
     else:
         q0, p0 = 0.0, 0.0
     num = critical_forcing_numeric(Om, xi_max, q0=q0, p0=p0, Psi=Psi, cycles=cycles, tol=tol,

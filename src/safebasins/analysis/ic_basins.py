@@ -19,7 +19,10 @@ one progress line each, for the job's log.
 """
 from __future__ import annotations
 
+from typing import cast
+
 import numpy as np
+import numpy.typing as npt
 import xarray as xr
 import contourpy
 
@@ -63,10 +66,11 @@ def mask_outline(safe, q0, p0, Psi, *, well=None):
     S = np.asarray(safe, bool)
     if S.shape != (qa.size, pa.size):
         raise ValueError(f"safe must have shape (len(q0), len(p0)) = {(qa.size, pa.size)}, got {S.shape}")
-    lines = []
+    lines: list[npt.NDArray[np.float64]] = []
     if S.any() and not S.all() and qa.size > 1 and pa.size > 1:
         gen = contourpy.contour_generator(qa, pa, S.T.astype(float), line_type="Separate")
-        lines = [ln for ln in gen.lines(0.5) if len(ln) > 1]
+        # line_type Separate: a list of (n, 2) point arrays (lines() is typed as every line type's return)
+        lines = [ln for ln in cast(list[npt.NDArray[np.float64]], gen.lines(0.5)) if len(ln) > 1]
     qv = np.concatenate([ln[:, 0] for ln in lines]) if lines else np.empty(0)
     pv = np.concatenate([ln[:, 1] for ln in lines]) if lines else np.empty(0)
     idx = np.concatenate([np.full(len(ln), k, np.int64) for k, ln in enumerate(lines)]) if lines else \

@@ -357,7 +357,7 @@ def _measures_xarray(safe, q0, p0, xi_max, bottom, well):
     if isinstance(xi_max, xr.DataArray):
         extra = set(xi_max.dims) - set(lead_dims)
         if extra:
-            raise ValueError(f"xi_max has dims {sorted(extra)} that the mask does not have")
+            raise ValueError(f"xi_max has dims {sorted(map(str, extra))} that the mask does not have")
         xi_np = xi_max.broadcast_like(template).transpose(*lead_dims).values
     elif xi_max is None:
         raise ValueError("xi_max is required: pass it or give the mask an xi_max coordinate")

@@ -36,6 +36,8 @@ minimal period found this way (independent route), started at the island centroi
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from safebasins.core import checks
@@ -296,7 +298,7 @@ def chain_orbits(step, q, p, period, *, max_period=40, same_tol=1e-6):
     """
     q, p = _orbits(q, p)
     period = np.atleast_1d(np.asarray(period, np.int64))
-    chains = []
+    chains: list[dict[str, Any]] = []
     member = np.full(q.shape[0], -1, np.int64)
     def contains(i, ch):
         """Every island (sub-orbit bounding box) of orbit i holds a point of chain ch."""

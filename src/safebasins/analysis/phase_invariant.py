@@ -80,8 +80,8 @@ def _first_escaping_circle(lo, hi, n_xi, F, Omega, xi_max, well, gamma):
     k = np.flatnonzero(e)
     if k.size == 0:
         return None
-    k = int(k[0])
-    return (xs[k - 1] if k > 0 else None), xs[k]
+    k0 = int(k[0])
+    return (xs[k0 - 1] if k0 > 0 else None), xs[k0]
 
 
 def xi_true_analytic(F, Omega, xi_max, fourier=None, *, n_gamma=512, n_xi=400, levels=3, well=None):

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 import xarray as xr
-from scipy import ndimage  # type: ignore[import-untyped]
+from scipy import ndimage
 
 from safebasins.analysis.basin_labels import LabelsLike, check_labels
 from safebasins.core import checks
