@@ -32,6 +32,7 @@ on disk is never reused after an edit of any of them.
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 from typing import Any
 
 import numpy as np
@@ -42,7 +43,7 @@ from safebasins.numerics.kernels import run_tasks, specialised
 from safebasins.numerics.scheme_code import SchemeCode, fingerprint
 from safebasins.numerics.steps import coefs, row, step, wtuple
 from safebasins.wells import elementary
-from safebasins.wells.compiled import WellCode, abs_tracking, cpu_jit, fma, well_energy2
+from safebasins.wells.compiled import WellCode, abs_tracking, cpu_jit, fma, mul, well_energy2
 
 __all__ = ["RNG_KEY", "MAX_STEPS", "escape_steps", "final_states", "gaussian_pairs"]
 
@@ -50,11 +51,52 @@ __all__ = ["RNG_KEY", "MAX_STEPS", "escape_steps", "final_states", "gaussian_pai
 RNG_KEY = int(fingerprint([__file__, philox.__file__])[:15], 16) ^ int(elementary.MODULE_HASH[:15], 16)
 #: a path's step index is the counter's first 32-bit word
 MAX_STEPS = 2 ** 32 - 1
-_TWO_PI = 2.0 * math.pi
 _ZERO = np.uint64(0)
 _MASK32 = philox.MASK32
 _philox = cpu_jit(philox.philox4x32)
 _uniform53 = cpu_jit(philox.uniform53)
+#: rounds |x| < 2^51 to an integer: (x + _ROUND) - _ROUND
+_ROUND = 6755399441055744.0
+
+
+def _taylor(k: int) -> float:
+    """(-1)^k (pi/2)^(2k+1) / (2k+1)! (odd k of the sine) or, as _taylor_cos, the cosine's term,
+    correctly rounded from the double pi/2 (exact rational arithmetic: the same constant on every
+    machine)."""
+    return float((-1) ** k * Fraction(math.pi / 2) ** (2 * k + 1) / math.factorial(2 * k + 1))
+
+
+def _taylor_cos(k: int) -> float:
+    return float((-1) ** k * Fraction(math.pi / 2) ** (2 * k) / math.factorial(2 * k))
+
+
+# sin(pi r / 2) = r (S0 + S1 z + ... + S7 z^7), cos(pi r / 2) = C0 + C1 z + ... + C8 z^8, z = r^2,
+# |r| <= 1/2 (|pi r/2| <= pi/4): truncation below 5e-17 relative
+_S0, _S1, _S2, _S3, _S4, _S5, _S6, _S7 = (_taylor(k) for k in range(8))
+_C0, _C1, _C2, _C3, _C4, _C5, _C6, _C7, _C8 = (_taylor_cos(k) for k in range(9))
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _sincos_2pi(u: Any) -> tuple[float, float]:
+    """(sin 2 pi u, cos 2 pi u) for u in [0, 1]: 4u = n + r with n an integer and |r| <= 1/2 (r
+    exact), the Taylor polynomials of sin and cos(pi r / 2), rotated by the quadrant n mod 4
+    (selects, no branch: the lane loop vectorises).  A few ulps; the same operations (fma, mul)
+    on every target."""
+    x = mul(4.0, u)
+    nf = (x + _ROUND) - _ROUND
+    r = x - nf
+    z = mul(r, r)
+    sp = fma(fma(fma(fma(fma(fma(fma(_S7, z, _S6), z, _S5), z, _S4), z, _S3), z, _S2), z, _S1), z, _S0)
+    sn = mul(r, sp)
+    cs = fma(fma(fma(fma(fma(fma(fma(fma(_C8, z, _C7), z, _C6), z, _C5), z, _C4), z, _C3), z, _C2), z, _C1), z, _C0)
+    # n in {0, 1, 2, 3, 4} (4: the quadrant of 0), compared as a float
+    s_out = cs if nf == 1.0 else sn
+    s_out = -sn if nf == 2.0 else s_out
+    s_out = -cs if nf == 3.0 else s_out
+    c_out = -sn if nf == 1.0 else cs
+    c_out = -cs if nf == 2.0 else c_out
+    c_out = sn if nf == 3.0 else c_out
+    return s_out, c_out
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -62,8 +104,8 @@ def _gauss2(k0: Any, k1: Any, k: Any, m: Any, i: Any) -> tuple[float, float]:
     """The Box-Muller pair of step k of path m from initial condition i (module docstring)."""
     w0, w1, w2, w3 = _philox(np.uint64(k) & _MASK32, np.uint64(m) & _MASK32, np.uint64(i) & _MASK32, _ZERO, k0, k1)
     r = elementary.sqrt(-2.0 * elementary.log(_uniform53(w0, w1)))
-    s, c = elementary.sincos(_TWO_PI * _uniform53(w2, w3))
-    return r * c, r * s
+    s, c = _sincos_2pi(_uniform53(w2, w3))
+    return mul(r, c), mul(r, s)
 
 
 @njit(cache=True, error_model="numpy")

@@ -1,0 +1,112 @@
+"""Speed of the noisy ensemble (numerics.noise) against the deterministic engine and a numba
+Euler-Maruyama, in one process (docs/noise.md).
+
+    python benchmarks/bench_noise.py            # quick: 4096 paths x 200 cycles x 32 steps
+    python benchmarks/bench_noise.py --full     # 16384 paths x 400 cycles
+
+Trajectory-steps per second on one thread, five interleaved rounds (the best of each is kept), for the quartic
+at F = 0.02, Omega = 0.8, ICs near the bottom of the well (nothing escapes: every trajectory runs
+the whole horizon, so steps are counted exactly):
+
+* deterministic: numerics.escape_chart (SRKN6b, the engine's vector lanes);
+* noisy: noise_kernels.escape_steps at sigma = 0.002 (SRKN6b + two Gaussians a step from one
+  Philox block, escape checked after every step);
+* Euler-Maruyama: a hand-written numba loop (symplectic Euler drift, one numpy normal a step,
+  escape checked after every step), weak order 1.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import time
+
+import numba
+import numpy as np
+from numba import njit
+
+from _report import machine, report  # noqa: E402  (benchmarks/ is on sys.path)
+
+from safebasins.numerics import escape_chart, noise_kernels, schemes
+from safebasins.numerics.noise import noise_amplitude
+from safebasins.numerics.scheme_code import scheme_code
+from safebasins.wells.compiled import quartic_code
+
+F, OMEGA, PSI, XI, SIGMA, S = 0.02, 0.8, 0.0, 0.25, 0.002, 32
+
+
+@njit(cache=True)
+def euler_maruyama(q0, p0, F, Omega, h, sigma, xi2, n_steps, seed):
+    """Symplectic Euler-Maruyama for every path; first step beyond 2 H0 > xi2 or |q| > 1 (-1: none)."""
+    np.random.seed(seed)
+    out = np.full(q0.size, -1, np.int64)
+    sh = sigma * math.sqrt(h)
+    for j in range(q0.size):
+        q, p = q0[j], p0[j]
+        for n in range(n_steps):
+            p += h * (q * q * q - q + F * math.sin(Omega * n * h)) + sh * np.random.standard_normal()
+            q += h * p
+            if p * p + q * q - 0.5 * q ** 4 > xi2 or abs(q) > 1.0:
+                out[j] = n + 1
+                break
+    return out
+
+
+def best(fns, rounds=5):
+    """The best time of each function over interleaved rounds (a load change on the shared
+    machine then hits every function alike)."""
+    times = [[] for _ in fns]
+    for _ in range(rounds):
+        for k, fn in enumerate(fns):
+            t = time.perf_counter()
+            fn()
+            times[k].append(time.perf_counter() - t)
+    return [min(t) for t in times]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--full", action="store_true")
+    args = ap.parse_args()
+    n, cycles = (16384, 400) if args.full else (4096, 200)
+    numba.set_num_threads(1)
+    rng = np.random.default_rng(1)
+    q0 = rng.uniform(-0.05, 0.05, n)
+    p0 = rng.uniform(-0.05, 0.05, n)
+    steps = n * cycles * S
+    h = 2 * math.pi / (OMEGA * S)
+
+    det = escape_chart(q0, p0, F, OMEGA, PSI, xi_max=XI, cycles=cycles, grid=False, threads=1)
+    assert np.isinf(det.escape_cycle_energy).all(), "a deterministic trajectory escaped: steps not exact"
+
+    def deterministic():
+        return escape_chart(q0, p0, F, OMEGA, PSI, xi_max=XI, cycles=cycles, grid=False, threads=1)
+
+    code, sc = quartic_code(), scheme_code("srkn6b")
+    coef, tab = schemes.lane_coefficients([OMEGA], S), schemes.sine_table(S, PSI)
+
+    def noisy():
+        return noise_kernels.escape_steps(code, sc, q0, p0, 1, coef, tab, F, 2 * XI, cycles,
+                                          noise_amplitude(SIGMA, h), 7)
+    assert (noisy() < 0).all(), "a noisy path escaped: steps not exact"
+
+    def em():
+        return euler_maruyama(q0, p0, F, OMEGA, h, SIGMA, 2 * XI, cycles * S, 7)
+    assert (em() < 0).all(), "an Euler-Maruyama path escaped: steps not exact"
+    t_det, t_noise, t_em = best([deterministic, noisy, em])
+
+    r_det, r_noise, r_em = steps / t_det, steps / t_noise, steps / t_em
+    print(f"machine: {machine()}; one thread; {n} trajectories x {cycles} cycles x {S} steps")
+    print(f"deterministic engine (SRKN6b)      : {r_det:.3e} trajectory-steps/s")
+    print(f"noisy ensemble (SRKN6b + Philox)   : {r_noise:.3e} trajectory-steps/s")
+    print(f"numba Euler-Maruyama (weak order 1): {r_em:.3e} trajectory-steps/s")
+    print(f"noisy / deterministic = {r_noise / r_det:.3f} (target >= 0.5); noisy / Euler-Maruyama = "
+          f"{r_noise / r_em:.3f} per step")
+    report("noise_vs_deterministic", round(r_noise / r_det, 3), "noisy / deterministic trajectory-steps per second",
+           f"{n} x {cycles} cycles x {S} steps, one thread")
+    report("noise_vs_euler_maruyama_per_step", round(r_noise / r_em, 3),
+           "noisy ensemble / numba Euler-Maruyama trajectory-steps per second (per step, not at equal accuracy)",
+           f"{n} x {cycles} cycles x {S} steps, one thread")
+
+
+if __name__ == "__main__":
+    main()
