@@ -24,7 +24,7 @@ import numba
 import numpy as np
 from numba import njit
 
-from _report import machine, report  # noqa: E402  (benchmarks/ is on sys.path)
+from _report import machine, report
 
 from safebasins.numerics import escape_chart, noise_kernels, schemes
 from safebasins.numerics.noise import noise_amplitude
@@ -37,13 +37,13 @@ F, OMEGA, PSI, XI, SIGMA, S = 0.02, 0.8, 0.0, 0.25, 0.002, 32
 @njit(cache=True)
 def euler_maruyama(q0, p0, F, Omega, h, sigma, xi2, n_steps, seed):
     """Symplectic Euler-Maruyama for every path; first step beyond 2 H0 > xi2 or |q| > 1 (-1: none)."""
-    np.random.seed(seed)
+    np.random.seed(seed)  # noqa: NPY002  (numba compiles the legacy global generator, per thread)
     out = np.full(q0.size, -1, np.int64)
     sh = sigma * math.sqrt(h)
     for j in range(q0.size):
         q, p = q0[j], p0[j]
         for n in range(n_steps):
-            p += h * (q * q * q - q + F * math.sin(Omega * n * h)) + sh * np.random.standard_normal()
+            p += h * (q * q * q - q + F * math.sin(Omega * n * h)) + sh * np.random.standard_normal()  # noqa: NPY002
             q += h * p
             if p * p + q * q - 0.5 * q ** 4 > xi2 or abs(q) > 1.0:
                 out[j] = n + 1
