@@ -71,7 +71,10 @@ def wilson_interval(k: npt.ArrayLike, n: int, z: float = WILSON_Z) -> tuple[np.n
     z2 = z * z
     centre = (p + z2 / (2 * n)) / (1 + z2 / n)
     half = z / (1 + z2 / n) * np.sqrt(p * (1 - p) / n + z2 / (4 * n * n))
-    return np.clip(centre - half, 0.0, 1.0), np.clip(centre + half, 0.0, 1.0)
+    # the ends are exactly 0 at k = 0 and 1 at k = n (the rounding of centre -+ half is not)
+    low = np.where(kk == 0, 0.0, np.clip(centre - half, 0.0, 1.0))
+    high = np.where(kk == n, 1.0, np.clip(centre + half, 0.0, 1.0))
+    return low, high
 
 
 def _check_seed(seed: object) -> int:

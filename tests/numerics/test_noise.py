@@ -1,0 +1,163 @@
+"""numerics.escape_probability and its kernels: noise = 0 is escape_chart bitwise, the paths do
+not depend on threads, lanes or order (counter-based streams), the Gaussian pairs are standard
+normal, the dataset's statistics follow from the escape times, and bad input is refused by name."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from safebasins.numerics import escape_chart, noise_kernels, schemes
+from safebasins.numerics.noise import escape_probability, wilson_interval
+from safebasins.numerics.scheme_code import scheme_code
+from safebasins.wells.compiled import quartic_code
+
+Q = np.linspace(-0.6, 0.6, 9)
+P = np.linspace(-0.5, 0.5, 7)
+FORCING = dict(F=0.04, Omega=0.9, Psi=0.3)
+
+
+@pytest.mark.parametrize("damping", [0.0, 0.02])
+def test_zero_noise_is_escape_chart_bitwise(damping):
+    """sigma = 0: every path is the engine's trajectory (the half kicks add exact zeros), so the
+    escape cycles are escape_chart's, bit for bit, for every path and seed."""
+    chart = escape_chart(Q, P, **FORCING, xi_max=0.2, cycles=40, damping=damping)
+    want = np.minimum(chart.escape_cycle_energy.isel(xi_max=0).values, 40.0)
+    assert np.isinf(want).any() is np.False_ and (want == 40).any() and ((want > 0) & (want < 40)).any()
+    ds = escape_probability(Q, P, **FORCING, noise=0.0, paths=1, xi_max=0.2, t_eval=[40], cycles=40, damping=damping,
+                            seed=5)
+    np.testing.assert_array_equal(ds.first_passage_mean.values, want)
+    np.testing.assert_array_equal(ds.censored_fraction.values, np.isinf(chart.escape_cycle_energy[0]).values)
+    three = escape_probability(Q, P, **FORCING, noise=0.0, paths=3, xi_max=0.2, t_eval=[10, 40], cycles=40,
+                               damping=damping, seed=9)
+    for t in (10, 40):
+        np.testing.assert_array_equal(three.P_escape.sel(t_eval=t).values,
+                                      (chart.escape_cycle_energy[0] <= t).values.astype(float))
+
+
+def _kernel_run(n_tasks, lanes, n_paths=37, seed=11):
+    code, sc = quartic_code(), scheme_code("srkn6b", True)
+    coef = schemes.lane_coefficients([0.9], 16, "srkn6b", 0.05)
+    tab = schemes.sine_table(16, 0.0)
+    q0, p0 = np.array([0.0, 0.3, -0.5, 0.9]), np.array([0.0, 0.1, 0.2, 0.5])
+    return noise_kernels.escape_steps(code, sc, q0, p0, n_paths, coef, tab, 0.03, 0.4, 30, 0.02, seed, shift=0.01,
+                                      n_tasks=n_tasks, lanes=lanes)
+
+
+def test_paths_do_not_depend_on_tasks_lanes_or_order():
+    """Counter-based streams: the first-passage steps are the same for 1 or 3 tasks and 256 or 7
+    lanes (lanes refilled and compacted at other moments); a path's steps do not depend on how
+    many paths are run (path m of IC i is the same path in a longer run)."""
+    ref = _kernel_run(1, 256)
+    assert (ref > 0).any() and (ref < 0).any()
+    np.testing.assert_array_equal(_kernel_run(3, 7), ref)
+    np.testing.assert_array_equal(_kernel_run(2, 64), ref)
+    np.testing.assert_array_equal(_kernel_run(1, 256, n_paths=50)[:, :37], ref)
+    assert not np.array_equal(_kernel_run(1, 256, seed=12), ref)
+    kw = dict(noise=0.03, paths=40, xi_max=0.2, t_eval=[5, 20], damping=0.05, seed=3)
+    a = escape_probability(Q, P, **FORCING, threads=1, **kw)
+    b = escape_probability(Q, P, **FORCING, threads=2, **kw)
+    for v in ("P_escape", "survival", "first_passage_mean"):
+        np.testing.assert_array_equal(a[v].values, b[v].values)
+
+
+def test_gaussian_pairs_are_independent_standard_normals():
+    """Box-Muller pairs of the Philox blocks: mean, variance, skewness, kurtosis and the pair's
+    correlation within 5 standard errors; Kolmogorov-Smirnov against N(0, 1) (p > 1e-4); distinct
+    (step, path, ic) give distinct numbers."""
+    n = 200_000
+    k = np.arange(n)
+    z = noise_kernels.gaussian_pairs(2026, k % 1000, k // 1000, np.full(n, 3))
+    x = z.ravel()
+    se = 1 / math.sqrt(x.size)
+    assert abs(x.mean()) < 5 * se
+    assert abs(x.var() - 1) < 5 * math.sqrt(2) * se
+    assert abs(stats.skew(x)) < 5 * math.sqrt(6) * se
+    assert abs(stats.kurtosis(x)) < 5 * math.sqrt(24) * se
+    assert abs(np.corrcoef(z[:, 0], z[:, 1])[0, 1]) < 5 / math.sqrt(n)
+    assert stats.kstest(x, "norm").pvalue > 1e-4
+    assert np.unique(x).size == x.size
+    again = noise_kernels.gaussian_pairs(2026, k[:10] % 1000, k[:10] // 1000, np.full(10, 3))
+    np.testing.assert_array_equal(again, z[:10])
+
+
+def test_sincos_2pi_accuracy():
+    """sin, cos(2 pi u) of the Box-Muller angle within 3e-16 (absolute) of numpy's at the
+    quadrant edges and at random u."""
+    from numba import njit
+
+    @njit
+    def both(u, s, c):
+        for j in range(u.size):
+            s[j], c[j] = noise_kernels._sincos_2pi(u[j])
+
+    u = np.concatenate([np.random.default_rng(0).random(20000), np.arange(0, 9) / 8, [2.0 ** -53, 1 - 2.0 ** -53]])
+    s, c = np.empty_like(u), np.empty_like(u)
+    both(u, s, c)
+    # numpy's sin(2 pi u) carries the rounding of 2 pi u (<= 4.5e-16 here): compare in long double
+    x = 2 * np.pi * u.astype(np.longdouble)
+    assert np.abs(s - np.sin(x)).max() < 6e-16
+    assert np.abs(c - np.cos(x)).max() < 6e-16
+
+
+def test_dataset_statistics_follow_from_the_escape_times():
+    ds = escape_probability([0.0, 0.3], [0.0, 0.1], F=0.03, Omega=0.9, Psi=0.0, noise=0.04, paths=300, xi_max=0.2,
+                            t_eval=[2, 5, 10, 25], cycles=25, damping=0.05, seed=1, grid=False)
+    Pe = ds.P_escape.values
+    assert Pe.shape == (2, 4) and (np.diff(Pe, axis=1) >= 0).all() and 0 < Pe[0, -1] < 1
+    low, high = wilson_interval(Pe * 300, 300)
+    np.testing.assert_allclose(ds.P_escape_low.values, low)
+    assert (ds.P_escape_low.values <= Pe).all() and (Pe <= ds.P_escape_high.values).all()
+    # survival on every cycle 0..25 is 1 - P_escape at the same times
+    np.testing.assert_allclose(ds.survival.sel(t_survival=[2.0, 5.0, 10.0, 25.0]).values, 1 - Pe)
+    assert ds.survival.values[:, 0].tolist() == [1.0, 1.0]
+    # the restricted mean is the integral of the survival curve (to the survival grid's
+    # resolution of one cycle: the curve is a step function between cycles)
+    integral = ds.survival.integrate("t_survival").values
+    assert np.all(np.abs(ds.first_passage_mean.values - integral) < 0.5 + 1e-12)
+    np.testing.assert_allclose(ds.censored_fraction.values, 1 - Pe[:, -1])
+    assert ds.attrs["noise"] == 0.04 and ds.attrs["seed"] == 1 and ds.attrs["paths"] == 300
+    assert "Philox" in ds.attrs["random_numbers"] and "Gobet" in ds.attrs["boundary_correction"]
+    assert ds.P_escape.attrs["units"] == "1" and "Wilson" in ds.P_escape_low.attrs["long_name"]
+
+
+def test_wilson_interval_closed_form():
+    """k = 0 of n: (0, z^2 / (n + z^2)); k = n: (n / (n + z^2), 1); a middle value against the
+    textbook formula written out."""
+    z = 1.959963984540054
+    lo, hi = wilson_interval([0, 20, 7], 20)
+    assert lo[0] == 0.0 and math.isclose(hi[0], z * z / (20 + z * z))
+    assert hi[1] == 1.0 and math.isclose(lo[1], 20 / (20 + z * z))
+    p, n = 7 / 20, 20
+    c = (p + z * z / (2 * n)) / (1 + z * z / n)
+    d = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    assert math.isclose(lo[2], c - d) and math.isclose(hi[2], c + d)
+
+
+GOOD = dict(noise=0.05, paths=10, xi_max=0.2, t_eval=[5])
+
+
+@pytest.mark.parametrize("change,name", [
+    (dict(noise=-0.1), "noise"), (dict(noise=float("nan")), "noise"), (dict(noise=[0.1, 0.2]), "noise"),
+    (dict(paths=0), "paths"), (dict(paths=2.5), "paths"), (dict(xi_max=0.3), "xi_max"), (dict(xi_max=-1), "xi_max"),
+    (dict(t_eval=[-1]), "t_eval"), (dict(t_eval=[20], cycles=10), "t_eval"), (dict(t_eval=[]), "t_eval"),
+    (dict(seed=-1), "seed"), (dict(seed=2 ** 63), "seed"), (dict(seed=1.5), "seed"), (dict(seed=True), "seed"),
+    (dict(correction="bridge"), "correction"), (dict(backend="cuda"), "backend"), (dict(damping=-0.1), "damping"),
+    (dict(cycles=0), "cycles"), (dict(steps_per_cycle=2), "steps_per_cycle"), (dict(threads=0), "threads"),
+    (dict(integrator="euler"), "integrator"),
+])
+def test_bad_input_is_refused_by_name(change, name):
+    kw = {**GOOD, **change}
+    with pytest.raises(ValueError, match=f"^{name}"):
+        escape_probability([0.0], [0.0], 0.05, 0.9, 0.0, **kw)
+
+
+@pytest.mark.parametrize("args,name", [(([0.0], [0.0], -0.1, 0.9, 0.0), "F"), (([0.0], [0.0], 0.1, 0.0, 0.0), "Omega"),
+                                       (([0.0], [0.0], 0.1, 0.9, math.inf), "Psi"),
+                                       (([[0.0, 1.0]], [0.0], 0.1, 0.9, 0.0), "q0 and p0"),
+                                       (([math.nan], [0.0], 0.1, 0.9, 0.0), "q0")])
+def test_bad_equation_is_refused_by_name(args, name):
+    with pytest.raises(ValueError, match=f"^{name}"):
+        escape_probability(*args, **GOOD)
