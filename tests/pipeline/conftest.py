@@ -26,7 +26,8 @@ def quick(tmp_path_factory):
         if not record.exists():
             make_sandbox(wd)
             t0 = time.perf_counter()
-            r = run_snakemake(wd, "-j2", "--keep-going", "all")
+            # the timeout only stops a hung run: 13 min here, slower CI machines take longer
+            r = run_snakemake(wd, "-j2", "--keep-going", "all", timeout=3600)
             print(f"\nquick run (all, -j2): {time.perf_counter() - t0:.1f} s")
             record.write_text(json.dumps({"args": r.args, "returncode": r.returncode, "stdout": r.stdout,
                                           "stderr": r.stderr}))

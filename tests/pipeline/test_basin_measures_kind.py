@@ -8,7 +8,6 @@ import xarray as xr
 
 from safebasins.pipeline.config import ConfigError
 from safebasins.pipeline.plan import plan
-from tests.pipeline.sandbox import make_sandbox, run_snakemake
 from tests.pipeline.test_config import base, merged  # noqa: F401  (the fixture)
 
 NAMES = ("damped_escape_measures", "damped_quartic_measures")
@@ -39,9 +38,8 @@ def test_refused_naming_the_key(base, override, key):
 
 
 @pytest.mark.pipeline
-def test_quick_run_builds_the_figures(tmp_path):
-    wd = make_sandbox(tmp_path / "wd")
-    res = run_snakemake(wd, "-j2", *(f"results/figures/{n}.png" for n in NAMES))
+def test_quick_run_builds_the_figures(quick):
+    wd, res = quick      # the shared quick run of `all` (tests/pipeline/conftest.py) builds them
     assert res.returncode == 0, res.stderr[-3000:]
     for name in NAMES:
         ds = xr.open_dataset(wd / f"results/data/extras/{name}.nc")

@@ -7,7 +7,6 @@ import xarray as xr
 
 from safebasins.pipeline.cost import DAMPED_BASIN_EVALUATIONS, analytic_cost
 from safebasins.pipeline.plan import plan
-from tests.pipeline.sandbox import make_sandbox, run_snakemake
 from tests.pipeline.test_config import base, merged  # noqa: F401  (the fixture)
 
 NAME = "damped_quartic_basins"
@@ -31,9 +30,8 @@ def test_basin_chart_with_zero_damping_is_the_undamped_experiment(base):
 
 
 @pytest.mark.pipeline
-def test_quick_run_builds_the_damped_figure(tmp_path):
-    wd = make_sandbox(tmp_path / "wd")
-    res = run_snakemake(wd, "-j2", f"results/figures/{NAME}.png")
+def test_quick_run_builds_the_damped_figure(quick):
+    wd, res = quick      # the shared quick run of `all` (tests/pipeline/conftest.py) builds it
     assert res.returncode == 0, res.stderr[-3000:]
     basin = xr.open_dataset(wd / f"results/data/analytic/basin_{NAME}.nc")
     chart = xr.open_dataset(wd / f"results/data/numeric/chart_{NAME}.nc")

@@ -8,7 +8,6 @@ import xarray as xr
 
 from safebasins.pipeline.config import ConfigError
 from safebasins.pipeline.plan import plan
-from tests.pipeline.sandbox import make_sandbox, run_snakemake
 from tests.pipeline.test_config import base, merged  # noqa: F401  (the fixture)
 
 NAME = "damped_escape_saddle"
@@ -36,9 +35,8 @@ def test_refused_naming_the_key(base, override, key):
 
 
 @pytest.mark.pipeline
-def test_quick_run_builds_the_figure(tmp_path):
-    wd = make_sandbox(tmp_path / "wd")
-    res = run_snakemake(wd, "-j2", f"results/figures/{NAME}.png")
+def test_quick_run_builds_the_figure(quick):
+    wd, res = quick      # the shared quick run of `all` (tests/pipeline/conftest.py) builds it
     assert res.returncode == 0, res.stderr[-3000:]
     ds = xr.open_dataset(wd / f"results/data/extras/{NAME}.nc")
     assert ds["escape_cycle"].dims == ("F", "q0", "p0") and ds.attrs["damping"] > 0
