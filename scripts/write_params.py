@@ -1,4 +1,4 @@
 """Rule `parameters`: one experiment's resolved parameters (results/params/{experiment}.yaml)."""
-from safebasins.pipeline.runtime import write_params
+from safebasins.pipeline.params_file import write_params
 
 write_params(snakemake)

@@ -15,7 +15,7 @@ from safebasins.pipeline import catalog
 from safebasins.pipeline.config import REPO_ROOT, ConfigError, build_schema, load_yaml, validate_config
 from safebasins.pipeline.plan import plan
 from safebasins.pipeline.registry import KINDS
-from safebasins.pipeline.runtime import dump_params
+from safebasins.pipeline.params_file import dump_params
 from safebasins.pipeline.values import range_values, tile_slice
 from safebasins.io.datasets import params_hash
 

@@ -18,7 +18,6 @@ Compare datasets by content with :mod:`safebasins.io.compare`, never by file byt
 from __future__ import annotations
 
 import datetime as _dt
-import hashlib
 import json
 from pathlib import Path
 from typing import Any
@@ -30,6 +29,7 @@ from safebasins.core.cf import INSTITUTION, REFERENCE, annotate
 from safebasins.core.provenance import git_commit
 from safebasins.core.version import __version__
 from safebasins.io import netcdf
+from safebasins.io.params import params_hash
 from safebasins.wells import spec_attrs
 
 
@@ -115,11 +115,6 @@ def write_netcdf(ds: xr.Dataset, path: Any) -> Path:
     """Write `ds` to netCDF4 (zlib) atomically (:func:`safebasins.io.netcdf.write`: no half file
     survives a failure; a full disk is a :class:`~safebasins.io.netcdf.NetCDFFileError` naming the file)."""
     return netcdf.write(ds, path, format="NETCDF4", engine="netcdf4", encoding=_encoding(ds))
-
-
-def params_hash(params: dict) -> str:
-    """SHA-256 of the canonical JSON of one experiment's resolved parameters."""
-    return hashlib.sha256(json.dumps(params, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
 
 
 def load(path: Any) -> xr.Dataset:

@@ -1,6 +1,6 @@
 """What the rule scripts call: one function per generic rule (``scripts/*.py`` stay thin).
 
-* :func:`write_params` -- rule ``parameters``: ``results/params/<experiment>.yaml``;
+* rule ``parameters`` (``results/params/<experiment>.yaml``): :mod:`safebasins.pipeline.params_file`;
 * :func:`make_dataset` -- rules ``analytic``, ``numeric``, ``extras``: the product of the
   registry that the output path names is built from its inputs (with ``numerics.tiles`` = 0 a
   product reading charts integrates its experiment's chart tasks itself), given CF/provenance
@@ -14,10 +14,8 @@ know the kinds.
 """
 from __future__ import annotations
 
-import json
 import os
 import sys
-from pathlib import Path
 
 import numba
 import yaml
@@ -50,26 +48,6 @@ def set_threads(n):
 def load_params(path) -> dict:
     with open(path) as fh:
         return yaml.safe_load(fh)
-
-
-def dump_params(params: dict) -> str:
-    return yaml.safe_dump(params, sort_keys=False, default_flow_style=None, width=100)
-
-
-def write_params(smk):
-    """Rule ``parameters``: write one experiment's resolved parameters atomically."""
-    from safebasins.io.datasets import params_hash
-    from safebasins.io.files import atomic_path
-
-    params = json.loads(smk.params.spec)
-    path = Path(smk.output[0])
-    text = (f"# Resolved parameters of {params['experiment']} ({params['kind']}), generated from the\n"
-            "# configuration by the `parameters` rule; edit config/config.yaml, not this file.\n"
-            + dump_params(params))
-    with atomic_path(path) as tmp:
-        tmp.write_text(text)
-    Path(smk.log[0]).parent.mkdir(parents=True, exist_ok=True)
-    Path(smk.log[0]).write_text(f"wrote {path} (params sha256 {params_hash(params)})\n")
 
 
 def _job(smk):
