@@ -155,7 +155,7 @@ def _escape_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks
     literally(rng)
     S = FS.shape[0]
     w = wtuple(wpar)
-    c = coefs(scheme, coef[0])  # type: ignore[no-untyped-call]  # (numba overloads: untyped)
+    c = coefs(scheme, coef[0])
     N = q0.shape[0] * n_paths
     total = np.int64(cycles) * S
     L = np.int64(lanes)
@@ -206,11 +206,11 @@ def _escape_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks
         if nact == 0:
             break
         for s in range(S):
-            f = row(scheme, FS, s)  # type: ignore[no-untyped-call]  # (as coefs)
+            f = row(scheme, FS, s)
             for l in range(nact):
                 n = BASE[l] + s
                 z1, z2 = _gauss2(k0, k1, n, PATH[l], IC[l])
-                q, p = step(scheme, well, w, Q[l], fma(amp, z1, P[l]), c, f)  # type: ignore[no-untyped-call]
+                q, p = step(scheme, well, w, Q[l], fma(amp, z1, P[l]), c, f)
                 p = fma(amp, z2, p)
                 Q[l] = q
                 P[l] = p
@@ -231,7 +231,7 @@ def _final_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks:
     literally(rng)
     S = FS.shape[0]
     w = wtuple(wpar)
-    c = coefs(scheme, coef[0])  # type: ignore[no-untyped-call]  # (numba overloads: untyped)
+    c = coefs(scheme, coef[0])
     N = q0.shape[0] * n_paths
     for j in range(task, N, n_tasks):
         i = j // n_paths
@@ -240,8 +240,8 @@ def _final_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks:
         p = p0[i]
         for n in range(n_steps):
             z1, z2 = _gauss2(k0, k1, n, m, i)
-            f = row(scheme, FS, n % S)  # type: ignore[no-untyped-call]  # (as coefs)
-            q, p = step(scheme, well, w, q, fma(amp, z1, p), c, f)  # type: ignore[no-untyped-call]
+            f = row(scheme, FS, n % S)
+            q, p = step(scheme, well, w, q, fma(amp, z1, p), c, f)
             p = fma(amp, z2, p)
         qo[j] = q
         po[j] = p
