@@ -13,16 +13,22 @@ reuses a kernel cached before it.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 import numpy as np
-from numba import njit
+from numba import njit, types
 from numba.extending import overload
 
-from safebasins.numerics.steps import cpu_helpers, cpu_lane, cpu_step, literal_scheme, wtuple
-from safebasins.wells.compiled import literal_code, cpu_functions
+from safebasins.numerics.steps import Floats, Int, Lane, Step, cpu_helpers, cpu_lane, cpu_step, literal_scheme, wtuple
+from safebasins.wells.compiled import Coefs, literal_code, cpu_functions
+
+#: ``energy2(w, q, p)``: 2 H0 of a well (w: its coefficients)
+Energy2 = Callable[[Coefs, float, float], float]
 
 
 @njit(cache=True, inline="always")
-def _keep_abs(l, q, p, e, Q, P, ME, MQ):
+def _keep_abs(l: Int, q: float, p: float, e: float, Q: Floats, P: Floats, ME: Floats, MQ: Floats) -> None:
     """Store lane l's new state and update its maxima of 2*H0 (e) and |q| (branch free; NaN wins,
     so that a NaN or inf state is detected as beyond every threshold at the period boundary)."""
     Q[l] = q
@@ -35,7 +41,7 @@ def _keep_abs(l, q, p, e, Q, P, ME, MQ):
 
 
 @njit(cache=True, inline="always")
-def _maxima_signed(l, q, e, ME, MQ, MN):
+def _maxima_signed(l: Int, q: float, e: float, ME: Floats, MQ: Floats, MN: Floats) -> None:
     """Update lane l's maxima of 2*H0 (e), q and -q (branch free; NaN wins)."""
     m = ME[l]
     ME[l] = e if not e <= m else m       # a NaN state propagates: it counts as a crossing
@@ -47,7 +53,7 @@ def _maxima_signed(l, q, e, ME, MQ, MN):
 
 
 @njit(cache=True, inline="always")
-def _reset(n, ME, MQ, MN, signed):
+def _reset(n: Int, ME: Floats, MQ: Floats, MN: Floats, signed: bool) -> None:
     for l in range(n):
         ME[l] = -np.inf
         MQ[l] = -np.inf
@@ -56,7 +62,8 @@ def _reset(n, ME, MQ, MN, signed):
             MN[l] = -np.inf
 
 
-def _arithmetic(scheme, well):
+def _arithmetic(scheme: types.Type,
+                well: types.Type) -> tuple[dict[str, Callable[..., Any]], bool, Step, Energy2, Lane]:
     """(helpers, abs_tracking, STEP, ENERGY2, LANE) of the literal scheme and kernel key: the
     scheme's tuple helpers, the code's step and energy compiled for the CPU lanes (njit
     inline="always") and the lane's coefficients (``LANE(l, HL, CL)``: formed from its step h =
@@ -70,7 +77,8 @@ def _arithmetic(scheme, well):
             cpu_lane(sc.key))
 
 
-def _period_shared_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
+def _period_shared_body(scheme: int, well: int, wpar: Floats, M: Int, Q: Floats, P: Floats, ME: Floats, MQ: Floats,
+                        MN: Floats, c: Floats, FS: Floats, s0: Int, s1: Int) -> None:
     """Steps [s0, s1) of the forcing period for lanes [0, 4M), all sharing one parameter set
     (coefficients c, scaled forcing table FS); ME, MQ (, MN) = the maxima over these steps.
     scheme and well are compile-time constants: one specialised loop per scheme and well.
@@ -86,12 +94,15 @@ def _period_shared_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
     raise NotImplementedError("compiled code (numba)")
 
 
+# Any on an overload's typing function and its implementation alike (see steps._ol_step)
 @overload(_period_shared_body)
-def _ol_period_shared_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
+def _ol_period_shared_body(scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, ME: Any, MQ: Any, MN: Any,
+                           c: Any, FS: Any, s0: Any, s1: Any) -> Callable[..., None]:
     H, ABS, STEP, ENERGY2, _ = _arithmetic(scheme, well)
     COEFS, ROW = H["coefs"], H["row"]
     if ABS:
-        def impl(scheme, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
+        def impl(scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, ME: Any, MQ: Any, MN: Any,
+                 c: Any, FS: Any, s0: Any, s1: Any) -> None:
             cc = COEFS(c)
             w = wtuple(wpar)
             _reset(4 * M, ME, MQ, MN, False)
@@ -111,7 +122,8 @@ def _ol_period_shared_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s
                     _keep_abs(l2, q2, p2, ENERGY2(w, q2, p2), Q, P, ME, MQ)
                     _keep_abs(l3, q3, p3, ENERGY2(w, q3, p3), Q, P, ME, MQ)
     else:
-        def impl(scheme, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s1):
+        def impl(scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, ME: Any, MQ: Any, MN: Any,
+                 c: Any, FS: Any, s0: Any, s1: Any) -> None:
             cc = COEFS(c)
             w = wtuple(wpar)
             n = 4 * M
@@ -141,7 +153,8 @@ def _ol_period_shared_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, c, FS, s0, s
     return impl
 
 
-def _period_lanes_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, HL, CL, FL, sintab, s0, s1):
+def _period_lanes_body(scheme: int, well: int, wpar: Floats, M: Int, Q: Floats, P: Floats, ME: Floats, MQ: Floats,
+                       MN: Floats, HL: Floats, CL: Floats, FL: Floats, sintab: Floats, s0: Int, s1: Int) -> None:
     """As _period_shared_body for lanes [0, 4M) with per-lane parameters: step h = HL[l] (damped
     schemes: the coefficient column CL[:, l]) and amplitude F = FL[l].  The undamped
     coefficients h*c_k and the forcing values F*sin_k are formed in the loop: the same IEEE
@@ -152,12 +165,14 @@ def _period_lanes_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, HL, CL, FL, sint
 
 
 @overload(_period_lanes_body)
-def _ol_period_lanes_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, HL, CL, FL, sintab, s0, s1):
+def _ol_period_lanes_body(scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, ME: Any, MQ: Any, MN: Any,
+                          HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any, s1: Any) -> Callable[..., None]:
     H, ABS, STEP, ENERGY2, LANE = _arithmetic(scheme, well)
     ROW, SCALED = H["row"], H["scaled"]
     SIGNED = not ABS
 
-    def impl(scheme, well, wpar, M, Q, P, ME, MQ, MN, HL, CL, FL, sintab, s0, s1):
+    def impl(scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, ME: Any, MQ: Any, MN: Any,
+             HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any, s1: Any) -> None:
         n = 4 * M
         w = wtuple(wpar)
         _reset(n, ME, MQ, MN, SIGNED)
