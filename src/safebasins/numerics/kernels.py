@@ -56,7 +56,7 @@ from numba.extending import overload
 
 from safebasins.numerics.periods import _period_lanes_body, _period_shared_body
 from safebasins.numerics.scheme_code import SchemeCode, scheme_code
-from safebasins.numerics.steps import coefs, is_damped, scaled_row, step, wtuple
+from safebasins.numerics.steps import Floats, Int, Ints, coefs, is_damped, scaled_row, step, wtuple
 from safebasins.wells.compiled import WellCode, abs_tracking, quartic_code, well_energy2
 
 # smallest lane segment of the 4-chain vector loop (lanes run: 4 * segment)
@@ -68,7 +68,8 @@ SEGMENTS = 4
 # not cached on disk by itself: keyed by the well alone, its cache would not see an edit of steps.py;
 # it is compiled into the cached kernels that call it (their scheme key hashes the engine)
 @njit
-def _check_state(well, wpar, i, q, p, step, thrE2, thrLo, thrHi, iE, iQ, outE, outQ):
+def _check_state(well: int, wpar: Floats, i: Int, q: float, p: float, step: Int, thrE2: Floats, thrLo: Floats,
+                 thrHi: Floats, iE: Int, iQ: Int, outE: Ints, outQ: Ints) -> tuple[Int, Int]:
     """Record, at `step`, every next-uncrossed threshold the state (q, p) is beyond."""
     e = well_energy2(well, wtuple(wpar), q, p)
     nE = thrE2.shape[0]
@@ -95,12 +96,13 @@ def _check_state(well, wpar, i, q, p, step, thrE2, thrLo, thrHi, iE, iQ, outE, o
 
 
 @njit(cache=True, inline="always")
-def _finished(iE, iQ, nE, nQ, stop_any):
+def _finished(iE: Int, iQ: Int, nE: int, nQ: int, stop_any: bool) -> bool | np.bool_:
     return (iE == nE and iQ == nQ) or (stop_any and (iE > 0 or iQ > 0))
 
 
 @njit(cache=True, inline="always")
-def _filters(well, wpar, iE, iQ, thrE2, thrLo, thrHi):
+def _filters(well: int, wpar: Floats, iE: Int, iQ: Int, thrE2: Floats, thrLo: Floats,
+             thrHi: Floats) -> tuple[float, float, float]:
     """(tE, tQ, tN): the lane's next uncrossed 2 xi_max, and the levels its max q (|q| tracking:
     max |q|) and max -q must exceed to cross its next uncrossed bound or, while an energy
     threshold is uncrossed, a barrier (inf: none)."""
@@ -122,8 +124,9 @@ def _filters(well, wpar, iE, iQ, thrE2, thrLo, thrHi):
 
 
 @njit(cache=True)
-def _replay(scheme, well, wpar, i, q, p, period, s0, s1, sintab, c, F, thrE2, thrLo, thrHi, iE, iQ, outE, outQ,
-            stop_any):
+def _replay(scheme: int, well: int, wpar: Floats, i: Int, q: float, p: float, period: Int, s0: Int, s1: Int,
+            sintab: Floats, c: Floats, F: float, thrE2: Floats, thrLo: Floats, thrHi: Floats, iE: Int, iQ: Int,
+            outE: Ints, outQ: Ints, stop_any: bool) -> tuple[Int, Int]:
     """Scalar replay of steps [s0, s1) of a period from the state before step s0 (same
     arithmetic as the vector loop); records the step of first crossing of every threshold
     crossed there."""
@@ -142,8 +145,10 @@ def _replay(scheme, well, wpar, i, q, p, period, s0, s1, sintab, c, F, thrE2, th
 
 
 @njit(cache=True, nogil=True)
-def _run_task(well, scheme, shared, wpar, task, n_tasks, lanes, q0, p0, pidx, coef, hpar, Fpar, sintab, thrE2, thrLo,
-              thrHi, cycles, stop_any, outE, outQ, store, do_store):
+def _run_task(well: int, scheme: int, shared: bool, wpar: Floats, task: int, n_tasks: int, lanes: int, q0: Floats,
+              p0: Floats, pidx: Ints, coef: Floats, hpar: Floats, Fpar: Floats, sintab: Floats, thrE2: Floats,
+              thrLo: Floats, thrHi: Floats, cycles: int, stop_any: bool, outE: Ints, outQ: Ints, store: Floats,
+              do_store: bool) -> None:
     """Trajectories task, task + n_tasks, ... (one thread): the lane machinery of the module
     docstring.  `well` is the kernel key of a compiled well, `scheme` the key of a scheme code and
     `shared` whether all trajectories share one parameter set (``coef.shape[0] == 1``: the
@@ -157,7 +162,7 @@ def _run_task(well, scheme, shared, wpar, task, n_tasks, lanes, q0, p0, pidx, co
     S = sintab.shape[0]
     nE = thrE2.shape[0]
     nQ = thrHi.shape[0]
-    L = np.int64(lanes)
+    L: Int = np.int64(lanes)
     # every array np.zeros: np.empty would be one more numba overload to compile (the cost is nil)
     Lmem = max(L, 4 * MIN_SEGMENT) + 32       # room for the padded segments
     Q = np.zeros(Lmem)
@@ -195,11 +200,11 @@ def _run_task(well, scheme, shared, wpar, task, n_tasks, lanes, q0, p0, pidx, co
 
     zero = np.int64(0)
     nxt = np.int64(task)
-    nact = np.int64(0)
+    nact: Int = np.int64(0)
     ndone = np.int64(0)        # lanes finished at the last period boundary
     while True:
         # ---------------------------------------------------- fill empty / finished lanes
-        l = np.int64(0)
+        l: Int = np.int64(0)
         if ndone == 0 and (nact == L or nxt >= N):
             l = nact           # nothing to refill or compact: skip the scan
         while l < nact or (l == nact and nact < L and nxt < N):
@@ -317,7 +322,9 @@ def _run_task(well, scheme, shared, wpar, task, n_tasks, lanes, q0, p0, pidx, co
             done[l] = d
 
 
-def _period(shared, scheme, well, wpar, M, Q, P, ME, MQ, MN, coef, FS, HL, CL, FL, sintab, s0, s1):
+def _period(shared: bool, scheme: int, well: int, wpar: Floats, M: Int, Q: Floats, P: Floats, ME: Floats, MQ: Floats,
+            MN: Floats, coef: Floats, FS: Floats, HL: Floats, CL: Floats, FL: Floats, sintab: Floats, s0: Int,
+            s1: Int) -> None:
     """Steps [s0, s1) of the period: ``_period_shared`` (one parameter set, coef[0] and the
     scaled table FS) when the literal ``shared`` is True, else ``_period_lanes`` (per lane).
     Their bodies are called directly: each compiled function between the task and the loop is
@@ -325,15 +332,19 @@ def _period(shared, scheme, well, wpar, M, Q, P, ME, MQ, MN, coef, FS, HL, CL, F
     raise NotImplementedError("compiled code (numba)")
 
 
+# Any on an overload's typing function and its implementation alike (see steps._ol_step)
 @overload(_period)
-def _ol_period(shared, scheme, well, wpar, M, Q, P, ME, MQ, MN, coef, FS, HL, CL, FL, sintab, s0, s1):
+def _ol_period(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, ME: Any, MQ: Any, MN: Any,
+               coef: Any, FS: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any, s1: Any) -> Callable[..., None]:
     if not isinstance(shared, types.BooleanLiteral):
         raise errors.TypingError(f"shared must be a compile-time constant (bool literal), got {shared}")
     if shared.literal_value:
-        def impl(shared, scheme, well, wpar, M, Q, P, ME, MQ, MN, coef, FS, HL, CL, FL, sintab, s0, s1):
+        def impl(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, ME: Any, MQ: Any, MN: Any,
+                 coef: Any, FS: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any, s1: Any) -> None:
             _period_shared_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, coef[0], FS, s0, s1)
     else:
-        def impl(shared, scheme, well, wpar, M, Q, P, ME, MQ, MN, coef, FS, HL, CL, FL, sintab, s0, s1):
+        def impl(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, ME: Any, MQ: Any, MN: Any,
+                 coef: Any, FS: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any, s1: Any) -> None:
             _period_lanes_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, HL, CL, FL, sintab, s0, s1)
     return impl
 
@@ -420,7 +431,9 @@ def _scheme(scheme: SchemeCode | None, sintab: np.ndarray, coef: np.ndarray) -> 
 
 
 @njit(cache=True, nogil=True)
-def _final_states(well, scheme, wpar, q0, p0, pidx, coef, Fpar, sintab, n_periods, task, n_tasks, qo, po):
+def _final_states(well: int, scheme: int, wpar: Floats, q0: Floats, p0: Floats, pidx: Ints, coef: Floats,
+                  Fpar: Floats, sintab: Floats, n_periods: int, task: int, n_tasks: int, qo: Floats,
+                  po: Floats) -> None:
     literally(well)
     literally(scheme)
     N = q0.shape[0]
