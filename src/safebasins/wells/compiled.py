@@ -416,7 +416,8 @@ def _ir_identity(arg: str, fn: Callable[..., Any]) -> tuple[Callable[..., Any], 
         d = njit(py)
         d.compile((types.float64,))
         ir = d.inspect_llvm((types.float64,))
-        returns = d.overloads[(types.float64,)].signature.return_type
+        # CompileResult is a namedtuple over a field list mypy cannot read
+        returns = d.overloads[(types.float64,)].signature.return_type  # type: ignore[attr-defined]
     except errors.NumbaError as exc:
         head = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise ValueError(f"{arg}: the compiled engines need {arg}(q) as a scalar function numba can compile "
