@@ -8,7 +8,6 @@ from __future__ import annotations
 
 from typing import Any
 
-from safebasins.analysis.boundary_measures import boundary_measures
 from safebasins.pipeline import values
 from safebasins.pipeline.registry import Job, Kind, Product, dataset_path, register
 from safebasins.pipeline.validation import CheckContext
@@ -19,6 +18,8 @@ LABELLED = ("F", "labelling")
 
 def build_measures(params: dict[str, Any], data: dict[str, Any], job: Job) -> Any:
     """One stroboscopic map per F, its labels and their measures."""
+    from safebasins.analysis.boundary_measures import boundary_measures
+
     q0, p0 = values.grid_axes(params["grid"])
     print(f"{params['experiment']}: basin measures at F = {params['F']} on {q0.size} x {p0.size} ICs, "
           f"{params['n_iter']} cycles", flush=True)

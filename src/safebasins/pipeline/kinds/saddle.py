@@ -7,7 +7,6 @@ from __future__ import annotations
 
 from typing import Any
 
-from safebasins.analysis.saddle_chart import saddle_chart
 from safebasins.pipeline import values
 from safebasins.pipeline.registry import Job, Kind, Product, dataset_path, register
 from safebasins.pipeline.validation import CheckContext
@@ -17,6 +16,8 @@ POSITIVE = {"type": "number", "exclusiveMinimum": 0}
 
 def build_saddle(params: dict[str, Any], data: dict[str, Any], job: Job) -> Any:
     """Escape charts, manifolds and orbit at each F; the tangency once."""
+    from safebasins.analysis.saddle_chart import saddle_chart
+
     q0, p0 = values.grid_axes(params["grid"])
     m, t = params["manifolds"], params["tangency"]
     print(f"{params['experiment']}: hilltop saddle's manifolds at F = {params['F']} over {q0.size} x {p0.size} ICs"
