@@ -27,7 +27,6 @@ from numba import njit
 from _report import machine, report
 
 from safebasins.numerics import escape_chart, noise_kernels, schemes
-from safebasins.numerics.noise import noise_amplitude
 from safebasins.numerics.scheme_code import scheme_code
 from safebasins.wells.compiled import quartic_code
 
@@ -86,7 +85,7 @@ def main():
 
     def noisy():
         return noise_kernels.escape_steps(code, sc, q0, p0, 1, coef, tab, F, 2 * XI, cycles,
-                                          noise_amplitude(SIGMA, h), 7)
+                                          noise_kernels.step_noise(SIGMA, h), 7)
     assert (noisy() < 0).all(), "a noisy path escaped: steps not exact"
 
     def em():

@@ -42,7 +42,8 @@ def _kernel_run(n_tasks, lanes, n_paths=37, seed=11):
     coef = schemes.lane_coefficients([0.9], 16, "srkn6b", 0.05)
     tab = schemes.sine_table(16, 0.0)
     q0, p0 = np.array([0.0, 0.3, -0.5, 0.9]), np.array([0.0, 0.1, 0.2, 0.5])
-    return noise_kernels.escape_steps(code, sc, q0, p0, n_paths, coef, tab, 0.03, 0.4, 30, 0.02, seed, shift=0.01,
+    return noise_kernels.escape_steps(code, sc, q0, p0, n_paths, coef, tab, 0.03, 0.4, 30,
+                                      noise_kernels.StepNoise(0.02), seed, shift=0.01,
                                       n_tasks=n_tasks, lanes=lanes)
 
 

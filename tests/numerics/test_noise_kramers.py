@@ -39,7 +39,8 @@ def first_passage_times(beta: float, T: float, seed: int = 3) -> np.ndarray:
     cycles = int(12 * kramers_mfpt(beta, T) / (2 * math.pi))
     steps = noise_kernels.escape_steps(code, sc, np.zeros(1), np.zeros(1), PATHS,
                                        schemes.lane_coefficients([1.0], S, "srkn6b", beta), schemes.sine_table(S, 0.0),
-                                       0.0, math.inf, cycles, math.sqrt(2 * beta * T) * math.sqrt(h / 2), seed,
+                                       0.0, math.inf, cycles, noise_kernels.step_noise(math.sqrt(2 * beta * T), h),
+                                       seed,
                                        bounds=(-1.5, 1.5), wpar=wpar, n_tasks=2)[0]
     return np.where(steps < 0, np.inf, steps * h)
 

@@ -45,8 +45,10 @@ def _setup(S):
 
 def _run(S, paths, seed, amp=None, q0=(Q0,), p0=(P0,), n_steps=None, F_=F):
     coef, tab, a = _setup(S)
-    return noise_kernels.final_states(HARMONIC, SCHEME, np.array(q0, float), np.array(p0, float), paths, coef, tab,
-                                      F_, CYCLES * S if n_steps is None else n_steps, a if amp is None else amp, seed)
+    noise = noise_kernels.StepNoise(a if amp is None else amp)
+    q, p, _ = noise_kernels.final_states(HARMONIC, SCHEME, np.array(q0, float), np.array(p0, float), paths, coef, tab,
+                                         F_, CYCLES * S if n_steps is None else n_steps, noise, seed)
+    return q, p
 
 
 def _scheme_moments(S):

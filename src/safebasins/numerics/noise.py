@@ -28,8 +28,7 @@ from safebasins.wells import resolve_well
 from safebasins.wells.base import WellLike
 from safebasins.wells.provenance import api_provenance
 
-__all__ = ["escape_probability", "wilson_interval", "CORRECTIONS", "GOBET_SHIFT", "WILSON_Z", "noise_amplitude",
-           "energy_shift"]
+__all__ = ["escape_probability", "wilson_interval", "CORRECTIONS", "GOBET_SHIFT", "WILSON_Z", "energy_shift"]
 
 #: beta_1 = -zeta(1/2) / sqrt(2 pi): the boundary shift, in units of the local volatility times
 #: sqrt(h), that removes the O(sqrt(h)) bias of a discretely monitored killed diffusion
@@ -50,18 +49,18 @@ SURVIVAL_POINTS = 256
 SCHEME_TEXT = ("Strang splitting p += a Z_1, deterministic step, p += a Z_2 with a = sigma sqrt(h/2), Z_i "
                "standard normal (the exact flow of the noise over h/2 around the deterministic scheme's step; "
                "weak order 2)")
+COLOURED_SCHEME_TEXT = ("Strang splitting eta = c1 eta + c2 Z_1, deterministic step with the force eta held "
+                        "constant, eta = c1 eta + c2 Z_2 (the exact Ornstein-Uhlenbeck flow over h/2 around the "
+                        "deterministic scheme's step; weak order 2)")
 RNG_TEXT = ("Philox4x32-10 with counter (step, path, initial condition, 0) and key (seed mod 2^32, seed div 2^32); "
             "Box-Muller pair from its two 53-bit uniforms (wells.elementary log, sqrt, sincos)")
 
 
-def noise_amplitude(sigma: float, h: float) -> float:
-    """a = sigma sqrt(h/2): the noise kick of each half step."""
-    return sigma * math.sqrt(0.5 * h)
-
-
-def energy_shift(sigma: float, h: float, correction: str) -> float:
-    """The shift of 2 xi_max per |p| (noise_kernels): 2 GOBET_SHIFT sigma sqrt(h) for "shift", 0 for "none"."""
-    return 2.0 * GOBET_SHIFT * sigma * math.sqrt(h) if correction == "shift" else 0.0
+def energy_shift(sigma: float, h: float, correction: str, noise_time: float = 0.0) -> float:
+    """The shift of 2 xi_max per |p| (noise_kernels): 2 GOBET_SHIFT sigma sqrt(h) for "shift" and
+    white noise; 0 for "none" and for coloured noise (p is then differentiable in time: no
+    O(sqrt(h)) monitoring bias to correct)."""
+    return 2.0 * GOBET_SHIFT * sigma * math.sqrt(h) if correction == "shift" and noise_time == 0.0 else 0.0
 
 
 def wilson_interval(k: npt.ArrayLike, n: int, z: float = WILSON_Z) -> tuple[np.ndarray, np.ndarray]:
@@ -105,7 +104,7 @@ def _counts_within(tc: np.ndarray, times: np.ndarray) -> np.ndarray:
 @api_provenance
 def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: float, Psi: float, *, noise: float,
                        paths: int, xi_max: float, t_eval: npt.ArrayLike, damping: float = 0.0, well: WellLike = None,
-                       seed: int = 0, cycles: int | None = None,
+                       seed: int = 0, cycles: int | None = None, noise_time: float = 0.0,
                        steps_per_cycle: int = engine.DEFAULT_STEPS_PER_CYCLE, grid: bool | None = None,
                        correction: str = "shift", integrator: str = engine.DEFAULT_INTEGRATOR,
                        threads: int | None = None, backend: str = "cpu") -> xr.Dataset:
@@ -119,6 +118,11 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
         scheme, as escape_chart (its damped variant for damping > 0).
     noise : sigma >= 0, the amplitude of the white noise dp = ... + sigma dW (thermal noise at
         temperature T: sigma^2 = 2 damping T).  0: every path is escape_chart's trajectory.
+    noise_time : tau >= 0, the correlation time of coloured noise (default 0: white): the force
+        eta in dp = (... + eta) dt is the Ornstein-Uhlenbeck process d eta = -(eta / tau) dt +
+        (sigma / tau) dW, started from its stationary law N(0, sigma^2 / (2 tau)), with
+        autocorrelation sigma^2 / (2 tau) exp(-|t| / tau) and the white noise's integrated
+        intensity (the integral of the autocorrelation is sigma^2; tau -> 0 is white noise).
     paths : paths per initial condition (positive integer).
     xi_max : the energy threshold (a scalar in (0, barrier energy]): escape when H0 > xi_max or q
         beyond a barrier, checked after every step.
@@ -150,6 +154,7 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
     damping = checks.check_damping(damping)
     sigma = checks.check_scalar("noise", noise, checks.check_nonnegative)
+    tau = checks.check_scalar("noise_time", noise_time, checks.check_nonnegative)
     paths = checks.check_positive_int("paths", paths)
     w = resolve_well(well)
     xi = checks.check_scalar("xi_max", w.check_threshold("xi_max", xi_max), checks.check_finite)
@@ -175,8 +180,8 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
         n_tasks = max(1, min(math.ceil(Q.size * paths / LANES), nthreads))
         steps = noise_kernels.escape_steps(problem.code, problem.scheme, Q, P, paths, problem.coefficients(),
                                            problem.sine_table(), F, float(problem.thrE2[0]), cycles,
-                                           noise_amplitude(sigma, h), seed,
-                                           shift=energy_shift(sigma, h, correction), n_tasks=n_tasks, lanes=LANES)
+                                           noise_kernels.step_noise(sigma, h, tau), seed,
+                                           shift=energy_shift(sigma, h, correction, tau), n_tasks=n_tasks, lanes=LANES)
     tc = engine.steps_to_cycles(steps, spc)                       # (n_ic, paths), inf: not within cycles
     ts = _survival_axis(cycles)
     k_eval = _counts_within(tc, te)
@@ -213,14 +218,28 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(
         F=F, Omega=Omega, Psi=Psi, xi_max=xi, noise=sigma, paths=paths, seed=seed, cycles=cycles, steps_per_cycle=spc,
-        noise_model="dp = (-beta p - V'(q) + F sin(Omega t + Psi)) dt + sigma dW (white, additive; sigma = noise)",
-        integrator=engine.integrator_text(integrator, damping), noise_scheme=SCHEME_TEXT, random_numbers=RNG_TEXT,
-        boundary_correction=(f"energy threshold shifted inwards by {GOBET_SHIFT} sigma |p| sqrt(h) (Gobet-Menozzi)"
-                             if correction == "shift" else "none: checked after every step only"),
+        noise_model=_model_text(tau), integrator=engine.integrator_text(integrator, damping),
+        noise_scheme=SCHEME_TEXT if tau == 0 else COLOURED_SCHEME_TEXT, random_numbers=RNG_TEXT,
+        boundary_correction=_correction_text(correction, tau),
         first_passage=("restricted mean E[min(tau, cycles)] in forcing cycles; censored_fraction of the paths had "
                        "not escaped within cycles (the mean first-passage time where it is 0, a lower bound "
                        "otherwise)"),
         grid=int(is_grid), escape_criteria=criteria.criteria_text(w), **w.numerics_attrs(),
-        **engine.damping_attrs(damping))
+        **engine.damping_attrs(damping), **({"noise_time": tau} if tau > 0 else {}))
     return ds
+
+
+def _model_text(tau: float) -> str:
+    if tau == 0:
+        return "dp = (-beta p - V'(q) + F sin(Omega t + Psi)) dt + sigma dW (white, additive; sigma = noise)"
+    return ("dp = (-beta p - V'(q) + F sin(Omega t + Psi) + eta) dt, d eta = -(eta / tau) dt + (sigma / tau) dW "
+            "(coloured: Ornstein-Uhlenbeck force, tau = noise_time, sigma = noise, eta(0) stationary)")
+
+
+def _correction_text(correction: str, tau: float) -> str:
+    if tau > 0:
+        return "none needed: p is differentiable in time under coloured noise"
+    if correction == "shift":
+        return f"energy threshold shifted inwards by {GOBET_SHIFT} sigma |p| sqrt(h) (Gobet-Menozzi)"
+    return "none: checked after every step only"
 

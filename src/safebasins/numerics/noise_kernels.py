@@ -1,22 +1,29 @@
 """Compiled ensembles of the Langevin equation: the CPU lanes of numerics.noise.
 
-Equation: dq = p dt, dp = (-beta p - V'(q) + F sin(Omega t + Psi)) dt + sigma dW.
+Equation: dq = p dt, dp = (-beta p - V'(q) + F sin(Omega t + Psi)) dt + sigma dW (white noise)
+or dp = (... + eta) dt with the Ornstein-Uhlenbeck force d eta = -(eta / tau) dt + (sigma / tau) dW
+(coloured noise of correlation time tau; sigma_w below is sigma for white noise, 0 otherwise).
 
 Scheme (weak order 2): the Strang splitting of the generator into the deterministic part
-(drift, damping, force; the engine's scheme, schemes.py, with its damped variant for beta > 0)
-and the noise ``(sigma^2/2) d^2/dp^2``, whose exact flow over h/2 is ``p += sigma sqrt(h/2) N``:
+(drift, damping, force, eta held constant; the engine's scheme, schemes.py, with its damped
+variant for beta > 0) and the noise: ``(sigma_w^2/2) d^2/dp^2``, whose exact flow over h/2 is
+``p += sigma_w sqrt(h/2) Z``, and the exact Ornstein-Uhlenbeck flow of eta over h/2,
+``eta = c_1 eta + c_2 Z`` (c_1 = exp(-h/(2 tau)), c_2 = sigma sqrt((1 - exp(-h/tau)) / (2 tau))):
 
-    p += a Z_1;   (q, p) = step(q, p);   p += a Z_2,        a = sigma sqrt(h/2)
+    p += a Z_1, eta = c_1 eta + c_2 Z_1;   (q, p) = step(q, p; f + eta);   p += a Z_2, eta = c_1 eta + c_2 Z_2
 
-with ``step`` the deterministic scheme's step (the same compiled step as the engine's: at
-sigma = 0 the two half kicks add exact zeros and every state is bitwise the engine's).
+with ``step`` the deterministic scheme's step (the same compiled step as the engine's) and
+a = sigma_w sqrt(h/2).  White noise: c_1 = c_2 = 0, eta = 0; coloured: a = 0, eta(0) drawn from
+its stationary law N(0, sigma^2 / (2 tau)).  At sigma = 0 the kicks add exact zeros and every
+state is the engine's (bitwise up to the sign of a zero).
 
 Gaussian variates: (Z_1, Z_2) of step k of path m from initial condition i are the Box-Muller pair of
 one Philox4x32-10 block (numerics.philox) with counter (k, m, i, 0) and key (seed mod 2^32,
-seed div 2^32): ``Z_1 = r cos(2 pi u_2)``, ``Z_2 = r sin(2 pi u_2)``, ``r = sqrt(-2 log u_1)``,
-u_1, u_2 the two 53-bit uniforms in (0, 1] of the block (numerics.philox.uniform53), log, sqrt
-and sincos from wells.elementary (the same bits on every target).  A path's numbers are a pure
-function of (seed, i, m, k): lanes, tasks, threads and the order of the paths cannot change them.
+seed div 2^32) (eta(0): Z_1 of the counter (0, m, i, 1)): ``Z_1 = r cos(2 pi u_2)``,
+``Z_2 = r sin(2 pi u_2)``, ``r = sqrt(-2 log u_1)``, u_1, u_2 the two 53-bit uniforms in (0, 1] of
+the block (numerics.philox.uniform53), log and sqrt from wells.elementary, sin and cos of 2 pi u
+by :func:`_sincos_2pi` (the same bits on every target).  A path's numbers are a pure function of
+(seed, i, m, k): lanes, tasks, threads and the order of the paths cannot change them.
 
 Escape: after every step, by the engine's criteria (2 H0 > 2 xi_max or q beyond a barrier, a
 NaN state beyond every threshold; and, for the kernels' own callers, a displacement pair
@@ -32,11 +39,13 @@ on disk is never reused after an edit of any of them.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from fractions import Fraction
 from typing import Any
 
 import numpy as np
 from numba import literally, njit
+from numba.extending import overload
 
 from safebasins.numerics import philox
 from safebasins.numerics.kernels import run_tasks, specialised
@@ -45,7 +54,7 @@ from safebasins.numerics.steps import coefs, row, step, wtuple
 from safebasins.wells import elementary
 from safebasins.wells.compiled import WellCode, abs_tracking, cpu_jit, fma, mul, well_energy2
 
-__all__ = ["RNG_KEY", "MAX_STEPS", "escape_steps", "final_states", "gaussian_pairs"]
+__all__ = ["RNG_KEY", "MAX_STEPS", "StepNoise", "step_noise", "escape_steps", "final_states", "gaussian_pairs"]
 
 #: the numba literal of the random-number and noise code (module docstring)
 RNG_KEY = int(fingerprint([__file__, philox.__file__])[:15], 16) ^ int(elementary.MODULE_HASH[:15], 16)
@@ -100,12 +109,30 @@ def _sincos_2pi(u: Any) -> tuple[float, float]:
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _gauss2(k0: Any, k1: Any, k: Any, m: Any, i: Any) -> tuple[float, float]:
-    """The Box-Muller pair of step k of path m from initial condition i (module docstring)."""
-    w0, w1, w2, w3 = _philox(np.uint64(k) & _MASK32, np.uint64(m) & _MASK32, np.uint64(i) & _MASK32, _ZERO, k0, k1)
+def _gauss2(k0: Any, k1: Any, k: Any, m: Any, i: Any, tag: Any = _ZERO) -> tuple[float, float]:
+    """The Box-Muller pair of step k of path m from initial condition i (module docstring; tag 1:
+    the initial value of the coloured noise)."""
+    w0, w1, w2, w3 = _philox(np.uint64(k) & _MASK32, np.uint64(m) & _MASK32, np.uint64(i) & _MASK32, tag, k0, k1)
     r = elementary.sqrt(-2.0 * elementary.log(_uniform53(w0, w1)))
     s, c = _sincos_2pi(_uniform53(w2, w3))
     return mul(r, c), mul(r, s)
+
+
+def _plus(f: Any, x: Any) -> Any:
+    """The tuple f with x added to each value (the forcing values plus the coloured noise)."""
+    raise NotImplementedError("compiled code (numba)")
+
+
+@overload(_plus, inline="always")
+def _ol_plus(f: Any, x: Any) -> Any:
+    n = f.count
+    ns: dict[str, Any] = {"Any": Any}
+    # (numba compares the implementation's parameter annotations with the overload's)
+    exec(f"def impl(f: Any, x: Any) -> Any:\n    return ({''.join(f'f[{j}] + x, ' for j in range(n))})", ns)
+    return ns["impl"]
+
+
+_ONE = np.uint64(1)
 
 
 @njit(cache=True, error_model="numpy")
@@ -144,7 +171,7 @@ def _beyond(well: Any, wpar: Any, q: Any, e: Any, thrE2: Any, lo: Any, hi: Any) 
 @njit(cache=True, nogil=True, error_model="numpy")
 def _escape_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks: Any, lanes: Any, q0: Any, p0: Any,
                  n_paths: Any, coef: Any, FS: Any, thrE2: Any, lo: Any, hi: Any, cycles: Any, amp: Any, shift: Any,
-                 k0: Any, k1: Any, out: Any) -> None:
+                 c1: Any, c2: Any, s_eta: Any, k0: Any, k1: Any, out: Any) -> None:
     """Trajectories j = task, task + n_tasks, ... (path j % n_paths of initial condition
     j // n_paths): out[j] = the step after which it is first beyond (0: the initial condition,
     -1: not within cycles periods).  Lanes run one forcing period at a time; at the period
@@ -161,6 +188,7 @@ def _escape_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks
     L = np.int64(lanes)
     Q = np.zeros(L)
     P = np.zeros(L)
+    E = np.zeros(L)                      # the coloured noise eta of the lane
     IC = np.zeros(L, np.int64)
     PATH = np.zeros(L, np.int64)
     J = np.zeros(L, np.int64)
@@ -176,6 +204,7 @@ def _escape_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks
             else:
                 Q[k] = Q[l]
                 P[k] = P[l]
+                E[k] = E[l]
                 IC[k] = IC[l]
                 PATH[k] = PATH[l]
                 J[k] = J[l]
@@ -197,8 +226,9 @@ def _escape_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks
                 continue
             Q[nact] = q
             P[nact] = p
-            IC[nact] = i
             PATH[nact] = j - i * n_paths
+            E[nact] = mul(s_eta, _gauss2(k0, k1, 0, PATH[nact], i, _ONE)[0])
+            IC[nact] = i
             J[nact] = j
             BASE[nact] = 0
             FIRST[nact] = -1
@@ -210,10 +240,12 @@ def _escape_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks
             for l in range(nact):
                 n = BASE[l] + s
                 z1, z2 = _gauss2(k0, k1, n, PATH[l], IC[l])
-                q, p = step(scheme, well, w, Q[l], fma(amp, z1, P[l]), c, f)
+                eta = fma(c2, z1, mul(c1, E[l]))
+                q, p = step(scheme, well, w, Q[l], fma(amp, z1, P[l]), c, _plus(f, eta))
                 p = fma(amp, z2, p)
                 Q[l] = q
                 P[l] = p
+                E[l] = fma(c2, z2, mul(c1, eta))
                 e = fma(shift, abs(p), well_energy2(well, w, q, p))
                 hit = _beyond(well, wpar, q, e, thrE2, lo, hi) & (FIRST[l] < 0)
                 FIRST[l] = n + 1 if hit else FIRST[l]
@@ -223,7 +255,8 @@ def _escape_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks
 
 @njit(cache=True, nogil=True, error_model="numpy")
 def _final_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks: Any, q0: Any, p0: Any, n_paths: Any,
-                coef: Any, FS: Any, n_steps: Any, amp: Any, k0: Any, k1: Any, qo: Any, po: Any) -> None:
+                coef: Any, FS: Any, n_steps: Any, amp: Any, c1: Any, c2: Any, s_eta: Any, k0: Any, k1: Any, qo: Any,
+                po: Any, eo: Any) -> None:
     """Plain integration (no escape) of trajectories j = task, task + n_tasks, ... for n_steps
     steps; the same step as _escape_task."""
     literally(well)
@@ -238,13 +271,40 @@ def _final_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks:
         m = j - i * n_paths
         q = q0[i]
         p = p0[i]
+        e = mul(s_eta, _gauss2(k0, k1, 0, m, i, _ONE)[0])
         for n in range(n_steps):
             z1, z2 = _gauss2(k0, k1, n, m, i)
             f = row(scheme, FS, n % S)
-            q, p = step(scheme, well, w, q, fma(amp, z1, p), c, f)
+            e = fma(c2, z1, mul(c1, e))
+            q, p = step(scheme, well, w, q, fma(amp, z1, p), c, _plus(f, e))
             p = fma(amp, z2, p)
+            e = fma(c2, z2, mul(c1, e))
         qo[j] = q
         po[j] = p
+        eo[j] = e
+
+
+@dataclass(frozen=True)
+class StepNoise:
+    """The noise coefficients of one step (module docstring): the white half kick ``amp`` =
+    sigma sqrt(h/2), the Ornstein-Uhlenbeck half step ``eta = c1 eta + c2 Z`` and ``s_eta``, the
+    standard deviation of eta's stationary law (eta(0) = s_eta Z)."""
+
+    amp: float
+    c1: float = 0.0
+    c2: float = 0.0
+    s_eta: float = 0.0
+
+
+def step_noise(sigma: float, h: float, noise_time: float = 0.0) -> StepNoise:
+    """The coefficients of a step h for white noise of amplitude sigma (noise_time = 0) or an
+    Ornstein-Uhlenbeck force d eta = -(eta / tau) dt + (sigma / tau) dW of correlation time
+    tau = noise_time > 0 (the same integrated intensity: int <eta(0) eta(t)> dt = sigma^2)."""
+    if noise_time == 0.0:
+        return StepNoise(sigma * math.sqrt(0.5 * h))
+    x = h / noise_time
+    return StepNoise(0.0, math.exp(-0.5 * x), sigma * math.sqrt(-math.expm1(-x) / (2.0 * noise_time)),
+                     sigma / math.sqrt(2.0 * noise_time))
 
 
 def _common(code: WellCode, scheme: SchemeCode, q0: np.ndarray, coef: np.ndarray, sintab: np.ndarray, F: float,
@@ -260,14 +320,15 @@ def _common(code: WellCode, scheme: SchemeCode, q0: np.ndarray, coef: np.ndarray
 
 
 def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndarray, n_paths: int, coef: np.ndarray,
-                 sintab: np.ndarray, F: float, thrE2: float, cycles: int, amp: float, seed: int, *,
+                 sintab: np.ndarray, F: float, thrE2: float, cycles: int, noise: StepNoise, seed: int, *,
                  shift: float = 0.0, bounds: tuple[float, float] = (-math.inf, math.inf),
                  wpar: np.ndarray | None = None, n_tasks: int = 1, lanes: int = 256) -> np.ndarray:
     """First steps beyond the thresholds of ``n_paths`` paths from every initial condition,
     shape (len(q0), n_paths), int64 (0: the initial condition is beyond, -1: not within
     ``cycles`` periods of ``sintab.shape[0]`` steps).  code, scheme: the compiled well and scheme
     (damped variant for beta > 0); coef: their lane_coefficients (one row); sintab: the forcing
-    table (schemes.sine_table), times F; thrE2 = 2 xi_max; amp = sigma sqrt(h/2); shift: the
+    table (schemes.sine_table), times F; thrE2 = 2 xi_max; noise: the step's noise coefficients
+    (:func:`step_noise`); shift: the
     energy boundary shift per |p| (module docstring); bounds: a displacement pair (lo, hi);
     wpar: the well's wpar (None: code.wpar; the barriers are its first two entries).  The
     result does not depend on n_tasks or lanes."""
@@ -280,23 +341,26 @@ def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
     wp = code.wpar if wpar is None else np.ascontiguousarray(wpar, dtype=float)
     args = [code.key, scheme.key, RNG_KEY, wp, 0, int(n_tasks), int(lanes), q, p, int(n_paths),
             np.ascontiguousarray(coef), FS, float(thrE2), float(bounds[0]), float(bounds[1]), int(cycles),
-            float(amp), float(shift), k0, k1, out]
+            float(noise.amp), float(shift), float(noise.c1), float(noise.c2), float(noise.s_eta), k0, k1, out]
     entry = specialised(_escape_task, args, n_literal=3)
     run_tasks(lambda task: entry(*args[:4], task, *args[5:]), int(n_tasks))
     return out.reshape(q.size, int(n_paths))
 
 
 def final_states(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndarray, n_paths: int, coef: np.ndarray,
-                 sintab: np.ndarray, F: float, n_steps: int, amp: float, seed: int, n_tasks: int = 1
-                 ) -> tuple[np.ndarray, np.ndarray]:
-    """(q, p) of every path after ``n_steps`` steps, shape (len(q0), n_paths) each, no escape
+                 sintab: np.ndarray, F: float, n_steps: int, noise: StepNoise, seed: int, n_tasks: int = 1
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(q, p, eta) of every path after ``n_steps`` steps, shape (len(q0), n_paths) each, no escape
     checks (weak-order tests, benchmarks); arguments as :func:`escape_steps`."""
     q, FS, k0, k1 = _common(code, scheme, q0, coef, sintab, F, seed)
     p = np.ascontiguousarray(p0, dtype=float)
     qo = np.empty(q.size * int(n_paths))
     po = np.empty_like(qo)
+    eo = np.empty_like(qo)
     args = [code.key, scheme.key, RNG_KEY, code.wpar, 0, int(n_tasks), q, p, int(n_paths), np.ascontiguousarray(coef),
-            FS, int(n_steps), float(amp), k0, k1, qo, po]
+            FS, int(n_steps), float(noise.amp), float(noise.c1), float(noise.c2), float(noise.s_eta), k0, k1, qo, po,
+            eo]
     entry = specialised(_final_task, args, n_literal=3)
     run_tasks(lambda task: entry(*args[:4], task, *args[5:]), int(n_tasks))
-    return qo.reshape(q.size, int(n_paths)), po.reshape(q.size, int(n_paths))
+    shape = (q.size, int(n_paths))
+    return qo.reshape(shape), po.reshape(shape), eo.reshape(shape)
