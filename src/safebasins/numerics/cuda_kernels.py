@@ -77,6 +77,8 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 from numba import cuda, float64, int32, int64, uint64
@@ -84,7 +86,8 @@ from numba.cuda.core import config as cuda_config
 
 from safebasins.numerics import schemes
 from safebasins.wells import compiled
-from safebasins.numerics.scheme_code import scheme_code
+from safebasins.numerics.scheme_code import SchemeCode, scheme_code
+from safebasins.numerics.steps import Floats, Int, Ints, Row, Step
 
 SIMULATOR = bool(cuda_config.ENABLE_CUDASIM)
 BLOCK = 128                          # threads per block on a GPU
@@ -98,7 +101,7 @@ WARP = 32
 SHARED_TABLE_BYTES = 16 * 1024
 
 
-def _device(fn):
+def _device(fn: Callable[..., Any]) -> Any:
     return cuda.jit(device=True)(fn)
 
 
@@ -109,19 +112,24 @@ if not SIMULATOR:
     from numba.cuda import libdevice
     from numba.cuda.extending import overload as cuda_overload
 
+    # an overload's implementation takes its parameters with the same annotations (numba compares them)
     @cuda_overload(compiled.fma, inline="always")
-    def _ol_fma(a, b, c):
-        return lambda a, b, c: cuda.fma(a, b, c)
+    def _ol_fma(a: Any, b: Any, c: Any) -> Callable[..., float]:
+        def impl(a: Any, b: Any, c: Any) -> float:
+            return cuda.fma(a, b, c)  # type: ignore[no-any-return]  # numba-cuda's fma.rn.f64 (a float)
+        return impl
 
     @cuda_overload(compiled.mul, inline="always")
-    def _ol_mul(a, b):
-        return lambda a, b: libdevice.dmul_rn(a, b)
+    def _ol_mul(a: Any, b: Any) -> Callable[..., float]:
+        def impl(a: Any, b: Any) -> float:
+            return libdevice.dmul_rn(a, b)  # type: ignore[no-any-return]  # mul.rn.f64 (a float)
+        return impl
 
 fma = compiled.fma
 
 
 # ------------------------------------------------------------------------------- the well and the scheme
-def make_step(code, sc):
+def make_step(code: compiled.WellCode, sc: SchemeCode) -> tuple[Any, Any, Any]:
     """(step, energy2, flat_coefs) device functions of a compiled well (wells.compiled.WellCode) and a
     scheme code (scheme_code.SchemeCode): the well's one source and the scheme's one generated
     source, compiled for the GPU.
@@ -130,24 +138,25 @@ def make_step(code, sc):
     multiplied by F; o unsigned) and calls the scheme's step with them; c the coefficient tuple
     (flat_coefs(coef, o): schemes.lane_coefficients of one parameter set), w the well's 14
     coefficients (steps.wtuple).  energy2(q, p, w) = 2 H0 of the well."""
+    energy_w: Callable[[compiled.Coefs, float, float], float]
     force, energy_w = code.make(_device)
-    inner = sc.make(_device, force)
+    inner: Step = sc.make(_device, force)
     H = sc.helpers(_device)
     flat_row = H["flat_row"]
 
     @_device
-    def step(q, p, c, tab, o, w):
+    def step(q: float, p: float, c: Row, tab: Floats, o: np.uint64, w: compiled.Coefs) -> tuple[float, float]:
         return inner(w, q, p, c, flat_row(tab, o))
 
     @_device
-    def energy2w(q, p, w):
+    def energy2w(q: float, p: float, w: compiled.Coefs) -> float:
         return energy_w(w, q, p)
 
     return step, energy2w, H["flat_coefs"]
 
 
 # ------------------------------------------------------------------------------- escape bookkeeping
-def make_criteria(abs_q):
+def make_criteria(abs_q: bool) -> tuple[Any, Any, Any]:
     """(crossed, check_state, next_filters) for |q| tracking (abs_q, the quartic) or signed tracking:
 
     crossed(e, q, tE, tQ, tN): the branch-free filter (2 H0 above the next uncrossed 2 xi_max, q
@@ -161,11 +170,12 @@ def make_criteria(abs_q):
     CPU: a NaN state is beyond every threshold."""
     if abs_q:
         @_device
-        def crossed(e, q, tE, tQ, tN):
+        def crossed(e: float, q: float, tE: float, tQ: float, tN: float) -> bool:
             return not e <= tE or not abs(q) <= tQ
 
         @_device
-        def check_state(i, e, q, step, thrE2, nE, thrLo, thrHi, nQ, iE, iQ, outE, outQ, qL, qR):
+        def check_state(i: Int, e: float, q: float, step: Int, thrE2: Floats, nE: Int, thrLo: Floats, thrHi: Floats,
+                        nQ: Int, iE: Int, iQ: Int, outE: Ints, outQ: Ints, qL: float, qR: float) -> tuple[Int, Int]:
             aq = abs(q)
             while iE < nE and (not e <= thrE2[iE] or not aq <= qR):
                 outE[i * nE + iE] = step
@@ -176,7 +186,8 @@ def make_criteria(abs_q):
             return iE, iQ
 
         @_device
-        def next_filters(iE, iQ, thrE2, nE, thrLo, thrHi, nQ, qL, qR):
+        def next_filters(iE: Int, iQ: Int, thrE2: Floats, nE: Int, thrLo: Floats, thrHi: Floats, nQ: Int, qL: float,
+                         qR: float) -> tuple[float, float, float]:
             tE = math.inf
             tQ = math.inf
             if iQ < nQ:
@@ -188,11 +199,12 @@ def make_criteria(abs_q):
             return tE, tQ, math.inf
     else:
         @_device
-        def crossed(e, q, tE, tQ, tN):
+        def crossed(e: float, q: float, tE: float, tQ: float, tN: float) -> bool:
             return not e <= tE or not q <= tQ or not -q <= tN
 
         @_device
-        def check_state(i, e, q, step, thrE2, nE, thrLo, thrHi, nQ, iE, iQ, outE, outQ, qL, qR):
+        def check_state(i: Int, e: float, q: float, step: Int, thrE2: Floats, nE: Int, thrLo: Floats, thrHi: Floats,
+                        nQ: Int, iE: Int, iQ: Int, outE: Ints, outQ: Ints, qL: float, qR: float) -> tuple[Int, Int]:
             out = not q <= qR or not q >= qL
             while iE < nE and (not e <= thrE2[iE] or out):
                 outE[i * nE + iE] = step
@@ -203,7 +215,8 @@ def make_criteria(abs_q):
             return iE, iQ
 
         @_device
-        def next_filters(iE, iQ, thrE2, nE, thrLo, thrHi, nQ, qL, qR):
+        def next_filters(iE: Int, iQ: Int, thrE2: Floats, nE: Int, thrLo: Floats, thrHi: Floats, nQ: Int, qL: float,
+                         qR: float) -> tuple[float, float, float]:
             tE = math.inf
             tQ = math.inf
             tN = math.inf
@@ -221,13 +234,14 @@ def make_criteria(abs_q):
 
 
 @_device
-def finished(iE, iQ, nE, nQ, stop_any):
+def finished(iE: Int, iQ: Int, nE: Int, nQ: Int, stop_any: bool) -> bool | np.bool_:
     return (iE == nE and iQ == nQ) or (stop_any and (iE > 0 or iQ > 0))
 
 
 # ------------------------------------------------------------------------------- the kernel
 @functools.cache
-def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WARP, well=None, damped=False):
+def ensemble_kernel(integrator: str = "srkn6b", shared_table: bool = True, block: int = BLOCK, warp: int = WARP,
+                    well: compiled.WellCode | None = None, damped: bool = False) -> Any:
     """The compiled ensemble kernel for one scheme and well (cached per argument set).
 
     integrator: a name of schemes.SCHEMES; shared_table: copy the forcing table into dynamic shared
@@ -260,8 +274,9 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
     if BLK % WRP:
         raise ValueError(f"block ({BLK}) must be a multiple of warp ({WRP})")
 
-    def ensemble(q0, p0, pidx, coef, FS, thrE2, nE, thrLo, thrHi, nQ, N, S, cycles, stop_any, A, counter,
-                 outE, outQ, wpar):
+    def ensemble(q0: Floats, p0: Floats, pidx: Ints, coef: Floats, FS: Floats, thrE2: Floats, nE: Int, thrLo: Floats,
+                 thrHi: Floats, nQ: Int, N: Int, S: Int, cycles: Int, stop_any: bool, A: Int, counter: Ints,
+                 outE: Ints, outQ: Ints, wpar: Floats) -> None:
         tid = cuda.threadIdx.x
         qL = wpar[0]
         qR = wpar[1]
@@ -292,7 +307,7 @@ def ensemble_kernel(integrator="srkn6b", shared_table=True, block=BLOCK, warp=WA
         nlive_c = BLK             # live lanes lie in [0, nlive_c) (after the last compaction)
         i = int64(0)
         k = int64(0)
-        per = int64(0)
+        per: Int = int64(0)
         iE = int64(0)
         iQ = int64(0)
         q = 0.0
