@@ -35,7 +35,7 @@ __all__ = ["escape_probability", "wilson_interval", "CORRECTIONS", "GOBET_SHIFT"
 #: (Broadie, Glasserman & Kou 1997; Gobet & Menozzi 2010)
 GOBET_SHIFT = 0.5825971579390106
 #: the discrete-monitoring corrections: "shift" (the energy threshold moved inwards by
-#: GOBET_SHIFT sigma |p| sqrt(h), the local volatility of H0 being sigma |p|) or "none"
+#: GOBET_SHIFT sigma ``|p|`` sqrt(h), the local volatility of H0 being sigma ``|p|``) or "none"
 CORRECTIONS = ("shift", "none")
 #: the normal quantile of the 95% Wilson interval
 WILSON_Z = 1.959963984540054
@@ -57,7 +57,7 @@ RNG_TEXT = ("Philox4x32-10 with counter (step, path, initial condition, 0) and k
 
 
 def energy_shift(sigma: float, h: float, correction: str, noise_time: float = 0.0) -> float:
-    """The shift of 2 xi_max per |p| (noise_kernels): 2 GOBET_SHIFT sigma sqrt(h) for "shift" and
+    """The shift of 2 xi_max per ``|p|`` (noise_kernels): 2 GOBET_SHIFT sigma sqrt(h) for "shift" and
     white noise; 0 for "none" and for coloured noise (p is then differentiable in time: no
     O(sqrt(h)) monitoring bias to correct)."""
     return 2.0 * GOBET_SHIFT * sigma * math.sqrt(h) if correction == "shift" and noise_time == 0.0 else 0.0
@@ -121,7 +121,7 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
     noise_time : tau >= 0, the correlation time of coloured noise (default 0: white): the force
         eta in dp = (... + eta) dt is the Ornstein-Uhlenbeck process d eta = -(eta / tau) dt +
         (sigma / tau) dW, started from its stationary law N(0, sigma^2 / (2 tau)), with
-        autocorrelation sigma^2 / (2 tau) exp(-|t| / tau) and the white noise's integrated
+        autocorrelation sigma^2 / (2 tau) exp(-``|t|`` / tau) and the white noise's integrated
         intensity (the integral of the autocorrelation is sigma^2; tau -> 0 is white noise).
     paths : paths per initial condition (positive integer).
     xi_max : the energy threshold (a scalar in (0, barrier energy]): escape when H0 > xi_max or q
@@ -131,7 +131,7 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
         draws the same numbers for any threads, lanes or order (numerics.noise_kernels).
     cycles : the horizon in forcing cycles (None: the largest t_eval rounded up); the first-passage
         mean is restricted to it.
-    correction : "shift" (default: the energy threshold moved inwards by GOBET_SHIFT sigma |p|
+    correction : "shift" (default: the energy threshold moved inwards by GOBET_SHIFT sigma ``|p|``
         sqrt(h), removing the O(sqrt(h)) bias of checking the threshold only at the steps) or
         "none".
     threads : numba threads (None: the current setting); the result does not depend on it.

@@ -29,7 +29,7 @@ Escape: after every step, by the engine's criteria (2 H0 > 2 xi_max or q beyond 
 NaN state beyond every threshold; and, for the kernels' own callers, a displacement pair
 (lo, hi)); ``shift`` > 0 moves the energy threshold inwards by ``shift |p|``: the boundary
 shift of Gobet and Menozzi for a discretely monitored diffusion, here the energy H0 whose
-local volatility is sigma |p| (numerics.noise sets shift = 2 * 0.5826 sigma sqrt(h) for 2 H0).
+local volatility is sigma ``|p|`` (numerics.noise sets shift = 2 * 0.5826 sigma sqrt(h) for 2 H0).
 
 The kernels are specialised on three numba literals: the well's and the scheme's keys (as the
 engine's, kernels.py) and :data:`RNG_KEY`, a hash of the files inlined from outside the
@@ -329,7 +329,7 @@ def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
     (damped variant for beta > 0); coef: their lane_coefficients (one row); sintab: the forcing
     table (schemes.sine_table), times F; thrE2 = 2 xi_max; noise: the step's noise coefficients
     (:func:`step_noise`); shift: the
-    energy boundary shift per |p| (module docstring); bounds: a displacement pair (lo, hi);
+    energy boundary shift per ``|p|`` (module docstring); bounds: a displacement pair (lo, hi);
     wpar: the well's wpar (None: code.wpar; the barriers are its first two entries).  The
     result does not depend on n_tasks or lanes."""
     q, FS, k0, k1 = _common(code, scheme, q0, coef, sintab, F, seed)
