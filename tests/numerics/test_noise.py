@@ -30,11 +30,13 @@ def test_zero_noise_is_escape_chart_bitwise(damping):
                             seed=5)
     np.testing.assert_array_equal(ds.first_passage_mean.values, want)
     np.testing.assert_array_equal(ds.censored_fraction.values, np.isinf(chart.escape_cycle_energy[0]).values)
+    assert np.isnan(ds.first_passage_sem).all()          # one path: no standard error (documented)
     three = escape_probability(Q, P, **FORCING, noise=0.0, paths=3, xi_max=0.2, t_eval=[10, 40], cycles=40,
                                damping=damping, seed=9)
     for t in (10, 40):
         np.testing.assert_array_equal(three.P_escape.sel(t_eval=t).values,
                                       (chart.escape_cycle_energy[0] <= t).values.astype(float))
+    assert (three.first_passage_sem == 0).all()          # three equal paths
 
 
 def _kernel_run(n_tasks, lanes, n_paths=37, seed=11):

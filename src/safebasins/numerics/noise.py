@@ -143,7 +143,8 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
     its 95% Wilson interval P_escape_low, P_escape_high; survival (ic dims, t_survival), the
     fraction not escaped by t_survival (every forcing cycle up to 256 cycles, else 257 points);
     first_passage_mean (ic dims): the restricted mean first-passage time E[min(tau, cycles)]
-    in forcing cycles with its standard error first_passage_sem and censored_fraction, the
+    in forcing cycles with its standard error first_passage_sem (NaN for paths = 1: not
+    estimable) and censored_fraction, the
     fraction of paths not escaped within cycles (where it is 0 the restricted mean is the mean
     first-passage time; otherwise a lower bound of it).  Attributes: the equation, noise, paths,
     seed, the scheme, the random numbers, the correction, the escape criteria and the well.
@@ -188,7 +189,8 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
     k_surv = _counts_within(tc, ts)
     low, high = wilson_interval(k_eval, paths)
     restricted = np.minimum(tc, float(cycles))
-    sem = restricted.std(axis=1, ddof=1) / math.sqrt(paths) if paths > 1 else np.full(Q.size, np.inf)
+    # one path has no spread to estimate the standard error from: NaN, as documented
+    sem = restricted.std(axis=1, ddof=1) / math.sqrt(paths) if paths > 1 else np.full(Q.size, np.nan)
 
     shape: tuple[int, ...]
     dims: tuple[str, ...]
