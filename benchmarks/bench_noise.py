@@ -13,6 +13,12 @@ the whole horizon, so steps are counted exactly):
   Philox block, escape checked after every step);
 * Euler-Maruyama: a hand-written numba loop (symplectic Euler drift, one numpy normal a step,
   escape checked after every step), weak order 1.
+
+Equal accuracy: on the forced, damped harmonic oscillator (beta = 0.5, sigma = 0.5, F = 0.3,
+Omega = 1.3, two cycles; closed-form Gaussian moments) the exact moments of both schemes follow
+from their linear recursions; the steps per cycle Euler-Maruyama needs for the splitting's error
+in Var p at 32 steps per cycle, times the per-step speed ratio, is the time ratio at equal weak
+accuracy.
 """
 from __future__ import annotations
 
@@ -26,9 +32,11 @@ from numba import njit
 
 from _report import machine, report
 
+from scipy.integrate import solve_ivp
+
 from safebasins.numerics import escape_chart, noise_kernels, schemes
 from safebasins.numerics.scheme_code import scheme_code
-from safebasins.wells.compiled import quartic_code
+from safebasins.wells.compiled import polynomial_code, quartic_code
 
 F, OMEGA, PSI, XI, SIGMA, S = 0.02, 0.8, 0.0, 0.25, 0.002, 32
 
@@ -60,6 +68,62 @@ def best(fns, rounds=5):
             fn()
             times[k].append(time.perf_counter() - t)
     return [min(t) for t in times]
+
+
+# the equal-accuracy problem: q'' + beta q' + q = F sin(Omega t + Psi) + sigma dW/dt from (Q0, P0)
+OU = dict(beta=0.5, sigma=0.5, F=0.3, Omega=1.3, Psi=0.4, q0=0.2, p0=-0.1, cycles=2)
+
+
+def exact_var_p():
+    """Var p at the end from the covariance ODE C' = A C + C A^T + diag(0, sigma^2) (DOP853)."""
+    A = np.array([[0.0, 1.0], [-1.0, -OU["beta"]]])
+    D = np.diag([0.0, OU["sigma"] ** 2])
+    T = OU["cycles"] * 2 * math.pi / OU["Omega"]
+    y = solve_ivp(lambda t, c: (A @ c.reshape(2, 2) + c.reshape(2, 2) @ A.T + D).ravel(), (0.0, T), np.zeros(4),
+                  method="DOP853", rtol=1e-13, atol=1e-15).y[:, -1]
+    return y[3]
+
+
+def splitting_var_p(S):
+    """Var p of the splitting after cycles * S steps (the kernel's one-step map, noise half kicks)."""
+    code, sc = polynomial_code([0.0, 0.0, 0.5], (-math.inf, math.inf), "harmonic"), scheme_code("srkn6b", True)
+    coef = schemes.lane_coefficients([OU["Omega"]], S, "srkn6b", OU["beta"])
+    tab = schemes.sine_table(S, OU["Psi"])
+    q, p, _ = noise_kernels.final_states(code, sc, np.array([1.0, 0.0]), np.array([0.0, 1.0]), 1, coef, tab, 0.0, 1,
+                                         noise_kernels.StepNoise(0.0), 0)
+    M = np.array([[q[0, 0], q[1, 0]], [p[0, 0], p[1, 0]]])
+    a2 = OU["sigma"] ** 2 * math.pi / (OU["Omega"] * S)           # (sigma sqrt(h/2))^2
+    E = np.diag([0.0, a2])
+    C = np.zeros((2, 2))
+    for _ in range(OU["cycles"] * S):
+        C = M @ (C + E) @ M.T + E
+    return C[1, 1]
+
+
+def euler_maruyama_var_p(S):
+    """Var p of the symplectic Euler-Maruyama (p += h (-q - beta p + f) + sigma sqrt(h) Z; q += h p)."""
+    h = 2 * math.pi / (OU["Omega"] * S)
+    b = OU["beta"]
+    A = np.array([[1.0 - h * h, h * (1.0 - b * h)], [-h, 1.0 - b * h]])
+    v = OU["sigma"] * math.sqrt(h) * np.array([h, 1.0])
+    C = np.zeros((2, 2))
+    for _ in range(OU["cycles"] * S):
+        C = A @ C @ A.T + np.outer(v, v)
+    return C[1, 1]
+
+
+def equal_accuracy_steps(S_split=32):
+    """(splitting's error at S_split, Euler-Maruyama's steps per cycle for the same error)."""
+    exact = exact_var_p()
+    target = abs(splitting_var_p(S_split) - exact)
+    S = S_split
+    while abs(euler_maruyama_var_p(S) - exact) > target:
+        S *= 2
+    lo, hi = S // 2, S
+    while hi - lo > max(1, lo // 100):              # bisect to 1%: the error is monotone in S here
+        mid = (lo + hi) // 2
+        lo, hi = (mid, hi) if abs(euler_maruyama_var_p(mid) - exact) > target else (lo, mid)
+    return target, hi
 
 
 def main():
@@ -105,6 +169,13 @@ def main():
     report("noise_vs_euler_maruyama_per_step", round(r_noise / r_em, 3),
            "noisy ensemble / numba Euler-Maruyama trajectory-steps per second (per step, not at equal accuracy)",
            f"{n} x {cycles} cycles x {S} steps, one thread")
+    err, S_em = equal_accuracy_steps(32)
+    speedup = S_em / 32 * r_noise / r_em
+    print(f"equal weak accuracy (Var p error {err:.2e} of the splitting at 32 steps/cycle): Euler-Maruyama needs "
+          f"{S_em} steps/cycle ({S_em / 32:.0f}x the steps): the splitting is {speedup:.0f}x faster")
+    report("noise_vs_euler_maruyama_equal_accuracy", round(speedup, 1),
+           "time of a numba Euler-Maruyama / time of the noisy ensemble at equal weak error (harmonic oscillator, "
+           "Var p)", f"splitting 32 steps/cycle, Euler-Maruyama {S_em}")
 
 
 if __name__ == "__main__":
