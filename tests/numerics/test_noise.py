@@ -149,7 +149,8 @@ GOOD = dict(noise=0.05, paths=10, xi_max=0.2, t_eval=[5])
     (dict(seed=-1), "seed"), (dict(seed=2 ** 63), "seed"), (dict(seed=1.5), "seed"), (dict(seed=True), "seed"),
     (dict(correction="bridge"), "correction"), (dict(backend="cuda"), "backend"), (dict(damping=-0.1), "damping"),
     (dict(cycles=0), "cycles"), (dict(steps_per_cycle=2), "steps_per_cycle"), (dict(threads=0), "threads"),
-    (dict(integrator="euler"), "integrator"),
+    (dict(integrator="euler"), "integrator"), (dict(noise_time=-1.0), "noise_time"),
+    (dict(noise_time=0.05), "noise_time"),
 ])
 def test_bad_input_is_refused_by_name(change, name):
     kw = {**GOOD, **change}

@@ -122,7 +122,8 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
         eta in dp = (... + eta) dt is the Ornstein-Uhlenbeck process d eta = -(eta / tau) dt +
         (sigma / tau) dW, started from its stationary law N(0, sigma^2 / (2 tau)), with
         autocorrelation sigma^2 / (2 tau) exp(-``|t|`` / tau) and the white noise's integrated
-        intensity (the integral of the autocorrelation is sigma^2; tau -> 0 is white noise).
+        intensity (the integral of the autocorrelation is sigma^2; tau -> 0 is white noise).  The
+        step must resolve it: a step h = 2 pi / (Omega steps_per_cycle) > tau is refused.
     paths : paths per initial condition (positive integer).
     xi_max : the energy threshold (a scalar in (0, barrier energy]): escape when H0 > xi_max or q
         beyond a barrier, checked after every step.
@@ -144,10 +145,10 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
     fraction not escaped by t_survival (every forcing cycle up to 256 cycles, else 257 points);
     first_passage_mean (ic dims): the restricted mean first-passage time E[min(tau, cycles)]
     in forcing cycles with its standard error first_passage_sem (NaN for paths = 1: not
-    estimable) and censored_fraction, the
-    fraction of paths not escaped within cycles (where it is 0 the restricted mean is the mean
-    first-passage time; otherwise a lower bound of it).  Attributes: the equation, noise, paths,
-    seed, the scheme, the random numbers, the correction, the escape criteria and the well.
+    estimable) and censored_fraction, the fraction of paths not escaped within cycles (where it
+    is 0 the restricted mean is the mean first-passage time; otherwise a lower bound of it).
+    Attributes: the equation, noise (and noise_time), paths, seed, the scheme, the random
+    numbers, the correction, the escape criteria and the well.
     """
     is_grid, qa, pa, Q, P = _ic_arrays(q0, p0, grid)
     F = checks.check_scalar("F", F, checks.check_nonnegative)
@@ -169,6 +170,13 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
     schemes.check_integrator(integrator)
     spc = engine.check_step(Omega, engine.check_steps_per_cycle(steps_per_cycle), w, integrator)
     threads = engine.check_threads(threads)
+    h = 2.0 * math.pi / (Omega * spc)
+    if 0.0 < tau < h:
+        # the splitting holds eta constant over a step: on the damped oscillator the variance's
+        # relative error is ~0.1 (h / tau)^2 (docs/noise.md), unbounded as tau -> 0 at fixed h
+        raise ValueError(f"noise_time = {tau:.4g} is shorter than the step h = {h:.4g} ({spc} steps per forcing "
+                         f"cycle at Omega = {Omega:.4g}): the coloured noise is not resolved; use steps_per_cycle >= "
+                         f"{math.ceil(2.0 * math.pi / (Omega * tau))} or noise_time = 0 (white noise)")
     if cycles * spc > noise_kernels.MAX_STEPS:
         raise ValueError(f"cycles: {cycles} cycles of {spc} steps exceed {noise_kernels.MAX_STEPS} steps per path")
     if Q.size * paths >= 2 ** 62:
@@ -176,7 +184,7 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
 
     problem = ensemble_problem(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=[xi], cycles=cycles,
                                steps_per_cycle=spc, integrator=integrator, well=w, damping=damping)
-    h = float(problem.step_sizes()[0])
+    h = float(problem.step_sizes()[0])              # (the same h, as the engine forms it)
     with engine.thread_count(threads) as nthreads:
         n_tasks = max(1, min(math.ceil(Q.size * paths / LANES), nthreads))
         steps = noise_kernels.escape_steps(problem.code, problem.scheme, Q, P, paths, problem.coefficients(),

@@ -69,9 +69,9 @@ _ROUND = 6755399441055744.0
 
 
 def _taylor(k: int) -> float:
-    """(-1)^k (pi/2)^(2k+1) / (2k+1)! (odd k of the sine) or, as _taylor_cos, the cosine's term,
-    correctly rounded from the double pi/2 (exact rational arithmetic: the same constant on every
-    machine)."""
+    """The k-th Taylor coefficient of sin(pi r / 2) in r, (-1)^k (pi/2)^(2k+1) / (2k+1)!, from the
+    double pi/2 in exact rational arithmetic, rounded once: the same constant on every machine
+    (_taylor_cos: the cosine's, (-1)^k (pi/2)^(2k) / (2k)!)."""
     return float((-1) ** k * Fraction(math.pi / 2) ** (2 * k + 1) / math.factorial(2 * k + 1))
 
 
