@@ -144,7 +144,8 @@ GOOD = dict(noise=0.05, paths=10, xi_max=0.2, t_eval=[5])
 
 @pytest.mark.parametrize("change,name", [
     (dict(noise=-0.1), "noise"), (dict(noise=float("nan")), "noise"), (dict(noise=[0.1, 0.2]), "noise"),
-    (dict(paths=0), "paths"), (dict(paths=2.5), "paths"), (dict(xi_max=0.3), "xi_max"), (dict(xi_max=-1), "xi_max"),
+    (dict(paths=0), "paths"), (dict(paths=2.5), "paths"), (dict(paths=2 ** 32 + 1), "paths"),
+    (dict(xi_max=0.3), "xi_max"), (dict(xi_max=-1), "xi_max"),
     (dict(t_eval=[-1]), "t_eval"), (dict(t_eval=[20], cycles=10), "t_eval"), (dict(t_eval=[]), "t_eval"),
     (dict(seed=-1), "seed"), (dict(seed=2 ** 63), "seed"), (dict(seed=1.5), "seed"), (dict(seed=True), "seed"),
     (dict(correction="bridge"), "correction"), (dict(backend="cuda"), "backend"), (dict(damping=-0.1), "damping"),

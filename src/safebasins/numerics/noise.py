@@ -179,8 +179,11 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
                          f"{math.ceil(2.0 * math.pi / (Omega * tau))} or noise_time = 0 (white noise)")
     if cycles * spc > noise_kernels.MAX_STEPS:
         raise ValueError(f"cycles: {cycles} cycles of {spc} steps exceed {noise_kernels.MAX_STEPS} steps per path")
-    if Q.size * paths >= 2 ** 62:
-        raise ValueError(f"paths: {paths} paths from {Q.size} initial conditions are too many")
+    # the path and the IC index are 32-bit words of the random counter: beyond, streams would repeat
+    if paths > 2 ** 32:
+        raise ValueError(f"paths must be <= 2^32 (a word of the random counter), got {paths}")
+    if Q.size > 2 ** 32:
+        raise ValueError(f"q0 and p0: at most 2^32 initial conditions (a word of the random counter), got {Q.size}")
 
     problem = ensemble_problem(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=[xi], cycles=cycles,
                                steps_per_cycle=spc, integrator=integrator, well=w, damping=damping)
