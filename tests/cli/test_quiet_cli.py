@@ -17,7 +17,9 @@ STRICT = dict(os.environ, PYTHONWARNINGS="error::RuntimeWarning,error::UserWarni
     ["basin", "--F", "0.02", "--Omega", "0.9", "--Psi", "pi", "--xi-max", "0.18", "--n", "12x10", "--damping", "0.05"],
     ["fcr", "--xi-max", "0.15", "--Omega-range", "0.8,1.0,3", "--damping", "0.01"],
     ["fcr", "--xi-max", "0.15,0.15", "--Omega-range", "0.8,1.0,3", "--damping", "0.01,0.02"],
-], ids=["chart", "basin", "fcr", "fcr-two-betas"])
+    ["escape-probability", "--F", "0.05", "--Omega", "0.9", "--xi-max", "0.2", "--noise", "0.06", "--t-eval", "2",
+     "--n", "5", "--paths", "8", "--damping", "0.05"],
+], ids=["chart", "basin", "fcr", "fcr-two-betas", "escape-probability"])
 def test_damped_commands_warn_nothing(tmp_path, args):
     res = run([*args, "-o", "x"], tmp_path, env=STRICT)
     assert res.returncode == 0, res.stderr

@@ -15,6 +15,7 @@ check_config  the ``check-config`` command: a pipeline configuration checked as 
 reproduction  the ``verify-reproduction`` command: a new run checked against a results archive
 basin_measures  the ``basin-measures`` command: fractal boundary measures of a damped well's basins
 saddle    the ``hilltop-saddle`` command: the hilltop saddle's manifolds over escape charts, their tangency
+noise     the ``escape-probability`` command: escape probabilities under noise over a grid of ICs
 """
 from safebasins.cli.commands import main
 from safebasins.cli.explore import explore
@@ -22,11 +23,13 @@ from safebasins.cli.check_config import check_config
 from safebasins.cli.reproduction import verify_reproduction
 from safebasins.cli.basin_measures import basin_measures
 from safebasins.cli.saddle import hilltop_saddle
+from safebasins.cli.noise import escape_probability
 
 main.add_command(explore)
 main.add_command(check_config)
 main.add_command(verify_reproduction)
 main.add_command(basin_measures)
 main.add_command(hilltop_saddle)
+main.add_command(escape_probability)
 
 __all__ = ["main"]

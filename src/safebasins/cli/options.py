@@ -26,7 +26,8 @@ OPTION_OF = {"F": "--F", "Omega": "--Omega", "Psi": "--Psi", "xi_max": "--xi-max
              "cycles": "--cycles", "steps_per_cycle": "--steps-per-cycle", "threads": "--threads",
              "xi_ini": "--xi-ini", "gamma_ini": "--gamma-ini", "tol": "--tol", "n_scan": "--n-scan",
              "F_bracket": "--F-bracket", "n_points": "--n-points", "q0": "--grid", "p0": "--grid",
-             "xi_top": "--xi-top", "t_eval": "--t-eval", "backend": "--backend", "damping": "--damping"}
+             "xi_top": "--xi-top", "t_eval": "--t-eval", "backend": "--backend", "damping": "--damping",
+             "noise": "--noise", "noise_time": "--noise-time", "paths": "--paths", "seed": "--seed"}
 
 _ANGLE = re.compile(r"^([+-]?)(\d+(?:\.\d*)?|\.\d+)?\*?pi(?:/(\d+(?:\.\d*)?))?$", re.IGNORECASE)
 
@@ -362,14 +363,15 @@ def check_writable(prefix: Path):
         raise OSError(f"no file can be created in {folder} ({exc.strerror or exc})") from None
 
 
-def cost_guard(kind, params, allow_expensive, numeric=True):
+def cost_guard(kind, params, allow_expensive, numeric=True, steps=None):
     """The pipeline's cost guard (safebasins.pipeline.cost, the config schema's default budgets)
-    for one command: a usage error naming --allow-expensive above a budget."""
+    for one command: a usage error naming --allow-expensive above a budget.  ``steps``: the
+    trajectory-steps counted by a command that has no pipeline kind (``kind`` is then unused)."""
     from safebasins.pipeline.cost import ANALYTIC_RATE, RATE_PER_CORE, budgets, params_cost
 
     if allow_expensive:
         return
-    steps, evaluations = params_cost(kind, params, numeric)
+    steps, evaluations = params_cost(kind, params, numeric) if steps is None else (steps, 0)
     b = budgets()
     core_hours = steps / RATE_PER_CORE / 3600
     if core_hours > b["budget_core_hours"]:

@@ -1,0 +1,115 @@
+"""The ``escape-probability`` command: escape probabilities under noise over a grid of initial
+conditions (:func:`safebasins.numerics.escape_probability`, docs/noise.md)."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import click
+
+from safebasins.cli.commands import check_step, damping_text, grid_axes, well_label
+from safebasins.cli.options import (NONNEG, THRESHOLD, Deferred, Number, NumberList, checked, common_options,
+                                    cost_guard, current_well, damping_option, engine_check, forcing_options,
+                                    from_library, grid_options, grid_params, joined, lib_check, library_errors,
+                                    out_option)
+from safebasins.cli.output import chatter, draw, finish, write_outputs
+from safebasins.pipeline.values import fmt
+
+__all__ = ["escape_probability"]
+
+#: the library function whose defaults the options take
+LIBRARY = "safebasins.numerics:escape_probability"
+#: at most this many --t-eval values (one panel each)
+MAX_T_EVAL = 4
+
+
+@click.command("escape-probability")
+@forcing_options
+@click.option("--xi-max", "xi_max", type=Number("xi_max", THRESHOLD), required=True,
+              help="Escape threshold (energy) in (0, E_b], E_b the well's barrier energy; also escape past a barrier.")
+@click.option("--noise", "noise", type=Number("noise", NONNEG), required=True,
+              help="Noise amplitude sigma >= 0 of dp = ... + sigma dW (thermal noise at temperature T: "
+                   "sigma^2 = 2 beta T; 0: every path is the deterministic trajectory).")
+@click.option("--noise-time", "noise_time", cls=Deferred, type=Number("noise_time", NONNEG),
+              default=from_library(LIBRARY, "noise_time"),
+              help="Correlation time tau >= 0 of coloured noise (an Ornstein-Uhlenbeck force of the same "
+                   "low-frequency intensity sigma^2; 0: white noise). The step must resolve it.")
+@click.option("--paths", "paths", type=int, default=100, show_default=True,
+              callback=checked("paths", lib_check("safebasins.core.checks:check_positive_int")),
+              help="Paths per initial condition (the 95% Wilson interval of P_escape is about +-1/sqrt(paths)).")
+@click.option("--seed", "seed", cls=Deferred, type=click.IntRange(0, 2 ** 63 - 1),
+              default=from_library(LIBRARY, "seed"),
+              help="Key of the counter-based random streams (the same numbers for any --threads).")
+@click.option("--t-eval", "t_eval", type=NumberList("t_eval", NONNEG), multiple=True, required=True,
+              callback=joined(unique=True),
+              help=f"Evaluation times in forcing cycles (>= 0): comma list or repeated, at most {MAX_T_EVAL} "
+                   "(one panel each); all from one pass.")
+@click.option("--cycles", type=click.IntRange(min=1), default=None,
+              help="Horizon in forcing cycles (>= every --t-eval; the first-passage mean is restricted to it) "
+                   "[default: the largest --t-eval rounded up].")
+@grid_options
+@click.option("--steps-per-cycle", "steps_per_cycle", cls=Deferred, type=int,
+              default=from_library(LIBRARY, "steps_per_cycle"),
+              callback=checked(None, engine_check("check_steps_per_cycle")),
+              help="Fixed integrator steps per forcing period (>= 4).")
+@click.option("--threads", type=int, default=None, callback=checked(None, engine_check("check_threads")),
+              help="Numba threads (default: all; results do not depend on it).")
+@damping_option()
+@common_options
+@out_option("escape_probability")
+def escape_probability(F: float, Omega: float, Psi: float, xi_max: float, noise: float, noise_time: float, paths: int,
+                       seed: int, t_eval: list[float], cycles: int | None, grid: Any, n: Any, steps_per_cycle: int,
+                       threads: int | None, damping: float, fourier: Any, well: dict[str, Any], no_plot: bool,
+                       quiet: bool, verbose: bool, allow_expensive: bool, out: str) -> None:
+    """Escape probabilities under noise over a grid of initial conditions.
+
+    From each initial condition --paths paths of dq = p dt, dp = (-beta p - V'(q) + F sin(Omega t
+    + Psi)) dt + sigma dW (or an Ornstein-Uhlenbeck force with --noise-time) are integrated (weak
+    order 2, counter-based random numbers) and escape by the criteria of the escape charts.
+    PREFIX.nc is the library's dataset: P_escape(q0, p0, t_eval) with its 95% Wilson interval,
+    the survival curve and the restricted mean first-passage time (docs/noise.md); PREFIX.png
+    maps P_escape at each --t-eval.
+
+    Example: safebasins escape-probability --F 0.05 --Omega 0.9 --xi-max 0.2 --damping 0.05 --noise 0.06
+    --t-eval 3,5 --n 41 --paths 200
+    """
+    if len(t_eval) > MAX_T_EVAL:
+        raise click.BadParameter(f"at most {MAX_T_EVAL} values, got {len(t_eval)}", param_hint="'--t-eval'")
+    if cycles is not None and max(t_eval) > cycles:
+        raise click.BadParameter(f"evaluation time {fmt(max(t_eval))} beyond the horizon --cycles {cycles}",
+                                 param_hint="'--t-eval'")
+    ctx = click.get_current_context()
+    name = Path(out).name
+    params: dict[str, Any] = dict(command="escape-probability", experiment=name, well=well, F=F, Omega=Omega, Psi=Psi,
+                                  xi_max=xi_max, damping=damping, noise=noise, noise_time=noise_time, paths=paths,
+                                  seed=seed, t_eval=t_eval, cycles=cycles, grid=grid_params(grid, n),
+                                  steps_per_cycle=steps_per_cycle)
+    damped, beta = damping_text(damping)
+    params["title"] = (f"Escape probability under noise sigma = {fmt(noise)}"
+                       + (f", tau = {fmt(noise_time)}" if noise_time > 0 else "")
+                       + f", {damped}{well_label(well)} well, F = {fmt(F)}, Omega = {fmt(Omega)}, "
+                       f"Psi = {fmt(Psi, angle=True)}{beta} (safebasins escape-probability {name})")
+    check_step(Omega, steps_per_cycle)
+    nq, np_ = params["grid"]["n"]
+    horizon = cycles if cycles is not None else max(1, math.ceil(max(t_eval)))
+    cost_guard(None, params, allow_expensive, steps=nq * np_ * paths * horizon * steps_per_cycle)
+    # the ensemble and its figure load numba and matplotlib: imported when the command runs, so
+    # that `safebasins --help` and the other commands start without them
+    from safebasins.numerics import escape_probability as ensemble
+    from safebasins.plotting.noise import figure_escape_probability
+
+    q0, p0 = grid_axes(params["grid"])
+    with library_errors(), chatter(verbose):
+        ds = ensemble(q0, p0, F, Omega, Psi, noise=noise, paths=paths, xi_max=xi_max, t_eval=t_eval,
+                      damping=damping, well=current_well(ctx), seed=seed, cycles=cycles, noise_time=noise_time,
+                      steps_per_cycle=steps_per_cycle, grid=True, threads=threads)
+        params["cycles"] = int(ds.attrs["cycles"])
+        ds = finish(ds, title=params["title"], params=params)
+        fig = None if no_plot else draw(figure_escape_probability, ds)
+    write_outputs([(f"{out}.nc", ds)], fig, f"{out}.png")
+    for t in t_eval:
+        p = ds["P_escape"].sel(t_eval=t)
+        half = float((ds["P_escape_high"] - ds["P_escape_low"]).sel(t_eval=t).max()) / 2
+        click.echo(f"within {fmt(t)} cycles: mean P_escape {float(p.mean()):.4f} over {p.size} ICs, "
+                   f"{float((p == 0).mean()):.1%} with no path escaped (95% intervals at most +-{half:.2g})")

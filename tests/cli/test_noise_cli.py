@@ -1,0 +1,105 @@
+"""``safebasins escape-probability``: the dataset is the library's escape_probability value for value
+(white and coloured noise, the well's own IC window), zero noise gives escape_chart's escapes, bad
+options are named before anything runs, and the command is listed."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import xarray as xr
+from click.testing import CliRunner
+
+from safebasins.cli import main
+from safebasins.numerics import escape_chart, escape_probability
+from safebasins.wells import resolve_well
+
+BASE = ["escape-probability", "--F", "0.05", "--Omega", "0.9", "--xi-max", "0.2", "--noise", "0.06", "--t-eval", "2,4",
+        "--n", "5x4", "--paths", "12", "--quiet"]
+VARIABLES = ("P_escape", "P_escape_low", "P_escape_high", "survival", "first_passage_mean", "first_passage_sem",
+             "censored_fraction")
+
+
+def invoke(args, tmp_path, prefix="ep"):
+    return CliRunner().invoke(main, [*args, "-o", str(tmp_path / prefix)], catch_exceptions=False)
+
+
+def window(well, nq, np_):
+    (q_lo, q_hi), (p_lo, p_hi) = resolve_well(well).ic_window()
+    return np.linspace(q_lo, q_hi, nq), np.linspace(p_lo, p_hi, np_)
+
+
+@pytest.mark.parametrize("extra, well, kw", [
+    (["--damping", "0.05", "--seed", "7"], "quartic", dict(damping=0.05, seed=7)),
+    (["--well", "cubic", "--F", "0.06", "--Omega", "0.85", "--xi-max", "0.16", "--noise-time", "0.5",
+      "--steps-per-cycle", "24", "--cycles", "5", "--no-plot"], "cubic",
+     dict(F=0.06, Omega=0.85, xi_max=0.16, noise_time=0.5, steps_per_cycle=24, cycles=5)),
+], ids=["quartic-white-damped", "cubic-coloured"])
+def test_writes_the_library_dataset(tmp_path, extra, well, kw):
+    res = invoke([*BASE, *extra], tmp_path)
+    assert res.exit_code == 0, res.output
+    with xr.open_dataset(tmp_path / "ep.nc") as ds:
+        q0, p0 = window(well, 5, 4)
+        args = {"F": 0.05, "Omega": 0.9, "xi_max": 0.2, **kw}
+        ref = escape_probability(q0, p0, args.pop("F"), args.pop("Omega"), 0.0, noise=0.06, paths=12, t_eval=[2, 4],
+                                 well=well, grid=True, **args)
+        np.testing.assert_array_equal(ds["q0"].values, q0)
+        np.testing.assert_array_equal(ds["p0"].values, p0)
+        for v in VARIABLES:
+            np.testing.assert_array_equal(ds[v].values, ref[v].values, err_msg=v)
+        params = json.loads(ds.attrs["parameters"])
+        assert params["command"] == "escape-probability" and params["paths"] == 12
+        assert params["cycles"] == ref.attrs["cycles"] and ds.attrs["seed"] == kw.get("seed", 0)
+        assert ds.attrs["history"].startswith("safebasins ")       # sys.argv of this process (in-process runner)
+        assert "safebasins escape-probability ep" in ds.attrs["title"]
+    png = tmp_path / "ep.png"
+    assert png.exists() != ("--no-plot" in extra)
+    mean = float(ref["P_escape"].sel(t_eval=4).mean())
+    assert f"within 4 cycles: mean P_escape {mean:.4f} over 20 ICs" in res.output
+
+
+@pytest.mark.parametrize("damping", [0.0, 0.05])
+def test_zero_noise_is_the_escape_chart(tmp_path, damping):
+    res = invoke([*BASE, "--noise", "0", "--n", "6x5", "--paths", "3", "--damping", str(damping), "--no-plot"],
+                 tmp_path)
+    assert res.exit_code == 0, res.output
+    q0, p0 = window("quartic", 6, 5)
+    chart = escape_chart(q0, p0, 0.05, 0.9, 0.0, xi_max=0.2, cycles=4, damping=damping)
+    tc = chart["escape_cycle_energy"].sel(xi_max=0.2).values
+    with xr.open_dataset(tmp_path / "ep.nc") as ds:
+        P = ds["P_escape"].values
+        assert set(np.unique(P)) <= {0.0, 1.0}
+        for k, t in enumerate((2, 4)):
+            np.testing.assert_array_equal(P[:, :, k], (tc <= t).astype(float), err_msg=f"t_eval = {t}")
+        assert 0 < P[:, :, 1].sum() < P[:, :, 1].size        # some escape, some stay: the test can fail
+
+
+@pytest.mark.parametrize("args, option, reason", [
+    (["--noise", "-0.1"], "'--noise'", ">= 0"),
+    (["--paths", "0"], "'--paths'", "paths"),
+    (["--seed", "-1"], "'--seed'", "0<=x"),
+    (["--cycles", "3"], "'--t-eval'", "beyond the horizon"),
+    (["--t-eval", "1,3,5"], "'--t-eval'", "at most 4"),             # added to BASE's 2,4
+    (["--noise-time", "0.01"], "'--noise-time'", "shorter than the step"),      # the library's check, named
+    (["--xi-max", "0.3"], "'--xi-max'", "1/4"),
+    (["--Omega", "0.02"], "'--steps-per-cycle'", "steps_per_cycle >="),
+], ids=lambda v: v if isinstance(v, str) else " ".join(v))
+def test_bad_options_named_before_anything_runs(tmp_path, args, option, reason):
+    res = CliRunner().invoke(main, [*BASE, *args, "-o", str(tmp_path / "bad")])
+    assert res.exit_code == 2, res.output
+    last = res.output.strip().splitlines()[-1]
+    assert option in last and reason in last, last
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_cost_guard_counts_paths(tmp_path):
+    res = CliRunner().invoke(main, [*BASE, "--n", "2000", "--paths", "100000", "-o", str(tmp_path / "x")])
+    assert res.exit_code == 2 and "--allow-expensive" in res.output, res.output
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_help_lists_the_command():
+    res = CliRunner().invoke(main, ["--help"])
+    assert res.exit_code == 0 and "escape-probability" in res.output
+    res = CliRunner().invoke(main, ["escape-probability", "--help"])
+    assert res.exit_code == 0 and all(o in res.output for o in ("--noise", "--noise-time", "--paths", "--t-eval"))
