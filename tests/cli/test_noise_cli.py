@@ -103,3 +103,16 @@ def test_help_lists_the_command():
     assert res.exit_code == 0 and "escape-probability" in res.output
     res = CliRunner().invoke(main, ["escape-probability", "--help"])
     assert res.exit_code == 0 and all(o in res.output for o in ("--noise", "--noise-time", "--paths", "--t-eval"))
+
+
+
+@pytest.mark.parametrize("args", [
+    BASE,
+    ["basin-measures", "--F", "0.055,0.07", "--Omega", "0.85", "--xi-max", "0.2", "--damping", "0.1"],
+    ["hilltop-saddle", "--F", "0.055", "--Omega", "0.85", "--xi-max", "0.2", "--damping", "0.1"],
+], ids=["escape-probability", "basin-measures", "hilltop-saddle"])
+def test_numeric_commands_refuse_fourier(args, tmp_path):
+    """--fourier changes nothing these commands compute: refused by name, not ignored."""
+    res = CliRunner().invoke(main, [*args, "--fourier", "exact", "-o", str(tmp_path / "x")])
+    assert res.exit_code == 2 and "--fourier" in res.output, res.output
+    assert not list(tmp_path.iterdir())

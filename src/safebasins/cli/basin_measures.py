@@ -10,7 +10,7 @@ import click
 from safebasins.cli.commands import well_label
 from safebasins.cli.options import (FINITE, NONNEG, POSITIVE, THRESHOLD, Deferred, Fields, Number, NumberList,
                                     checked, common_options, cost_guard, engine_check, from_library, from_schema,
-                                    grid_params, joined, library_errors, out_option)
+                                    grid_params, joined, library_errors, no_fourier, out_option)
 from safebasins.cli.output import chatter, draw, finish, job, write_outputs
 from safebasins.pipeline.values import fmt
 
@@ -63,6 +63,7 @@ def basin_measures(F: tuple[float, ...], Omega: float, Psi: float, xi_max: float
 
     Example: safebasins basin-measures --well cubic --F 0.055,0.07 --Omega 0.85 --xi-max 0.1666 --damping 0.1
     """
+    no_fourier(fourier)
     if len(F) > 4:
         raise click.BadParameter(f"at most 4 values, got {len(F)}", param_hint="'--F'")
     name = Path(out).name

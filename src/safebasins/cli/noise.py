@@ -12,8 +12,9 @@ from safebasins.cli.commands import check_step, damping_text, grid_axes, well_la
 from safebasins.cli.options import (NONNEG, THRESHOLD, Deferred, Number, NumberList, checked, common_options,
                                     cost_guard, current_well, damping_option, engine_check, forcing_options,
                                     from_library, grid_options, grid_params, joined, lib_check, library_errors,
-                                    out_option)
+                                    no_fourier, out_option)
 from safebasins.cli.output import chatter, draw, finish, write_outputs
+from safebasins.pipeline.cost import NOISE_STEP_COST
 from safebasins.pipeline.values import fmt
 
 __all__ = ["escape_probability"]
@@ -74,6 +75,7 @@ def escape_probability(F: float, Omega: float, Psi: float, xi_max: float, noise:
     Example: safebasins escape-probability --F 0.05 --Omega 0.9 --xi-max 0.2 --damping 0.05 --noise 0.06
     --t-eval 3,5 --n 41 --paths 200
     """
+    no_fourier(fourier)
     if len(t_eval) > MAX_T_EVAL:
         raise click.BadParameter(f"at most {MAX_T_EVAL} values, got {len(t_eval)}", param_hint="'--t-eval'")
     if cycles is not None and max(t_eval) > cycles:
@@ -93,7 +95,10 @@ def escape_probability(F: float, Omega: float, Psi: float, xi_max: float, noise:
     check_step(Omega, steps_per_cycle)
     nq, np_ = params["grid"]["n"]
     horizon = cycles if cycles is not None else max(1, math.ceil(max(t_eval)))
-    cost_guard(None, params, allow_expensive, steps=nq * np_ * paths * horizon * steps_per_cycle)
+    # each noisy step: the well's force and the random numbers (pipeline.cost.NOISE_STEP_COST)
+    step_cost = current_well(ctx).step_cost + NOISE_STEP_COST
+    cost_guard(None, params, allow_expensive, steps=nq * np_ * paths * horizon * steps_per_cycle * step_cost,
+               reduce="--n, --paths or --cycles")
     # the ensemble and its figure load numba and matplotlib: imported when the command runs, so
     # that `safebasins --help` and the other commands start without them
     from safebasins.numerics import escape_probability as ensemble

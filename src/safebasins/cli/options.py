@@ -363,10 +363,11 @@ def check_writable(prefix: Path):
         raise OSError(f"no file can be created in {folder} ({exc.strerror or exc})") from None
 
 
-def cost_guard(kind, params, allow_expensive, numeric=True, steps=None):
+def cost_guard(kind, params, allow_expensive, numeric=True, steps=None, reduce="--n, --cycles or the scanned values"):
     """The pipeline's cost guard (safebasins.pipeline.cost, the config schema's default budgets)
     for one command: a usage error naming --allow-expensive above a budget.  ``steps``: the
-    trajectory-steps counted by a command that has no pipeline kind (``kind`` is then unused)."""
+    trajectory-steps (in quartic steps) counted by a command that has no pipeline kind (``kind``
+    is then unused); ``reduce``: the options the message suggests reducing."""
     from safebasins.pipeline.cost import ANALYTIC_RATE, RATE_PER_CORE, budgets, params_cost
 
     if allow_expensive:
@@ -378,7 +379,7 @@ def cost_guard(kind, params, allow_expensive, numeric=True, steps=None):
         raise click.UsageError(
             f"this run integrates up to {steps:.2e} trajectory-steps = {core_hours:.3g} core-hours (at "
             f"{RATE_PER_CORE:.1e} steps/s per core), above the budget of {b['budget_core_hours']:g} core-hours: "
-            "reduce --n, --cycles or the scanned values, or pass --allow-expensive")
+            f"reduce {reduce}, or pass --allow-expensive")
     if evaluations > b["budget_analytic_evaluations"]:
         raise click.UsageError(
             f"the analytic part of this run needs {evaluations:.2e} slow-flow evaluations (~"
@@ -427,6 +428,14 @@ def well_option(f):
              "polynomial:c0,c1,c2,... (V = sum c_k q^k), expression:'<formula in q>' (e.g. expression:'1 - cos(q)'), "
              "or a mapping {expression: '...'} (a mapping may add tol: 1e-11, the accuracy of the well's "
              "action-angle tables, for a formula whose rounding does not reach the default 1e-13).")(f)
+
+
+def no_fourier(fourier):
+    """A command whose numbers do not use the first harmonic G(xi) (numerics only) refuses
+    --fourier rather than ignoring it."""
+    if fourier is not None:
+        raise click.BadParameter("this command integrates the equation of motion only; the first harmonic "
+                                 "is not used", param_hint="'--fourier'")
 
 
 def common_options(f):

@@ -27,6 +27,10 @@ RATE_PER_CORE = 5.0e8
 #: 2e6 per IC of the quartic, 4e5 of a numeric well, 1e6 per resonance-manifold point, 2e7 per
 #: xi node of F_cr)
 ANALYTIC_RATE = 1.0e6
+#: the random numbers of one step of a noisy ensemble (safebasins.numerics.noise: Philox and a
+#: Box-Muller pair), in steps of the quartic: added to the well's step_cost (benchmarks/bench_noise.py:
+#: the noisy quartic runs at 0.15-0.20 of the deterministic rate)
+NOISE_STEP_COST = 5.0
 
 
 def exp_cost(exp) -> int:
