@@ -104,6 +104,7 @@ def test_mfs_is_the_lim_at_the_grid_resolution(quartic, cubic):
         mfs, lim, grid = (ds[v].sel(norm="energy").values for v in ("mfs", "lim", "mfs_grid"))
         assert np.all(lim - h <= mfs) and np.all(mfs <= lim * (1 + 1e-9))
         assert np.all(mfs <= grid)
+        assert np.all(np.isfinite(ds.escape_cycle.values))       # the MFS shock itself escapes
 
 
 def test_quartic_symmetry(quartic):

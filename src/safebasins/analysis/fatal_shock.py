@@ -61,6 +61,8 @@ SETTLE = 15.0
 STEPS_PER_CYCLE = 128
 #: DOP853 tolerance of the attractor's orbit (Newton on the map, flow to each phase)
 _RTOL = 1e-11
+#: k-section rounds at most (the bracket has shrunk by 32^12 ~ 1e18 by then)
+_MAX_ROUNDS = 12
 _ONE = {"units": "1"}
 
 
@@ -95,10 +97,10 @@ class _Shocks:
         until ``hi - lo <= tol hi``; each round keeps the first escaping point and the one below it."""
         lo, hi = lo.copy(), hi.copy()
         frac = np.arange(1, K_SECTION + 1) / (K_SECTION + 1)
-        while True:
+        for _ in range(_MAX_ROUNDS):
             open_ = np.flatnonzero(hi - lo > self.tol * hi)
             if open_.size == 0:
-                return lo, hi
+                break
             r = lo[open_, None] + (hi - lo)[open_, None] * frac[None, :]       # (m, K)
             X = x_a[:, None, None] + U[:, open_, None] * r[None]
             esc = np.isfinite(self.escape_cycle(X.reshape(2, -1), phi)).reshape(r.shape)
@@ -106,6 +108,7 @@ class _Shocks:
             rows = np.arange(open_.size)
             hi[open_] = np.where(first < K_SECTION, r[rows, np.minimum(first, K_SECTION - 1)], hi[open_])
             lo[open_] = np.where(first > 0, r[rows, np.maximum(first - 1, 0)], lo[open_])
+        return lo, hi
 
     def ray(self, x_a: Array, phi: float, u: Array, r_cap: float, n: int) -> tuple[float, float]:
         """``(lo, hi)``: the first escaping radius along u (2,) on ``n`` radii up to ``r_cap``, refined;
@@ -291,8 +294,12 @@ def minimal_fatal_shock(F: float, Omega: float, damping: float, well: WellLike =
                 S1, S2 = np.meshgrid(radii[n] * s_lim, radii[n] * s_lim, indexing="ij")
                 cart = np.stack([S1.ravel() / math.sqrt(nw[0]), S2.ravel() / math.sqrt(nw[1])])
                 blocks.append(X_a[:, a, k][:, None] + np.concatenate([polar, cart], axis=1))
-        esc = np.isfinite(sh.escape_cycle(np.concatenate(blocks, axis=1), float(phi[k])))
-        esc = esc.reshape(len(atts), len(norms), -1)
+        centres = X_a[:, :, k]
+        esc = np.isfinite(sh.escape_cycle(np.concatenate(blocks + [centres], axis=1), float(phi[k])))
+        if esc[-len(atts):].any():
+            raise ValueError(f"xi_max: the attractor itself crosses xi_max = {xi!r} at phase {phi[k]!r} (its fatal "
+                             "shock is 0); raise xi_max")
+        esc = esc[:-len(atts)].reshape(len(atts), len(norms), -1)
         for a in range(len(atts)):
             for n, (_, nw) in enumerate(norms):
                 r = radii[n] * np.arange(1, n_rad + 1) / n_rad
