@@ -11,8 +11,8 @@ checked after every step).  It is the distance from ``x_a`` to the unsafe set, i
 of the safe basin of that horizon centred on the attractor, found without a grid's resolution.
 
 Norms: ``N(d) = sqrt(w_q dq^2 + w_p dp^2)``; the energy norm has ``(w_q, w_p) = (omega0^2, 1)``
-(``omega0`` the well's linear frequency at the bottom: ``sqrt(2 x`` the linearised energy of the
-kick``)``), the weighted norm the user's ``weights``.
+(``omega0`` the well's linear frequency at the bottom; ``N^2 / 2`` is the energy the kick gives the
+linearised oscillator), the weighted norm the user's ``weights``.
 
 Algorithm (:func:`minimal_fatal_shock`): the attractors by iterating the compiled map from a grid
 of seeds (:func:`safebasins.analysis.basin_labels.map_labels`), polished by Newton on the DOP853
@@ -229,7 +229,7 @@ def minimal_fatal_shock(F: float, Omega: float, damping: float, well: WellLike =
     n_lim : nodes per side of the Cartesian grid of the LIM (odd: the attractor is a node);
     n_seeds : seeds per side of the grid iterated to find the attractors;
     tol : relative width of the final radius bracket.
-    steps_per_cycle, threads : of the compiled engine.
+    steps_per_cycle, threads : of the compiled engine (default :data:`STEPS_PER_CYCLE`, 128).
 
     Returns
     -------
