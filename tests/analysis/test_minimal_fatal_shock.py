@@ -9,6 +9,8 @@ LIM of a Cartesian grid (the same quantity at the grid's resolution), the quarti
 q -> -q, phase -> phase + pi leaves it unchanged, and the shock of the escape equation escapes
 (and a slightly smaller one does not) under a separate DOP853 integration with event location.
 """
+import warnings
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -127,6 +129,15 @@ def test_shock_escapes_under_dop853(cubic, quartic):
     assert cubic.sizes["attractor"] == 2
     assert np.all(cubic.escape_cycle.values > 0)
     assert cubic.response_amplitude.values[0] < cubic.response_amplitude.values[1]
+
+
+def test_quiet(capsys):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        minimal_fatal_shock(0.02, 0.9, 0.05, phases=(0.0, 1.0), cycles=3, weights=(2.0, 1.0), n_directions=16,
+                            n_radii=12, n_refine=1, n_lim=21)
+    out = capsys.readouterr()
+    assert out.out == "" and out.err == "", out
 
 
 @pytest.mark.parametrize("kwargs, name", [
