@@ -5,7 +5,11 @@ Fig 19 counts), the first-harmonic comparison and the tests.
 """
 from __future__ import annotations
 
+from collections.abc import Hashable, Sequence
+from typing import Any, Literal, overload
+
 import numpy as np
+import numpy.typing as npt
 import xarray as xr
 
 from safebasins.analysis.safe import CRITERIA, check_chart, check_t_eval, is_safe
@@ -51,7 +55,18 @@ def _pair(a, b, dims, names=("a", "b")):
     return a, b
 
 
-def iou(a, b, dims=("q0", "p0"), *, names=("a", "b")):
+@overload
+def iou(a: xr.DataArray, b: xr.DataArray, dims: Sequence[Hashable] = ("q0", "p0"), *,
+        names: tuple[str, str] = ("a", "b")) -> xr.DataArray: ...
+
+
+@overload
+def iou(a: npt.ArrayLike, b: npt.ArrayLike, dims: Sequence[Hashable] = ("q0", "p0"), *,
+        names: tuple[str, str] = ("a", "b")) -> npt.NDArray[np.float64]: ...
+
+
+def iou(a: Any, b: Any, dims: Sequence[Hashable] = ("q0", "p0"), *,
+        names: tuple[str, str] = ("a", "b")) -> xr.DataArray | npt.NDArray[np.float64]:
     """Intersection over union ``|A and B| / |A or B|`` of two boolean masks (1 when both are
     empty: perfect agreement).  DataArrays reduce over the named ``dims``; numpy arrays over the
     axes ``dims`` (default: the last two)."""
@@ -67,7 +82,18 @@ def iou(a, b, dims=("q0", "p0"), *, names=("a", "b")):
     return np.where(union > 0, inter / np.maximum(union, 1), 1.0)
 
 
-def pixel_agreement(a, b, dims=("q0", "p0"), *, names=("a", "b")):
+@overload
+def pixel_agreement(a: xr.DataArray, b: xr.DataArray, dims: Sequence[Hashable] = ("q0", "p0"), *,
+                    names: tuple[str, str] = ("a", "b")) -> xr.DataArray: ...
+
+
+@overload
+def pixel_agreement(a: npt.ArrayLike, b: npt.ArrayLike, dims: Sequence[Hashable] = ("q0", "p0"), *,
+                    names: tuple[str, str] = ("a", "b")) -> npt.NDArray[np.float64]: ...
+
+
+def pixel_agreement(a: Any, b: Any, dims: Sequence[Hashable] = ("q0", "p0"), *,
+                    names: tuple[str, str] = ("a", "b")) -> xr.DataArray | npt.NDArray[np.float64]:
     """Fraction of grid points on which two boolean masks agree."""
     if not isinstance(a, xr.DataArray) and not isinstance(b, xr.DataArray) and dims == ("q0", "p0"):
         dims = (-2, -1)
@@ -77,14 +103,16 @@ def pixel_agreement(a, b, dims=("q0", "p0"), *, names=("a", "b")):
     return (a == b).mean(axis=dims)
 
 
-def mask_agreement(analytic_safe, numeric_safe, dims=("q0", "p0")):
+def mask_agreement(analytic_safe: xr.DataArray, numeric_safe: xr.DataArray, dims: Sequence[Hashable] = ("q0", "p0")
+                   ) -> tuple[xr.DataArray, xr.DataArray]:
     """``(iou, pixel_agreement)`` of two boolean safe masks (DataArrays), reduced over ``dims``."""
     names = ("analytic_safe", "numeric_safe")
     return (iou(analytic_safe, numeric_safe, dims, names=names),
             pixel_agreement(analytic_safe, numeric_safe, dims, names=names))
 
 
-def criteria_counts(chart, t_eval, groups):
+def criteria_counts(chart: xr.Dataset, t_eval: float, groups: int
+                    ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
     """Safe counts of the energy and displacement criteria on random ICs (paper Appendix, Fig 19).
 
     ``chart``: an escape chart over ``sample`` with one ``xi_max`` and one ``q_max`` threshold;
@@ -112,7 +140,8 @@ def criteria_counts(chart, t_eval, groups):
     return out[0], out[1]
 
 
-def criteria_table(charts, F, *, n_ic, repeats, seeds, cycles):
+def criteria_table(charts: Sequence[xr.Dataset], F: Sequence[float] | npt.NDArray[np.float64], *, n_ic: int,
+                   repeats: int, seeds: Sequence[int] | npt.NDArray[np.integer[Any]], cycles: float) -> xr.Dataset:
     """Energy versus displacement criterion (paper Appendix, Fig 19): ``A_E``, ``A_q`` (safe counts
     at ``cycles``) and ``rel_diff = (A_q - A_E) / A_E`` over ``(F, repeat)``, from one escape chart
     per F over ``n_ic * repeats`` random samples (``repeats`` consecutive groups of ``n_ic``,
@@ -133,7 +162,7 @@ def criteria_table(charts, F, *, n_ic, repeats, seeds, cycles):
     )
 
 
-def chart_agreement(chart, basin, t_eval, scan):
+def chart_agreement(chart: xr.Dataset, basin: xr.Dataset, t_eval: float, scan: Literal["xi_max", "F"]) -> xr.Dataset:
     """The escape chart with its agreement with the analytic basin, per value of ``scan``.
 
     numeric safe = ``escape_cycle_energy > t_eval``; analytic safe = not ``escapes``

@@ -22,7 +22,7 @@ import numpy.typing as npt
 import xarray as xr
 
 from safebasins.analysis.integrity import grid_spacing
-from safebasins.analysis.safe import check_t_eval, escape_variable, is_safe
+from safebasins.analysis.safe import AnyCriterion, check_t_eval, escape_variable, is_safe
 
 __all__ = ["check_labels", "chart_labels", "map_labels", "ESCAPED", "SAFE", "LabelsLike"]
 
@@ -70,7 +70,7 @@ def check_labels(labels: LabelsLike, name: str = "labels") -> tuple[npt.NDArray[
 
 
 def chart_labels(chart: xr.Dataset, t_eval: float | None = None, *, threshold: float | None = None,
-                 criterion: str = "energy") -> xr.DataArray:
+                 criterion: AnyCriterion = "energy") -> xr.DataArray:
     """The basins of an escape chart on a grid: 0 = escaped by ``t_eval``, 1 = safe.
 
     Parameters
@@ -108,7 +108,7 @@ def chart_labels(chart: xr.Dataset, t_eval: float | None = None, *, threshold: f
         if hit.size != 1:
             raise ValueError(f"threshold {threshold!r} is not one of the chart's {thr!r} values {values.tolist()}")
         k = int(hit[0])
-    cycles = chart.attrs.get("cycles")
+    cycles: Any = chart.attrs.get("cycles")
     if t_eval is None and cycles is None:
         raise ValueError("t_eval is required: the chart records no horizon (attribute 'cycles')")
     t = float(check_t_eval(cycles if t_eval is None else t_eval, cycles))

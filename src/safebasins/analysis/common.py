@@ -1,19 +1,26 @@
 """Small helpers shared by the analysis modules (erosion, phase-invariant basins, first harmonic)."""
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
+from typing import Any
+
 import numpy as np
+import numpy.typing as npt
 import xarray as xr
 
 from safebasins.core import checks
 from safebasins.analysis.integrity import grid_spacing
 from safebasins.wells.quartic import FOURIER_VARIANTS
 from safebasins.wells import QuarticWell, resolve_well
+from safebasins.wells.base import Well, WellLike
+
+Array = npt.NDArray[np.float64]
 
 
-def fourier_list(fourier):
+def fourier_list(fourier: str | Sequence[str]) -> tuple[list[str], bool]:
     """Normalise ``fourier`` to (list_of_variants, is_scalar)."""
     scalar = isinstance(fourier, str)
-    items = [fourier] if scalar else list(fourier)
+    items = [fourier] if isinstance(fourier, str) else list(fourier)
     if not items:
         raise ValueError("fourier must name at least one variant")
     for f in items:
@@ -22,7 +29,7 @@ def fourier_list(fourier):
     return items, scalar
 
 
-def variant_well(well, fourier):
+def variant_well(well: WellLike, fourier: str | None) -> Well:
     """The well of one first-harmonic variant.
 
     The rule for ``fourier`` (every analysis function that takes ``well=`` and ``fourier=``):
@@ -42,7 +49,8 @@ def variant_well(well, fourier):
     return w
 
 
-def well_variants(well, fourier):
+def well_variants(well: WellLike, fourier: str | Sequence[str] | None
+                  ) -> tuple[list[str], list[Well], bool]:
     """``(names, wells, scalar)`` of a ``fourier`` argument (None, one variant or a list) for
     ``well`` (:func:`variant_well` gives the rule): ``None`` is the well's own single variant
     ("paper" for the default quartic, "exact" for any other well)."""
@@ -53,19 +61,19 @@ def well_variants(well, fourier):
     return names, [variant_well(well, f) for f in names], scalar
 
 
-def as_1d(name, values, check=checks.as_array):
+def as_1d(name: str, values: npt.ArrayLike, check: checks.Check = checks.as_array) -> Array:
     """``check(name, values)`` as a 1-D float array."""
     return checks.check_1d(name, values, check)
 
 
-def mesh(q0, p0):
+def mesh(q0: npt.ArrayLike, p0: npt.ArrayLike) -> tuple[Array, Array, Array, Array]:
     """Validated uniform grid axes and their ``ij`` mesh: ``(q, p, Q, P)``."""
     q, p, _, _ = grid_spacing(q0, p0)
     Q, P = np.meshgrid(q, p, indexing="ij")
     return q, p, Q, P
 
 
-def chart_param(ds, name):
+def chart_param(ds: xr.Dataset, name: str) -> Any:
     """A parameter of an escape chart: coordinate if stacked over it, else the attribute."""
     if name in ds.coords:
         return ds[name]
@@ -74,7 +82,7 @@ def chart_param(ds, name):
     raise ValueError(f"chart has neither a coordinate nor an attribute {name!r}")
 
 
-def stack_charts(charts, dim):
+def stack_charts(charts: xr.Dataset | Iterable[xr.Dataset], dim: str) -> xr.Dataset:
     """Accept one Dataset (possibly already stacked over ``dim``) or a sequence of charts.
 
     A sequence is concatenated along ``dim`` using each chart's attribute ``dim``.

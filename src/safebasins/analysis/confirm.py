@@ -8,6 +8,7 @@ each connected part of the analytic basin tells them apart from the real basin.
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 from scipy import ndimage
 
 from safebasins.analysis.safe import is_safe
@@ -15,7 +16,8 @@ from safebasins.analysis.safe import is_safe
 __all__ = ["confirm_regions"]
 
 
-def confirm_regions(safe_analytic, escape_cycle, t_eval):
+def confirm_regions(safe_analytic: npt.ArrayLike, escape_cycle: npt.ArrayLike, t_eval: float
+                    ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64], npt.NDArray[np.float64]]:
     """Connected parts of an analytic safe mask and the fraction of each that the numerics keep.
 
     Parameters

@@ -72,12 +72,18 @@ t_eval, thresholds, phases...) and on ``xarray.DataArray`` with dims
 """
 from __future__ import annotations
 
+from typing import overload
+
 import numpy as np
+import numpy.typing as npt
 import xarray as xr
 from scipy import ndimage
 
 from safebasins.core import checks
 from safebasins.wells import from_attrs, resolve_well, well_attrs
+from safebasins.wells.base import WellLike
+
+Array = npt.NDArray[np.float64]
 
 __all__ = [
     "unforced_safe_mask",
@@ -106,7 +112,7 @@ _RAW = ("area", "r_local", "r_global", "if_q0", "if_p0")
 
 
 # --------------------------------------------------------------------------- basics
-def grid_spacing(q0, p0):
+def grid_spacing(q0: npt.ArrayLike, p0: npt.ArrayLike) -> tuple[Array, Array, float, float]:
     """Validate 1-D, increasing, uniform grid axes; return ``(q0, p0, dq, dp)``."""
     out = []
     for name, ax in (("q0", q0), ("p0", p0)):
@@ -123,7 +129,8 @@ def grid_spacing(q0, p0):
     return q, p, dq, dp
 
 
-def unforced_safe_mask(q0, p0, xi_max, well=None):
+def unforced_safe_mask(q0: npt.ArrayLike, p0: npt.ArrayLike, xi_max: npt.ArrayLike, well: WellLike = None
+                       ) -> npt.NDArray[np.bool_]:
     """Unforced safe set S0 = {H0 < xi_max, q_minus < q0 < q_plus} (eqs 4, 7) on the grid: the
     well's ``unforced_safe`` (None: the paper's quartic, ``|q0| < q_max(xi_max)``).
 
@@ -136,7 +143,7 @@ def unforced_safe_mask(q0, p0, xi_max, well=None):
     return w.unforced_safe(Q, P, xi[..., None, None])
 
 
-def unforced_radii2(xi, well=None, *, n=1001):
+def unforced_radii2(xi: float, well: WellLike = None, *, n: int = 1001) -> tuple[float, float]:
     """Squared LIM and IF radii ``(r_local^2, r_global^2)`` of the unforced set S0(xi) of
     ``well`` (None: the quartic) from the orbit curve, not from a grid (module docstring).
 
@@ -290,7 +297,22 @@ def _measures_numpy(safe, q0, p0, xi_max, bottom, well=None):
     return out
 
 
-def integrity_measures(safe, q0=None, p0=None, xi_max=None, *, bottom=(0.0, 0.0), well=None):
+@overload
+def integrity_measures(safe: xr.DataArray, q0: npt.ArrayLike | None = None, p0: npt.ArrayLike | None = None,
+                       xi_max: npt.ArrayLike | xr.DataArray | None = None, *,
+                       bottom: tuple[float, float] = (0.0, 0.0), well: WellLike = None) -> xr.Dataset: ...
+
+
+@overload
+def integrity_measures(safe: npt.ArrayLike, q0: npt.ArrayLike | None = None, p0: npt.ArrayLike | None = None,
+                       xi_max: npt.ArrayLike | None = None, *,
+                       bottom: tuple[float, float] = (0.0, 0.0), well: WellLike = None) -> dict[str, Array]: ...
+
+
+def integrity_measures(safe: xr.DataArray | npt.ArrayLike, q0: npt.ArrayLike | None = None,
+                       p0: npt.ArrayLike | None = None, xi_max: npt.ArrayLike | xr.DataArray | None = None, *,
+                       bottom: tuple[float, float] = (0.0, 0.0), well: WellLike = None
+                       ) -> xr.Dataset | dict[str, Array]:
     """GIM, LIM and IF of safe-basin masks (see the module docstring for definitions and errors).
 
     Parameters

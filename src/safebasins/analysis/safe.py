@@ -8,16 +8,25 @@ basins, criteria counts, figures) goes through :func:`is_safe`.
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import Any, Literal, overload
+
 import numpy as np
+import numpy.typing as npt
 import xarray as xr
 
 from safebasins.core import checks
 from safebasins.core import cf
 from safebasins.wells import from_attrs, QuarticWell
+from safebasins.wells.base import Well
 
 __all__ = ["is_safe", "check_t_eval", "check_chart", "safe_mask", "safe_area", "safe_stack", "escape_variable",
            "chart_well", "displacement_energy", "q_max_energy"]
 
+#: a threshold criterion of escape charts
+Criterion = Literal["energy", "displacement"]
+#: those two or the asymmetric displacement bounds ``q_bounds`` (charts made with ``q_bounds``)
+AnyCriterion = Literal["energy", "displacement", "bounds"]
 #: escape-time variable and threshold dimension of each criterion
 CRITERIA = {"energy": ("escape_cycle_energy", "xi_max"),
             "displacement": ("escape_cycle_displacement", "q_max")}
@@ -25,12 +34,21 @@ CRITERIA = {"energy": ("escape_cycle_energy", "xi_max"),
 BOUNDS = ("escape_cycle_bounds", "q_bounds")
 
 
-def is_safe(escape_cycle, t_eval):
+@overload
+def is_safe(escape_cycle: xr.DataArray, t_eval: npt.ArrayLike | xr.DataArray) -> xr.DataArray: ...
+
+
+@overload
+def is_safe(escape_cycle: npt.NDArray[Any], t_eval: npt.ArrayLike) -> npt.NDArray[np.bool_]: ...
+
+
+def is_safe(escape_cycle: xr.DataArray | npt.NDArray[Any], t_eval: npt.ArrayLike | xr.DataArray
+            ) -> xr.DataArray | npt.NDArray[np.bool_]:
     """``escape_cycle > t_eval``: not escaped by ``t_eval`` (numpy arrays or DataArrays)."""
     return escape_cycle > t_eval
 
 
-def escape_variable(chart, criterion):
+def escape_variable(chart: xr.Dataset, criterion: AnyCriterion) -> tuple[xr.DataArray, str]:
     """(escape-time DataArray, threshold dimension) of ``criterion`` ("energy" | "displacement" |
     "bounds": the asymmetric displacement bounds ``q_bounds`` of the chart)."""
     known = {**CRITERIA, "bounds": BOUNDS}
@@ -47,7 +65,7 @@ def escape_variable(chart, criterion):
 _CHART_VARIABLES = tuple(v for v, _ in CRITERIA.values())
 
 
-def check_chart(chart, name="chart", variables=_CHART_VARIABLES):
+def check_chart(chart: Any, name: str = "chart", variables: Sequence[str] = _CHART_VARIABLES) -> xr.Dataset:
     """``chart`` is an escape chart Dataset (numerics.escape_chart) with ``variables``; ValueError
     naming ``name`` otherwise."""
     if not isinstance(chart, xr.Dataset):
@@ -60,7 +78,7 @@ def check_chart(chart, name="chart", variables=_CHART_VARIABLES):
     return chart
 
 
-def chart_well(chart):
+def chart_well(chart: xr.Dataset) -> Well:
     """The well an escape chart was integrated in (its ``well`` attributes, written by
     ``numerics.escape_chart``); ValueError when the chart does not name one."""
     if "well" not in chart.attrs:
@@ -69,7 +87,7 @@ def chart_well(chart):
     return from_attrs(chart.attrs)
 
 
-def displacement_energy(well, q_lower, q_upper):
+def displacement_energy(well: Well, q_lower: npt.ArrayLike, q_upper: npt.ArrayLike) -> npt.NDArray[np.float64]:
     """Energy of the unforced safe set of a displacement criterion ``q_lower < q < q_upper``.
 
     An unforced orbit of energy E stays inside the bounds iff its turning points do,
@@ -91,7 +109,7 @@ def displacement_energy(well, q_lower, q_upper):
     return np.minimum(well.V(lo), well.V(hi))
 
 
-def q_max_energy(well, q_max):
+def q_max_energy(well: Well, q_max: npt.ArrayLike) -> npt.NDArray[np.float64]:
     """Energy of the unforced safe set of the symmetric criterion ``|q| < q_max``:
     :func:`displacement_energy` of ``(-q_max, q_max)``; for the quartic its closed form
     ``V(q_max)`` (eq (4) inverted, ``QuarticWell.xi_from_q_max``: both sides are equal, and
@@ -102,7 +120,7 @@ def q_max_energy(well, q_max):
     return displacement_energy(well, -qm, qm)
 
 
-def check_t_eval(t_eval, cycles):
+def check_t_eval(t_eval: npt.ArrayLike, cycles: float | None) -> npt.NDArray[np.float64]:
     """Validated evaluation times (scalar or 1-D, forcing cycles), each <= the horizon ``cycles``."""
     t = checks.check_nonempty("t_eval", checks.check_nonnegative("t_eval", t_eval))
     if t.ndim > 1:
@@ -117,7 +135,7 @@ def _t_eval_array(t, name="t_eval"):
     return xr.DataArray(t, dims=(name,) if t.ndim else (), name=name, attrs=cf.attrs("t_eval"))
 
 
-def safe_mask(chart, t_eval):
+def safe_mask(chart: xr.Dataset, t_eval: npt.ArrayLike) -> xr.Dataset:
     """Safe basins of an escape chart at evaluation time(s) ``t_eval`` (cycles, <= chart cycles).
 
     Returns a Dataset with bool ``safe_energy`` (xi_max, ...) and ``safe_displacement``
@@ -147,7 +165,7 @@ def _cell_widths(name, x):
     return np.abs(w)
 
 
-def safe_area(chart, t_eval):
+def safe_area(chart: xr.Dataset, t_eval: npt.ArrayLike) -> xr.Dataset:
     """Safe-basin size versus evaluation time, vectorised over t_eval.
 
     Returns a Dataset with ``pixels_energy`` (t_eval?, xi_max) and ``pixels_displacement``
@@ -179,7 +197,8 @@ def safe_area(chart, t_eval):
     return out
 
 
-def safe_stack(chart, t_eval=None, criterion="energy"):
+def safe_stack(chart: xr.Dataset, t_eval: npt.ArrayLike | None = None, criterion: AnyCriterion = "energy"
+               ) -> tuple[xr.DataArray, xr.DataArray]:
     """Safe masks with a leading dimension ``t_eval`` (default: the chart horizon).
 
     Returns ``(safe (t_eval, ..., q0, p0), xi_norm)`` where ``xi_norm`` is the energy that
@@ -192,7 +211,7 @@ def safe_stack(chart, t_eval=None, criterion="energy"):
     if not {"q0", "p0"} <= set(esc.dims):
         raise ValueError(f"chart must be an escape chart on a (q0, p0) grid (integrity needs a grid), got dims "
                          f"{esc.dims}")
-    cycles = chart.attrs.get("cycles")
+    cycles: Any = chart.attrs.get("cycles")
     t = np.atleast_1d(check_t_eval(float(cycles) if t_eval is None else t_eval, cycles)).astype(float)
     tda = xr.DataArray(t, dims="t_eval", coords={"t_eval": t},
                        attrs=cf.attrs("t_eval"))
