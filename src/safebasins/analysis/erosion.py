@@ -28,8 +28,11 @@ of S0 settles at the bottom).
 from __future__ import annotations
 
 import warnings
+from collections.abc import Iterable, Sequence
+from typing import Any, overload
 
 import numpy as np
+import numpy.typing as npt
 import xarray as xr
 
 from safebasins.core import checks
@@ -37,13 +40,14 @@ from safebasins.core import cf
 from safebasins.theory.slow_flow_grid import GridSlowFlow
 from safebasins.analysis.common import as_1d, mesh, stack_charts, well_variants
 from safebasins.analysis.integrity import integrity_measures, unforced_safe_mask
-from safebasins.analysis.safe import chart_well, safe_stack
+from safebasins.analysis.safe import AnyCriterion, chart_well, safe_stack
 from safebasins.core.cf import annotate
 from safebasins.numerics import escape_chart
 from safebasins.numerics.engine import damping_attrs
 from safebasins.theory.damped_escape import UndecidedWarning, slow_flow_outcomes
 from safebasins.theory.damped_flow import SETTLED, UNDECIDED
 from safebasins.wells import resolve_well, well_attrs
+from safebasins.wells.base import WellLike
 from safebasins.wells.provenance import api_provenance
 
 __all__ = [
@@ -95,7 +99,9 @@ def _analytic_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier, well, damping
     return da, undecided, scalar
 
 
-def analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier=None, well=None, *, damping=0.0):
+def analytic_safe_masks(F_values: npt.ArrayLike, Omega: float, Psi: float, xi_max: npt.ArrayLike, q0: npt.ArrayLike,
+                        p0: npt.ArrayLike, fourier: str | Sequence[str] | None = None, well: WellLike = None, *,
+                        damping: float = 0.0) -> xr.DataArray:
     """Analytic safe masks ``~slow_flow_escapes`` stacked as DataArray (fourier?, F, xi_max, q0, p0).
 
     ``fourier`` may be None (the well's own first harmonic: eq (20) as printed for the default
@@ -114,8 +120,9 @@ def analytic_safe_masks(F_values, Omega, Psi, xi_max, q0, p0, fourier=None, well
 
 
 @api_provenance
-def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier=None, *, keep_masks=False, well=None,
-                             damping=0.0):
+def erosion_profile_analytic(F_values: npt.ArrayLike, Omega: float, Psi: float, xi_max: npt.ArrayLike,
+                             q0: npt.ArrayLike, p0: npt.ArrayLike, fourier: str | Sequence[str] | None = None, *,
+                             keep_masks: bool = False, well: WellLike = None, damping: float = 0.0) -> xr.Dataset:
     """Analytic erosion profile: GIM/LIM/IF versus F from the slow flow on the (q0, p0) grid.
 
     Parameters
@@ -166,7 +173,8 @@ def erosion_profile_analytic(F_values, Omega, Psi, xi_max, q0, p0, fourier=None,
 
 # --------------------------------------------------------------------------- numeric
 @api_provenance
-def profile_from_charts(charts, t_eval=None, *, criterion="energy", stack_dim="F"):
+def profile_from_charts(charts: xr.Dataset | Iterable[xr.Dataset], t_eval: npt.ArrayLike | None = None, *,
+                        criterion: AnyCriterion = "energy", stack_dim: str = "F") -> xr.Dataset:
     """Integrity profile from existing escape charts (no integration).
 
     Parameters
@@ -204,8 +212,11 @@ def profile_from_charts(charts, t_eval=None, *, criterion="energy", stack_dim="F
 
 
 @api_provenance
-def erosion_profile_numeric(F_values, Omega, Psi, xi_max, q0, p0, t_eval=None, cycles=3000, *,
-                            q_max=(), keep_charts=False, well=None, damping=0.0, **chart_kwargs):
+def erosion_profile_numeric(F_values: npt.ArrayLike, Omega: float, Psi: float, xi_max: npt.ArrayLike,
+                            q0: npt.ArrayLike, p0: npt.ArrayLike, t_eval: npt.ArrayLike | None = None,
+                            cycles: int = 3000, *, q_max: npt.ArrayLike = (), keep_charts: bool = False,
+                            well: WellLike = None, damping: float = 0.0, **chart_kwargs: Any
+                            ) -> xr.Dataset | tuple[xr.Dataset, xr.Dataset]:
     """Numeric erosion profile: ONE escape chart per F, all thresholds and t_eval read from it.
 
     Parameters
@@ -244,8 +255,17 @@ def erosion_profile_numeric(F_values, Omega, Psi, xi_max, q0, p0, t_eval=None, c
 
 
 # --------------------------------------------------------------------------- summaries
+@overload
+def level_crossing(profile: xr.DataArray, level: float = 0.5, dim: str = "F") -> xr.DataArray: ...
+
+
+@overload
+def level_crossing(profile: xr.Dataset, level: float = 0.5, dim: str = "F") -> xr.Dataset: ...
+
+
 @api_provenance
-def level_crossing(profile, level=0.5, dim="F"):
+def level_crossing(profile: xr.DataArray | xr.Dataset, level: float = 0.5, dim: str = "F"
+                   ) -> xr.DataArray | xr.Dataset:
     """First value of ``dim`` at which a profile falls below ``level`` (linear interpolation).
 
     ``profile`` is a DataArray (e.g. ``ds["GIM"]``) or a Dataset (applied to GIM, LIM,
@@ -290,7 +310,7 @@ def level_crossing(profile, level=0.5, dim="F"):
 
 
 @api_provenance
-def compare_profiles(analytic, numeric, level=0.5):
+def compare_profiles(analytic: xr.Dataset, numeric: xr.Dataset, level: float = 0.5) -> xr.Dataset:
     """Side-by-side Dataset: ``<measure>_analytic``, ``<measure>_numeric`` and the F at which
     each falls below ``level`` (``F_<measure>_analytic``, ``F_<measure>_numeric``).
 

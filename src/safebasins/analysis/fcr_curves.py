@@ -6,8 +6,15 @@ from a config block); the pipeline's ``fcr_theory`` / ``fcr_compare`` kinds and 
 """
 from __future__ import annotations
 
-import numpy as np
+from collections.abc import Mapping, Sequence
+from typing import Any, cast
 
+import numpy as np
+import numpy.typing as npt
+import xarray as xr
+
+from safebasins.analysis.safe import Criterion
+from safebasins.wells.base import WellLike
 from safebasins.wells.provenance import api_provenance
 from safebasins.core.stacking import stack
 from safebasins.theory import critical_forcing, initial_condition
@@ -17,7 +24,8 @@ __all__ = ["analytic_fcr_curves", "numeric_fcr_curves"]
 
 
 @api_provenance
-def analytic_fcr_curves(Omega, curves, *, well=None, label=""):
+def analytic_fcr_curves(Omega: npt.ArrayLike, curves: Sequence[Mapping[str, Any]], *, well: WellLike = None,
+                        label: str = "") -> xr.Dataset:
     """One :func:`safebasins.theory.critical_forcing` per curve (eqs 22-26), stacked over ``curve``
     with the coordinates xi_max, xi_ini, gamma_ini, label (and Psi when every curve has one)."""
     Omega = np.asarray(Omega, dtype=float)
@@ -38,8 +46,10 @@ def _curve_coords(curves, keys, optional):
 
 
 @api_provenance
-def numeric_fcr_curves(Omega, curves, *, well=None, cycles, tol, F_bracket, criterion, n_scan, steps_per_cycle,
-                       threads=None, backend="cpu", label=""):
+def numeric_fcr_curves(Omega: npt.ArrayLike, curves: Sequence[Mapping[str, Any]], *, well: WellLike = None,
+                       cycles: int, tol: float, F_bracket: Sequence[float] | None, criterion: Criterion, n_scan: int,
+                       steps_per_cycle: int, threads: int | None = None, backend: str = "cpu",
+                       label: str = "") -> xr.Dataset:
     """One :func:`safebasins.numerics.critical_forcing_numeric` per curve, from the IC
     ``theory.initial_condition(xi_ini, gamma_ini, Psi)``, stacked over ``curve`` with the
     coordinates xi_max, xi_ini, gamma_ini, Psi, label, q0, p0."""
@@ -52,7 +62,7 @@ def numeric_fcr_curves(Omega, curves, *, well=None, cycles, tol, F_bracket, crit
         print(f"{label}: {c['label']}: IC (q0, p0) = ({q0:.6f}, {p0:.6f})", flush=True)
         parts.append(critical_forcing_numeric(
             Omega, c["xi_max"], q0=q0, p0=p0, Psi=c["Psi"], cycles=cycles, tol=tol,
-            F_bracket=None if F_bracket is None else tuple(F_bracket),
+            F_bracket=None if F_bracket is None else cast(tuple[float, float], tuple(F_bracket)),
             criterion=criterion, n_scan=n_scan, steps_per_cycle=steps_per_cycle, threads=threads, backend=backend,
             well=well, damping=c.get("damping", 0.0)))
     coords = _curve_coords(curves, ("xi_max", "xi_ini", "gamma_ini", "Psi", "label"), ("damping",))

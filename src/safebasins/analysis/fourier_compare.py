@@ -18,18 +18,22 @@ dataset), or ``well=`` another well, raise ValueError.
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
+import numpy.typing as npt
 import xarray as xr
 
 from safebasins.core import checks
 from safebasins.analysis.agreement import iou, pixel_agreement
 from safebasins.analysis.common import as_1d, chart_param, mesh
 from safebasins.analysis.integrity import integrity_measures, unforced_safe_mask
-from safebasins.analysis.safe import chart_well, safe_stack
+from safebasins.analysis.safe import Criterion, chart_well, safe_stack
 from safebasins.core.cf import annotate
 from safebasins.numerics import critical_forcing_numeric
 from safebasins.theory import angle_energy, critical_forcing, initial_condition, slow_flow_escapes
 from safebasins.wells.quartic import FOURIER_VARIANTS, QUARTIC, QuarticWell
+from safebasins.wells.base import WellLike
 from safebasins.wells.provenance import api_provenance
 
 __all__ = ["fcr_fourier_comparison", "fcr_fourier_comparison_from_numeric", "iou_fourier_comparison"]
@@ -89,8 +93,9 @@ def _fcr_dataset(Omega, F_num, F_an, extra=None, attrs=None):
 
 
 @api_provenance
-def fcr_fourier_comparison(Omega, xi_max, *, xi_ini=0.0, gamma_ini=0.0, Psi=0.0, cycles=3000, tol=5e-5,
-                           well=None, **numeric_kwargs):
+def fcr_fourier_comparison(Omega: npt.ArrayLike, xi_max: float, *, xi_ini: float = 0.0, gamma_ini: float = 0.0,
+                           Psi: float = 0.0, cycles: int = 3000, tol: float = 5e-5, well: WellLike = None,
+                           **numeric_kwargs: Any) -> xr.Dataset:
     """F_cr(Omega): paper vs exact first harmonic against the numeric bisection.
 
     The numeric IC is ``(q0, p0) = theory.initial_condition(xi_ini, gamma_ini, Psi)`` so that
@@ -132,7 +137,8 @@ def _curve_param(ds, name, default=None):
 
 
 @api_provenance
-def fcr_fourier_comparison_from_numeric(numeric, *, xi_ini=None, gamma_ini=None):
+def fcr_fourier_comparison_from_numeric(numeric: xr.Dataset, *, xi_ini: float | None = None,
+                                        gamma_ini: float | None = None) -> xr.Dataset:
     """Paper vs exact F_cr against an existing ``critical_forcing_numeric`` Dataset.
 
     ``numeric`` may be stacked over ``curve`` (pipeline files ``fcr_fig10-12.nc``, with
@@ -173,7 +179,8 @@ def fcr_fourier_comparison_from_numeric(numeric, *, xi_ini=None, gamma_ini=None)
 
 
 @api_provenance
-def iou_fourier_comparison(chart, t_eval=None, *, criterion="energy"):
+def iou_fourier_comparison(chart: xr.Dataset, t_eval: npt.ArrayLike | None = None, *,
+                           criterion: Criterion = "energy") -> xr.Dataset:
     """Safe basins: analytic masks with both first-harmonic variants vs a numeric chart.
 
     ``chart`` is an ``escape_chart`` Dataset on a (q0, p0) grid, optionally stacked over
