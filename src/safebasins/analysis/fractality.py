@@ -15,10 +15,15 @@ escape chart (paired ICs) and fits ``log f`` against ``log eps`` by weighted lea
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import Any
+
 import numpy as np
+import numpy.typing as npt
 import xarray as xr
 
 from safebasins.core import checks
+from safebasins.wells.base import WellLike
 from safebasins.wells.provenance import api_provenance
 from safebasins.analysis.safe import is_safe
 from safebasins.numerics import escape_chart
@@ -29,7 +34,8 @@ __all__ = ["uncertainty_exponent", "MIN_UNCERTAIN"]
 MIN_UNCERTAIN = 10
 
 
-def exponent_dataset(eps, n_uncertain, n, eps_attrs) -> xr.Dataset:
+def exponent_dataset(eps: npt.ArrayLike, n_uncertain: npt.ArrayLike, n: int,
+                     eps_attrs: Mapping[str, Any]) -> xr.Dataset:
     """f(eps) = n_uncertain / n of n random base points, its binomial standard error and the
     weighted least-squares fit of log f against log eps over the eps with at least MIN_UNCERTAIN
     uncertain points: a Dataset over ``eps`` (``n_uncertain``, ``fraction``, ``fraction_err``,
@@ -70,9 +76,10 @@ def _box(box):
 
 
 @api_provenance
-def uncertainty_exponent(F, Omega, Psi, xi_max, box, *, eps=(1e-2, 3e-3, 1e-3, 3e-4, 1e-4), n=4000, cycles=500,
-                         t_eval=None, seed=0, well=None, damping=0.0, steps_per_cycle=32, threads=None,
-                         backend="cpu"):
+def uncertainty_exponent(F: float, Omega: float, Psi: float, xi_max: float, box: npt.ArrayLike, *,
+                         eps: npt.ArrayLike = (1e-2, 3e-3, 1e-3, 3e-4, 1e-4), n: int = 4000, cycles: int = 500,
+                         t_eval: float | None = None, seed: int = 0, well: WellLike = None, damping: float = 0.0,
+                         steps_per_cycle: int = 32, threads: int | None = None, backend: str = "cpu") -> xr.Dataset:
     """Uncertainty exponent alpha of the safe-basin boundary (energy criterion H0 > xi_max) and
     the boundary dimension ``2 - alpha``.
 

@@ -19,7 +19,8 @@ one progress line each, for the job's log.
 """
 from __future__ import annotations
 
-from typing import cast
+from collections.abc import Sequence
+from typing import Literal, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -29,6 +30,7 @@ import contourpy
 from safebasins.core import checks
 from safebasins.wells.provenance import api_provenance
 from safebasins.wells import resolve_well
+from safebasins.wells.base import WellLike
 from safebasins.theory import safe_basin_boundaries, slow_flow_escapes, escapes_on_manifold, first_integral
 from safebasins.core.stacking import stack
 from safebasins.analysis.confirm import confirm_regions
@@ -49,7 +51,8 @@ def _log(label, text):
 
 
 @api_provenance
-def mask_outline(safe, q0, p0, Psi, *, well=None):
+def mask_outline(safe: npt.ArrayLike, q0: npt.ArrayLike, p0: npt.ArrayLike, Psi: float, *,
+                 well: WellLike = None) -> xr.Dataset:
     """The outline of a safe mask on the IC grid as boundary curves in the layout of
     :func:`safebasins.theory.safe_basin_boundaries` (dims ``curve``, ``vertex``).
 
@@ -105,7 +108,9 @@ def mask_outline(safe, q0, p0, Psi, *, well=None):
 
 
 @api_provenance
-def analytic_basin(F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, label=None, damping=0.0):
+def analytic_basin(F: float, Omega: float, Psi: float, xi_max: float, q0: npt.ArrayLike, p0: npt.ArrayLike, *,
+                   well: WellLike = None, n_points: int = 2000, label: str | None = None,
+                   damping: float = 0.0) -> xr.Dataset:
     """Boundaries + per-IC analytic escape mask on the (q0, p0) grid of 1-D axes ``q0``, ``p0``.
 
     ``well``: any form :func:`safebasins.wells.resolve_well` reads (its first harmonic included);
@@ -134,15 +139,19 @@ def analytic_basin(F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, l
 
 
 @api_provenance
-def analytic_basin_stack(scan, values, F, Omega, Psi, xi_max, q0, p0, *, well=None, n_points=2000, label=None,
-                         damping=0.0):
+def analytic_basin_stack(scan: Literal["F", "xi_max"], values: Sequence[float], F: float | None, Omega: float,
+                         Psi: float, xi_max: float | None, q0: npt.ArrayLike, p0: npt.ArrayLike, *,
+                         well: WellLike = None, n_points: int = 2000, label: str | None = None,
+                         damping: float = 0.0) -> xr.Dataset:
     """Analytic basins stacked over the scanned parameter ``scan`` ("F" or "xi_max", taking
     ``values``; the other one is the scalar argument).  Each basin's saddle point is a coordinate
     along ``scan`` (``saddle_gamma``, ``saddle_xi``; NaN for a damped basin); attribute ``scan``.
     ``damping``: as :func:`analytic_basin`."""
     if scan not in ("F", "xi_max"):
         raise ValueError(f"scan must be 'F' or 'xi_max', got {scan!r}")
-    parts = [analytic_basin(v if scan == "F" else F, Omega, Psi, v if scan == "xi_max" else xi_max, q0, p0,
+    # the scanned one of F, xi_max may be None (unused): the other one is a float
+    parts = [analytic_basin(v if scan == "F" else cast(float, F), Omega, Psi,
+                            v if scan == "xi_max" else cast(float, xi_max), q0, p0,
                             well=well, n_points=n_points, label=label, damping=damping) for v in values]
     saddle = {k: [float(b.attrs.get(k, np.nan)) for b in parts] for k in ("saddle_gamma", "saddle_xi")}
     out = stack(parts, scan, values, coords=saddle)
@@ -150,7 +159,8 @@ def analytic_basin_stack(scan, values, F, Omega, Psi, xi_max, q0, p0, *, well=No
     return out
 
 
-def add_resonance_manifold(basin, F, Omega, xi_max, *, n_gamma, n_xi, xi_top, well=None):
+def add_resonance_manifold(basin: xr.Dataset, F: float, Omega: float, xi_max: float, *, n_gamma: int, n_xi: int,
+                           xi_top: float, well: WellLike = None) -> xr.Dataset:
     """``basin`` with the first integral ``C(gamma_rm, xi_rm)`` (eq 18) and the escape
     classification ``escapes_rm`` on a gamma in [-pi, pi] x xi in [0, xi_top] grid."""
     g = np.linspace(-np.pi, np.pi, n_gamma)
@@ -165,7 +175,9 @@ def add_resonance_manifold(basin, F, Omega, xi_max, *, n_gamma, n_xi, xi_top, we
 
 
 @api_provenance
-def numeric_check(basin, F, Omega, Psi, xi_max, *, cycles, steps_per_cycle, well=None, threads=None, label=None):
+def numeric_check(basin: xr.Dataset, F: float, Omega: float, Psi: float, xi_max: float, *, cycles: int,
+                  steps_per_cycle: int, well: WellLike = None, threads: int | None = None,
+                  label: str | None = None) -> xr.Dataset:
     """Integrate the analytic-safe ICs of ``basin``'s grid for ``cycles`` forcing cycles (energy
     criterion) and store, per connected part of the analytic basin, the fraction the numerics
     keep: ``escape_cycle_numeric(q0, p0)``, ``region(q0, p0)``, ``region_size``,

@@ -18,7 +18,11 @@ normalised by the unforced basin) form a map over (Omega, F).
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import Any
+
 import numpy as np
+import numpy.typing as npt
 import xarray as xr
 
 from safebasins.core import checks
@@ -31,6 +35,7 @@ from safebasins.core.cf import annotate
 from safebasins.wells.provenance import api_provenance
 from safebasins.numerics import escape_chart_batch
 from safebasins.wells import well_attrs
+from safebasins.wells.base import WellLike
 
 __all__ = ["integrity_map_analytic", "integrity_map_numeric", "integrity_from_batch", "erosion_front"]
 
@@ -44,7 +49,9 @@ def _control(Omega, F):
 
 
 @api_provenance
-def integrity_map_analytic(Omega, F, Psi, xi_max, q0, p0, *, fourier=None, n_gamma=128, n_xi=64, well=None):
+def integrity_map_analytic(Omega: npt.ArrayLike, F: npt.ArrayLike, Psi: float, xi_max: float, q0: npt.ArrayLike,
+                           p0: npt.ArrayLike, *, fourier: str | None = None, n_gamma: int = 128, n_xi: int = 64,
+                           well: WellLike = None) -> xr.Dataset:
     """Analytic integrity map over (Omega, F): GIM, LIM, IF of the slow-flow basin for phase Psi,
     and ``xi_true``, ``GIM_true``, ``LIM_true``, ``IF_true`` of the basin safe for every phase.
     ``well``: any well (None: the quartic); ``fourier``: one variant (None: the well's own, "paper"
@@ -105,7 +112,7 @@ def _closed_measures(xis, xi_max, well):
 
 
 @api_provenance
-def integrity_from_batch(charts, t_eval=None):
+def integrity_from_batch(charts: xr.Dataset, t_eval: npt.ArrayLike | None = None) -> xr.Dataset:
     """GIM, LIM, IF per control point and t_eval from an ``escape_chart_batch`` Dataset (one
     energy threshold), over (control, t_eval)."""
     if charts.sizes["xi_max"] != 1:
@@ -116,7 +123,9 @@ def integrity_from_batch(charts, t_eval=None):
 
 
 @api_provenance
-def integrity_map_numeric(Omega, F, Psi, xi_max, q0, p0, *, cycles=1000, t_eval=None, well=None, **chart_kwargs):
+def integrity_map_numeric(Omega: npt.ArrayLike, F: npt.ArrayLike, Psi: float, xi_max: float, q0: npt.ArrayLike,
+                          p0: npt.ArrayLike, *, cycles: int = 1000, t_eval: npt.ArrayLike | None = None,
+                          well: WellLike = None, **chart_kwargs: Any) -> xr.Dataset:
     """Numeric integrity map over (Omega, F, t_eval): one escape chart per control point (all
     control points in one ensemble), safe = escape_cycle > t_eval."""
     Om, Fv = _control(Omega, F)
@@ -138,7 +147,7 @@ def integrity_map_numeric(Omega, F, Psi, xi_max, q0, p0, *, cycles=1000, t_eval=
 
 
 @api_provenance
-def erosion_front(ds, level=0.5, measures=MEASURES):
+def erosion_front(ds: xr.Dataset, level: float = 0.5, measures: Sequence[str] = MEASURES) -> xr.Dataset:
     """The F at which each measure first falls below ``level``, per Omega (and t_eval): variables
     ``F_<measure>`` (NaN where it never does)."""
     level = checks.check_scalar("level", level, checks.check_positive)
