@@ -63,6 +63,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+import numpy.typing as npt
 import xarray as xr
 from numpy.polynomial import legendre as _leg
 from scipy.integrate import solve_ivp
@@ -71,6 +72,7 @@ from scipy.interpolate import CubicSpline
 
 from safebasins.core import checks
 from safebasins.wells import resolve_well, well_attrs
+from safebasins.wells.base import WellLike
 from safebasins.wells.orbit_quadrature import clenshaw_curtis
 from safebasins.wells.provenance import api_provenance
 
@@ -122,7 +124,7 @@ class SeparatrixOrbit:
     energy: float
 
 
-def separatrix_orbit(well=None) -> SeparatrixOrbit:
+def separatrix_orbit(well: WellLike = None) -> SeparatrixOrbit:
     """The separatrix orbit (module docstring) of ``well`` (any form :func:`resolve_well` reads).
 
     ValueError naming ``well`` when the escape energy is not set by a hilltop saddle (a well open
@@ -272,7 +274,8 @@ def _check_omega(Omega):
     return Om
 
 
-def separatrix_integrals(Omega, well=None):
+def separatrix_integrals(Omega: npt.ArrayLike, well: WellLike = None
+                         ) -> tuple[float, npt.NDArray[np.complex128], SeparatrixOrbit]:
     """``(I1, I2, orbit)`` along the separatrix orbit (:func:`separatrix_orbit`) of ``well``, by
     the quadrature of the module docstring: ``I1 = int p0^2 dt`` (float) and the complex
     ``I2(Omega) = int p0(t) e^{i Omega t} dt`` (array shaped like ``Omega``) with the time origin
@@ -299,7 +302,7 @@ def separatrix_integrals(Omega, well=None):
     return I1, I2.reshape(Om.shape), orbit
 
 
-def melnikov_threshold(Omega, damping, well=None):
+def melnikov_threshold(Omega: npt.ArrayLike, damping: float, well: WellLike = None) -> float | npt.NDArray[np.float64]:
     """Melnikov forcing threshold ``F_M(Omega) = damping * I1 / |I2(Omega)|`` of
     ``q'' + damping q' + V'(q) = F sin(Omega t + Psi)`` (module docstring): below ``F_M`` the
     stable and unstable manifolds of the forced hilltop saddle do not intersect (to first order in
@@ -319,7 +322,8 @@ def melnikov_threshold(Omega, damping, well=None):
     return float(F) if np.ndim(F) == 0 else F
 
 
-def melnikov_function(t0, F, Omega, damping, well=None, Psi=0.0):
+def melnikov_function(t0: npt.ArrayLike, F: float, Omega: float, damping: float, well: WellLike = None,
+                      Psi: float = 0.0) -> float | npt.NDArray[np.float64]:
     """First-order Melnikov function ``M(t0) = -damping I1 + F Im(e^{i (Omega t0 + Psi)} I2(Omega))``
     (array shaped like ``t0``): the energy ``H0`` of the unstable manifold minus that of the stable
     manifold where they cross the normal of the separatrix orbit at its middle (the turning point
@@ -337,7 +341,7 @@ def melnikov_function(t0, F, Omega, damping, well=None, Psi=0.0):
 
 
 @api_provenance
-def melnikov_curve(Omega, damping, well=None) -> xr.Dataset:
+def melnikov_curve(Omega: npt.ArrayLike, damping: float, well: WellLike = None) -> xr.Dataset:
     """:func:`melnikov_threshold` over the 1-D ``Omega`` as a Dataset: ``F_M(Omega)``, the separatrix
     integrals ``I1`` and ``I2_abs(Omega)``, attributes naming the well (:func:`well_attrs`), the
     damping, the orbit kind ("heteroclinic" / "homoclinic"), its saddles and energy."""
@@ -492,7 +496,8 @@ def _manifold_section(well, F, Omega, damping, Psi, q_b, direction, unstable, se
 
 
 @api_provenance
-def manifold_splitting(F, Omega, damping, well=None, Psi=0.0, n_phase=48, offset=1e-6, rtol=1e-11):
+def manifold_splitting(F: float, Omega: float, damping: float, well: WellLike = None, Psi: float = 0.0,
+                       n_phase: int = 48, offset: float = 1e-6, rtol: float = 1e-11) -> xr.Dataset:
     """Numeric splitting of the forced saddle's manifolds: the energy gap ``H0(W^u) - H0(W^s)``
     where the unstable and stable manifolds first cross the normal section of the separatrix orbit
     at its middle (homoclinic: ``p = 0`` at the turning point; heteroclinic: ``q = (q_left +

@@ -14,7 +14,10 @@ Omega = 0.85).  This module puts the three measurements side by side:
 """
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import numpy as np
+import numpy.typing as npt
 import xarray as xr
 
 from safebasins.core import checks
@@ -24,12 +27,13 @@ from safebasins.analysis.fractality import uncertainty_exponent
 from safebasins.analysis.melnikov import melnikov_threshold
 from safebasins.analysis.safe import chart_well, safe_stack
 from safebasins.core.cf import annotate
+from safebasins.wells.base import WellLike
 from safebasins.wells.provenance import api_provenance
 
 __all__ = ["tangency_profile", "fractality_profile", "melnikov_variable"]
 
 
-def melnikov_variable(Omega, damping, well):
+def melnikov_variable(Omega: float, damping: float, well: WellLike) -> xr.DataArray:
     """``F_melnikov`` as a scalar DataArray (the first-order tangency threshold of the lowest
     hilltop saddle, :func:`~safebasins.analysis.melnikov.melnikov_threshold`)."""
     F_M = float(melnikov_threshold(float(Omega), float(damping), well=well))
@@ -38,7 +42,8 @@ def melnikov_variable(Omega, damping, well):
 
 
 @api_provenance
-def tangency_profile(charts, t_eval=None, *, keep_F=(), level=0.5):
+def tangency_profile(charts: xr.Dataset | Iterable[xr.Dataset], t_eval: npt.ArrayLike | None = None, *,
+                     keep_F: npt.ArrayLike = (), level: float = 0.5) -> xr.Dataset:
     """Integrity profile of damped long-time basins with the Melnikov threshold.
 
     Parameters
@@ -83,8 +88,10 @@ def tangency_profile(charts, t_eval=None, *, keep_F=(), level=0.5):
 
 
 @api_provenance
-def fractality_profile(F_values, Omega, Psi, xi_max, box, *, damping, eps=(1e-2, 3e-3, 1e-3, 3e-4, 1e-4), n=4000,
-                       cycles=500, t_eval=None, seed=0, well=None, steps_per_cycle=32, threads=None, backend="cpu"):
+def fractality_profile(F_values: npt.ArrayLike, Omega: float, Psi: float, xi_max: float, box: npt.ArrayLike, *,
+                       damping: float, eps: npt.ArrayLike = (1e-2, 3e-3, 1e-3, 3e-4, 1e-4), n: int = 4000,
+                       cycles: int = 500, t_eval: float | None = None, seed: int = 0, well: WellLike = None,
+                       steps_per_cycle: int = 32, threads: int | None = None, backend: str = "cpu") -> xr.Dataset:
     """Uncertainty exponent alpha(F) of the safe basin's boundary, with the Melnikov threshold.
 
     One :func:`~safebasins.analysis.fractality.uncertainty_exponent` per F (the same seeded base
