@@ -36,13 +36,22 @@ minimal period found this way (independent route), started at the island centroi
 """
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
+import xarray as xr
 
 from safebasins.core import checks
 from safebasins.wells.provenance import api_provenance
 from safebasins.numerics import stroboscopic_map, escape_chart
+from safebasins.analysis.safe import Criterion
+from safebasins.wells.base import WellLike
+
+Array = npt.NDArray[np.float64]
+#: one iteration of a map, ``step(q, p) -> (q', p')`` on arrays
+Step = Callable[[Array, Array], tuple[Array, Array]]
 
 __all__ = ["birkhoff_weights", "weighted_birkhoff", "rotation_numbers", "island_chains", "classify_orbits",
            "portrait_with_criteria",
@@ -55,7 +64,7 @@ ORBIT_CLASSES = {0: "escaped", 1: "main island", 2: "island chain", 3: "chaotic"
 MAX_DIGITS = 16.0
 
 
-def birkhoff_weights(n):
+def birkhoff_weights(n: int) -> Array:
     """Normalised bump weights ``exp(-1 / (t (1 - t)))`` at t = (i + 1/2) / n, i = 0..n-1."""
     n = checks.check_positive_int("n", n)
     t = (np.arange(n) + 0.5) / n
@@ -63,7 +72,7 @@ def birkhoff_weights(n):
     return w / w.sum()
 
 
-def weighted_birkhoff(values, axis=-1):
+def weighted_birkhoff(values: npt.ArrayLike, axis: int = -1) -> Array | np.float64:
     """Weighted Birkhoff average of ``values`` along ``axis`` (bump weights, see module doc)."""
     v = np.moveaxis(np.asarray(values, float), axis, -1)
     if v.shape[-1] < 1:
@@ -79,7 +88,7 @@ def _angle_steps(q, p, center):
     return d / (2 * np.pi)
 
 
-def _orbits(q, p):
+def _orbits(q: npt.ArrayLike, p: npt.ArrayLike) -> tuple[Array, Array]:
     q = np.atleast_2d(np.asarray(q, float))
     p = np.atleast_2d(np.asarray(p, float))
     if q.shape != p.shape:
@@ -89,7 +98,7 @@ def _orbits(q, p):
     return q, p
 
 
-def rotation_numbers(q, p, center):
+def rotation_numbers(q: npt.ArrayLike, p: npt.ArrayLike, center: npt.ArrayLike) -> tuple[Array, Array]:
     """Rotation number about ``center`` and its convergence digits, per orbit.
 
     Parameters
@@ -124,7 +133,9 @@ def rotation_numbers(q, p, center):
     return rho, digits
 
 
-def island_chains(q, p, rho, digits, *, max_period=40, confine=0.5, rational_tol=1e-6, min_digits=5.0):
+def island_chains(q: npt.ArrayLike, p: npt.ArrayLike, rho: npt.ArrayLike, digits: npt.ArrayLike, *,
+                  max_period: int = 40, confine: float = 0.5, rational_tol: float = 1e-6, min_digits: float = 5.0
+                  ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
     """Period k and winding m of the island chain each regular orbit lies on (0, 0 if none).
 
     A regular orbit (``digits >= min_digits``) lies on a chain of period k (2 <= k <=
@@ -149,7 +160,9 @@ def island_chains(q, p, rho, digits, *, max_period=40, confine=0.5, rational_tol
     return period, winding
 
 
-def classify_orbits(q, p, center, *, min_digits=5.0, max_period=40, confine=0.5, rational_tol=1e-6):
+def classify_orbits(q: npt.ArrayLike, p: npt.ArrayLike, center: npt.ArrayLike, *, min_digits: float = 5.0,
+                    max_period: int = 40, confine: float = 0.5, rational_tol: float = 1e-6
+                    ) -> dict[str, npt.NDArray[Any]]:
     """Rotation number, convergence digits, chain period / winding and class of every orbit.
 
     Classes (:data:`ORBIT_CLASSES`): 0 escaped (NaN iterates), 1 main island (regular, winds
@@ -176,7 +189,8 @@ def _iterate(step, x, k):
     return np.stack([q, p], axis=-1)
 
 
-def periodic_orbit(step, x0, period, *, h=1e-7, tol=1e-11, max_iter=40):
+def periodic_orbit(step: Step, x0: npt.ArrayLike, period: int, *, h: float = 1e-7, tol: float = 1e-11,
+                   max_iter: int = 40) -> tuple[Array, float, float] | None:
     """Newton's method for ``P^period(x) = x``.
 
     Parameters
@@ -216,7 +230,7 @@ def periodic_orbit(step, x0, period, *, h=1e-7, tol=1e-11, max_iter=40):
     return None
 
 
-def minimal_period(step, x, max_period, *, tol=1e-8):
+def minimal_period(step: Step, x: npt.ArrayLike, max_period: int, *, tol: float = 1e-8) -> int:
     """Smallest j <= max_period with ``|P^j(x) - x| < tol`` (0 if none)."""
     max_period = checks.check_positive_int("max_period", max_period)
     y = np.asarray(x, float).reshape(1, 2)
@@ -254,11 +268,13 @@ def _island_period(q, p, max_period, confine):
     return 0
 
 
-def strobe_step(F, Omega, Psi, *, xi_max=None, q_max=None, steps_per_cycle=None, integrator=None, well=None):
+def strobe_step(F: float, Omega: float, Psi: float, *, xi_max: float | None = None, q_max: float | None = None,
+                steps_per_cycle: int | None = None, integrator: str | None = None, well: WellLike = None) -> Step:
     """The period map of eq (29) as ``step(q, p) -> (q', p')`` (NaN once a threshold is crossed),
     for :func:`periodic_orbit` and :func:`minimal_period`; ``well``: the well of eq (1) (None: the
     paper's quartic; see ``numerics.stroboscopic_map``)."""
-    kw = {k: v for k, v in (("steps_per_cycle", steps_per_cycle), ("integrator", integrator)) if v is not None}
+    kw: dict[str, Any] = {k: v for k, v in (("steps_per_cycle", steps_per_cycle), ("integrator", integrator))
+                          if v is not None}
 
     def step(q, p):
         q, p = np.atleast_1d(np.asarray(q, float)), np.atleast_1d(np.asarray(p, float))
@@ -281,7 +297,8 @@ def _orbit_points(step, x, k):
     return np.array(pts)
 
 
-def chain_orbits(step, q, p, period, *, max_period=40, same_tol=1e-6):
+def chain_orbits(step: Step, q: npt.ArrayLike, p: npt.ArrayLike, period: npt.ArrayLike, *, max_period: int = 40,
+                 same_tol: float = 1e-6) -> tuple[npt.NDArray[np.int64], list[dict[str, Any]]]:
     """The periodic orbits at the centres of the island chains (independent check of the
     periods found from orbit statistics by :func:`island_chains`).
 
@@ -339,9 +356,11 @@ def chain_orbits(step, q, p, period, *, max_period=40, same_tol=1e-6):
 
 
 @api_provenance
-def period_map_portrait(q0, p0, F, Omega, Psi, *, n_keep, n_iter=3000, xi_max=None, q_max=None,
-                        steps_per_cycle=None, threads=None, min_digits=5.0, max_period=40, confine=0.5,
-                        rational_tol=1e-6, well=None):
+def period_map_portrait(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: float, Psi: float, *, n_keep: int,
+                        n_iter: int = 3000, xi_max: float | None = None, q_max: float | None = None,
+                        steps_per_cycle: int | None = None, threads: int | None = None, min_digits: float = 5.0,
+                        max_period: int = 40, confine: float = 0.5, rational_tol: float = 1e-6,
+                        well: WellLike = None) -> xr.Dataset:
     """Stroboscopic map of the first ``n_keep`` non-escaping candidates, classified.
 
     The centre of the main island is the elliptic fixed point of the map found by Newton's
@@ -378,7 +397,7 @@ def period_map_portrait(q0, p0, F, Omega, Psi, *, n_keep, n_iter=3000, xi_max=No
 
 
     n_keep = checks.check_positive_int("n_keep", n_keep)
-    kw = {} if steps_per_cycle is None else {"steps_per_cycle": steps_per_cycle}
+    kw: dict[str, Any] = {} if steps_per_cycle is None else {"steps_per_cycle": steps_per_cycle}
     ds = stroboscopic_map(q0, p0, F, Omega, Psi, n_iter=n_iter, xi_max=xi_max, q_max=q_max, threads=threads,
                           well=well, **kw)
     safe = np.flatnonzero(~np.asarray(ds["escaped"].values, dtype=bool))
@@ -454,13 +473,15 @@ def period_map_portrait(q0, p0, F, Omega, Psi, *, n_keep, n_iter=3000, xi_max=No
     return out
 
 
-def portrait_with_criteria(q0, p0, origin, F, Omega, Psi, *, criterion, xi_max, q_max, n_keep, n_iter,
-                           steps_per_cycle, threads=None, min_digits=5.0, max_period=40):
+def portrait_with_criteria(q0: npt.ArrayLike, p0: npt.ArrayLike, origin: Sequence[str], F: float, Omega: float,
+                           Psi: float, *, criterion: Criterion, xi_max: float, q_max: float, n_keep: int, n_iter: int,
+                           steps_per_cycle: int, threads: int | None = None, min_digits: float = 5.0,
+                           max_period: int = 40) -> xr.Dataset:
     """Fig 18: :func:`period_map_portrait` of the candidates (q0, p0) under one escape
     ``criterion`` ("energy": H0 > xi_max, "displacement": ``|q| > q_max``), with each kept orbit's
     ``origin`` label and its escape cycle under BOTH criteria (``escape_cycle_energy``,
     ``escape_cycle_displacement``: one escape chart of the kept ICs, paired samples)."""
-    thresholds = dict(xi_max=xi_max) if criterion == "energy" else dict(q_max=q_max)
+    thresholds: dict[str, Any] = dict(xi_max=xi_max) if criterion == "energy" else dict(q_max=q_max)
     out = period_map_portrait(q0, p0, F, Omega, Psi, n_keep=n_keep, n_iter=n_iter, steps_per_cycle=steps_per_cycle,
                               threads=threads, min_digits=min_digits, max_period=max_period, **thresholds)
     cand = np.asarray(out["candidate"].values)
