@@ -39,17 +39,22 @@ over the phases.
 """
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
+from typing import Any
+
 import numpy as np
+import numpy.typing as npt
 import xarray as xr
 
 from safebasins.core import checks
 from safebasins.analysis.common import as_1d, mesh, stack_charts, variant_well, well_variants
 from safebasins.analysis.integrity import MEASURE_ATTRS, integrity_measures, unforced_radii2, unforced_safe_mask
-from safebasins.analysis.safe import chart_well, safe_stack
+from safebasins.analysis.safe import AnyCriterion, chart_well, safe_stack
 from safebasins.core.cf import annotate
 from safebasins.numerics import escape_chart
 from safebasins.theory import angle_energy, escapes_on_manifold
 from safebasins.wells import resolve_well, well_attrs
+from safebasins.wells.base import WellLike
 from safebasins.wells.provenance import api_provenance
 from safebasins.theory import safe_basin_boundaries
 
@@ -66,7 +71,7 @@ __all__ = [
 _KEEP = ("GIM", "LIM", "IF", "r_local", "r_global", "area", "if_q0", "if_p0")
 
 
-def default_phases(n_psi=16):
+def default_phases(n_psi: int = 16) -> npt.NDArray[np.float64]:
     """``n_psi`` phases uniformly covering [0, 2 pi)."""
     n = checks.check_positive_int("n_psi", n_psi)
     return 2 * np.pi * np.arange(n) / n
@@ -84,7 +89,8 @@ def _first_escaping_circle(lo, hi, n_xi, F, Omega, xi_max, well, gamma):
     return (xs[k0 - 1] if k0 > 0 else None), xs[k0]
 
 
-def xi_true_analytic(F, Omega, xi_max, fourier=None, *, n_gamma=512, n_xi=400, levels=3, well=None):
+def xi_true_analytic(F: float, Omega: float, xi_max: float, fourier: str | None = None, *, n_gamma: int = 512,
+                     n_xi: int = 400, levels: int = 3, well: WellLike = None) -> float:
     """Largest xi such that every circle ``xi' < xi`` of the resonance manifold is safe.
 
     The predicate "some point of the circle escapes" is monotone in xi (module
@@ -114,7 +120,7 @@ def xi_true_analytic(F, Omega, xi_max, fourier=None, *, n_gamma=512, n_xi=400, l
     return lo
 
 
-def closed_measures(xi_true, xi_max, well=None):
+def closed_measures(xi_true: float, xi_max: float, well: WellLike = None) -> tuple[float, float, float]:
     """Closed-form ``(GIM, LIM, IF)`` of the all-phase basin {H0 < xi_true} (module docstring):
     ``J(xi_true)/J(xi_max)`` (eq 19) and the ratios of the unforced radii
     (:func:`~safebasins.analysis.integrity.unforced_radii2`); ``sqrt(xi_true/xi_max)`` for both
@@ -177,8 +183,9 @@ def _assemble(safe, q, p, Psi, lead_dims, lead_coords, xi_norm, well):
 
 
 @api_provenance
-def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fourier=None, n_psi=16,
-                             n_gamma=512, well=None):
+def true_safe_basin_analytic(F: float, Omega: float, xi_max: npt.ArrayLike, q0: npt.ArrayLike, p0: npt.ArrayLike,
+                             Psi_values: npt.ArrayLike | None = None, *, fourier: str | Sequence[str] | None = None,
+                             n_psi: int = 16, n_gamma: int = 512, well: WellLike = None) -> xr.Dataset:
     """Analytic phase-invariant safe basin and its integrity.
 
     Parameters
@@ -255,7 +262,8 @@ def true_safe_basin_analytic(F, Omega, xi_max, q0, p0, Psi_values=None, *, fouri
 
 
 @api_provenance
-def true_safe_basin_from_charts(charts, t_eval=None, *, criterion="energy"):
+def true_safe_basin_from_charts(charts: xr.Dataset | Iterable[xr.Dataset], t_eval: npt.ArrayLike | None = None, *,
+                                criterion: AnyCriterion = "energy") -> xr.Dataset:
     """Numeric phase-invariant basin from escape charts stacked over ``Psi`` (or a list of charts).
 
     Returns a Dataset with ``safe(Psi, threshold, t_eval, q0, p0)``, ``true_safe(threshold,
@@ -281,8 +289,10 @@ def true_safe_basin_from_charts(charts, t_eval=None, *, criterion="energy"):
 
 
 @api_provenance
-def true_safe_basin_numeric(F, Omega, xi_max, q0, p0, Psi_values=None, t_eval=None, cycles=3000, *,
-                            n_psi=16, keep_charts=False, well=None, **chart_kwargs):
+def true_safe_basin_numeric(F: float, Omega: float, xi_max: npt.ArrayLike, q0: npt.ArrayLike, p0: npt.ArrayLike,
+                            Psi_values: npt.ArrayLike | None = None, t_eval: npt.ArrayLike | None = None,
+                            cycles: int = 3000, *, n_psi: int = 16, keep_charts: bool = False, well: WellLike = None,
+                            **chart_kwargs: Any) -> xr.Dataset | tuple[xr.Dataset, xr.Dataset]:
     """Numeric phase-invariant safe basin: one ``numerics.escape_chart`` per phase.
 
     Parameters as in :func:`true_safe_basin_analytic`, plus ``t_eval`` (cycles, each <=
@@ -304,7 +314,9 @@ def true_safe_basin_numeric(F, Omega, xi_max, q0, p0, Psi_values=None, t_eval=No
 
 
 @api_provenance
-def phase_boundaries(F, Omega, xi_max, Psi_values, *, fourier=None, n_points=400, well=None):
+def phase_boundaries(F: float, Omega: float, xi_max: npt.ArrayLike, Psi_values: npt.ArrayLike, *,
+                     fourier: str | Sequence[str] | None = None, n_points: int = 400,
+                     well: WellLike = None) -> xr.Dataset:
     """Boundary curves of the analytic per-phase basins on the IC plane, from the slow flow
     itself (:func:`safebasins.theory.safe_basin_boundaries` for every phase), not from a grid.
     ``well``, ``fourier`` as in :func:`true_safe_basin_analytic`.
