@@ -40,6 +40,16 @@ def _ic_arrays(q0: npt.ArrayLike, p0: npt.ArrayLike, grid: bool | None
     return False, qa, pa, qa.ravel(), pa.ravel()
 
 
+def ic_coords(is_grid: bool, qa: np.ndarray, pa: np.ndarray, Q: np.ndarray, P: np.ndarray
+              ) -> tuple[tuple[int, ...], tuple[str, ...], dict[str, Any]]:
+    """(shape, dims, coords) of a result over the initial conditions of :func:`_ic_arrays`: a
+    grid (q0, p0) of the axes qa, pa, or paired samples (sample) at Q, P."""
+    if is_grid:
+        return (qa.size, pa.size), ("q0", "p0"), {"q0": ("q0", qa, cf.attrs("q0")), "p0": ("p0", pa, cf.attrs("p0"))}
+    return (Q.size,), ("sample",), {"sample": ("sample", np.arange(Q.size), cf.attrs("sample")),
+                                    "q0": ("sample", Q, cf.attrs("q0")), "p0": ("sample", P, cf.attrs("p0"))}
+
+
 def _thresholds(w: Well, xi_max: npt.ArrayLike, q_max: npt.ArrayLike, q_bounds: npt.ArrayLike
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Checked thresholds of a chart in the well w: (xi, q_max, q_bounds (n, 2))."""
@@ -124,15 +134,7 @@ def escape_chart(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: float, P
     sE, sQ = engine.integrate(problem, backend, threads=threads)
     tE = engine.steps_to_cycles(sE, spc).T   # (nE, N)
     tQ = engine.steps_to_cycles(sQ, spc).T   # (nQ + nB, N)
-    shape: tuple[int, ...]
-    dims: tuple[str, ...]
-    if is_grid:
-        shape, dims = (qa.size, pa.size), ("q0", "p0")
-        coords = {"q0": ("q0", qa, cf.attrs("q0")), "p0": ("p0", pa, cf.attrs("p0"))}
-    else:
-        shape, dims = (Q.size,), ("sample",)
-        coords = {"sample": ("sample", np.arange(Q.size), cf.attrs("sample")), "q0": ("sample", Q, cf.attrs("q0")),
-                  "p0": ("sample", P, cf.attrs("p0"))}
+    shape, dims, coords = ic_coords(is_grid, qa, pa, Q, P)
     coords["xi_max"] = ("xi_max", xi, cf.attrs("xi_max"))
     coords["q_max"] = ("q_max", qm, cf.attrs("q_max"))
     data = {

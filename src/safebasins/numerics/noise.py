@@ -22,7 +22,7 @@ import xarray as xr
 
 from safebasins.core import cf, checks
 from safebasins.numerics import criteria, engine, noise_kernels, schemes
-from safebasins.numerics.charts import _ic_arrays
+from safebasins.numerics.charts import _ic_arrays, ic_coords
 from safebasins.numerics.problem import check_cycles, ensemble_problem
 from safebasins.wells import resolve_well
 from safebasins.wells.base import WellLike
@@ -203,15 +203,7 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
     # one path has no spread to estimate the standard error from: NaN, as documented
     sem = restricted.std(axis=1, ddof=1) / math.sqrt(paths) if paths > 1 else np.full(Q.size, np.nan)
 
-    shape: tuple[int, ...]
-    dims: tuple[str, ...]
-    if is_grid:
-        shape, dims = (qa.size, pa.size), ("q0", "p0")
-        coords = {"q0": ("q0", qa, cf.attrs("q0")), "p0": ("p0", pa, cf.attrs("p0"))}
-    else:
-        shape, dims = (Q.size,), ("sample",)
-        coords = {"sample": ("sample", np.arange(Q.size), cf.attrs("sample")), "q0": ("sample", Q, cf.attrs("q0")),
-                  "p0": ("sample", P, cf.attrs("p0"))}
+    shape, dims, coords = ic_coords(is_grid, qa, pa, Q, P)
     coords["t_eval"] = ("t_eval", te, cf.attrs("t_eval"))
     coords["t_survival"] = ("t_survival", ts, cf.attrs("t_survival"))
 
