@@ -103,6 +103,21 @@ def test_stability_limits_from_the_constants():
         assert schemes.step_limit(name) == schemes.STABILITY_FRACTION * x
 
 
+def test_stability_scan_is_the_pointwise_test():
+    """The vectorised scan that finds the limit decides every h as the one-point test does (the
+    harmonic one-step matrix, RK's stability function), on both sides of each limit and for a
+    scheme added as one constant."""
+    xs = np.linspace(1e-3, 6.0, 3001)
+    for s in (*schemes.SCHEMES.values(), VERLET):
+        lim = schemes.stability_limit(s)
+        keep = np.abs(xs - lim) > 1e-9
+        many = schemes._stable_many(s, xs)
+        one = np.array([schemes._stable(s, float(x)) for x in xs])
+        assert np.array_equal(many[keep], one[keep]), s.name
+        assert many[xs < lim].all() and not many[xs > lim + 1e-9].all(), s.name
+    assert schemes.stability_limit(VERLET) == pytest.approx(2.0, abs=1e-9)      # h omega < 2, closed form
+
+
 def test_step_check_uses_the_scheme_limit():
     """The engine refuses a step beyond the scheme's own limit: RK4 (1.41) refuses a step SRKN6b
     (1.58) accepts."""
