@@ -45,7 +45,8 @@ from typing import Any
 
 from numba import njit
 
-from safebasins.wells import elementary_reduction, elementary_targets
+from safebasins.wells import elementary_dd, elementary_reduction, elementary_targets
+from safebasins.wells.elementary_dd import _ABS, _copysign, _dd_mul, _fast_two_sum, _pow2, _two_prod, _two_sum
 from safebasins.wells.elementary_reduction import reduce_pio2 as _payne_hanek
 from safebasins.wells.elementary_targets import (as_bits, as_bits_cpu, cold_call_cpu, compile_code, from_bits,
                                                     from_bits_cpu, register_cpu_overload)
@@ -63,10 +64,10 @@ FUNCTIONS = ("sin", "cos", "tan", "sincos", "exp", "expm1", "log", "log1p", "tan
 #: division's rounding bound it by 2.62 ulp
 ULP_BOUNDS = {"sin": 0.55, "cos": 0.55, "sincos": 0.55, "tan": 2.7, "exp": 0.55, "expm1": 0.55, "log": 0.55,
               "log1p": 0.6, "tanh": 0.55, "cosh": 0.55, "sinh": 0.55, "sqrt": 0.5, "pow": 0.55, "powi": 0.55}
-#: hash of the source of the functions (this module and the two it compiles with): part of the key
+#: hash of the source of the functions (this module and the three it compiles with): part of the key
 #: of every compiled well that calls them (an edit never reuses a kernel cached before it)
 MODULE_HASH = hashlib.blake2b(b"".join(Path(str(m.__file__)).read_bytes() for m in (
-    sys.modules[__name__], elementary_reduction, elementary_targets)), digest_size=16).hexdigest()
+    sys.modules[__name__], elementary_dd, elementary_reduction, elementary_targets)), digest_size=16).hexdigest()
 #: ``|x|`` up to which sin and cos reduce by Cody-Waite (beyond: Payne-Hanek)
 SIN_COS_FAST_LIMIT = 2.0 ** 30
 
@@ -75,8 +76,6 @@ SIN_COS_FAST_LIMIT = 2.0 ** 30
 _h = float.fromhex
 _SHIFT = _h("0x1.8p52")             # (x + SHIFT) - SHIFT rounds |x| < 2^51 to an integer
 _SHIFT_BITS = 0x4338000000000000    # bits(SHIFT + n) - SHIFT_BITS = n
-_SIGN = -0x8000000000000000         # the sign bit (int64)
-_ABS = 0x7FFFFFFFFFFFFFFF
 _SQRT_HALF_BITS = 0x3FE6A09E667F3BCD
 _INF = math.inf
 _NAN = math.nan
@@ -131,41 +130,6 @@ _C0, _C1, _C2, _C3, _C4, _C5 = map(_h, (
 _H0, _H1, _H2, _H3, _H4 = map(_h, (
     "0x1.5555555555555p-3", "0x1.111111111132ap-7", "0x1.a01a019f98f55p-13", "0x1.71de34379e275p-19",
     "0x1.aec387149524dp-26"))
-
-
-# ------------------------------------------------------------------------------- double-double
-def _two_sum(a: float, b: float) -> tuple[float, float]:
-    """(s, e): s = a + b rounded, e its exact error (Knuth)."""
-    s = a + b
-    bb = s - a
-    return s, (a - (s - bb)) + (b - bb)
-
-
-def _fast_two_sum(a: float, b: float) -> tuple[float, float]:
-    """(s, e) as _two_sum, for |a| >= |b| or a = 0 (Dekker)."""
-    s = a + b
-    return s, b - (s - a)
-
-
-def _two_prod(a: float, b: float) -> tuple[float, float]:
-    """(p, e): p = a b rounded, e = fma(a, b, -p) its exact error."""
-    p = mul(a, b)
-    return p, fma(a, b, -p)
-
-
-def _dd_mul(ah: float, al: float, bh: float, bl: float) -> tuple[float, float]:
-    """(a_h + a_l)(b_h + b_l), normalised (relative error ~2^-104)."""
-    p = mul(ah, bh)
-    return _fast_two_sum(p, fma(ah, bh, -p) + (mul(ah, bl) + mul(al, bh)))
-
-
-def _pow2(k: int) -> float:
-    """2^k for an integer -1022 <= k <= 1023."""
-    return from_bits((k + 1023) << 52)
-
-
-def _copysign(a: float, x: float) -> float:
-    return from_bits((as_bits(a) & _ABS) | (as_bits(x) & _SIGN))
 
 
 # ------------------------------------------------------------------------------- exp family
@@ -571,7 +535,7 @@ def cos(x: float) -> float:
 # ------------------------------------------------------------------------------- targets
 #: functions here that are not code (compile_code compiles the others)
 NOT_CODE = ("cpu", "cuda_device", "for_target", "_cold", "_cpu_function")
-_MODULES = (sys.modules[__name__], elementary_reduction)
+_MODULES = (sys.modules[__name__], elementary_dd, elementary_reduction)
 
 
 def _cold(ns: SimpleNamespace, name: str) -> Any:
