@@ -425,6 +425,20 @@ _MEASURES_LOOK = (
     "hilltop saddle's manifolds cross. The ball test's smooth value is that of two basins: where three basins "
     "meet in a ball (the share is in the notes) S_bb rises above it without a fractal boundary, so in the "
     "attractor labelling read it with that share and with α.")
+_FATAL_SHOCK_CAPTION = (
+    "{system}, β, Ω and ξ_max in the title: the minimal fatal shock (MFS, docs/fatal-shock.md) of each stable "
+    "period-1 attractor inside the well, the smallest kick d = (dq, dp) at the forcing phase φ = Ωt + Ψ that "
+    "sends the steady response to escape (H0 = p²/2 + V(q) above ξ_max, or beyond a barrier) within the horizon, "
+    "in the energy norm sqrt(ω0² dq² + dp²); found on a polar grid of kicks and refined by k-section in the radius "
+    "and Brent over the direction. Beside it the LIM centred on the attractor (the largest safe disc on a grid of "
+    "kicks), which the MFS refines: LIM minus one node diagonal <= MFS <= LIM.")
+_FATAL_SHOCK_LOOK = (
+    "(a) The phase plane: the escape level H0 = ξ_max (dashed), each attractor's state at the shock phases (dots, "
+    "joined in phase order; ring: the section t = 0) and the arrow of its MFS to the escaping state (cross). A kick "
+    "that ends on the level escapes at once; one that ends inside escapes in flight. (b) The MFS over the phase, "
+    "one colour per attractor, with the grid's LIM as open markers just above it. Where a resonant and a "
+    "non-resonant attractor coexist, expect the resonant one (the larger response) far easier to kick out; "
+    "expect the MFS to vary with the phase the kick comes at.")
 DECLARATIONS += (
     Declaration(
         name="damped_tangency", kind="tangency", key=("damped", "escape_equation"), stem="damped_tangency",
@@ -503,6 +517,21 @@ DECLARATIONS += (
               "well's side, dashed: outer); black dot: the saddle fixed point. Below the tangency the inner W^s "
               "is the edge of the safe basin and the inner W^u spirals onto the attractor inside it; past the "
               "tangency W^u crosses W^s and the edge of the safe basin is tangled.")),
+    Declaration(
+        name="damped_escape_fatal_shock", kind="minimal_fatal_shock", key=("damped", "escape_equation_fatal_shock"),
+        stem="damped_escape_fatal_shock", label="Damped escape equation: the minimal fatal shock",
+        category=_DAMPED, options={},
+        title="Damped escape equation: the minimal fatal shock of the resonant and non-resonant attractors",
+        caption=_FATAL_SHOCK_CAPTION.format(system="Thompson's escape equation q'' + β q' + q - q² = F sin(Ωt + Ψ)"),
+        look=_FATAL_SHOCK_LOOK),
+    Declaration(
+        name="damped_quartic_fatal_shock", kind="minimal_fatal_shock", key=("damped", "quartic_fatal_shock"),
+        stem="damped_quartic_fatal_shock", label="Damped quartic: the minimal fatal shock at Fig. 14's forcing",
+        category=_DAMPED, options={},
+        title="Paper's quartic with damping at Fig 14's forcing: the minimal fatal shock of its attractor",
+        caption=_FATAL_SHOCK_CAPTION.format(system="the paper's quartic with damping, q'' + β q' + q - q³ = "
+                                                   "F sin(Ωt + Ψ), at Fig. 14's forcing"),
+        look=_FATAL_SHOCK_LOOK),
 )
 
 BY_NAME = {d.name: d for d in DECLARATIONS}
