@@ -9,6 +9,7 @@ notebooks, report captions, cost estimate); experiments declared in the config u
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 
 @dataclass(frozen=True)
@@ -22,7 +23,7 @@ class Declaration:
     category: str             # report category
     caption: str
     look: str
-    options: dict = field(default_factory=dict)
+    options: dict[str, Any] = field(default_factory=dict)
     seed_offset: int = 0      # experiments never share random streams: seed = config seed + offset
 
 
@@ -45,7 +46,7 @@ _NESTED = ('Grey regions: numeric safe basins (escape chart of eq. (1), energy c
      '(IoU). Boundaries of several values that run within a few chart pixels of each other are drawn as '
      'one line of alternating colours and named in the legend.')
 
-DECLARATIONS = (
+DECLARATIONS: tuple[Declaration, ...] = (
     Declaration(
         name="fig01", kind="fcr_theory", key=("figures", "fig01"), stem="fig01_fcr_xi_ini",
         label="Fig. 1", category="Figures", options={'color_by': 'curve', 'show_branches': False, 'F_max': None},

@@ -17,7 +17,10 @@ from __future__ import annotations
 import copy
 import importlib
 import math
+import os
+from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import yaml
 
@@ -25,6 +28,11 @@ from safebasins.core.checks import reaches
 from safebasins.pipeline import catalog, well_defaults
 from safebasins.pipeline.registry import KINDS
 from safebasins.pipeline.validation import CheckContext, ConfigError, fail, indexed, key_path
+
+if TYPE_CHECKING:
+    from safebasins.pipeline.catalog import Declaration
+    from safebasins.pipeline.registry import Block, Kind
+    from safebasins.wells.base import Well
 
 #: the package's config schema (shipped inside the package: an installed wheel reads it too)
 SCHEMA_PATH = Path(__file__).resolve().parent / "schemas" / "config.schema.yaml"
@@ -42,7 +50,7 @@ __all__ = ["ConfigError", "load_yaml", "merge_config", "build_schema", "validate
            "SCHEMA_PATH"]
 
 
-def load_yaml(path):
+def load_yaml(path: str | os.PathLike[str]) -> Any:
     """A YAML file as Python data; ConfigError naming the file and the line for a syntax error or
     a key given twice in one mapping (YAML would keep the later value silently)."""
     try:
@@ -70,10 +78,10 @@ def load_yaml(path):
         raise ConfigError(f"config file {path}: not valid YAML ({exc})") from None
 
 
-def _check_unique_keys(path, node, keys=()):
+def _check_unique_keys(path: str | os.PathLike[str], node: yaml.Node, keys: tuple[str | int, ...] = ()) -> None:
     """ConfigError for the first key that a mapping of the YAML node tree repeats."""
     if isinstance(node, yaml.MappingNode):
-        seen = {}
+        seen: dict[str, int] = {}
         for k, v in node.value:
             if isinstance(k, yaml.ScalarNode):
                 if k.value in seen:
@@ -87,7 +95,7 @@ def _check_unique_keys(path, node, keys=()):
             _check_unique_keys(path, v, (*keys, i))
 
 
-def merge_config(base: dict, override: dict) -> dict:
+def merge_config(base: dict[str, Any], override: dict[str, Any] | None) -> dict[str, Any]:
     """Merge ``override`` into ``base`` in place like ``snakemake --configfile``: mappings are
     merged key by key, everything else (lists included) is replaced."""
     for k, v in (override or {}).items():
@@ -98,14 +106,14 @@ def merge_config(base: dict, override: dict) -> dict:
     return base
 
 
-def load_kinds(extensions=()):
+def load_kinds(extensions: Iterable[str] = ()) -> None:
     """Import the package's kind modules and the config's ``extensions`` (modules registering
     further kinds)."""
     for mod in (*KIND_MODULES, *extensions):
         importlib.import_module(mod)
 
 
-def well_schema() -> dict:
+def well_schema() -> dict[str, Any]:
     """``$defs/well``: the forms of safebasins.wells (the named wells are read from its table)."""
     from safebasins.wells import NAMED_WELLS
     from safebasins.wells.interpolation import DEFAULT_TOL, TOL_RANGE
@@ -131,7 +139,7 @@ def well_schema() -> dict:
     }
 
 
-def build_schema(base=None) -> dict:
+def build_schema(base: dict[str, Any] | None = None) -> dict[str, Any]:
     """The full JSON schema: the base file plus one ``$defs`` entry per registered kind."""
     schema = copy.deepcopy(load_yaml(SCHEMA_PATH) if base is None else base)
     defs = schema.setdefault("$defs", {})
@@ -145,7 +153,7 @@ def build_schema(base=None) -> dict:
     props = schema["properties"]
     for d in catalog.DECLARATIONS:
         block, key = d.key
-        ref = {"$ref": f"#/$defs/{d.kind}"}
+        ref: dict[str, Any] = {"$ref": f"#/$defs/{d.kind}"}
         if block == "extras":
             ref["default"] = {}
         props[block].setdefault("properties", {})[key] = ref
@@ -161,13 +169,13 @@ def build_schema(base=None) -> dict:
 # --------------------------------------------------------------------------------------
 # JSON-schema errors in plain words
 # --------------------------------------------------------------------------------------
-def _default_filling_validator(schema):
+def _default_filling_validator(schema: dict[str, Any]) -> Any:
     from jsonschema import Draft202012Validator, validators
 
     base = Draft202012Validator
     validate_properties = base.VALIDATORS["properties"]
 
-    def set_defaults(validator, properties, instance, schema_):
+    def set_defaults(validator: Any, properties: dict[str, Any], instance: Any, schema_: Any) -> Iterator[Any]:
         if isinstance(instance, dict):
             for prop, sub in properties.items():
                 if isinstance(sub, dict) and "default" in sub:
@@ -177,7 +185,7 @@ def _default_filling_validator(schema):
     return validators.extend(base, {"properties": set_defaults})(schema)
 
 
-def _flatten(errors):
+def _flatten(errors: Iterable[Any]) -> Iterator[Any]:
     for e in errors:
         if e.context:
             yield from _flatten(e.context)
@@ -185,7 +193,7 @@ def _flatten(errors):
             yield e
 
 
-def _format_schema_error(err, prefix=()) -> str:
+def _format_schema_error(err: Any, prefix: Sequence[str | int] = ()) -> str:
     path = list(prefix) + list(err.absolute_path)
     key = key_path(path)
     msg = err.message
@@ -219,7 +227,7 @@ def _format_schema_error(err, prefix=()) -> str:
     return f"config key {key}: {msg}"
 
 
-def _schema_check(validator, instance, prefix=()):
+def _schema_check(validator: Any, instance: Any, prefix: Sequence[str | int] = ()) -> None:
     errors = list(validator.iter_errors(instance))
     if errors:
         # report the error closest to the offending value (deepest path first)
@@ -230,10 +238,10 @@ def _schema_check(validator, instance, prefix=()):
 # --------------------------------------------------------------------------------------
 # validation
 # --------------------------------------------------------------------------------------
-def experiment_blocks(config: dict):
+def experiment_blocks(config: dict[str, Any]) -> list[tuple[str, str, str, Block, Declaration | None]]:
     """``(name, kind name, dotted key, block, declaration or None)`` of every experiment of a
     validated config: the catalog's, then the config's ``experiments``."""
-    out = []
+    out: list[tuple[str, str, str, Block, Declaration | None]] = []
     for d in catalog.DECLARATIONS:
         block, key = d.key
         out.append((d.name, d.kind, f"{block}.{key}", config[block][key], d))
@@ -242,7 +250,7 @@ def experiment_blocks(config: dict):
     return out
 
 
-def _check_finite(value, path=()):
+def _check_finite(value: Any, path: tuple[str | int, ...] = ()) -> None:
     """Every number in the config is finite (YAML's .nan / .inf pass JSON Schema's type checks)."""
     if isinstance(value, dict):
         for k, v in value.items():
@@ -254,7 +262,7 @@ def _check_finite(value, path=()):
         fail(key_path(path), f"must be a finite number, got {value}")
 
 
-def validate_config(config: dict) -> dict:
+def validate_config(config: object) -> dict[str, Any]:
     """Validate ``config`` in place (filling schema defaults); raise ConfigError naming the key."""
     if not isinstance(config, dict):
         raise ConfigError(f"config key <config>: the configuration must be a mapping, got {type(config).__name__}")
@@ -288,7 +296,7 @@ def validate_config(config: dict) -> dict:
     return config
 
 
-def _check_well(block, key, well, kind):
+def _check_well(block: Block, key: str, well: Well, kind: Kind) -> None:
     """What depends on the experiment's well: the kind accepts it; every ``xi_max`` (truncation
     level) at most, every ``xi_ini`` below, its barrier energy (the schema only knows they are
     positive); the paper's first harmonic and symmetric displacement bounds only for the quartic."""

@@ -16,8 +16,14 @@ import functools
 import inspect
 import math
 import importlib
+from collections.abc import Callable, Collection
+from typing import TYPE_CHECKING, Any
 
 from safebasins.pipeline.validation import fail
+
+if TYPE_CHECKING:
+    from safebasins.pipeline.plan import Plan
+    from safebasins.pipeline.registry import Experiment, Params
 
 #: trajectory-steps per second and core of the CPU engine on an escape chart of the quartic
 #: (benchmarks/bench_escape.py: 1.0e9 on 2 cores of an AMD EPYC Zen 5 with AVX-512, ~4.4 GHz;
@@ -33,7 +39,7 @@ ANALYTIC_RATE = 1.0e6
 NOISE_STEP_COST = 5.0
 
 
-def exp_cost(exp) -> int:
+def exp_cost(exp: Experiment) -> int:
     """Upper-bound trajectory-steps of one experiment's numerics, in steps of the quartic (its
     kind's ``cost`` times its well's ``step_cost``, safebasins.wells.base: a transcendental well's
     scalar lanes cost up to 150 quartic steps each); 0 for analytic-only kinds."""
@@ -41,13 +47,13 @@ def exp_cost(exp) -> int:
     return int(steps * _step_cost(exp.params)) if steps else 0
 
 
-def _step_cost(params) -> float:
+def _step_cost(params: Params) -> float:
     from safebasins import wells
 
     return wells.from_spec(params["well"]).step_cost
 
 
-def costs(run, experiments=None) -> dict[str, int]:
+def costs(run: Plan, experiments: Collection[str] | None = None) -> dict[str, int]:
     """Experiment -> upper-bound trajectory-steps of its numerics (``experiments``: the names to
     count, default all)."""
     return {n: exp_cost(e) for n, e in run.experiments.items() if experiments is None or n in experiments}
@@ -55,18 +61,18 @@ def costs(run, experiments=None) -> dict[str, int]:
 
 # ---------------------------------------------------------------------- analytic work
 @functools.cache
-def _default(func, arg):
+def _default(func: str, arg: str) -> Any:
     """A library default (``"module:function"``), read from its signature, never restated."""
     mod, _, name = func.partition(":")
     return inspect.signature(getattr(importlib.import_module(mod), name)).parameters[arg].default
 
 
-def _grid(p):
+def _grid(p: Params) -> int:
     nq, np_ = p["grid"]["n"]
     return int(nq) * int(np_)
 
 
-def _n(v):
+def _n(v: Any) -> int:
     """Length of a list-valued parameter (1 for a scalar)."""
     return len(v) if isinstance(v, (list, tuple)) else 1
 
@@ -76,7 +82,7 @@ def _n(v):
 DAMPED_FCR_EVALUATIONS = 400_000
 
 
-def _fcr(p):
+def _fcr(p: Params) -> int:
     # critical_forcing solves each (Omega, curve) on an xi grid of n_grid nodes; a damped curve
     # integrates slow trajectories instead
     per = [DAMPED_FCR_EVALUATIONS if c.get("damping", 0.0) > 0 else _default("safebasins.theory:critical_forcing",
@@ -90,12 +96,12 @@ def _fcr(p):
 DAMPED_BASIN_EVALUATIONS = 200
 
 
-def _basin_ic(p):
+def _basin_ic(p: Params) -> int:
     # the IC grid of an analytic basin: one level-curve test per IC, or a damped slow trajectory
     return _grid(p) * (DAMPED_BASIN_EVALUATIONS if p.get("damping", 0.0) > 0 else 1)
 
 
-def _xi_true(n_gamma, n_xi=None):
+def _xi_true(n_gamma: int, n_xi: int | None = None) -> int:
     # xi_true_analytic: n_gamma x n_xi points per refinement level
     f = "safebasins.analysis.phase_invariant:xi_true_analytic"
     return n_gamma * (n_xi or _default(f, "n_xi")) * _default(f, "levels")
@@ -103,7 +109,7 @@ def _xi_true(n_gamma, n_xi=None):
 
 #: kind name -> slow-flow evaluations of its analytic products (resolved params; run for the
 #: kinds that read other experiments).  A kind may instead define ``analytic_cost(params)``.
-ANALYTIC_COSTS = {
+ANALYTIC_COSTS: dict[str, Callable[[Params, Plan | None], int]] = {
     "fcr_theory": lambda p, run: _fcr(p),
     "fcr_compare": lambda p, run: _fcr(p),
     "basin_rm": lambda p, run: _basin_ic(p) + p["manifold"]["n_gamma"] * p["manifold"]["n_xi"] + p["n_points"],
@@ -114,13 +120,19 @@ ANALYTIC_COSTS = {
     "true_basin": lambda p, run: _n(p["fourier"]) * _n(p["xi_max"]) * (
         _n(p["Psi"]) * (_grid(p) + p["n_points"]) + _xi_true(p["n_gamma"])),
     "integrity_map": lambda p, run: _n(p["Omega"]) * _n(p["F"]) * (_grid(p) + _xi_true(p["n_gamma"], p["n_xi"])),
-    # both first harmonics of the F_cr curves and basins it compares
-    "fourier_compare": lambda p, run: 2 * sum(analytic_cost(run.experiments[n], run)
-                                              for n in (*p["fcr"], *p["iou"]) if n in run.experiments),
+    "fourier_compare": lambda p, run: _fourier_compare(p, run),
 }
 
 
-def analytic_cost(exp, run=None) -> int:
+def _fourier_compare(p: Params, run: Plan | None) -> int:
+    # both first harmonics of the F_cr curves and basins it compares (experiments of the run)
+    if run is None:
+        raise ValueError("the analytic cost of a fourier_compare experiment needs the run holding the experiments "
+                         "it compares")
+    return 2 * sum(analytic_cost(run.experiments[n], run) for n in (*p["fcr"], *p["iou"]) if n in run.experiments)
+
+
+def analytic_cost(exp: Experiment, run: Plan | None = None) -> int:
     """Upper-bound slow-flow evaluations of one experiment's analytic products: its kind's
     ``analytic_cost(params)`` if it has one, else :data:`ANALYTIC_COSTS` (0 for a kind without
     analytic products)."""
@@ -131,12 +143,12 @@ def analytic_cost(exp, run=None) -> int:
     return int(f(exp.params, run)) if f is not None else 0
 
 
-def analytic_costs(run, experiments=None) -> dict[str, int]:
+def analytic_costs(run: Plan, experiments: Collection[str] | None = None) -> dict[str, int]:
     """Experiment -> upper-bound slow-flow evaluations (``experiments``: the names, default all)."""
     return {n: analytic_cost(e, run) for n, e in run.experiments.items() if experiments is None or n in experiments}
 
 
-def params_cost(kind, params, numeric=True) -> tuple[int, int]:
+def params_cost(kind: str, params: Params, numeric: bool = True) -> tuple[int, int]:
     """(trajectory-steps, slow-flow evaluations) of one run of ``kind`` (a registered kind's name)
     with resolved ``params`` (the command line's runs; ``numeric=False``: analytic only)."""
     from safebasins.pipeline.config import load_kinds
@@ -149,7 +161,7 @@ def params_cost(kind, params, numeric=True) -> tuple[int, int]:
     return (exp_cost(exp) if numeric else 0), analytic_cost(exp)
 
 
-def budgets() -> dict:
+def budgets() -> dict[str, float]:
     """The default budgets of the config schema (its one home): ``budget_core_hours``,
     ``budget_analytic_evaluations``."""
     from safebasins.pipeline.config import SCHEMA_PATH, load_yaml
@@ -167,7 +179,8 @@ def _duration(seconds: float) -> str:
     return f"{seconds / 3600:.1f} h"
 
 
-def report(run, cores=1, rate=RATE_PER_CORE, experiments=None) -> list[str]:
+def report(run: Plan, cores: int = 1, rate: float = RATE_PER_CORE,
+           experiments: Collection[str] | None = None) -> list[str]:
     """One line per experiment with numerics or analytic work, and the totals."""
     c, a = costs(run, experiments), analytic_costs(run, experiments)
     lines = [f"{e:22s} {c[e]:10.3e} steps  <= {_duration(c[e] / rate / cores):>8s}   "
@@ -180,12 +193,13 @@ def report(run, cores=1, rate=RATE_PER_CORE, experiments=None) -> list[str]:
     return lines
 
 
-def _largest(c, scale, unit):
+def _largest(c: dict[str, int], scale: float, unit: str) -> str:
     top = sorted(c.items(), key=lambda kv: -kv[1])[:3]
     return ", ".join(f"{e} {s / scale:.3g} {unit}" for e, s in top if s)
 
 
-def guard(run, cores=1, rate=RATE_PER_CORE, experiments=None) -> str:
+def guard(run: Plan, cores: int = 1, rate: float = RATE_PER_CORE,
+          experiments: Collection[str] | None = None) -> str:
     """The cost summary line of ``experiments`` (default: all); ConfigError naming
     ``numerics.budget_core_hours`` or ``numerics.budget_analytic_evaluations`` if over budget
     (unless ``numerics.allow_expensive``)."""
@@ -229,13 +243,13 @@ MEM_BASE_MB = 1000
 MEM_PER_POINT_BYTES = 2048
 
 
-def _grid_points(params) -> int:
+def _grid_points(params: Params) -> int:
     """Points of the experiment's initial-condition grid (0 if it has none)."""
     grid = params.get("grid")
     return int(grid["n"][0]) * int(grid["n"][1]) if isinstance(grid, dict) and "n" in grid else 0
 
 
-def job_cost(run, *, tile_of: str | None = None, dataset: str | None = None) -> tuple[float, int]:
+def job_cost(run: Plan, *, tile_of: str | None = None, dataset: str | None = None) -> tuple[float, int]:
     """(upper-bound trajectory-steps, points held) of one job.
 
     ``tile_of=experiment``: one ``chart_tile`` job, the experiment's cost split evenly over its
@@ -255,6 +269,7 @@ def job_cost(run, *, tile_of: str | None = None, dataset: str | None = None) -> 
         n_jobs = len(exp.tasks) * run.tiles
         steps = exp_cost(exp) / n_jobs
         return steps, math.ceil(steps / (int(exp.params["cycles"]) * int(exp.params["steps_per_cycle"])))
+    assert dataset is not None  # (exactly one of tile_of, dataset: checked above)
     exp, prod = run.experiment_of(dataset), run.product(dataset)
     points = _grid_points(exp.params) * max(len(exp.tasks), 1)
     heavy = [p for p in exp.products if p.heavy]

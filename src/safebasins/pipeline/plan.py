@@ -11,8 +11,10 @@ from __future__ import annotations
 
 import os
 import zlib
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from safebasins import wells
 from safebasins.pipeline import values
@@ -20,6 +22,10 @@ from safebasins.pipeline.config import experiment_blocks, load_yaml, merge_confi
 from safebasins.pipeline.validation import ConfigError, fail
 from safebasins.pipeline.registry import (KINDS, PARAMS_DIR, PARTS_DIR, Experiment, FigureSpec, Product,
                                           params_path)
+
+if TYPE_CHECKING:
+    from safebasins.pipeline.catalog import Declaration
+    from safebasins.pipeline.registry import Kind, Params
 
 __all__ = ["Plan", "ResolveContext", "plan", "tile_path", "load_config"]
 
@@ -29,7 +35,7 @@ class ResolveContext:
     """Global settings a kind's ``resolve`` may use."""
 
     fourier: str         # the config's fourier for the quartic; "exact" for every other well
-    well: dict           # the experiment's well spec (safebasins.wells.spec_of)
+    well: dict[str, Any]  # the experiment's well spec (safebasins.wells.spec_of)
     steps_per_cycle: int
     seed: int            # the config seed plus this experiment's offset
 
@@ -38,14 +44,14 @@ def tile_path(experiment: str, task: int, tile: int, tiles: int) -> str:
     return f"{PARTS_DIR}/{experiment}/task{task}_tile{tile}of{tiles}.nc"
 
 
-def _seed_offset(name, decl):
+def _seed_offset(name: str, decl: Declaration | None) -> int:
     if decl is not None:
         return decl.seed_offset
     # experiments declared in the config get a stable offset of their own (never a catalog one)
     return 1_000_000 + 1000 * (zlib.crc32(name.encode()) % 100_000)
 
 
-def _figure(name, kind, params, decl):
+def _figure(name: str, kind: Kind, params: Params, decl: Declaration | None) -> FigureSpec | None:
     if kind.builder is None:
         return None
     if decl is not None:
@@ -58,7 +64,7 @@ def _figure(name, kind, params, decl):
                       packaged=False)
 
 
-def _check_compiled(exp, spec):
+def _check_compiled(exp: Experiment, spec: dict[str, Any]) -> None:
     """The well of an experiment with numerics has a compiled form (a polynomial up to the degree
     of wells.compiled.POLY_DEGREES): refused here, naming the key, not when its job runs."""
     if spec["name"] == "polynomial" and exp.kind.cost(exp.params) > 0:
@@ -71,7 +77,7 @@ def _check_compiled(exp, spec):
 class Plan:
     """Experiments of one validated config, in catalog order then config order."""
 
-    def __init__(self, config: dict):
+    def __init__(self, config: dict[str, Any]) -> None:
         self.config = config
         num = config["numerics"]
         self.threads = int(num["threads"])
@@ -103,13 +109,13 @@ class Plan:
                 self._products[prod.path] = (exp, prod)
 
     # ------------------------------------------------------------------ lookups
-    def params(self) -> dict[str, dict]:
+    def params(self) -> dict[str, Params]:
         return {n: e.params for n, e in self.experiments.items()}
 
-    def product(self, path) -> Product:
+    def product(self, path: str | os.PathLike[str]) -> Product:
         return self._products[str(path)][1]
 
-    def experiment_of(self, path) -> Experiment:
+    def experiment_of(self, path: str | os.PathLike[str]) -> Experiment:
         return self._products[str(path)][0]
 
     def datasets(self, stage: str | None = None) -> list[str]:
@@ -127,21 +133,21 @@ class Plan:
     def chart_experiments(self) -> list[str]:
         return [n for n, e in self.experiments.items() if e.tasks]
 
-    def integrates_tasks(self, path) -> bool:
+    def integrates_tasks(self, path: str | os.PathLike[str]) -> bool:
         """The dataset ``path`` integrates its experiment's chart tasks in its own job: it reads
         the charts and ``numerics.tiles`` is 0 (no chart_tile jobs)."""
         return self.tiles == 0 and self.product(path).tiles
 
-    def integrates(self, path) -> bool:
+    def integrates(self, path: str | os.PathLike[str]) -> bool:
         """The dataset's job integrates trajectories or the slow flow (runs with numerics.threads):
         a heavy product, or one integrating its chart tasks."""
         return self.product(path).heavy or self.integrates_tasks(path)
 
-    def product_inputs(self, path) -> dict:
+    def product_inputs(self, path: str | os.PathLike[str]) -> dict[str, object]:
         """Snakemake inputs of a dataset: its experiment's parameter file, its tiles (chart kinds
         whose product gathers them) and the files the product names."""
         exp, prod = self._products[str(path)]
-        inputs = {"params": exp.params_file, **prod.inputs}
+        inputs: dict[str, object] = {"params": exp.params_file, **prod.inputs}
         if prod.tiles and self.tiles:
             inputs["tiles"] = self.tile_files(exp.name)
         return inputs
@@ -149,17 +155,18 @@ class Plan:
     def figures(self) -> list[FigureSpec]:
         return [e.figure for e in self.experiments.values() if e.figure is not None]
 
-    def experiments_for(self, files) -> set[str] | None:
+    def experiments_for(self, files: Iterable[str | os.PathLike[str]]) -> set[str] | None:
         """The experiments whose datasets building ``files`` (snakemake target files) needs: a
         dataset, its chart tiles or a figure of an experiment, and the datasets of other
         experiments these read.  None (= every experiment) when that is all of them, or when a file
         under results/ is none of these (a parameter file needs no computation; files outside
         results/ are sources)."""
-        figures = {}
+        figures: dict[str, FigureSpec] = {}
         for f in self.figures():
             for p in (f.png, f.pdf, f.executed_notebook, f"results/captions/{f.name}.rst"):
                 figures[p] = f
-        need, todo = set(), []
+        need: set[str] = set()
+        todo: list[str] = []
         for path in map(_relative, files):
             if path in self._products:
                 todo.append(path)
@@ -171,7 +178,7 @@ class Plan:
                 continue
             elif path.startswith("results/"):
                 return None
-        seen = set()
+        seen: set[str] = set()
         while todo:
             path = todo.pop()
             if path in seen or path not in self._products:
@@ -183,16 +190,16 @@ class Plan:
         return None if {n for n, e in self.experiments.items() if e.products} <= need else need
 
 
-def _relative(path) -> str:
+def _relative(path: str | os.PathLike[str]) -> str:
     """A target path as the plan names it (relative to the working directory, normalised)."""
     p = Path(path)
     return Path(os.path.relpath(p) if p.is_absolute() else os.path.normpath(p)).as_posix()
 
 
-def load_config(paths) -> dict:
+def load_config(paths: Iterable[str | os.PathLike[str]]) -> dict[str, Any]:
     """Merge config files like ``snakemake --configfile`` (later files win, dicts merged); each
     must hold a mapping (or nothing)."""
-    cfg = {}
+    cfg: dict[str, Any] = {}
     for path in paths:
         data = load_yaml(path)
         if data is not None and not isinstance(data, dict):
@@ -202,7 +209,7 @@ def load_config(paths) -> dict:
     return cfg
 
 
-def plan(config) -> Plan:
+def plan(config: dict[str, Any] | str | Path | Sequence[str | Path]) -> Plan:
     """Validate (filling defaults, in place) and resolve a config dict or config file path(s)."""
     if isinstance(config, (str, Path)):
         config = load_config([config])

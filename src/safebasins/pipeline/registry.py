@@ -22,17 +22,43 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from collections.abc import Callable, Mapping
-from typing import ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, TypeAlias, TypeVar
 
 from safebasins.pipeline.well_defaults import WellDefault
 
-__all__ = ["Kind", "Job", "Product", "FigureSpec", "Experiment", "KINDS", "register", "STAGES"]
+if TYPE_CHECKING:
+    import numpy as np
+    import xarray as xr
+    from numpy.typing import NDArray
+
+    from safebasins.pipeline.plan import ResolveContext
+    from safebasins.pipeline.validation import CheckContext
+
+__all__ = ["Kind", "Job", "Product", "FigureSpec", "Experiment", "KINDS", "register", "STAGES", "Block", "Params",
+           "Inputs", "Build", "Contract", "FigureInputs", "ChartICs"]
 
 #: dataset stages and their directories under results/data
 STAGES = {"analytic": "results/data/analytic", "numeric": "results/data/numeric", "extras": "results/data/extras"}
 PARAMS_DIR = "results/params"
 PARTS_DIR = "results/data/numeric/parts"
 FIGURE_DIR = "results/figures"
+
+
+#: one experiment's config block (YAML data, the schema's defaults filled in)
+Block: TypeAlias = dict[str, Any]
+#: one experiment's resolved parameters (plain YAML data: results/params/<experiment>.yaml)
+Params: TypeAlias = dict[str, Any]
+#: the datasets a product reads, loaded (:func:`safebasins.pipeline.runtime.load_inputs`): name -> a
+#: Dataset or a list of them; ``tiles``: one list of tile Datasets per chart task
+Inputs: TypeAlias = dict[str, Any]
+#: a product's library call ``build(params, inputs, job)`` returning its Dataset
+Build: TypeAlias = "Callable[[Params, Inputs, Job], xr.Dataset]"
+#: the variables of a dataset that readers rely on -> their dims (docs/contracts.md)
+Contract: TypeAlias = dict[str, tuple[str, ...]]
+#: a figure's notebook parameters: name -> dataset path, or a list of paths
+FigureInputs: TypeAlias = Mapping[str, str | list[str]]
+#: the ICs of a kind's chart tasks: ``(q0, p0, grid)``, grid axes (grid=True) or paired samples
+ChartICs: TypeAlias = "tuple[NDArray[np.float64], NDArray[np.float64], bool]"
 
 
 def params_path(experiment: str) -> str:
@@ -45,9 +71,9 @@ def dataset_path(stage: str, name: str) -> str:
 
 @dataclass(frozen=True)
 class Job:
-    """How a job computes (never what): numba threads and the numerics backend."""
+    """How a job computes (never what): numba threads (None: all) and the numerics backend."""
 
-    threads: int = 1
+    threads: int | None = 1
     backend: str = "cpu"
 
 
@@ -67,13 +93,13 @@ class Product:
 
     path: str
     stage: str
-    build: Callable
+    build: Build
     title: str
     history: str
     inputs: Mapping[str, object] = field(default_factory=dict)
     heavy: bool = False
     tiles: bool = False
-    contract: Mapping[str, tuple] = field(default_factory=dict)
+    contract: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
 
     @property
     def name(self) -> str:
@@ -87,7 +113,7 @@ class FigureSpec:
     name: str            # results/figures/<name>.png|pdf
     stem: str            # notebook file stem
     builder: str         # "safebasins.plotting.<module>:<function>"
-    inputs: Mapping[str, object]
+    inputs: FigureInputs
     options: Mapping[str, object]
     caption: str         # the paper's caption (or what the figure shows)
     look: str            # what to look for
@@ -122,7 +148,7 @@ class Kind:
 
     name: ClassVar[str]
     description: ClassVar[str]
-    schema: ClassVar[dict]
+    schema: ClassVar[dict[str, Any]]
     #: plotting function of its figure, "safebasins.plotting.<module>:<function>" (None: no figure)
     builder: ClassVar[str | None] = None
     #: False: the kind is written for the paper's quartic only (a config naming another well
@@ -137,41 +163,41 @@ class Kind:
     #: filled in before ``check``
     well_defaults: ClassVar[dict[str, WellDefault]] = {}
 
-    def check(self, block: dict, key: str, ctx) -> None:
+    def check(self, block: Block, key: str, ctx: CheckContext) -> None:
         """Checks beyond the schema; raise ``ctx.fail(key + ".field", message)``."""
 
-    def resolve(self, block: dict, ctx) -> dict:
+    def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         raise NotImplementedError
 
-    def products(self, experiment: str, params: dict) -> list[Product]:
+    def products(self, experiment: str, params: Params) -> list[Product]:
         return []
 
-    def tasks(self, params: dict) -> list[dict]:
+    def tasks(self, params: Params) -> list[dict[str, Any]]:
         """Escape-chart tasks (one chart each), split into tile jobs by ``numerics.tiles``: kinds
         that integrate charts resolve them into ``params["tasks"]`` (each with ``F``,
         ``xi_max``, ``q_max`` lists and optionally ``Psi``)."""
         return list(params.get("tasks", ()))
 
-    def chart_ics(self, params: dict):
+    def chart_ics(self, params: Params) -> ChartICs:
         """``(q0, p0, grid)`` of the chart tasks: grid axes (grid=True) or paired samples."""
         raise NotImplementedError(f"kind {self.name!r} has no escape-chart tasks")
 
-    def compute_tile(self, params: dict, task: int, tile: int, tiles: int, job):
+    def compute_tile(self, params: Params, task: int, tile: int, tiles: int, job: Job) -> xr.Dataset:
         """One job of the ``chart_tile`` rule: by default tile ``tile`` of ``tiles`` (a block of q0
         rows or samples) of the escape chart of task ``task``."""
         from safebasins.pipeline.tiles import chart_tile
 
         return chart_tile(self, params, task, tile, tiles, job)
 
-    def cost(self, params: dict) -> int:
+    def cost(self, params: Params) -> int:
         """Upper bound of the trajectory-steps its numerics integrate (no early escape)."""
         return 0
 
-    def figure_inputs(self, experiment: str, params: dict) -> dict:
+    def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         """Notebook parameter name -> dataset path(s) of its figure."""
         return {}
 
-    def default_figure_text(self, experiment: str, params: dict) -> tuple[str, str]:
+    def default_figure_text(self, experiment: str, params: Params) -> tuple[str, str]:
         """(caption, what to look for) of a figure not described in the catalog."""
         return self.description, self.description
 
@@ -179,21 +205,23 @@ class Kind:
 class GridChartKind(Kind):
     """A kind whose chart tasks all integrate the experiment's (q0, p0) grid ``params["grid"]``."""
 
-    def chart_ics(self, params: dict):
+    def chart_ics(self, params: Params) -> ChartICs:
         from safebasins.pipeline.values import grid_axes
 
         q0, p0 = grid_axes(params["grid"])
         return q0, p0, True
 
-    def cost(self, params: dict) -> int:
+    def cost(self, params: Params) -> int:
         nq, np_ = params["grid"]["n"]
         return len(params["tasks"]) * nq * np_ * params["cycles"] * params["steps_per_cycle"]
 
 
 KINDS: dict[str, Kind] = {}
 
+K = TypeVar("K", bound=Kind)
 
-def register(cls):
+
+def register(cls: type[K]) -> type[K]:
     """Class decorator: add a kind to the registry (its ``name`` must be new)."""
     name = cls.name
     if name in KINDS and type(KINDS[name]) is not cls:
@@ -209,10 +237,10 @@ class Experiment:
     name: str
     kind: Kind
     key: str                 # dotted config key of its block, for messages
-    params: dict
+    params: Params
     figure: FigureSpec | None
     products: tuple[Product, ...]
-    tasks: tuple[dict, ...]
+    tasks: tuple[dict[str, Any], ...]
 
     @property
     def params_file(self) -> str:

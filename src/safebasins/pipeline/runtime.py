@@ -16,15 +16,20 @@ from __future__ import annotations
 
 import os
 import sys
+from collections.abc import Mapping
+from typing import IO, Any
 
 import numba
 import yaml
 
 from safebasins.pipeline.config import load_kinds
-from safebasins.pipeline.registry import KINDS, Job
+from safebasins.pipeline.registry import KINDS, Inputs, Job, Kind, Params
+
+# a rule script's ``snakemake`` object (snakemake.script.Snakemake: untyped, attributes by rule)
+Snakemake = Any
 
 
-def redirect_output(log_path):
+def redirect_output(log_path: str | os.PathLike[str]) -> IO[str]:
     """Send stdout and stderr of a rule script to its log file (line buffered)."""
     os.makedirs(os.path.dirname(os.fspath(log_path)) or ".", exist_ok=True)
     fh = open(log_path, "w", buffering=1)
@@ -33,7 +38,7 @@ def redirect_output(log_path):
     return fh
 
 
-def set_threads(n):
+def set_threads(n: int) -> None:
     """Limit numba's thread pool to the rule's ``threads:`` (no oversubscription under -j2).
 
     Only the number of threads in use is set (``numba.set_num_threads``), never the environment's
@@ -42,15 +47,17 @@ def set_threads(n):
     started is refused ("Cannot set NUMBA_NUM_THREADS to a different value once the threads have
     been launched")."""
     n = max(1, int(n))
-    numba.set_num_threads(min(n, numba.config.NUMBA_NUM_THREADS))
+    # (numba.config sets NUMBA_NUM_THREADS at import from the environment: not declared to mypy)
+    numba.set_num_threads(min(n, numba.config.NUMBA_NUM_THREADS))  # type: ignore[attr-defined]
 
 
-def load_params(path) -> dict:
+def load_params(path: str | os.PathLike[str]) -> Params:
     with open(path) as fh:
-        return yaml.safe_load(fh)
+        params: Params = yaml.safe_load(fh)
+    return params
 
 
-def _job(smk):
+def _job(smk: Snakemake) -> tuple[Params, Kind]:
     redirect_output(smk.log[0])
     set_threads(smk.threads)
     load_kinds(smk.params.extensions)
@@ -58,14 +65,14 @@ def _job(smk):
     return params, KINDS[params["kind"]]
 
 
-def load_inputs(inputs, ntasks) -> dict:
+def load_inputs(inputs: Mapping[str, Any], ntasks: int) -> Inputs:
     """The datasets a product reads, loaded: ``tiles`` as one list of tile Datasets per task
     (task-major), every other named input (a path or a list of paths) as Dataset(s); the
     parameter file is read by the rule itself."""
     from safebasins.io.datasets import load
     from safebasins.io.gather import load_blocks
 
-    out = {}
+    out: Inputs = {}
     for k, v in inputs.items():
         if k == "params":
             continue
@@ -78,7 +85,7 @@ def load_inputs(inputs, ntasks) -> dict:
     return out
 
 
-def make_dataset(smk):
+def make_dataset(smk: Snakemake) -> None:
     """Rules ``analytic`` / ``numeric`` / ``extras``: build, finalize and write one product.
     A product reading the chart tiles gets them from the ``chart_tile`` jobs, or with
     ``numerics.tiles`` = 0 integrates every task here (the rule's ``integrate_tasks``,
@@ -100,7 +107,7 @@ def make_dataset(smk):
     print(ds)
 
 
-def make_tile(smk):
+def make_tile(smk: Snakemake) -> None:
     """Rule ``chart_tile``: one tile job of one task of a kind with escape-chart tasks
     (``Kind.compute_tile``; by default a block of q0 rows or samples of the task's chart)."""
     from safebasins.io.datasets import write_netcdf

@@ -8,17 +8,27 @@ for any tile count.
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from safebasins.pipeline.values import base_well, damping, tile_slice
 
+if TYPE_CHECKING:
+    import xarray as xr
 
-def chart_tile(kind, params, k, tile, tiles, job):
+    from safebasins.pipeline.registry import Job, Kind, Params
+
+
+def chart_tile(kind: Kind, params: Params, k: int, tile: int, tiles: int, job: Job) -> xr.Dataset:
     from safebasins.numerics import escape_chart
 
     task = kind.tasks(params)[k]
     Psi = task.get("Psi", params.get("Psi"))
     Omega = task.get("Omega", params.get("Omega"))
+    if Omega is None or Psi is None:
+        raise ValueError(f"experiment {params['experiment']!r}, chart task {k}: no forcing "
+                         f"{'frequency Omega' if Omega is None else 'phase Psi'} in the task or the parameters")
     q0, p0, grid = kind.chart_ics(params)
     sl = tile_slice(q0.size, tiles, tile)
     q0 = q0[sl]
@@ -35,7 +45,7 @@ def chart_tile(kind, params, k, tile, tiles, job):
     return ds
 
 
-def task_tiles(kind, params, job) -> list[list]:
+def task_tiles(kind: Kind, params: Params, job: Job) -> list[list[xr.Dataset]]:
     """Every chart task of an experiment integrated here, one whole-task tile each (the
     ``inputs["tiles"]`` of the product that reads them: tasks x 1, task-major) -- what the
     ``chart_tile`` jobs would have written with one tile per task."""

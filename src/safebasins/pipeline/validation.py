@@ -5,14 +5,19 @@ Messages read ``config key figures.fig13.xi_max[2]: <what is wrong and what to d
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, NoReturn
+
+if TYPE_CHECKING:
+    from safebasins.wells.base import Well
 
 
 class ConfigError(ValueError):
     """A configuration error; the message starts with the offending key."""
 
 
-def key_path(path) -> str:
+def key_path(path: Iterable[str | int]) -> str:
     """Dotted key of a JSON path: ``("figures", "fig13", "xi_max", 2)`` -> ``figures.fig13.xi_max[2]``."""
     out = ""
     for part in path:
@@ -23,11 +28,11 @@ def key_path(path) -> str:
     return out or "<config>"
 
 
-def fail(key: str, msg: str):
+def fail(key: str, msg: str) -> NoReturn:
     raise ConfigError(f"config key {key}: {msg}")
 
 
-def indexed(key: str, values, i: int) -> str:
+def indexed(key: str, values: Any, i: int) -> str:
     """``key[i]`` when the config value is a list, else ``key``."""
     return f"{key}[{i}]" if isinstance(values, (list, tuple)) else key
 
@@ -37,16 +42,16 @@ class CheckContext:
     """What a kind's ``check`` may consult: the whole config, and the kind and config block of
     every experiment by name (for cross-references between experiments)."""
 
-    config: dict
-    kinds: dict          # experiment name -> kind name
-    blocks: dict         # experiment name -> its (default-filled) config block
-    keys: dict           # experiment name -> its dotted config key
-    _wells: dict = field(default_factory=dict)   # well spec -> well object (built once)
+    config: dict[str, Any]
+    kinds: dict[str, str]              # experiment name -> kind name
+    blocks: dict[str, dict[str, Any]]  # experiment name -> its (default-filled) config block
+    keys: dict[str, str]               # experiment name -> its dotted config key
+    _wells: dict[str, Well] = field(default_factory=dict)   # well spec -> well object (built once)
 
-    def block(self, experiment: str) -> dict:
+    def block(self, experiment: str) -> dict[str, Any]:
         return self.blocks[experiment]
 
-    def well(self, experiment: str):
+    def well(self, experiment: str) -> Well:
         """The experiment's well (safebasins.wells); an invalid well is an error naming ``<key>.well``."""
         from safebasins import wells
 
@@ -59,7 +64,7 @@ class CheckContext:
                 fail(f"{self.keys[experiment]}.well", f"not a potential well: {exc}")
         return self._wells[key]
 
-    def well_at(self, key: str):
+    def well_at(self, key: str) -> Well:
         """The well of the experiment at dotted config key ``key`` (what a kind's ``check`` gets)."""
         (name,) = [n for n, k in self.keys.items() if k == key]
         return self.well(name)
@@ -70,7 +75,7 @@ class CheckContext:
 
     fail = staticmethod(fail)
 
-    def check_range(self, key, r, *, positive=False):
+    def check_range(self, key: str, r: Mapping[str, Any], *, positive: bool = False) -> None:
         start, stop = float(r["start"]), float(r["stop"])
         num, step = r.get("num"), r.get("step")
         if num is not None and step is not None:
@@ -92,21 +97,21 @@ class CheckContext:
         if positive and start <= 0:
             fail(f"{key}.start", f"must be > 0, got {start}")
 
-    def check_unique(self, key, values):
+    def check_unique(self, key: str, values: Any) -> None:
         """A list that becomes a coordinate must not repeat a value."""
         if isinstance(values, (list, tuple)):
-            seen = set()
+            seen: set[Any] = set()
             for i, v in enumerate(values):
                 if v in seen:
                     fail(f"{key}[{i}]", f"{v!r} is listed twice: each value is one point of a coordinate")
                 seen.add(v)
 
-    def check_interval(self, key, iv):
+    def check_interval(self, key: str, iv: Sequence[float]) -> None:
         lo, hi = iv
         if not hi > lo:
             fail(key, f"empty interval [{lo}, {hi}]: the second value must be greater than the first")
 
-    def check_grid(self, key, g):
+    def check_grid(self, key: str, g: Mapping[str, Any]) -> None:
         self.check_interval(f"{key}.q0", g["q0"])
         self.check_interval(f"{key}.p0", g["p0"])
         n = g["n"]
@@ -114,7 +119,8 @@ class CheckContext:
         if self.tiles > nq:
             fail("numerics.tiles", f"{self.tiles} tiles but {key} has only {nq} q0 rows")
 
-    def check_thresholds_below_separatrix(self, key, values, what, well, damping=0.0):
+    def check_thresholds_below_separatrix(self, key: str, values: float | list[float] | tuple[float, ...], what: str,
+                                          well: Well, damping: float | list[float] | tuple[float, ...] = 0.0) -> None:
         """Analytic products of the undamped slow flow need xi_max below the well's barrier energy
         (``Well.check_analytic_threshold``, the library's one rule); a damped one (``damping`` > 0: a
         value, or one per curve like ``values``) takes xi_max = E_b, as the numerics do."""
@@ -133,7 +139,7 @@ class CheckContext:
                             f"action-angle map is singular on the separatrix), got {x!r}"
                             + (" (within a relative 1e-12 of it, which counts as at it)" if x < top else ""))
 
-    def check_t_eval_within(self, key, t_eval, cycles):
+    def check_t_eval_within(self, key: str, t_eval: float | list[float] | tuple[float, ...], cycles: float) -> None:
         t = t_eval if isinstance(t_eval, (list, tuple)) else [t_eval]
         if max(t) > cycles:
             fail(key, f"evaluation time {max(t)} beyond the horizon cycles = {cycles}")

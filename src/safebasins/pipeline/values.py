@@ -6,41 +6,48 @@ hash stably (``results/params/<experiment>.yaml``).
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, SupportsFloat
 
 import numpy as np
+from numpy.typing import NDArray
+
+if TYPE_CHECKING:
+    from safebasins.wells.base import Well
 
 
-def as_list(v):
+def as_list(v: Any) -> list[Any]:
     return list(v) if isinstance(v, (list, tuple)) else [v]
 
 
-def angle(v) -> float:
+def angle(v: SupportsFloat | str) -> float:
     """A config angle: a number (radians) or the string "pi" / "-pi"."""
     if isinstance(v, str):
         return -math.pi if v.strip().startswith("-") else math.pi
     return float(v)
 
 
-def fmt(v, angle=False) -> str:
+def fmt(v: SupportsFloat | str, angle: bool = False) -> str:
     """Compact number for titles, labels and captions (``%g``; a string stays as it is).  With
     ``angle=True`` a simple multiple of pi is written with pi: ``pi``, ``-pi/2``, ``3pi/4``
     (the one angle formatter of the command line and the pipeline's texts)."""
     if isinstance(v, str):
         return v
-    v = float(v)
-    if angle and v != 0:
+    x = float(v)
+    if angle and x != 0:
         for den in (1, 2, 3, 4, 6):
-            num = v / math.pi * den
+            num = x / math.pi * den
             if abs(num - round(num)) < 1e-12:
-                num = round(num)
-                return f"{'-' if num < 0 else ''}{abs(num) if abs(num) != 1 else ''}pi{f'/{den}' if den > 1 else ''}"
-    return f"{v:g}"
+                k = round(num)
+                return f"{'-' if k < 0 else ''}{abs(k) if abs(k) != 1 else ''}pi{f'/{den}' if den > 1 else ''}"
+    return f"{x:g}"
 
 
-def range_values(r) -> list[float]:
+def range_values(r: Mapping[str, Any]) -> list[float]:
     """Values of a {start, stop, num} or {start, stop, step} range (endpoints included; a key
     set to null counts as absent)."""
     start, stop = float(r["start"]), float(r["stop"])
+    vals: NDArray[np.floating[Any]]
     if r.get("num") is not None:
         vals = np.linspace(start, stop, int(r["num"]))
     else:
@@ -51,14 +58,14 @@ def range_values(r) -> list[float]:
     return [float(np.round(v, 12)) for v in vals]
 
 
-def values(v) -> list[float]:
+def values(v: Any) -> list[float]:
     """A scalar, a list or a range, as a list of floats."""
     if isinstance(v, dict):
         return range_values(v)
     return [float(x) for x in as_list(v)]
 
 
-def grid(g) -> dict:
+def grid(g: Mapping[str, Any]) -> dict[str, list[float] | list[int]]:
     """Resolved IC grid ``{q0: [lo, hi], p0: [lo, hi], n: [nq, np]}``."""
     n = g["n"]
     nq, np_ = (n, n) if isinstance(n, int) else (int(n[0]), int(n[1]))
@@ -66,35 +73,35 @@ def grid(g) -> dict:
             "n": [nq, np_]}
 
 
-def grid_axes(g: dict):
+def grid_axes(g: Mapping[str, Any]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """1-D q0 and p0 axes of a resolved grid (endpoints included)."""
     nq, np_ = g["n"]
     return (np.linspace(g["q0"][0], g["q0"][1], nq), np.linspace(g["p0"][0], g["p0"][1], np_))
 
 
-def box(b) -> list[list[float]]:
+def box(b: Iterable[Sequence[SupportsFloat]]) -> list[list[float]]:
     return [[float(lo), float(hi)] for lo, hi in b]
 
 
-def curve_lists(blk) -> dict:
+def curve_lists(blk: Mapping[str, Any]) -> dict[str, list[Any]]:
     """The list-valued keys that make F_cr curves: xi_max, xi_ini, gamma_ini and, for a damped
     block (:func:`damping_param`), damping."""
     keys = ("xi_max", "xi_ini", "gamma_ini") + (("damping",) if damping_param(blk.get("damping", 0.0)) else ())
     return {k: as_list(blk[k]) for k in keys}
 
 
-def curves(blk, with_psi) -> list[dict]:
+def curves(blk: Mapping[str, Any], with_psi: bool) -> list[dict[str, Any]]:
     """F_cr curves from list-valued xi_max / xi_ini / gamma_ini (and damping; equal lengths or
     length 1)."""
     lists = curve_lists(blk)
     n = max(len(v) for v in lists.values())
     varying = [k for k, v in lists.items() if len(v) > 1]
-    out = []
+    out: list[dict[str, Any]] = []
     for i in range(n):
         c = {k: (v[i] if len(v) > 1 else v[0]) for k, v in lists.items()}
         xi_max, xi_ini, gamma_ini = float(c["xi_max"]), float(c["xi_ini"]), angle(c["gamma_ini"])
         label = ", ".join(f"{k} = {fmt(c[k])}" for k in varying) if varying else f"xi_max = {fmt(xi_max)}"
-        cur = {"label": label, "xi_max": xi_max, "xi_ini": xi_ini, "gamma_ini": gamma_ini}
+        cur: dict[str, Any] = {"label": label, "xi_max": xi_max, "xi_ini": xi_ini, "gamma_ini": gamma_ini}
         if "damping" in c:
             cur["damping"] = float(c["damping"])
         if with_psi:
@@ -111,7 +118,7 @@ def tile_slice(n: int, tiles: int, tile: int) -> slice:
     return slice(int(edges[tile]), int(edges[tile + 1]))
 
 
-def well(params, fourier=None):
+def well(params: Mapping[str, Any], fourier: str | None = None) -> Well:
     """The well object of resolved parameters (``params["well"]``, a spec of
     :func:`safebasins.wells.spec_of`) with the experiment's first harmonic (``fourier``: one
     variant of a list-valued ``params["fourier"]``; numeric-only kinds have none)."""
@@ -121,7 +128,7 @@ def well(params, fourier=None):
     return wells.from_spec(params["well"], params.get("fourier") if fourier is None else fourier)
 
 
-def base_well(params):
+def base_well(params: Mapping[str, Any]) -> Well:
     """The well of resolved parameters for the numerics (which have no first harmonic) and for
     library calls that loop over the variants of a list-valued ``params["fourier"]`` themselves
     (the quartic with eq (20) as printed; safebasins.analysis.common.variant_well picks each)."""
@@ -130,7 +137,7 @@ def base_well(params):
     return wells.from_spec(params["well"])
 
 
-def damping_param(beta) -> dict:
+def damping_param(beta: float | list[float]) -> dict[str, float | list[float]]:
     """``{"damping": beta}`` (a float, or a list for kinds whose curves vary it) of an experiment
     with damping; nothing for the undamped equation, whose parameter files (and datasets) stay
     the paper's: no ``damping`` parameter means beta = 0."""
@@ -140,7 +147,7 @@ def damping_param(beta) -> dict:
     return {"damping": vals if isinstance(beta, list) else vals[0]}
 
 
-def damping(params) -> float:
+def damping(params: Mapping[str, Any]) -> float:
     """The damping beta of resolved parameters (0 for the undamped equation; :func:`damping_param`)."""
     beta = params.get("damping", 0.0)
     if isinstance(beta, list):

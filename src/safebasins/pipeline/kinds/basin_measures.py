@@ -6,17 +6,22 @@ and of each attractor, beside the Melnikov threshold.  Dataset:
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 from safebasins.pipeline import values
-from safebasins.pipeline.registry import Job, Kind, Product, dataset_path, register
-from safebasins.pipeline.validation import CheckContext
+from safebasins.pipeline.registry import Block, FigureInputs, Inputs, Job, Kind, Params, Product, dataset_path, register
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from safebasins.pipeline.plan import ResolveContext
+    from safebasins.pipeline.validation import CheckContext
 
 STEPS = {"type": "array", "minItems": 2, "uniqueItems": True, "items": {"type": "integer", "minimum": 1}}
 LABELLED = ("F", "labelling")
 
 
-def build_measures(params: dict[str, Any], data: dict[str, Any], job: Job) -> Any:
+def build_measures(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """One stroboscopic map per F, its labels and their measures."""
     from safebasins.analysis.boundary_measures import boundary_measures
 
@@ -68,7 +73,7 @@ class BasinMeasures(Kind):
         },
     }
 
-    def check(self, block: dict[str, Any], key: str, ctx: CheckContext) -> None:
+    def check(self, block: Block, key: str, ctx: CheckContext) -> None:
         if not block["damping"] > 0:
             ctx.fail(f"{key}.damping", "attractors inside the well need damping > 0")
         ctx.check_grid(f"{key}.grid", block["grid"])
@@ -84,7 +89,7 @@ class BasinMeasures(Kind):
             ctx.fail(f"{key}.measures.eps", f"the largest eps ({max(m['eps'])} steps) needs more than "
                                             f"{2 * max(m['eps'])} nodes a side, the grid has {side}")
 
-    def resolve(self, block: dict[str, Any], ctx: Any) -> dict[str, Any]:
+    def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         m = block["measures"]
         return dict(F=[float(f) for f in block["F"]], Omega=float(block["Omega"]), Psi=values.angle(block["Psi"]),
                     xi_max=float(block["xi_max"]), grid=values.grid(block["grid"]), n_iter=int(block["n_iter"]),
@@ -92,11 +97,11 @@ class BasinMeasures(Kind):
                     measures={"box": int(m["box"]), "radius": float(m["radius"]), "n_balls": int(m["n_balls"]),
                               "eps": [int(e) for e in m["eps"]]})
 
-    def cost(self, params: dict[str, Any]) -> int:
+    def cost(self, params: Params) -> int:
         nq, np_ = params["grid"]["n"]
         return int(len(params["F"]) * nq * np_ * params["n_iter"] * params["steps_per_cycle"])
 
-    def products(self, experiment: str, params: dict[str, Any]) -> list[Product]:
+    def products(self, experiment: str, params: Params) -> list[Product]:
         return [Product(dataset_path("extras", experiment), "extras", build_measures, heavy=True,
                         title=params["title"] + " (boundary measures)",
                         history=f"safebasins.analysis.boundary_measures.boundary_measures ({experiment})",
@@ -104,5 +109,5 @@ class BasinMeasures(Kind):
                                   "p_value": LABELLED, "alpha": LABELLED, "alpha_err": LABELLED, "W": ("F",),
                                   "wada": ("F",), "F_melnikov": ()})]
 
-    def figure_inputs(self, experiment: str, params: dict[str, Any]) -> dict[str, str]:
+    def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         return {"measures": dataset_path("extras", experiment)}

@@ -13,19 +13,28 @@ classified period map (:func:`safebasins.analysis.period_map.period_map_portrait
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from safebasins import wells
 from safebasins.pipeline import values
-from safebasins.pipeline.registry import GridChartKind, Kind, Product, dataset_path, register
+from safebasins.pipeline.registry import (Block, Build, Contract, FigureInputs, GridChartKind, Inputs, Job, Kind,
+                                          Params, Product, dataset_path, register)
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from safebasins.pipeline.plan import ResolveContext
+    from safebasins.pipeline.validation import CheckContext
 
 N_POINTS = {"type": "integer", "minimum": 16, "default": 2000}
 
 
-def basin_contract(scan=(), manifold=False):
+def basin_contract(scan: tuple[str, ...] = (), manifold: bool = False) -> Contract:
     """Variables of an analytic basin dataset (``scan``: the leading stack dimension, if any)."""
-    c = {**{v: (*scan, "curve") for v in ("kind", "C_level")},
+    c: Contract = {**{v: (*scan, "curve") for v in ("kind", "C_level")},
          **{v: (*scan, "vertex") for v in ("gamma", "xi", "q0_vertex", "p0_vertex", "curve_index")},
          "escapes": (*scan, "q0", "p0")}
     if manifold:
@@ -33,13 +42,13 @@ def basin_contract(scan=(), manifold=False):
     return c
 
 
-def chart_contract(scan=()):
+def chart_contract(scan: tuple[str, ...] = ()) -> Contract:
     """Variables of a gathered escape chart on a grid."""
     return {"escape_cycle_energy": (*scan, "xi_max", "q0", "p0"),
             "escape_cycle_displacement": (*scan, "q_max", "q0", "p0")}
 
 
-def _basin_attrs(out, params):
+def _basin_attrs(out: xr.Dataset, params: Params) -> xr.Dataset:
     for k in ("F", "Omega", "Psi", "xi_max"):
         if k not in out.dims and k not in out.coords:
             out.attrs[k] = params[k]
@@ -47,7 +56,7 @@ def _basin_attrs(out, params):
     return out
 
 
-def build_basin_single(params, data, job):
+def build_basin_single(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """One analytic basin (Fig 18); with a ``manifold`` grid also C and escapes_rm (Figs 5-9); with
     ``check_cycles`` also the numeric check of its connected parts (safebasins.analysis.ic_basins)."""
     from safebasins.analysis import ic_basins
@@ -68,7 +77,7 @@ def build_basin_single(params, data, job):
     return _basin_attrs(out, params)
 
 
-def build_basin_stack(params, data, job):
+def build_basin_stack(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """Analytic basins stacked over the scanned parameter (Figs 13-17); with damping the
     damped slow flow's classification and the outline of its safe mask (analytic_basin)."""
     from safebasins.analysis.ic_basins import analytic_basin_stack
@@ -80,7 +89,7 @@ def build_basin_stack(params, data, job):
     return _basin_attrs(out, params)
 
 
-def gather_chart(params, blocks):
+def gather_chart(params: Params, blocks: list[list[xr.Dataset]]) -> xr.Dataset:
     """The escape chart of every task gathered from its tiles (stacked over F for F scans)."""
     from safebasins.io.gather import gather_chart as gather, task_charts
 
@@ -88,7 +97,7 @@ def gather_chart(params, blocks):
                   F=[t["F"] for t in params["tasks"]], t_eval=params.get("t_eval"))
 
 
-def build_chart_agreement(params, data, job):
+def build_chart_agreement(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """Gathered chart + IoU and pixel agreement with the analytic basin, per scanned value
     (safebasins.analysis.agreement.chart_agreement at t_eval = cycles)."""
     from safebasins.analysis.agreement import chart_agreement
@@ -96,7 +105,7 @@ def build_chart_agreement(params, data, job):
     return chart_agreement(gather_chart(params, data["tiles"]), data["basin"], params["cycles"], params["scan"])
 
 
-def strobe_candidates(params):
+def strobe_candidates(params: Params) -> tuple[NDArray[np.float64], NDArray[np.float64], list[str]]:
     """Candidate ICs of the period map in priority order: the ``line`` of ICs (if any), then the
     seeded random ones in ``box``; and their origin labels."""
     from safebasins.numerics import random_initial_conditions
@@ -113,7 +122,7 @@ def strobe_candidates(params):
     return np.r_[ql, np.asarray(qr, float)], np.r_[pl, np.asarray(pr, float)], origin
 
 
-def build_strobe(params, data, job):
+def build_strobe(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """Stroboscopic map of the first ``n_trajectories`` non-escaping candidates (the line of ICs
     first, then seeded random ones), classified, each kept orbit with both criteria's escape
     cycles (safebasins.analysis.period_map.portrait_with_criteria)."""
@@ -143,7 +152,7 @@ def build_strobe(params, data, job):
     return out
 
 
-def _basin_product(experiment, params, build, contract):
+def _basin_product(experiment: str, params: Params, build: Build, contract: Contract) -> Product:
     return Product(dataset_path("analytic", f"basin_{experiment}"), "analytic", build, title=params["title"],
                    contract=contract,
                    history=(f"safebasins.theory.slow_flow_escapes (damped slow flow) + mask outline ({experiment})"
@@ -183,14 +192,14 @@ class BasinRM(Kind):
         },
     }
 
-    def check(self, block, key, ctx):
+    def check(self, block: Block, key: str, ctx: CheckContext) -> None:
         ctx.check_grid(f"{key}.grid", block["grid"])
         ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin",
                                               ctx.well_at(key), block.get("damping", 0.0))
         if block["manifold"]["xi_top"] is not None and block["manifold"]["xi_top"] <= 0:
             ctx.fail(f"{key}.manifold.xi_top", "must be > 0")
 
-    def resolve(self, block, ctx):
+    def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         man = block["manifold"]
         return dict(fourier=ctx.fourier, F=float(block["F"]), Omega=float(block["Omega"]),
                     Psi=values.angle(block["Psi"]), xi_max=float(block["xi_max"]), grid=values.grid(block["grid"]),
@@ -200,18 +209,18 @@ class BasinRM(Kind):
                                               else man["xi_top"])},
                     check_cycles=int(block["check_cycles"]), steps_per_cycle=ctx.steps_per_cycle)
 
-    def cost(self, params):
+    def cost(self, params: Params) -> int:
         nq, np_ = params["grid"]["n"]
         return nq * np_ * params["check_cycles"] * params["steps_per_cycle"]
 
-    def products(self, experiment, params):
+    def products(self, experiment: str, params: Params) -> list[Product]:
         contract = basin_contract(manifold=True)
         if params["check_cycles"]:
             contract.update(escape_cycle_numeric=("q0", "p0"), region=("q0", "p0"), region_size=("region_index",),
                             region_numeric_safe=("region_index",))
         return [_basin_product(experiment, params, build_basin_single, contract)]
 
-    def figure_inputs(self, experiment, params):
+    def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         return {"analytic": dataset_path("analytic", f"basin_{experiment}")}
 
 
@@ -237,7 +246,7 @@ class BasinChart(GridChartKind):
         },
     }
 
-    def check(self, block, key, ctx):
+    def check(self, block: Block, key: str, ctx: CheckContext) -> None:
         ctx.check_grid(f"{key}.grid", block["grid"])
         ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin",
                                               ctx.well_at(key), block.get("damping", 0.0))
@@ -246,7 +255,7 @@ class BasinChart(GridChartKind):
         ctx.check_unique(f"{key}.F", block["F"])
         ctx.check_unique(f"{key}.xi_max", block["xi_max"])
 
-    def resolve(self, block, ctx):
+    def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         scan = "F" if isinstance(block["F"], list) else "xi_max"
         Fs = [float(f) for f in values.as_list(block["F"])]
         xis = [float(x) for x in values.as_list(block["xi_max"])]
@@ -256,7 +265,7 @@ class BasinChart(GridChartKind):
                     n_points=int(block["n_points"]), steps_per_cycle=ctx.steps_per_cycle,
                     tasks=[{"F": f, "xi_max": xis, "q_max": []} for f in Fs])
 
-    def products(self, experiment, params):
+    def products(self, experiment: str, params: Params) -> list[Product]:
         scan = (params["scan"],)
         basin = _basin_product(experiment, params, build_basin_stack, basin_contract(scan))
         stack = scan if params["scan"] == "F" else ()  # one chart serves every xi_max; one per F
@@ -266,7 +275,7 @@ class BasinChart(GridChartKind):
                                history=(f"safebasins.numerics.escape_chart tiles gathered + analytic/numeric "
                                         f"agreement ({experiment})"))]
 
-    def figure_inputs(self, experiment, params):
+    def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         return {"analytic": dataset_path("analytic", f"basin_{experiment}"),
                 "numeric": dataset_path("numeric", f"chart_{experiment}")}
 
@@ -315,7 +324,7 @@ class Strobe(Kind):
         },
     }
 
-    def check(self, block, key, ctx):
+    def check(self, block: Block, key: str, ctx: CheckContext) -> None:
         ctx.check_grid(f"{key}.grid", block["grid"])
         ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "an analytic safe basin",
                                               ctx.well_at(key), block.get("damping", 0.0))
@@ -327,7 +336,7 @@ class Strobe(Kind):
             ctx.fail(f"{key}.n_trajectories", f"{block['n_trajectories']} trajectories requested but only "
                                               f"n_candidates + line.n = {block['n_candidates'] + n_line} drawn")
 
-    def resolve(self, block, ctx):
+    def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         from safebasins.wells.quartic import QUARTIC
 
         xi = float(block["xi_max"])
@@ -345,11 +354,11 @@ class Strobe(Kind):
                     line=line or None, seed=ctx.seed, steps_per_cycle=ctx.steps_per_cycle,
                     classification={"min_digits": float(cl["min_digits"]), "max_period": int(cl["max_period"])})
 
-    def cost(self, params):
+    def cost(self, params: Params) -> int:
         n_line = params["line"]["n"] if params.get("line") else 0
         return (params["n_candidates"] + n_line) * params["n_iter"] * params["steps_per_cycle"]
 
-    def products(self, experiment, params):
+    def products(self, experiment: str, params: Params) -> list[Product]:
         return [_basin_product(experiment, params, build_basin_single, basin_contract()),
                 Product(dataset_path("numeric", f"strobe_{experiment}"), "numeric", build_strobe, heavy=True,
                         title=params["title"],
@@ -364,6 +373,6 @@ class Strobe(Kind):
                         history=(f"safebasins.numerics.stroboscopic_map + safebasins.analysis.period_map."
                                  f"period_map_portrait ({experiment})"))]
 
-    def figure_inputs(self, experiment, params):
+    def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         return {"analytic": dataset_path("analytic", f"basin_{experiment}"),
                 "numeric": dataset_path("numeric", f"strobe_{experiment}")}

@@ -6,16 +6,25 @@ threshold; every evaluation time ``t_eval <= cycles`` is read from it afterwards
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from safebasins.pipeline import values
 from safebasins.pipeline.kinds.basins import chart_contract, gather_chart
-from safebasins.pipeline.registry import GridChartKind, Kind, Product, dataset_path, params_path, register
+from safebasins.pipeline.registry import (Block, ChartICs, FigureInputs, GridChartKind, Inputs, Job, Kind, Params,
+                                          Product, dataset_path, params_path, register)
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from safebasins.pipeline.plan import ResolveContext
+    from safebasins.pipeline.validation import CheckContext
 
 Q_MAX = {"type": "number", "exclusiveMinimum": 0, "maximum": 1}
 
 
-def build_criteria(params, data, job):
+def build_criteria(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """A_E, A_q (safe counts by the energy and displacement criterion) per (F, repeat)
     (safebasins.analysis.agreement.criteria_table)."""
     from safebasins.analysis.agreement import criteria_table
@@ -32,7 +41,7 @@ def build_criteria(params, data, job):
     return out
 
 
-def build_chart(params, data, job):
+def build_chart(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """The escape chart gathered from its tiles (attributes ``t_eval``, ``cycles``)."""
     return gather_chart(params, data["tiles"])
 
@@ -62,7 +71,7 @@ class Criteria(Kind):
         },
     }
 
-    def check(self, block, key, ctx):
+    def check(self, block: Block, key: str, ctx: CheckContext) -> None:
         ctx.check_interval(f"{key}.box[0]", block["box"][0])
         ctx.check_interval(f"{key}.box[1]", block["box"][1])
         if ctx.tiles > block["n_ic"] * block["repeats"]:
@@ -73,7 +82,7 @@ class Criteria(Kind):
                 ctx.fail(f"{key}.F.start", f"must be >= 0 (a forcing amplitude), got {block['F']['start']}")
         ctx.check_unique(f"{key}.F", block["F"])
 
-    def resolve(self, block, ctx):
+    def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         from safebasins.wells.quartic import QUARTIC
 
         Fs = values.values(block["F"])
@@ -85,7 +94,7 @@ class Criteria(Kind):
                     box=values.box(block["box"]), cycles=int(block["cycles"]), steps_per_cycle=ctx.steps_per_cycle,
                     tasks=[{"F": f, "xi_max": [xi], "q_max": [qm]} for f in Fs])
 
-    def chart_ics(self, params):
+    def chart_ics(self, params: Params) -> ChartICs:
         from safebasins.numerics import random_initial_conditions
 
         qs, ps = [], []
@@ -95,16 +104,16 @@ class Criteria(Kind):
             ps.append(np.asarray(p, dtype=float))
         return np.concatenate(qs), np.concatenate(ps), False
 
-    def cost(self, params):
+    def cost(self, params: Params) -> int:
         return len(params["tasks"]) * params["n_ic"] * params["repeats"] * params["cycles"] * params["steps_per_cycle"]
 
-    def products(self, experiment, params):
+    def products(self, experiment: str, params: Params) -> list[Product]:
         return [Product(dataset_path("numeric", f"criteria_{experiment}"), "numeric", build_criteria, tiles=True,
                         title=params["title"], contract={"A_E": ("F", "repeat"), "A_q": ("F", "repeat"),
                                                          "rel_diff": ("F", "repeat"), "seed": ("repeat",)},
                         history=f"safebasins.numerics.escape_chart on seeded random ICs ({experiment})")]
 
-    def figure_inputs(self, experiment, params):
+    def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         return {"numeric": dataset_path("numeric", f"criteria_{experiment}")}
 
 
@@ -128,7 +137,7 @@ class Chart(GridChartKind):
         },
     }
 
-    def check(self, block, key, ctx):
+    def check(self, block: Block, key: str, ctx: CheckContext) -> None:
         ctx.check_grid(f"{key}.grid", block["grid"])
         if "t_eval" in block:
             ctx.check_t_eval_within(f"{key}.t_eval", block["t_eval"], block["cycles"])
@@ -137,7 +146,7 @@ class Chart(GridChartKind):
         for k in ("xi_max", "q_max", "t_eval"):
             ctx.check_unique(f"{key}.{k}", block.get(k))
 
-    def resolve(self, block, ctx):
+    def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         xis = [float(x) for x in values.as_list(block["xi_max"])]
         qms = [float(x) for x in values.as_list(block["q_max"])]
         return dict(F=float(block["F"]), Omega=float(block["Omega"]), Psi=values.angle(block["Psi"]), xi_max=xis,
@@ -146,12 +155,12 @@ class Chart(GridChartKind):
                     steps_per_cycle=ctx.steps_per_cycle,
                     tasks=[{"F": float(block["F"]), "xi_max": xis, "q_max": qms}])
 
-    def products(self, experiment, params):
+    def products(self, experiment: str, params: Params) -> list[Product]:
         return [Product(dataset_path("numeric", f"chart_{experiment}"), "numeric", build_chart, tiles=True,
                         title=params["title"], contract=chart_contract(),
                         history=f"safebasins.numerics.escape_chart tiles gathered ({experiment})")]
 
-    def figure_inputs(self, experiment, params):
+    def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         return {"numeric": dataset_path("numeric", f"chart_{experiment}"), "params": params_path(experiment)}
 
 
@@ -169,7 +178,7 @@ class AreaTime(Kind):
         },
     }
 
-    def check(self, block, key, ctx):
+    def check(self, block: Block, key: str, ctx: CheckContext) -> None:
         src = block["source"]
         if ctx.kinds.get(src) != "chart":
             choices = ", ".join(sorted(e for e, k in ctx.kinds.items() if k == "chart"))
@@ -180,8 +189,8 @@ class AreaTime(Kind):
             ctx.fail(f"{key}.t_eval.stop",
                      f"{block['t_eval']['stop']} is beyond the horizon of {src} (cycles = {horizon})")
 
-    def resolve(self, block, ctx):
+    def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         return dict(source=block["source"], t_eval=values.range_values(block["t_eval"]))
 
-    def figure_inputs(self, experiment, params):
+    def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         return {"numeric": dataset_path("numeric", f"chart_{params['source']}"), "params": params_path(experiment)}

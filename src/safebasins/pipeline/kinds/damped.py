@@ -9,14 +9,23 @@ exponent alpha(F) of the basin boundary
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from safebasins.pipeline import values
-from safebasins.pipeline.registry import GridChartKind, Product, dataset_path, register
+from safebasins.pipeline.registry import (Block, FigureInputs, GridChartKind, Inputs, Job, Params, Product,
+                                          dataset_path, register)
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from safebasins.pipeline.plan import ResolveContext
+    from safebasins.pipeline.validation import CheckContext
 
 F_LIST = {"type": "array", "minItems": 2, "items": {"$ref": "#/$defs/forcing"}}
 EPS = {"type": "array", "minItems": 2, "uniqueItems": True, "items": {"type": "number", "exclusiveMinimum": 0}}
 
 
-def build_profile(params, data, job):
+def build_profile(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """GIM / LIM / IF versus F (every t_eval), F_melnikov and the kept basins."""
     from safebasins.analysis.tangency import tangency_profile
     from safebasins.io.gather import task_charts
@@ -27,7 +36,7 @@ def build_profile(params, data, job):
     return tangency_profile(charts, params["t_eval"], keep_F=params["basins_F"], level=params["level"])
 
 
-def build_fractality(params, data, job):
+def build_fractality(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """The uncertainty exponent alpha(F) of the basin boundary (seeded paired ICs)."""
     from safebasins.analysis.tangency import fractality_profile
 
@@ -75,7 +84,7 @@ class Tangency(GridChartKind):
         },
     }
 
-    def check(self, block, key, ctx):
+    def check(self, block: Block, key: str, ctx: CheckContext) -> None:
         if not block["damping"] > 0:
             ctx.fail(f"{key}.damping", "the Melnikov tangency needs damping > 0 (undamped manifolds always "
                                        "intersect)")
@@ -94,7 +103,7 @@ class Tangency(GridChartKind):
             ctx.check_interval(f"{key}.fractality.box[{i}]", frac["box"][i])
         ctx.check_unique(f"{key}.fractality.F", frac["F"])
 
-    def resolve(self, block, ctx):
+    def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         Fs = values.values(block["F"])
         xi = float(block["xi_max"])
         frac = block["fractality"]
@@ -107,12 +116,12 @@ class Tangency(GridChartKind):
                                 "n": int(frac["n"]), "eps": [float(e) for e in frac["eps"]]},
                     tasks=[{"F": f, "xi_max": [xi], "q_max": []} for f in Fs])
 
-    def cost(self, params):
+    def cost(self, params: Params) -> int:
         f = params["fractality"]
         paired = len(f["F"]) * f["n"] * (1 + 2 * len(f["eps"])) * params["cycles"] * params["steps_per_cycle"]
         return super().cost(params) + paired
 
-    def products(self, experiment, params):
+    def products(self, experiment: str, params: Params) -> list[Product]:
         return [
             Product(dataset_path("extras", f"{experiment}_profile"), "extras", build_profile, tiles=True,
                     title=params["title"] + " (integrity profile)",
@@ -126,6 +135,6 @@ class Tangency(GridChartKind):
                     history=f"safebasins.analysis.tangency.fractality_profile ({experiment})"),
         ]
 
-    def figure_inputs(self, experiment, params):
+    def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         return {"profile": dataset_path("extras", f"{experiment}_profile"),
                 "fractality": dataset_path("extras", f"{experiment}_fractality")}

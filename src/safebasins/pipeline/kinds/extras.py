@@ -9,12 +9,20 @@ from __future__ import annotations
 
 from functools import partial
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from safebasins.pipeline import values
 from safebasins.pipeline import well_defaults as WD
-from safebasins.pipeline.registry import GridChartKind, Kind, Product, dataset_path, register
+from safebasins.pipeline.registry import (Block, FigureInputs, GridChartKind, Inputs, Job, Kind, Params, Product,
+                                          dataset_path, register)
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from safebasins.pipeline.plan import ResolveContext
+    from safebasins.pipeline.validation import CheckContext
 
 FOURIER_LIST = {"description": "first-harmonic variants of the analytic products (\"paper\", \"exact\")",
                 "oneOf": [{"enum": ["paper", "exact"]},
@@ -24,7 +32,7 @@ T_EVAL_LIST = {"description": "evaluation times in forcing cycles (each <= cycle
                          {"type": "array", "minItems": 1, "items": {"type": "number", "minimum": 0}}]}
 
 
-def _grid_charts(params, blocks, attr):
+def _grid_charts(params: Params, blocks: list[list[xr.Dataset]], attr: str) -> list[xr.Dataset]:
     """The chart of every task, each tagged with its task value ``attr`` (F or Psi) and cycles."""
     from safebasins.io.gather import task_charts
 
@@ -34,7 +42,7 @@ def _grid_charts(params, blocks, attr):
     return charts
 
 
-def _level_crossings(ds, level):
+def _level_crossings(ds: xr.Dataset, level: float) -> xr.Dataset:
     from safebasins.analysis.erosion import level_crossing
 
     cross = level_crossing(ds, level)
@@ -43,7 +51,7 @@ def _level_crossings(ds, level):
     return ds
 
 
-def build_erosion_analytic(params, data, job):
+def build_erosion_analytic(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """GIM / LIM / IF versus F from the slow flow on the chart grid, per first-harmonic variant
     (with damping: the damped slow flow, every IC's trajectory followed)."""
     from safebasins.analysis.erosion import erosion_profile_analytic
@@ -60,7 +68,7 @@ def build_erosion_analytic(params, data, job):
     return ds
 
 
-def build_erosion_numeric(params, data, job):
+def build_erosion_numeric(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """GIM / LIM / IF versus (F, xi_max, t_eval) from one escape chart per F (integrated with the
     experiment's damping by the chart tiles; the profile carries the charts' ``damping``)."""
     from safebasins.analysis.erosion import profile_from_charts
@@ -71,7 +79,7 @@ def build_erosion_numeric(params, data, job):
     return ds
 
 
-def build_true_basin_analytic(params, data, job):
+def build_true_basin_analytic(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """Per-phase analytic basins, their intersection and the all-phase basin H0 < xi_true."""
     from safebasins.analysis.phase_invariant import true_safe_basin_analytic
 
@@ -88,19 +96,19 @@ def build_true_basin_analytic(params, data, job):
     return ds.merge(b.assign_coords({c: ds[c] for c in b.coords if c in ds.coords}))
 
 
-def build_true_basin_numeric(params, data, job):
+def build_true_basin_numeric(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """Intersection over Psi of the numeric safe basins (one escape chart per Psi)."""
     from safebasins.analysis.phase_invariant import true_safe_basin_from_charts
 
     return true_safe_basin_from_charts(_grid_charts(params, data["tiles"], "Psi"), params["t_eval"])
 
 
-def _fourier_source(what, source):
+def _fourier_source(what: str, source: str) -> str:
     """The numeric dataset of experiment ``source`` that a fourier_compare product reads."""
     return dataset_path("numeric", f"{'fcr' if what == 'fcr' else 'chart'}_{source}")
 
 
-def build_fourier(params, data, job, *, what, source):
+def build_fourier(params: Params, data: Inputs, job: Job, *, what: str, source: str) -> xr.Dataset:
     """Paper vs exact first harmonic against the numerics of experiment ``source``."""
     from safebasins.analysis import fourier_compare as fc
 
@@ -118,7 +126,7 @@ def build_fourier(params, data, job, *, what, source):
     return ds
 
 
-def _check_grid_block(block, key, ctx):
+def _check_grid_block(block: Block, key: str, ctx: CheckContext) -> None:
     ctx.check_grid(f"{key}.grid", block["grid"])
     ctx.check_thresholds_below_separatrix(f"{key}.xi_max", block["xi_max"], "the analytic criterion", ctx.well_at(key),
                                           block.get("damping", 0.0))
@@ -127,7 +135,7 @@ def _check_grid_block(block, key, ctx):
         ctx.check_unique(f"{key}.{k}", block[k])
 
 
-def _analytic_numeric_inputs(experiment):
+def _analytic_numeric_inputs(experiment: str) -> dict[str, str]:
     """Figure inputs of a kind with an analytic and a numeric product."""
     return {"analytic": dataset_path("extras", f"{experiment}_analytic"),
             "numeric": dataset_path("extras", f"{experiment}_numeric")}
@@ -167,7 +175,7 @@ class Erosion(GridChartKind):
     well_defaults = {"F": WD.force_range(0.15, 31), "Omega": WD.frequency(0.9), "xi_max": WD.energies([0.18, 0.22]),
                      "grid": WD.window((-0.85, 0.85), (-0.70, 0.70), 121), "fourier": WD.fourier(["paper", "exact"])}
 
-    def check(self, block, key, ctx):
+    def check(self, block: Block, key: str, ctx: CheckContext) -> None:
         _check_grid_block(block, key, ctx)
         if isinstance(block["F"], dict):
             ctx.check_range(f"{key}.F", block["F"])
@@ -175,7 +183,7 @@ class Erosion(GridChartKind):
                 ctx.fail(f"{key}.F.start", f"must be >= 0 (a forcing amplitude), got {block['F']['start']}")
         ctx.check_unique(f"{key}.F", block["F"])
 
-    def resolve(self, block, ctx):
+    def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         Fs = values.values(block["F"])
         xis = [float(x) for x in values.as_list(block["xi_max"])]
         return dict(fourier=[str(f) for f in values.as_list(block["fourier"])], F=Fs, Omega=float(block["Omega"]),
@@ -186,7 +194,7 @@ class Erosion(GridChartKind):
                     tasks=[{"F": f, "xi_max": xis, "q_max": []} for f in Fs])
 
 
-    def products(self, experiment, params):
+    def products(self, experiment: str, params: Params) -> list[Product]:
         return [
             Product(dataset_path("extras", f"{experiment}_analytic"), "extras", build_erosion_analytic, heavy=True,
                     title=params["title"] + " (analytic)",
@@ -201,7 +209,7 @@ class Erosion(GridChartKind):
                              f"profile_from_charts ({experiment})")),
         ]
 
-    def figure_inputs(self, experiment, params):
+    def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         return _analytic_numeric_inputs(experiment)
 
 
@@ -234,10 +242,10 @@ class TrueBasin(GridChartKind):
     well_defaults = {"F": WD.force(0.01), "Omega": WD.frequency(0.9), "xi_max": WD.energy(0.18),
                      "grid": WD.window((-0.72, 0.72), (-0.63, 0.63), 121), "fourier": WD.fourier(["paper", "exact"])}
 
-    def check(self, block, key, ctx):
+    def check(self, block: Block, key: str, ctx: CheckContext) -> None:
         _check_grid_block(block, key, ctx)
 
-    def resolve(self, block, ctx):
+    def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         xis = [float(x) for x in values.as_list(block["xi_max"])]
         n = int(block["n_psi"])
         psis = [float(np.round(2 * math.pi * k / n, 12)) for k in range(n)]
@@ -248,7 +256,7 @@ class TrueBasin(GridChartKind):
                     tasks=[{"F": float(block["F"]), "Psi": ps, "xi_max": xis, "q_max": []} for ps in psis])
 
 
-    def products(self, experiment, params):
+    def products(self, experiment: str, params: Params) -> list[Product]:
         return [
             Product(dataset_path("extras", f"{experiment}_analytic"), "extras", build_true_basin_analytic, heavy=True,
                     title=params["title"] + " (analytic)",
@@ -267,7 +275,7 @@ class TrueBasin(GridChartKind):
                              f"true_safe_basin_from_charts ({experiment})")),
         ]
 
-    def figure_inputs(self, experiment, params):
+    def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         return _analytic_numeric_inputs(experiment)
 
 
@@ -291,9 +299,9 @@ class FourierCompare(Kind):
         },
     }
 
-    def check(self, block, key, ctx):
+    def check(self, block: Block, key: str, ctx: CheckContext) -> None:
         for what, (kind, label) in self.SOURCES.items():
-            seen = set()
+            seen: set[str] = set()
             for i, name in enumerate(block[what]):
                 if ctx.kinds.get(name) != kind:
                     choices = ", ".join(sorted(e for e, k in ctx.kinds.items() if k == kind))
@@ -307,12 +315,12 @@ class FourierCompare(Kind):
                 if block["t_eval"] > horizon:
                     ctx.fail(f"{key}.t_eval", f"{block['t_eval']} is beyond the horizon of {name} (cycles = {horizon})")
 
-    def resolve(self, block, ctx):
+    def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         return dict(fcr=list(block["fcr"]), iou=list(block["iou"]),
                     t_eval=None if block["t_eval"] is None else float(block["t_eval"]))
 
-    def products(self, experiment, params):
-        out = []
+    def products(self, experiment: str, params: Params) -> list[Product]:
+        out: list[Product] = []
         for what, label in (("fcr", "F_cr"), ("iou", "safe-basin IoU")):
             for source in params[what]:
                 out.append(Product(
@@ -325,6 +333,6 @@ class FourierCompare(Kind):
                     history=f"safebasins.analysis.fourier_compare on the numerics of {source} ({experiment})"))
         return out
 
-    def figure_inputs(self, experiment, params):
+    def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         return {"fcr": [dataset_path("extras", f"{experiment}_fcr_{e}") for e in params["fcr"]],
                 "iou": [dataset_path("extras", f"{experiment}_iou_{e}") for e in params["iou"]]}

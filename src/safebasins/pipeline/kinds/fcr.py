@@ -8,29 +8,38 @@ IC ``theory.initial_condition(xi_ini, gamma_ini, Psi)``.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING, Any
 
 from safebasins.pipeline import values
-from safebasins.pipeline.registry import Kind, Product, dataset_path, register
+from safebasins.pipeline.registry import (Block, Contract, FigureInputs, Inputs, Job, Kind, Params, Product,
+                                          dataset_path, register)
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from safebasins.pipeline.plan import ResolveContext
+    from safebasins.pipeline.validation import CheckContext
+    from safebasins.wells.base import Well
 
 _CO = ("curve", "Omega")
-ANALYTIC_CONTRACT = {**{v: _CO for v in ("F_cr", "mechanism", "F_MM_0", "F_MM_pi", "F_SM", "F_SMM")},
+ANALYTIC_CONTRACT: Contract = {**{v: _CO for v in ("F_cr", "mechanism", "F_MM_0", "F_MM_pi", "F_SM", "F_SMM")},
                      **{c: ("curve",) for c in ("xi_max", "xi_ini", "gamma_ini", "label")}}
-NUMERIC_CONTRACT = {**{v: _CO for v in ("F_cr", "F_cr_low", "F_cr_high", "F_escape_low", "F_escape_all",
+NUMERIC_CONTRACT: Contract = {**{v: _CO for v in ("F_cr", "F_cr_low", "F_cr_high", "F_escape_low", "F_escape_all",
                                          "non_monotone", "F_bracket_used_high", "F_bracket_widenings")},
                     **{c: ("curve",) for c in ("xi_max", "xi_ini", "gamma_ini", "Psi", "label", "q0", "p0")}}
 
 #: the damped theory's variables (theory.critical_forcing with damping > 0: no mechanism branches)
-DAMPED_ANALYTIC_CONTRACT = {**{v: _CO for v in ("F_cr", "F_settle", "F_cr_undamped", "F_min", "xi_attractor",
+DAMPED_ANALYTIC_CONTRACT: Contract = {**{v: _CO for v in ("F_cr", "F_settle", "F_cr_undamped", "F_min", "xi_attractor",
                                                  "t_escape", "undecided")},
                             **{c: ("curve",) for c in ("xi_max", "xi_ini", "gamma_ini", "label", "damping")}}
 
 
-def analytic_contract(params):
+def analytic_contract(params: Params) -> Contract:
     """The analytic dataset's contract: the damped theory's when the experiment is damped."""
     return DAMPED_ANALYTIC_CONTRACT if "damping" in params else ANALYTIC_CONTRACT
 
 
-CURVES_SCHEMA = {
+CURVES_SCHEMA: dict[str, Any] = {
     "Omega": {"$ref": "#/$defs/omega_range"},
     "xi_max": {"$ref": "#/$defs/threshold_list"},
     "xi_ini": {"$ref": "#/$defs/energy_list", "default": 0.0},
@@ -40,7 +49,7 @@ CURVES_SCHEMA = {
 }
 
 
-def _check_curves(block, key, ctx):
+def _check_curves(block: Block, key: str, ctx: CheckContext) -> None:
     ctx.check_range(f"{key}.Omega", block["Omega"], positive=True)
     lists = values.curve_lists(block)
     lens = {k: len(v) for k, v in lists.items()}
@@ -56,7 +65,7 @@ def _check_curves(block, key, ctx):
                                           block["damping"])
     full = {k: v * (n // len(v)) for k, v in lists.items()}
     xm, xi = full["xi_max"], full["xi_ini"]
-    seen = set()
+    seen: set[tuple[Any, ...]] = set()
     for i, curve in enumerate(zip(*full.values())):
         if curve in seen:
             ctx.fail(key, f"curve {i} ({', '.join(full)}) = {curve} repeats an earlier curve")
@@ -67,7 +76,7 @@ def _check_curves(block, key, ctx):
                      f"initial energy {b} must be below the truncation level xi_max = {a}")
 
 
-def _bracket(value, well):
+def _bracket(value: list[float] | None, well: Well | dict[str, Any]) -> list[float]:
     """The numeric F bracket of a config: as given, or (null) the well's default."""
     if value is not None:
         return [float(x) for x in value]
@@ -76,7 +85,7 @@ def _bracket(value, well):
     return list(default_bracket(well))
 
 
-def build_fcr_analytic(params, data, job):
+def build_fcr_analytic(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """One theory.critical_forcing per curve, stacked over ``curve``."""
     from safebasins.analysis.fcr_curves import analytic_fcr_curves
 
@@ -85,7 +94,7 @@ def build_fcr_analytic(params, data, job):
     return out
 
 
-def build_fcr_numeric(params, data, job):
+def build_fcr_numeric(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """One numerics.critical_forcing_numeric per curve (IC from (xi_ini, gamma_ini, Psi))."""
     from safebasins.analysis.fcr_curves import numeric_fcr_curves
 
@@ -108,19 +117,19 @@ class FcrTheory(Kind):
         "properties": dict(CURVES_SCHEMA),
     }
 
-    def check(self, block, key, ctx):
+    def check(self, block: Block, key: str, ctx: CheckContext) -> None:
         _check_curves(block, key, ctx)
 
-    def resolve(self, block, ctx):
+    def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         return dict(fourier=ctx.fourier, Omega=values.range_values(block["Omega"]),
                     curves=values.curves(block, False))
 
-    def products(self, experiment, params):
+    def products(self, experiment: str, params: Params) -> list[Product]:
         return [Product(dataset_path("analytic", f"fcr_{experiment}"), "analytic", build_fcr_analytic,
                         title=params["title"], contract=analytic_contract(params),
                         history=f"safebasins.theory.critical_forcing per curve ({experiment})")]
 
-    def figure_inputs(self, experiment, params):
+    def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         return {"analytic": dataset_path("analytic", f"fcr_{experiment}")}
 
 
@@ -156,7 +165,7 @@ class FcrCompare(Kind):
         },
     }
 
-    def check(self, block, key, ctx):
+    def check(self, block: Block, key: str, ctx: CheckContext) -> None:
         _check_curves(block, key, ctx)
         num = block["numeric"]
         ctx.check_range(f"{key}.numeric.Omega", num["Omega"], positive=True)
@@ -165,7 +174,7 @@ class FcrCompare(Kind):
             if not hi > lo:
                 ctx.fail(f"{key}.numeric.F_bracket", f"empty bracket [{lo}, {hi}]")
 
-    def resolve(self, block, ctx):
+    def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         nb = block["numeric"]
         return dict(fourier=ctx.fourier, Omega=values.range_values(block["Omega"]), curves=values.curves(block, True),
                     numeric={"Omega": values.range_values(nb["Omega"]), "cycles": int(nb["cycles"]),
@@ -173,7 +182,7 @@ class FcrCompare(Kind):
                              "n_scan": int(nb["n_scan"]), "criterion": nb["criterion"],
                              "steps_per_cycle": ctx.steps_per_cycle})
 
-    def products(self, experiment, params):
+    def products(self, experiment: str, params: Params) -> list[Product]:
         return [
             Product(dataset_path("analytic", f"fcr_{experiment}"), "analytic", build_fcr_analytic,
                     title=params["title"], contract={**analytic_contract(params), "Psi": ("curve",)},
@@ -184,7 +193,7 @@ class FcrCompare(Kind):
                     history=f"safebasins.numerics.critical_forcing_numeric per curve ({experiment})"),
         ]
 
-    def cost(self, params):
+    def cost(self, params: Params) -> int:
         n = params["numeric"]
         from safebasins.numerics.bisection import MAX_WIDENINGS
 
@@ -194,6 +203,6 @@ class FcrCompare(Kind):
         return (len(params["curves"]) * len(n["Omega"]) * (levels + n["n_scan"]) * n["cycles"]
                 * n["steps_per_cycle"])
 
-    def figure_inputs(self, experiment, params):
+    def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         return {"analytic": dataset_path("analytic", f"fcr_{experiment}"),
                 "numeric": dataset_path("numeric", f"fcr_{experiment}")}

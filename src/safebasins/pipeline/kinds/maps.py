@@ -9,17 +9,23 @@ integrates its block of control points in one ensemble and keeps only the integr
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 import xarray as xr
 
 from safebasins.pipeline import values
 from safebasins.pipeline import well_defaults as WD
-from safebasins.pipeline.registry import Kind, Product, dataset_path, register
+from safebasins.pipeline.registry import Block, FigureInputs, Inputs, Job, Kind, Params, Product, dataset_path, register
+
+if TYPE_CHECKING:
+    from safebasins.pipeline.plan import ResolveContext
+    from safebasins.pipeline.validation import CheckContext
 
 MEASURES = ("GIM", "LIM", "IF")
 
 
-def build_analytic(params, data, job):
+def build_analytic(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     from safebasins.analysis.integrity_map import erosion_front, integrity_map_analytic
 
     q0, p0 = values.grid_axes(params["grid"])
@@ -33,7 +39,7 @@ def build_analytic(params, data, job):
     return ds
 
 
-def build_numeric(params, data, job):
+def build_numeric(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """Tiles (one Omega x a block of F each) gathered; numeric - analytic difference; fronts."""
     from safebasins.analysis.integrity_map import erosion_front
     from safebasins.io.gather import TILE_ATTRS
@@ -81,7 +87,7 @@ class IntegrityMap(Kind):
     well_defaults = {"xi_max": WD.energy(0.18), "grid": WD.window((-0.72, 0.72), (-0.63, 0.63), 61),
                      "fourier": WD.fourier("paper")}
 
-    def check(self, block, key, ctx):
+    def check(self, block: Block, key: str, ctx: CheckContext) -> None:
         ctx.check_grid(f"{key}.grid", block["grid"])
         ctx.check_range(f"{key}.Omega", block["Omega"], positive=True)
         ctx.check_range(f"{key}.F", block["F"])
@@ -95,7 +101,7 @@ class IntegrityMap(Kind):
         if ctx.tiles > n_F:
             ctx.fail("numerics.tiles", f"{ctx.tiles} tiles but {key}.F has only {n_F} values")
 
-    def resolve(self, block, ctx):
+    def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         Om, Fs = values.range_values(block["Omega"]), values.range_values(block["F"])
         xi = float(block["xi_max"])
         return dict(Omega=Om, F=Fs, Psi=values.angle(block["Psi"]), xi_max=xi, grid=values.grid(block["grid"]),
@@ -105,7 +111,7 @@ class IntegrityMap(Kind):
                     steps_per_cycle=ctx.steps_per_cycle,
                     tasks=[{"Omega": om, "F": Fs, "xi_max": [xi], "q_max": []} for om in Om])
 
-    def compute_tile(self, params, task, tile, tiles, job):
+    def compute_tile(self, params: Params, task: int, tile: int, tiles: int, job: Job) -> xr.Dataset:
         """Control points (Omega_task, F in block ``tile``): one ensemble, integrity per t_eval."""
         from safebasins.analysis.integrity_map import integrity_from_batch
         from safebasins.numerics import escape_chart_batch
@@ -121,11 +127,11 @@ class IntegrityMap(Kind):
         m = integrity_from_batch(charts, params["t_eval"])
         return m.swap_dims(control="F").drop_vars("control").assign_coords(Omega=t["Omega"])
 
-    def cost(self, params):
+    def cost(self, params: Params) -> int:
         nq, np_ = params["grid"]["n"]
         return len(params["Omega"]) * len(params["F"]) * nq * np_ * params["cycles"] * params["steps_per_cycle"]
 
-    def products(self, experiment, params):
+    def products(self, experiment: str, params: Params) -> list[Product]:
         analytic = dataset_path("extras", f"{experiment}_analytic")
         map_dims, front_dims = ("Omega", "F", "t_eval"), ("Omega", "t_eval")
         return [
@@ -141,11 +147,11 @@ class IntegrityMap(Kind):
                               "F_GIM": front_dims, "F_LIM": front_dims}),
         ]
 
-    def figure_inputs(self, experiment, params):
+    def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         return {"analytic": dataset_path("extras", f"{experiment}_analytic"),
                 "numeric": dataset_path("extras", f"{experiment}_numeric")}
 
-    def default_figure_text(self, experiment, params):
+    def default_figure_text(self, experiment: str, params: Params) -> tuple[str, str]:
         caption = ("Integrity over the control plane: GIM and LIM of the safe basin for xi_max = "
                    f"{params['xi_max']:g}, Psi = {values.fmt(params['Psi'], angle=True)}, on a "
                    f"{len(params['Omega'])} x {len(params['F'])} grid of (Omega, F), "

@@ -5,16 +5,21 @@ damped well at a few F, with the numeric F of their first tangency beside the Me
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 from safebasins.pipeline import values
-from safebasins.pipeline.registry import Job, Kind, Product, dataset_path, register
-from safebasins.pipeline.validation import CheckContext
+from safebasins.pipeline.registry import Block, FigureInputs, Inputs, Job, Kind, Params, Product, dataset_path, register
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from safebasins.pipeline.plan import ResolveContext
+    from safebasins.pipeline.validation import CheckContext
 
 POSITIVE = {"type": "number", "exclusiveMinimum": 0}
 
 
-def build_saddle(params: dict[str, Any], data: dict[str, Any], job: Job) -> Any:
+def build_saddle(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """Escape charts, manifolds and orbit at each F; the tangency once."""
     from safebasins.analysis.saddle_chart import saddle_chart
 
@@ -72,13 +77,13 @@ class HilltopSaddle(Kind):
         },
     }
 
-    def check(self, block: dict[str, Any], key: str, ctx: CheckContext) -> None:
+    def check(self, block: Block, key: str, ctx: CheckContext) -> None:
         if not block["damping"] > 0:
             ctx.fail(f"{key}.damping", "attractors inside the well and a tangency at F > 0 need damping > 0")
         ctx.check_grid(f"{key}.grid", block["grid"])
         ctx.check_unique(f"{key}.F", block["F"])
 
-    def resolve(self, block: dict[str, Any], ctx: Any) -> dict[str, Any]:
+    def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         m, t = block["manifolds"], block["tangency"]
         return dict(F=[float(f) for f in block["F"]], Omega=float(block["Omega"]), Psi=values.angle(block["Psi"]),
                     xi_max=float(block["xi_max"]), grid=values.grid(block["grid"]), cycles=int(block["cycles"]),
@@ -88,11 +93,11 @@ class HilltopSaddle(Kind):
                     tangency={"enabled": bool(t["enabled"]), "xtol": float(t["xtol"]), "ds_max": float(t["ds_max"]),
                               "rtol": float(t["rtol"])})
 
-    def cost(self, params: dict[str, Any]) -> int:
+    def cost(self, params: Params) -> int:
         nq, np_ = params["grid"]["n"]
         return int(len(params["F"]) * nq * np_ * params["cycles"] * params["steps_per_cycle"])
 
-    def products(self, experiment: str, params: dict[str, Any]) -> list[Product]:
+    def products(self, experiment: str, params: Params) -> list[Product]:
         return [Product(dataset_path("extras", experiment), "extras", build_saddle, heavy=True,
                         title=params["title"] + " (hilltop saddle)",
                         history=f"safebasins.analysis.saddle_chart.saddle_chart ({experiment})",
@@ -101,5 +106,5 @@ class HilltopSaddle(Kind):
                                   "kind": ("F", "curve"), "side": ("F", "curve"), "q_fixed": ("F", "saddle"),
                                   "p_fixed": ("F", "saddle"), "F_melnikov": (), "F_tangency": ()})]
 
-    def figure_inputs(self, experiment: str, params: dict[str, Any]) -> dict[str, str]:
+    def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         return {"saddle": dataset_path("extras", experiment)}
