@@ -39,7 +39,7 @@ LEVEL_COLOUR = "0.25"
 def _phase_text(phi: float) -> str:
     """A shock phase in [0, 2 pi), in units of pi (plain text for captions)."""
     r = float(np.mod(phi, 2.0 * np.pi)) / np.pi
-    return "0" if r == 0 else f"{r:.3g}π"
+    return "0" if r == 0 else "π" if r == 1 else f"{r:.3g}π"
 
 
 def figure_fatal_shock(shock: Any, *, title: str | None = None) -> Figure:
@@ -53,12 +53,13 @@ def figure_fatal_shock(shock: Any, *, title: str | None = None) -> Figure:
     x = np.mod(phi, 2.0 * np.pi)[order]
     norms = [str(n) for n in var(ds, "norm").values]
     n_att = ds.sizes["attractor"]
+    amp = var(ds, "response_amplitude").values
     fig, (axP, axM) = plt.subplots(1, 2, figsize=(11.0, 4.6), gridspec_kw={"width_ratios": [1.0, 1.15]})
     _phase_plane(axP, ds)
     for a in range(n_att):
         for n, name in enumerate(norms):
             st = NORM_STYLE.get(name, NORM_STYLE["weighted"])
-            label = f"attractor {a}, {name} norm" if len(norms) > 1 else f"attractor {a}"
+            label = f"attractor {a} (amplitude {amp[a]:.3g})" + (f", {name} norm" if len(norms) > 1 else "")
             axM.plot(x, var(ds, "mfs").values[a, order, n], color=_colour(a), ms=4, lw=1.2, label=label, **st)
             axM.plot(x, var(ds, "lim").values[a, order, n], color=_colour(a), marker=st["marker"], ls="",
                      mfc="none", ms=7, mew=0.8)
@@ -67,11 +68,11 @@ def figure_fatal_shock(shock: Any, *, title: str | None = None) -> Figure:
     axM.set_xlim(-0.1, 2.0 * np.pi + 0.1)
     pi_ticks(axM, 0.0, 2.0 * np.pi)
     top = float(np.nanmax(np.r_[var(ds, "mfs").values.ravel(), var(ds, "lim").values.ravel()]))
-    axM.set_ylim(0.0, 1.5 * top)    # room for the legend above the curves
+    axM.set_ylim(0.0, 1.6 * top)    # room for the legend above the curves
     axM.set_xlabel(r"shock phase $\varphi = \Omega t + \Psi$")
     axM.set_ylabel("minimal fatal shock (norm of the kick)")
     axM.set_title(f"(b) minimal fatal shock over the phase, {int(param(ds, 'cycles'))}-cycle horizon", fontsize=9)
-    axM.legend(fontsize=7, frameon=False, loc="upper center", ncol=2)
+    axM.legend(fontsize=7, frameon=False, loc="upper right")
     par = {k: param(ds, k) for k in ("F", "Omega", "damping", "xi_max")}
     fig.suptitle(title or "Minimal fatal shock of the attractors: " + param_text(par), fontsize=10)
     fig.tight_layout()
