@@ -297,15 +297,15 @@ def minimal_fatal_shock(F: float, Omega: float, damping: float, well: WellLike =
         centres = X_a[:, :, k]
         esc = np.isfinite(sh.escape_cycle(np.concatenate(blocks + [centres], axis=1), float(phi[k])))
         if esc[-len(atts):].any():
-            raise ValueError(f"xi_max: the attractor itself crosses xi_max = {xi!r} at phase {phi[k]!r} (its fatal "
-                             "shock is 0); raise xi_max")
+            raise ValueError(f"xi_max: the attractor itself crosses xi_max = {xi!r} at phase {float(phi[k])!r} "
+                             "(its fatal shock is 0); raise xi_max")
         esc = esc[:-len(atts)].reshape(len(atts), len(norms), -1)
         for a in range(len(atts)):
             for n, (_, nw) in enumerate(norms):
                 r = radii[n] * np.arange(1, n_rad + 1) / n_rad
                 e_pol = esc[a, n, :n_dir * n_rad].reshape(n_dir, n_rad)
                 if not e_pol.any():
-                    raise ValueError(f"radius_max: no shock up to it escapes attractor {a} at phase {phi[k]!r} "
+                    raise ValueError(f"radius_max: no shock up to it escapes attractor {a} at phase {float(phi[k])!r} "
                                      f"within {cycles} cycles (norm {norms[n][0]}); raise radius_max or cycles")
                 i = np.where(e_pol.any(axis=1), np.argmax(e_pol, axis=1), -1)
                 first = np.where(i >= 0, r[np.maximum(i, 0)], np.inf)

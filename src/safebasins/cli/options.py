@@ -27,7 +27,8 @@ OPTION_OF = {"F": "--F", "Omega": "--Omega", "Psi": "--Psi", "xi_max": "--xi-max
              "xi_ini": "--xi-ini", "gamma_ini": "--gamma-ini", "tol": "--tol", "n_scan": "--n-scan",
              "F_bracket": "--F-bracket", "n_points": "--n-points", "q0": "--grid", "p0": "--grid",
              "xi_top": "--xi-top", "t_eval": "--t-eval", "backend": "--backend", "damping": "--damping",
-             "noise": "--noise", "noise_time": "--noise-time", "paths": "--paths", "seed": "--seed"}
+             "noise": "--noise", "noise_time": "--noise-time", "paths": "--paths", "seed": "--seed",
+             "radius_max": "--radius-max", "weights": "--weights"}
 
 _ANGLE = re.compile(r"^([+-]?)(\d+(?:\.\d*)?|\.\d+)?\*?pi(?:/(\d+(?:\.\d*)?))?$", re.IGNORECASE)
 
