@@ -148,7 +148,7 @@ GOOD = dict(noise=0.05, paths=10, xi_max=0.2, t_eval=[5])
     (dict(xi_max=0.3), "xi_max"), (dict(xi_max=-1), "xi_max"),
     (dict(t_eval=[-1]), "t_eval"), (dict(t_eval=[20], cycles=10), "t_eval"), (dict(t_eval=[]), "t_eval"),
     (dict(seed=-1), "seed"), (dict(seed=2 ** 63), "seed"), (dict(seed=1.5), "seed"), (dict(seed=True), "seed"),
-    (dict(correction="bridge"), "correction"), (dict(backend="cuda"), "backend"), (dict(damping=-0.1), "damping"),
+    (dict(correction="bridge"), "correction"), (dict(backend="gpu"), "backend"), (dict(damping=-0.1), "damping"),
     (dict(cycles=0), "cycles"), (dict(steps_per_cycle=2), "steps_per_cycle"), (dict(threads=0), "threads"),
     (dict(integrator="euler"), "integrator"), (dict(noise_time=-1.0), "noise_time"),
     (dict(noise_time=0.05), "noise_time"),

@@ -6,7 +6,8 @@
 sigma^2 = 2 beta T).  :func:`escape_probability` integrates ``paths`` paths from every initial
 condition with the compiled lanes of numerics.noise_kernels (the Strang splitting of the noise
 around the engine's deterministic step: weak order 2; counter-based Philox streams keyed by
-(seed, initial condition, path, step)) and escapes by the criteria of
+(seed, initial condition, path, step)), or their CUDA twin numerics.cuda_noise (the same escape
+steps bitwise), and escapes by the criteria of
 :func:`~safebasins.numerics.escape_chart` (energy H0 > xi_max or q beyond a barrier; a NaN state
 counts as escaped), checked after every step.  At sigma = 0 every path is the engine's
 trajectory, bitwise: the escape times are escape_chart's.  docs/noise.md: the model, the scheme
@@ -14,7 +15,9 @@ and its measured weak order, the boundary correction and the Kramers check.
 """
 from __future__ import annotations
 
+import importlib
 import math
+from types import ModuleType
 
 import numpy as np
 import numpy.typing as npt
@@ -39,8 +42,10 @@ GOBET_SHIFT = 0.5825971579390106
 CORRECTIONS = ("shift", "none")
 #: the normal quantile of the 95% Wilson interval
 WILSON_Z = 1.959963984540054
-#: the backends of the noisy ensemble (the CPU lanes; the CUDA kernels are not written)
-NOISE_BACKENDS = ("cpu",)
+#: the backends of the noisy ensemble, as the engine's: the CPU lanes (noise_kernels, the
+#: reference), the CUDA kernel (cuda_noise: bitwise the same escape steps) or "auto" (the GPU when
+#: one is visible)
+NOISE_BACKENDS = engine.BACKENDS
 #: paths in flight per task
 LANES = 256
 #: at most this many points on the survival curve's time axis
@@ -135,8 +140,11 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
     correction : "shift" (default: the energy threshold moved inwards by GOBET_SHIFT sigma ``|p|``
         sqrt(h), removing the O(sqrt(h)) bias of checking the threshold only at the steps) or
         "none".
-    threads : numba threads (None: the current setting); the result does not depend on it.
-    backend : "cpu" (the only backend of the noisy ensemble).
+    threads : numba threads of the CPU backend (None: the current setting); the result does not
+        depend on it.
+    backend : "cpu" (default: the compiled CPU lanes, the reference), "cuda" (numerics.cuda_noise
+        on a CUDA GPU, or numba's CUDA simulator: the same escape steps bitwise, so the same
+        Dataset) or "auto" (the GPU when numba-cuda sees one, else the CPU).
 
     Returns
     -------
@@ -166,7 +174,7 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
         raise ValueError(f"t_eval must be <= cycles = {cycles}, got max {float(te.max())!r}")
     seed = _check_seed(seed)
     correction = _check_choice("correction", correction, CORRECTIONS)
-    _check_choice("backend", backend, NOISE_BACKENDS)
+    gpu = _cuda_backend(_check_choice("backend", backend, NOISE_BACKENDS))
     schemes.check_integrator(integrator)
     spc = engine.check_step(Omega, engine.check_steps_per_cycle(steps_per_cycle), w, integrator)
     threads = engine.check_threads(threads)
@@ -188,12 +196,16 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
     problem = ensemble_problem(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=[xi], cycles=cycles,
                                steps_per_cycle=spc, integrator=integrator, well=w, damping=damping)
     h = float(problem.step_sizes()[0])              # (the same h, as the engine forms it)
-    with engine.thread_count(threads) as nthreads:
-        n_tasks = max(1, min(math.ceil(Q.size * paths / LANES), nthreads))
-        steps = noise_kernels.escape_steps(problem.code, problem.scheme, Q, P, paths, problem.coefficients(),
-                                           problem.sine_table(), F, float(problem.thrE2[0]), cycles,
-                                           noise_kernels.step_noise(sigma, h, tau), seed,
-                                           shift=energy_shift(sigma, h, correction, tau), n_tasks=n_tasks, lanes=LANES)
+    # one argument list, either backend (cuda_noise.escape_steps takes noise_kernels.escape_steps's)
+    args = (problem.code, problem.scheme, Q, P, paths, problem.coefficients(), problem.sine_table(), F,
+            float(problem.thrE2[0]), cycles, noise_kernels.step_noise(sigma, h, tau), seed)
+    shift = energy_shift(sigma, h, correction, tau)
+    if gpu is not None:
+        steps = gpu.escape_steps(*args, shift=shift)
+    else:
+        with engine.thread_count(threads) as nthreads:
+            n_tasks = max(1, min(math.ceil(Q.size * paths / LANES), nthreads))
+            steps = noise_kernels.escape_steps(*args, shift=shift, n_tasks=n_tasks, lanes=LANES)
     tc = engine.steps_to_cycles(steps, spc)                       # (n_ic, paths), inf: not within cycles
     ts = _survival_axis(cycles)
     k_eval = _counts_within(tc, te)
@@ -232,6 +244,16 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
         grid=int(is_grid), escape_criteria=criteria.criteria_text(w), **w.numerics_attrs(),
         **engine.damping_attrs(damping), **({"noise_time": tau} if tau > 0 else {}))
     return ds
+
+
+def _cuda_backend(backend: str) -> ModuleType | None:
+    """numerics.cuda_noise when ``backend`` resolves to "cuda" (engine.resolve_backend), None for the
+    CPU: ImportError naming the extra without numba-cuda, RuntimeError without a GPU or the
+    simulator, before anything runs."""
+    if engine.resolve_backend(backend) != "cuda":
+        return None
+    engine.cuda_engine().require_cuda()
+    return importlib.import_module("safebasins.numerics.cuda_noise")
 
 
 def _model_text(tau: float) -> str:

@@ -54,7 +54,8 @@ from safebasins.numerics.steps import coefs, row, step, wtuple
 from safebasins.wells import elementary
 from safebasins.wells.compiled import WellCode, abs_tracking, cpu_jit, fma, mul, well_energy2
 
-__all__ = ["RNG_KEY", "MAX_STEPS", "StepNoise", "step_noise", "escape_steps", "final_states", "gaussian_pairs"]
+__all__ = ["RNG_KEY", "MAX_STEPS", "StepNoise", "step_noise", "prepare", "escape_steps", "final_states",
+           "gaussian_pairs"]
 
 #: the numba literal of the random-number and noise code (module docstring)
 RNG_KEY = int(fingerprint([__file__, philox.__file__])[:15], 16) ^ int(elementary.MODULE_HASH[:15], 16)
@@ -316,8 +317,13 @@ def step_noise(sigma: float, h: float, noise_time: float = 0.0) -> StepNoise:
                      sigma / math.sqrt(2.0 * noise_time))
 
 
-def _common(code: WellCode, scheme: SchemeCode, q0: np.ndarray, coef: np.ndarray, sintab: np.ndarray, F: float,
-            seed: int) -> tuple[np.ndarray, np.ndarray, np.uint64, np.uint64]:
+def prepare(code: WellCode, scheme: SchemeCode, q0: np.ndarray, coef: np.ndarray, sintab: np.ndarray, F: float,
+            seed: int, n_steps: int, name: str = "cycles") -> tuple[np.ndarray, np.ndarray, np.uint64, np.uint64]:
+    """The checks of every backend's arguments (as :func:`escape_steps`; n_steps: the steps of a
+    path, set by the argument ``name``) and what they share: (q0 as float64, the forcing products
+    F * sintab, the Philox key)."""
+    if n_steps > MAX_STEPS:
+        raise ValueError(f"{name}: {n_steps} steps per path exceed {MAX_STEPS} (the random counter's range)")
     if coef.ndim != 2 or coef.shape != (1, scheme.n_coef):
         raise ValueError(f"coef must be one row of lane_coefficients of {scheme.name}, got shape {coef.shape}")
     if sintab.ndim != 2 or sintab.shape[1] != scheme.width:
@@ -341,11 +347,8 @@ def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
     energy boundary shift per ``|p|`` (module docstring); bounds: a displacement pair (lo, hi);
     wpar: the well's wpar (None: code.wpar; the barriers are its first two entries).  The
     result does not depend on n_tasks or lanes."""
-    q, FS, k0, k1 = _common(code, scheme, q0, coef, sintab, F, seed)
+    q, FS, k0, k1 = prepare(code, scheme, q0, coef, sintab, F, seed, int(cycles) * sintab.shape[0])
     p = np.ascontiguousarray(p0, dtype=float)
-    if int(cycles) * sintab.shape[0] > MAX_STEPS:
-        raise ValueError(f"cycles: {cycles} periods of {sintab.shape[0]} steps exceed {MAX_STEPS} steps per path "
-                         "(the random counter's range)")
     out = np.full(q.size * int(n_paths), -1, np.int64)
     wp = code.wpar if wpar is None else np.ascontiguousarray(wpar, dtype=float)
     args = [code.key, scheme.key, RNG_KEY, wp, 0, int(n_tasks), int(lanes), q, p, int(n_paths),
@@ -361,7 +364,7 @@ def final_states(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(q, p, eta) of every path after ``n_steps`` steps, shape (len(q0), n_paths) each, no escape
     checks (weak-order tests, benchmarks); arguments as :func:`escape_steps`."""
-    q, FS, k0, k1 = _common(code, scheme, q0, coef, sintab, F, seed)
+    q, FS, k0, k1 = prepare(code, scheme, q0, coef, sintab, F, seed, int(n_steps), "n_steps")
     p = np.ascontiguousarray(p0, dtype=float)
     qo = np.empty(q.size * int(n_paths))
     po = np.empty_like(qo)
