@@ -48,9 +48,9 @@ __all__ = ["basin_measures"]
               help="Numba threads (default: all; results do not depend on it).")
 @common_options
 @out_option("basin_measures")
-def basin_measures(F: tuple[float, ...], Omega: float, Psi: float, xi_max: float, damping: float, n: Any,
-                   grid: Any, n_iter: int, radius: float, box: int, steps_per_cycle: int, threads: int | None,
-                   fourier: Any, well: dict[str, Any], no_plot: bool, quiet: bool,
+def basin_measures(F: list[float], Omega: float, Psi: float, xi_max: float, damping: float, n: list[int],
+                   grid: dict[str, list[float]] | None, n_iter: int, radius: float, box: int, steps_per_cycle: int,
+                   threads: int | None, fourier: str | None, well: dict[str, Any], no_plot: bool, quiet: bool,
                    verbose: bool, allow_expensive: bool, out: str) -> None:
     """Fractal boundary measures of a damped well's basins (escape and each attractor).
 

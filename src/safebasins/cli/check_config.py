@@ -8,7 +8,9 @@ error names the key and, where one of the files sets it, that file and line.
 """
 from __future__ import annotations
 
+import os
 import re
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 
 import click
@@ -20,15 +22,15 @@ __all__ = ["check_config", "key_location"]
 BASE = Path("config") / "config.yaml"
 
 
-def _key_parts(key: str) -> list:
+def _key_parts(key: str) -> list[str | int]:
     """``figures.fig13.xi_max[2]`` -> ``["figures", "fig13", "xi_max", 2]``."""
-    parts = []
+    parts: list[str | int] = []
     for name, index in re.findall(r"([^.\[\]]+)|\[(\d+)\]", key):
         parts.append(int(index) if index else name)
     return parts
 
 
-def _depth_and_line(node, parts) -> tuple[int, int]:
+def _depth_and_line(node: yaml.Node, parts: Sequence[str | int]) -> tuple[int, int]:
     """How many leading ``parts`` the YAML node tree holds, and the line of the deepest one."""
     depth, line = 0, node.start_mark.line + 1
     for part in parts:
@@ -43,7 +45,7 @@ def _depth_and_line(node, parts) -> tuple[int, int]:
     return depth, line
 
 
-def key_location(key: str, files) -> tuple[str, int, bool] | None:
+def key_location(key: str, files: Iterable[str | os.PathLike[str]]) -> tuple[str, int, bool] | None:
     """(file, line, whole key) where the last of ``files`` that sets the dotted config ``key``
     sets it, or else holds the deepest block on its way (whole key False); None when no file
     holds even its first part."""
@@ -69,7 +71,7 @@ def key_location(key: str, files) -> tuple[str, int, bool] | None:
                    f"Snakefile's  [default: {BASE} when the current directory has one (a checkout)]")
 @click.option("--no-base", "no_base", is_flag=True,
               help="Check the files merged on their own (a complete configuration).")
-def check_config(files, base, no_base):
+def check_config(files: tuple[Path, ...], base: Path | None, no_base: bool) -> None:
     """Check pipeline configuration files without running anything.
 
     Reads each file strictly (YAML syntax errors and keys given twice with file, line and

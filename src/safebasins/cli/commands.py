@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import click
 
@@ -15,9 +16,16 @@ from safebasins.cli.options import (DISPLACEMENT, ENERGY, FINITE, OPTION_OF, POS
 from safebasins.cli.interrupt import InterruptibleGroup
 from safebasins.cli.output import chatter, describe, draw, finish, fmt, job, progress, write_outputs
 
+if TYPE_CHECKING:
+    import numpy as np
+    import xarray as xr
+    from numpy.typing import NDArray
+
+    from safebasins.pipeline.registry import Job, Params
+    from safebasins.wells.base import Well
 
 
-def check_step(Omega, steps_per_cycle):
+def check_step(Omega: float | list[float], steps_per_cycle: int) -> None:
     """The engine's step check (numerics.engine.check_step) before anything is computed: a usage
     error naming --steps-per-cycle (the message says which value works, or a larger --Omega)."""
     from safebasins.numerics.engine import check_step as check
@@ -26,32 +34,32 @@ def check_step(Omega, steps_per_cycle):
         check(Omega, steps_per_cycle, current_well(click.get_current_context()))
 
 
-def well_of(params):
+def well_of(params: Params) -> Well:
     """The run's well with its first harmonic (the pipeline's values.well)."""
     from safebasins.pipeline.values import well
 
     return well(params)
 
 
-def grid_axes(grid):
+def grid_axes(grid: dict[str, Any]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     from safebasins.pipeline.values import grid_axes as axes
 
     return axes(grid)
 
 
-def damping_text(damping):
+def damping_text(damping: float) -> tuple[str, str]:
     """("damped ", ", beta = B") of a damped run's title; ("", "") undamped."""
     return ("damped ", f", beta = {fmt(damping)}") if damping > 0 else ("", "")
 
 
-def well_label(spec):
+def well_label(spec: dict[str, Any]) -> str:
     """How titles name the well of a run."""
     return spec.get("expression", spec["name"]) if spec["name"] == "expression" else spec["name"]
 
 
 @click.group(cls=InterruptibleGroup, context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
 @click.version_option(package_name="safebasins")
-def main():
+def main() -> None:
     """Safe basins of q'' + V'(q) = F sin(Omega t + Psi): analytic (slow flow) and numeric.
 
     The well is the paper's quartic V = q^2/2 - q^4/4 unless --well names another one (a name,
@@ -85,8 +93,10 @@ def main():
 @damping_option()
 @common_options
 @out_option("chart")
-def chart(F, Omega, Psi, xi_max, q_max, grid, n, cycles, steps_per_cycle, threads, backend, t_eval, n_points, tiles,
-          damping, fourier, well, no_plot, quiet, verbose, allow_expensive, out):
+def chart(F: float, Omega: float, Psi: float, xi_max: list[float], q_max: list[float],
+          grid: dict[str, list[float]] | None, n: list[int], cycles: int, steps_per_cycle: int, threads: int | None,
+          backend: str, t_eval: float | None, n_points: int, tiles: int | None, damping: float, fourier: str | None,
+          well: dict[str, Any], no_plot: bool, quiet: bool, verbose: bool, allow_expensive: bool, out: str) -> None:
     """Numeric escape chart on an IC grid with the analytic safe basins and their IoU.
 
     One integration serves every threshold.  PREFIX.nc is the chart in the layout of the
@@ -110,10 +120,11 @@ def chart(F, Omega, Psi, xi_max, q_max, grid, n, cycles, steps_per_cycle, thread
         raise click.BadParameter(f"{tiles} tiles but only {n[0]} q0 rows", param_hint="'--tiles'")
     name = Path(out).name
     fourier = fourier_of(click.get_current_context(), fourier)
-    params = dict(command="chart", kind="basin_chart", experiment=name, fourier=fourier, well=well, scan="xi_max", F=F,
-                  xi_max=xi_max, q_max=q_max, Omega=Omega, Psi=Psi, grid=grid_params(grid, n), cycles=cycles,
-                  t_eval=[t_eval], n_points=n_points, steps_per_cycle=steps_per_cycle,
-                  tasks=[{"F": F, "xi_max": xi_max, "q_max": q_max}], **damping_param(damping))
+    params: Params = dict(command="chart", kind="basin_chart", experiment=name, fourier=fourier, well=well,
+                          scan="xi_max", F=F, xi_max=xi_max, q_max=q_max, Omega=Omega, Psi=Psi,
+                          grid=grid_params(grid, n), cycles=cycles, t_eval=[t_eval], n_points=n_points,
+                          steps_per_cycle=steps_per_cycle, tasks=[{"F": F, "xi_max": xi_max, "q_max": q_max}],
+                          **damping_param(damping))
     damped, beta = damping_text(damping)
     params["title"] = (f"Escape chart and {damped}slow-flow safe basins, {well_label(well)} well, F = {fmt(F)}, "
                        f"Omega = {fmt(Omega)}, Psi = {fmt(Psi, angle=True)}{beta} (safebasins chart {name})")
@@ -132,7 +143,7 @@ def chart(F, Omega, Psi, xi_max, q_max, grid, n, cycles, steps_per_cycle, thread
         click.echo(f"xi_max = {fmt(x)}: IoU = {a:.4f}, pixel agreement = {px:.4f} (t_eval = {cycles} EC)")
 
 
-def chart_dataset(params, tiles, job, quiet):
+def chart_dataset(params: Params, tiles: int, job: Job, quiet: bool) -> tuple[xr.Dataset, xr.Dataset]:
     """(chart with agreement, analytic basins): the chart integrated in row tiles (one progress
     step each; the chart does not depend on the tiling), gathered, and compared with the slow-flow
     basins by the library functions the pipeline's basin_chart kind calls."""
@@ -160,7 +171,7 @@ def chart_dataset(params, tiles, job, quiet):
     return chart_agreement(chart, basins, params["cycles"], "xi_max"), basins
 
 
-def n_scan_check(n):
+def n_scan_check(n: int) -> int:
     if n < 0 or n == 1:
         raise ValueError(f"n_scan must be 0 (no scan) or an integer >= 2, got {n}")
     return n
@@ -199,9 +210,11 @@ def n_scan_check(n):
 @damping_option(multiple=True)
 @common_options
 @out_option("fcr")
-def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cycles, steps_per_cycle,
-        threads, backend, tol, n_scan, F_bracket, criterion, damping, fourier, well, no_plot, quiet, verbose,
-        allow_expensive, out):
+def fcr(Omega_range: dict[str, Any] | None, xi_max: list[float], xi_ini: list[float], gamma_ini: list[float],
+        numeric: bool, numeric_Omega: dict[str, Any] | None, Psi: float, cycles: int, steps_per_cycle: int,
+        threads: int | None, backend: str, tol: float, n_scan: int, F_bracket: list[float] | None, criterion: str,
+        damping: list[float], fourier: str | None, well: dict[str, Any], no_plot: bool, quiet: bool, verbose: bool,
+        allow_expensive: bool, out: str) -> None:
     """Critical forcing F_cr(Omega): analytic curves, optionally with the numeric bisection.
 
     Curves come from --xi-max / --xi-ini / --gamma-ini / --damping (equal lengths or length 1).  Writes
@@ -217,7 +230,7 @@ def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cyc
     if len(damping) > 1 and not all(b > 0 for b in damping):
         raise click.BadParameter(f"a list makes one damped curve per value: every value must be > 0, got {damping}",
                                  param_hint="'--damping'")
-    block = {"xi_max": xi_max, "xi_ini": xi_ini or [0.0], "gamma_ini": gamma_ini or [0.0], "Psi": Psi,
+    block: dict[str, Any] = {"xi_max": xi_max, "xi_ini": xi_ini or [0.0], "gamma_ini": gamma_ini or [0.0], "Psi": Psi,
              "damping": damping if len(damping) > 1 else damping[0]}
     lens = {k: len(v) for k, v in values.curve_lists(block).items()}
     ncurve = max(lens.values())
@@ -237,9 +250,9 @@ def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cyc
     if Omega_range is None:
         w0 = float(current_well(ctx).omega(0.0))
         Omega_range = {"start": round(0.5 * w0, 12), "stop": round(1.2 * w0, 12), "num": 351}
-    params = dict(command="fcr", kind="fcr_compare" if numeric else "fcr_theory", experiment=name, fourier=fourier,
-                  well=well, **values.damping_param(block["damping"]), Omega=values.range_values(Omega_range),
-                  curves=curves)
+    params: Params = dict(command="fcr", kind="fcr_compare" if numeric else "fcr_theory", experiment=name,
+                          fourier=fourier, well=well, **values.damping_param(block["damping"]),
+                          Omega=values.range_values(Omega_range), curves=curves)
     if numeric:
         if F_bracket is None:
             from safebasins.numerics.bisection import default_bracket
@@ -281,7 +294,7 @@ def fcr(Omega_range, xi_max, xi_ini, gamma_ini, numeric, numeric_Omega, Psi, cyc
         click.echo(f"{c['label']}: {line}")
 
 
-def fcr_numeric(params, job, quiet):
+def fcr_numeric(params: Params, job: Job, quiet: bool) -> xr.Dataset:
     """Numeric F_cr in chunks of Omega (each point bisects independently, so the result equals one
     call; the library offers no per-level hook), with a progress bar per chunk."""
     import numpy as np
@@ -336,8 +349,9 @@ def fcr_numeric(params, job, quiet):
 @damping_option()
 @common_options
 @out_option("basin")
-def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, damping, fourier, well, no_plot, quiet,
-          verbose, allow_expensive, out):
+def basin(F: float, Omega: float, Psi: float, xi_max: float, grid: dict[str, list[float]] | None, n: list[int],
+          n_points: int, n_gamma: int, n_xi: int, xi_top: float | None, damping: float, fourier: str | None,
+          well: dict[str, Any], no_plot: bool, quiet: bool, verbose: bool, allow_expensive: bool, out: str) -> None:
     """Analytic safe basin of the slow flow, on the resonance manifold and on the IC plane.
 
     PREFIX.nc has the layout of the pipeline's Figs 5-9: boundary curves (`gamma`, `xi`,
@@ -366,9 +380,9 @@ def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, dampi
         raise click.BadParameter(f"must be > 0, got {xi_top}", param_hint="'--xi-top'")
     name = Path(out).name
     fourier = fourier_of(ctx, fourier)
-    params = dict(command="basin", kind="basin_rm", experiment=name, fourier=fourier, well=well, F=F, Omega=Omega,
-                  Psi=Psi, xi_max=xi_max, grid=grid_params(grid, n), n_points=n_points,
-                  manifold={"n_gamma": n_gamma, "n_xi": n_xi, "xi_top": xi_top}, **damping_param(damping))
+    params: Params = dict(command="basin", kind="basin_rm", experiment=name, fourier=fourier, well=well, F=F,
+                          Omega=Omega, Psi=Psi, xi_max=xi_max, grid=grid_params(grid, n), n_points=n_points,
+                          manifold={"n_gamma": n_gamma, "n_xi": n_xi, "xi_top": xi_top}, **damping_param(damping))
     damped, beta = damping_text(damping)
     params["title"] = (f"Analytic {damped}safe basin, {well_label(well)} well, F = {fmt(F)}, Omega = {fmt(Omega)}, "
                        f"Psi = {fmt(Psi, angle=True)}, xi_max = {fmt(xi_max)}{beta} (safebasins basin {name})")
@@ -402,7 +416,7 @@ def basin(F, Omega, Psi, xi_max, grid, n, n_points, n_gamma, n_xi, xi_top, dampi
 @click.argument("file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option("--params/--no-params", "show_params", default=True, show_default=True,
               help="Print the parameters JSON (briefly).")
-def info(file, show_params):
+def info(file: Path, show_params: bool) -> None:
     """What a safebasins netCDF dataset holds and where it came from."""
     for line in describe(file, show_params=show_params):
         click.echo(line)

@@ -3,10 +3,11 @@ a static picture of one of its views (``--export`` HTML, ``--snapshot`` PNG)."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import click
 
-from safebasins.cli.options import (FINITE, NONNEG, POSITIVE, Number, analytic_threshold, library_errors,
+from safebasins.cli.options import (FINITE, NONNEG, POSITIVE, Callback, Number, analytic_threshold, library_errors,
                                     well_option)
 
 __all__ = ["explore"]
@@ -14,9 +15,9 @@ __all__ = ["explore"]
 WELL_DEFAULT = "  [default: the well's own, shown by the page]"
 
 
-def suffixed(*suffixes):
+def suffixed(*suffixes: str) -> Callback:
     """Callback: a file path ending in one of ``suffixes``."""
-    def callback(ctx, param, value):
+    def callback(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
         if value is not None and Path(value).suffix.lower() not in suffixes:
             raise click.BadParameter(f"give a file name ending in {' or '.join(suffixes)}, got {value!r}", ctx, param)
         return value
@@ -47,7 +48,9 @@ def suffixed(*suffixes):
 @click.option("--browser", "browser", metavar="PATH", default=None,
               help="Chromium or Chrome executable for --snapshot  [default: chromium, chromium-browser, "
                    "google-chrome, ... on PATH]")
-def explore(port, host, no_browser, well, Omega, F, Psi, xi_max, damping, export, snapshot, browser):
+def explore(port: int | None, host: str, no_browser: bool, well: dict[str, Any], Omega: float | None, F: float | None,
+            Psi: float | None, xi_max: float | None, damping: float | None, export: str | None, snapshot: str | None,
+            browser: str | None) -> None:
     """Interactive explorer of safe basins in the browser (a local Bokeh server).
 
     Pick a well, or type your own V(q), and move the Omega, F, Psi, xi_max and damping sliders:

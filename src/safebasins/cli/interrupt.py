@@ -5,6 +5,7 @@ file (a file completed before the interrupt stays)."""
 from __future__ import annotations
 
 import signal
+from typing import Any
 
 import click
 
@@ -17,7 +18,7 @@ class InterruptibleGroup(click.Group):
     """A click group whose commands exit with :data:`EXIT_SIGINT` when interrupted (click alone
     exits 1 with "Aborted!"; a command that caught the interrupt would exit 0)."""
 
-    def invoke(self, ctx):
+    def invoke(self, ctx: click.Context) -> Any:
         try:
             return super().invoke(ctx)
         except KeyboardInterrupt:

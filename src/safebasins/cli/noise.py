@@ -60,8 +60,9 @@ MAX_T_EVAL = 4
 @common_options
 @out_option("escape_probability")
 def escape_probability(F: float, Omega: float, Psi: float, xi_max: float, noise: float, noise_time: float, paths: int,
-                       seed: int, t_eval: list[float], cycles: int | None, grid: Any, n: Any, steps_per_cycle: int,
-                       threads: int | None, damping: float, fourier: Any, well: dict[str, Any], no_plot: bool,
+                       seed: int, t_eval: list[float], cycles: int | None, grid: dict[str, list[float]] | None,
+                       n: list[int], steps_per_cycle: int, threads: int | None, damping: float, fourier: str | None,
+                       well: dict[str, Any], no_plot: bool,
                        quiet: bool, verbose: bool, allow_expensive: bool, out: str) -> None:
     """Escape probabilities under noise over a grid of initial conditions.
 

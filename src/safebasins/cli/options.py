@@ -12,9 +12,23 @@ import importlib
 import inspect
 import math
 import re
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import click
+
+if TYPE_CHECKING:
+    from safebasins.pipeline.registry import Params
+    from safebasins.wells.base import Well
+
+#: a library check: ``check(name, value)``, a well's check also taking the click context, or (option
+#: callbacks) ``check(value)``; it returns the value and raises ValueError naming the argument
+Check = Callable[..., Any]
+#: an option callback ``callback(ctx, param, value)`` returning the parsed value
+Callback = Callable[[click.Context, click.Parameter, Any], Any]
+#: a click command function, as the option decorators take and return it
+Cmd = TypeVar("Cmd", bound=Callable[..., Any])
 
 #: numerics backends (safebasins.numerics.engine.BACKENDS: restated so that --help imports no numba;
 #: tests/cli checks that they agree)
@@ -33,7 +47,7 @@ OPTION_OF = {"F": "--F", "Omega": "--Omega", "Psi": "--Psi", "xi_max": "--xi-max
 _ANGLE = re.compile(r"^([+-]?)(\d+(?:\.\d*)?|\.\d+)?\*?pi(?:/(\d+(?:\.\d*)?))?$", re.IGNORECASE)
 
 
-def parse_number(text, angle=False) -> float:
+def parse_number(text: object, angle: bool = False) -> float:
     """A float; angles may also be written with pi: ``pi``, ``-pi/2``, ``3pi/4``, ``0.5*pi``."""
     if isinstance(text, (int, float)):
         return float(text)
@@ -52,13 +66,13 @@ def parse_number(text, angle=False) -> float:
                          f"got {text!r}") from None
 
 
-def lib_check(path):
+def lib_check(path: str) -> Check:
     """A library check named ``module:attribute`` (imported on use: --help stays fast)."""
-    def check(name, value):
+    def check(name: str, value: Any) -> Any:
         import importlib
 
         mod, _, attr = path.partition(":")
-        obj = importlib.import_module(mod)
+        obj: Any = importlib.import_module(mod)
         for part in attr.split("."):
             obj = getattr(obj, part)
         return obj(name, value)
@@ -72,7 +86,7 @@ FINITE = lib_check("safebasins.core.checks:check_finite")
 WELL_META = "safebasins.well"
 
 
-def current_well(ctx):
+def current_well(ctx: click.Context | None) -> Well:
     """The well of the command being parsed (--well, resolved before every other option)."""
     well = ctx.meta.get(WELL_META) if ctx is not None else None
     if well is None:
@@ -82,13 +96,23 @@ def current_well(ctx):
     return well
 
 
-def well_check(method):
+class WellCheck:
+    """A check of the command's well (``Well.<method>(name, value)``): energies below its barrier
+    energy, thresholds, displacements; called with the click context (``needs_ctx``)."""
+
+    needs_ctx = True
+
+    def __init__(self, method: str) -> None:
+        self.method = method
+
+    def __call__(self, name: str, value: Any, ctx: click.Context | None) -> Any:
+        return getattr(current_well(ctx), self.method)(name, value)
+
+
+def well_check(method: str) -> WellCheck:
     """A check of the command's well (``Well.<method>(name, value)``): energies below its barrier
     energy, thresholds, displacements."""
-    def check(name, value, ctx):
-        return getattr(current_well(ctx), method)(name, value)
-    check.needs_ctx = True
-    return check
+    return WellCheck(method)
 
 
 ENERGY = well_check("check_energy")          # [0, E_b)
@@ -98,7 +122,7 @@ DISPLACEMENT = well_check("check_displacement")
 analytic_threshold = well_check("check_analytic_threshold")
 
 
-def analytic_thresholds(ctx, pairs):
+def analytic_thresholds(ctx: click.Context, pairs: Iterable[tuple[float, float]]) -> None:
     """``(xi_max, damping)`` pairs of a command checked by the one rule of the library: where the
     slow flow is undamped, ``Well.check_analytic_threshold`` (below the barrier energy; its level
     curves need an orbit at xi_max); the damped slow flow and the numerics take xi_max = E_b
@@ -112,13 +136,14 @@ def analytic_thresholds(ctx, pairs):
                 raise click.BadParameter(str(exc), ctx, param_hint="'--xi-max'") from None
 
 
-def parse_well(text):
+def parse_well(text: object) -> dict[str, Any]:
     """A --well value: a name (quartic, cubic, pendulum, ...), ``polynomial:c0,c1,...``,
     ``expression:<formula in q>``, or the config's own mapping ``{expression: '1 - cos(q)'}``
     (YAML); returns the resolved spec (safebasins.wells.spec_of)."""
     from safebasins import wells
 
     t = str(text).strip()
+    value: object
     if t.startswith("{"):
         import yaml
 
@@ -135,7 +160,7 @@ def parse_well(text):
     return wells.spec_of(value)
 
 
-def well_callback(ctx, param, value):
+def well_callback(ctx: click.Context, param: click.Parameter, value: object) -> dict[str, Any]:
     """--well (eager): the resolved spec; the well itself goes to ctx.meta for the other checks."""
     from safebasins import wells
 
@@ -147,7 +172,7 @@ def well_callback(ctx, param, value):
     return spec
 
 
-def fourier_of(ctx, fourier):
+def fourier_of(ctx: click.Context, fourier: str | None) -> str:
     """The first harmonic of the run: --fourier for the quartic (default 'paper', eq 20 as printed);
     every other well uses its exact one ('paper' is a usage error there)."""
     well = current_well(ctx)
@@ -159,32 +184,37 @@ def fourier_of(ctx, fourier):
     return "exact"
 
 
-class Number(click.ParamType):
-    """One finite number checked by a library check under the library's argument name."""
+class _CheckedNumbers(click.ParamType):
+    """Numbers checked by a library check under the library's argument name (:class:`Number`,
+    :class:`NumberList`)."""
 
-    name = "number"
-
-    def __init__(self, arg, check, angle=False):
+    def __init__(self, arg: str, check: Check, angle: bool = False) -> None:
         self.arg, self.check, self.angle = arg, check, angle
 
-    def checked(self, value, ctx):
+    def checked(self, value: float, ctx: click.Context | None) -> Any:
         if getattr(self.check, "needs_ctx", False):
             return self.check(self.arg, value, ctx)
         return self.check(self.arg, value)
 
-    def convert(self, value, param, ctx):
+
+class Number(_CheckedNumbers):
+    """One finite number checked by a library check under the library's argument name."""
+
+    name = "number"
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> float:
         try:
             return float(self.checked(parse_number(value, self.angle), ctx))
         except ValueError as exc:
             self.fail(str(exc), param, ctx)
 
 
-class NumberList(Number):
+class NumberList(_CheckedNumbers):
     """Comma-separated numbers (the option may also be repeated); values must be distinct."""
 
     name = "list"
 
-    def convert(self, value, param, ctx):
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> list[float]:
         if isinstance(value, list):
             return value
         try:
@@ -199,12 +229,12 @@ class NumberList(Number):
 class Fields(click.ParamType):
     """Comma-separated fields with a fixed meaning: grid, range, bracket, resolution."""
 
-    def __init__(self, kind):
+    def __init__(self, kind: str) -> None:
         self.kind = kind
         self.name = {"grid": "q0min,q0max,p0min,p0max", "range": "start,stop,num", "bracket": "lo,hi",
                      "size": "N|NQxNP"}[kind]
 
-    def convert(self, value, param, ctx):
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
         if not isinstance(value, str):
             return value
         try:
@@ -213,20 +243,20 @@ class Fields(click.ParamType):
             self.fail(str(exc), param, ctx)
 
     @staticmethod
-    def _floats(text, n, what):
+    def _floats(text: str, n: int, what: str) -> list[float]:
         parts = text.split(",")
         if len(parts) != n:
             raise ValueError(f"expected {n} comma-separated values ({what}), got {text!r}")
         return [float(FINITE(what, parse_number(p))) for p in parts]
 
-    def _grid(self, text):
+    def _grid(self, text: str) -> dict[str, list[float]]:
         q_lo, q_hi, p_lo, p_hi = self._floats(text, 4, "q0min,q0max,p0min,p0max")
         for ax, lo, hi in (("q0", q_lo, q_hi), ("p0", p_lo, p_hi)):
             if not hi > lo:
                 raise ValueError(f"empty {ax} interval [{lo}, {hi}]: the max must exceed the min")
         return {"q0": [q_lo, q_hi], "p0": [p_lo, p_hi]}
 
-    def _range(self, text):
+    def _range(self, text: str) -> dict[str, float | int]:
         parts = text.split(",")
         if len(parts) != 3:
             raise ValueError(f"expected start,stop,num (num points, endpoints included), got {text!r}")
@@ -237,13 +267,13 @@ class Fields(click.ParamType):
             raise ValueError(f"empty range: stop ({stop}) must be greater than start ({start})")
         return {"start": start, "stop": stop, "num": int(parts[2])}
 
-    def _bracket(self, text):
+    def _bracket(self, text: str) -> list[float]:
         lo, hi = (float(NONNEG("F_bracket", v)) for v in self._floats(text, 2, "lo,hi"))
         if not hi > lo:
             raise ValueError(f"empty bracket [{lo}, {hi}]")
         return [lo, hi]
 
-    def _size(self, text):
+    def _size(self, text: str) -> list[int]:
         m = re.fullmatch(r"(\d+)(?:x(\d+))?", text.lower())
         if not m:
             raise ValueError(f"expected N or NQxNP (points per axis), got {text!r}")
@@ -253,9 +283,9 @@ class Fields(click.ParamType):
         return n
 
 
-def checked(arg, check):
+def checked(arg: str | None, check: Check) -> Callback:
     """Option callback running a library check that takes (name, value) or (value)."""
-    def callback(ctx, param, value):
+    def callback(ctx: click.Context, param: click.Parameter, value: Any) -> Any:
         if value is None:
             return None
         try:
@@ -265,10 +295,10 @@ def checked(arg, check):
     return callback
 
 
-def joined(unique):
+def joined(unique: bool) -> Callback:
     """Callback: a repeated list option -> one list; ``unique`` for values that become a coordinate
     (curve lists of `fcr` pair up element by element and may repeat)."""
-    def callback(ctx, param, value):
+    def callback(ctx: click.Context, param: click.Parameter, value: Iterable[list[float]]) -> list[float]:
         out = [v for chunk in value for v in chunk]
         for i, v in enumerate(out):
             if unique and v in out[:i]:
@@ -278,10 +308,10 @@ def joined(unique):
     return callback
 
 
-def from_library(func, arg):
+def from_library(func: str, arg: str) -> Callable[[], Any]:
     """Default of ``arg`` of a library function (``"module:function"``), looked up on use: the
     command line never restates a library default."""
-    def default():
+    def default() -> Any:
         import importlib
 
         mod, _, name = func.partition(":")
@@ -289,9 +319,9 @@ def from_library(func, arg):
     return default
 
 
-def from_schema(kind, *path):
+def from_schema(kind: str, *path: str) -> Callable[[], Any]:
     """Default of a config key of a pipeline experiment kind (its schema is their one home)."""
-    def default():
+    def default() -> Any:
         from safebasins.pipeline.config import load_kinds
         from safebasins.pipeline.registry import KINDS
 
@@ -307,16 +337,16 @@ class Deferred(click.Option):
     """An option whose default is looked up on use (``from_library`` / ``from_schema``) and shown
     as its value in --help (click shows callables as "(dynamic)")."""
 
-    def __init__(self, *args, **kw):
+    def __init__(self, *args: Any, **kw: Any) -> None:
         kw.setdefault("show_default", True)
         super().__init__(*args, **kw)
 
-    def get_default(self, ctx, call=True):
+    def get_default(self, ctx: click.Context, call: bool = True) -> Any:
         return super().get_default(ctx, call=True)
 
 
 @contextlib.contextmanager
-def library_errors():
+def library_errors() -> Iterator[None]:
     """Library ValueErrors (argument checks name the argument) -> usage errors naming the option."""
     try:
         yield
@@ -328,7 +358,7 @@ def library_errors():
         raise click.UsageError(msg) from None
 
 
-def out_prefix(ctx, param, value):
+def out_prefix(ctx: click.Context, param: click.Parameter, value: str) -> str:
     """PREFIX of PREFIX.nc / PREFIX.png: no extension, not a folder."""
     if value.endswith((".nc", ".png")):
         raise click.BadParameter(f"give a prefix without extension (PREFIX.nc and PREFIX.png are written), "
@@ -343,7 +373,7 @@ def out_prefix(ctx, param, value):
     return value
 
 
-def check_writable(prefix: Path):
+def check_writable(prefix: Path) -> None:
     """OSError unless PREFIX.nc / PREFIX.png can be written: the nearest existing folder above
     them is a folder in which a file can be created (probed, then removed: read-only mounts and
     permissions alike); checked before anything is computed."""
@@ -364,7 +394,8 @@ def check_writable(prefix: Path):
         raise OSError(f"no file can be created in {folder} ({exc.strerror or exc})") from None
 
 
-def cost_guard(kind, params, allow_expensive, numeric=True, steps=None, reduce="--n, --cycles or the scanned values"):
+def cost_guard(kind: str | None, params: Params, allow_expensive: bool, numeric: bool = True,
+               steps: float | None = None, reduce: str = "--n, --cycles or the scanned values") -> None:
     """The pipeline's cost guard (safebasins.pipeline.cost, the config schema's default budgets)
     for one command: a usage error naming --allow-expensive above a budget.  ``steps``: the
     trajectory-steps (in quartic steps) counted by a command that has no pipeline kind (``kind``
@@ -373,7 +404,12 @@ def cost_guard(kind, params, allow_expensive, numeric=True, steps=None, reduce="
 
     if allow_expensive:
         return
-    steps, evaluations = params_cost(kind, params, numeric) if steps is None else (steps, 0)
+    if steps is None:
+        if kind is None:
+            raise ValueError("cost_guard: give the pipeline kind of the run or its trajectory-steps")
+        steps, evaluations = params_cost(kind, params, numeric)
+    else:
+        evaluations = 0
     b = budgets()
     core_hours = steps / RATE_PER_CORE / 3600
     if core_hours > b["budget_core_hours"]:
@@ -392,7 +428,7 @@ def cost_guard(kind, params, allow_expensive, numeric=True, steps=None, reduce="
 # ----------------------------------------------------------------------------------------------
 # options shared by several commands
 # ----------------------------------------------------------------------------------------------
-def forcing_options(f):
+def forcing_options(f: Cmd) -> Cmd:
     f = click.option("--Psi", "Psi", type=Number("Psi", FINITE, angle=True), default="0", show_default=True,
                      help="Forcing phase (rad): a number, pi, pi/2, -3pi/4, ...")(f)
     f = click.option("--Omega", "Omega", type=Number("Omega", POSITIVE), required=True,
@@ -400,7 +436,7 @@ def forcing_options(f):
     return click.option("--F", "F", type=Number("F", NONNEG), required=True, help="Forcing amplitude (>= 0).")(f)
 
 
-def grid_options(f):
+def grid_options(f: Cmd) -> Cmd:
     f = click.option("--n", "n", type=Fields("size"), default="200", show_default=True,
                      help="Points per axis: N, or NQxNP (q0 x p0); at least 3.")(f)
     return click.option("--grid", "grid", type=Fields("grid"), default=None,
@@ -408,7 +444,7 @@ def grid_options(f):
                              "Well.ic_window(): -1,1,-0.75,0.75 for the quartic].")(f)
 
 
-def damping_option(multiple=False):
+def damping_option(multiple: bool = False) -> Callable[[Cmd], Cmd]:
     """``--damping`` beta >= 0 of q'' + beta q' + V'(q) = F sin(Omega t + Psi) (0: the paper's
     undamped equation); ``multiple``: a comma list or repeated, one F_cr curve each."""
     text = ("Linear damping beta >= 0 of q'' + beta q' + V'(q) = F sin(Omega t + Psi) (0: the undamped "
@@ -421,7 +457,7 @@ def damping_option(multiple=False):
                         help=text + ".")
 
 
-def well_option(f):
+def well_option(f: Cmd) -> Cmd:
     return click.option(
         "--well", "well", default="quartic", show_default=True, is_eager=True, callback=well_callback,
         metavar="WELL",
@@ -431,7 +467,7 @@ def well_option(f):
              "action-angle tables, for a formula whose rounding does not reach the default 1e-13).")(f)
 
 
-def no_fourier(fourier):
+def no_fourier(fourier: str | None) -> None:
     """A command whose numbers do not use the first harmonic G(xi) (numerics only) refuses
     --fourier rather than ignoring it."""
     if fourier is not None:
@@ -439,7 +475,7 @@ def no_fourier(fourier):
                                  "is not used", param_hint="'--fourier'")
 
 
-def common_options(f):
+def common_options(f: Cmd) -> Cmd:
     f = click.option("--allow-expensive", "allow_expensive", is_flag=True,
                      help="Run even above the pipeline's default cost budgets (config keys "
                           "numerics.budget_core_hours, numerics.budget_analytic_evaluations).")(f)
@@ -452,8 +488,8 @@ def common_options(f):
     return well_option(f)
 
 
-def numerics_options(func, what):
-    def deco(f):
+def numerics_options(func: str, what: str) -> Callable[[Cmd], Cmd]:
+    def deco(f: Cmd) -> Cmd:
         f = click.option("--backend", type=click.Choice(BACKENDS), default="cpu", show_default=True,
                          callback=backend_check,
                          help="Numerics backend: cpu (the reference), cuda (GPU, bitwise equal escapes), auto.")(f)
@@ -469,7 +505,7 @@ def numerics_options(func, what):
     return deco
 
 
-def backend_check(ctx, param, value):
+def backend_check(ctx: click.Context, param: click.Parameter, value: str) -> str:
     """--backend cuda without a usable GPU is a usage error found before anything is computed."""
     if value == "cuda":
         from safebasins.numerics.engine import cuda_engine
@@ -481,20 +517,21 @@ def backend_check(ctx, param, value):
     return value
 
 
-def engine_check(name, module="engine"):
+def engine_check(name: str, module: str = "engine") -> Check:
     """A check of safebasins.numerics.<module> (imports numba: only when the option is used)."""
-    def check(*args):
+    def check(*args: Any) -> Any:
         return getattr(importlib.import_module(f"safebasins.numerics.{module}"), name)(*args)
     return check
 
 
-def out_option(default):
+def out_option(default: str) -> Callable[[Cmd], Cmd]:
     return click.option("--out", "-o", "out", metavar="PREFIX", default=default, show_default=True,
                         callback=out_prefix, help="Output prefix: writes PREFIX.nc and PREFIX.png (folders are "
                                                   "created).")
 
 
-def grid_params(grid, n, ctx=None):
+def grid_params(grid: dict[str, list[float]] | None, n: list[int],
+                ctx: click.Context | None = None) -> dict[str, list[float] | list[int]]:
     """The resolved grid of --grid (default: the window of the command's well) and --n."""
     from safebasins.pipeline import values
 

@@ -6,10 +6,20 @@ import json
 import os
 import shlex
 import sys
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import click
 
 from safebasins.pipeline.values import fmt  # noqa: F401  (the one number/angle formatter: commands import it from here)
+
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
+
+    from safebasins.pipeline.registry import Job, Params
+
+T = TypeVar("T")
 
 #: global attributes shown under "provenance" (never among the physical parameters)
 PROVENANCE = ("safebasins_version", "git_commit", "date_created", "config_hash", "source", "history",
@@ -21,7 +31,7 @@ def command_line() -> str:
     return shlex.join(["safebasins", *sys.argv[1:]])
 
 
-def chatter(verbose):
+def chatter(verbose: bool) -> contextlib.redirect_stdout[Any]:
     """The pipeline build functions print log lines: to stderr with --verbose, else dropped (stdout
     is the command's own report)."""
     import io
@@ -29,33 +39,34 @@ def chatter(verbose):
     return contextlib.redirect_stdout(sys.stderr if verbose else io.StringIO())
 
 
-def progress(total, desc, unit, quiet):
-    """tqdm bar with ETA on stderr; off with --quiet, and off when stderr is not a terminal."""
-    from tqdm import tqdm
+def progress(total: float, desc: str, unit: str, quiet: bool) -> Any:
+    """tqdm bar with ETA on stderr; off with --quiet, and off when stderr is not a terminal (typed Any:
+    tqdm has no type information in the environment)."""
+    from tqdm import tqdm  # type: ignore[import-untyped,unused-ignore]  # (no stubs: types-tqdm not installed)
 
     try:  # a terminal that reports no size (a bare pty) would get no bar at all
         size = os.get_terminal_size(sys.stderr.fileno())
-        shape = {"ncols": size.columns or 80, "nrows": size.lines or 24}
+        shape: dict[str, int] = {"ncols": size.columns or 80, "nrows": size.lines or 24}
     except (OSError, ValueError):
         shape = {}
     return tqdm(total=total, desc=desc, unit=unit, file=sys.stderr, disable=True if quiet else None, **shape)
 
 
-def job(threads, backend):
+def job(threads: int | None, backend: str) -> Job:
     """How the pipeline build functions compute (threads, backend): never what they compute."""
     from safebasins.pipeline.registry import Job
 
     return Job(threads=threads, backend=backend)
 
 
-def finish(ds, *, title, params):
+def finish(ds: xr.Dataset, *, title: str, params: Params) -> xr.Dataset:
     """CF + provenance attributes (params = the command's resolved arguments; history = command line)."""
     from safebasins.io.datasets import finalize
 
     return finalize(ds, title=title, params=params, history=command_line())
 
 
-def draw(builder, *args, **kw):
+def draw(builder: Callable[..., T], *args: Any, **kw: Any) -> T:
     """Build a figure with a pipeline figure builder under the shared style (Agg: no display needed)."""
     import matplotlib
 
@@ -66,7 +77,7 @@ def draw(builder, *args, **kw):
         return builder(*args, **kw)
 
 
-def write_outputs(datasets, fig, png):
+def write_outputs(datasets: Sequence[tuple[str, xr.Dataset]], fig: Figure | None, png: str) -> None:
     """Write the datasets, then the PNG, each atomically.  Called once everything is computed and
     drawn, so a bad argument or a failed computation leaves no file behind."""
     from safebasins.io.datasets import write_netcdf
@@ -86,7 +97,7 @@ def write_outputs(datasets, fig, png):
         click.echo(f"wrote {png}")
 
 
-def describe(path, show_params=True, width=100):
+def describe(path: str | os.PathLike[str], show_params: bool = True, width: int = 100) -> list[str]:
     """Lines: title, dims, coordinates with ranges, variables with units, parameters, provenance, agreement."""
     import numpy as np
     import xarray as xr
@@ -100,7 +111,7 @@ def describe(path, show_params=True, width=100):
                                  param_hint="'FILE'") from None
     a = ds.attrs
 
-    def span(v):
+    def span(v: xr.DataArray) -> str:
         x = np.asarray(v.values)
         if x.size == 0:
             return "empty"
@@ -115,10 +126,10 @@ def describe(path, show_params=True, width=100):
         vals = [str(s) for s in x.ravel()[:4]]
         return ", ".join(vals) + (" ..." if x.size > 4 else "")
 
-    def number(c):
+    def number(c: Any) -> str:
         return f"{c:.6g}" if np.asarray(c).dtype.kind in "fiu" else str(c)
 
-    def label(v):
+    def label(v: xr.DataArray) -> str:
         u, ln = v.attrs.get("units"), v.attrs.get("long_name")
         return "  ".join(s for s in (f"[{u}]" if u else "", ln or "") if s)
 
@@ -131,10 +142,10 @@ def describe(path, show_params=True, width=100):
     lines.append("dimensions: " + (", ".join(f"{k}={v}" for k, v in ds.sizes.items()) or "none"))
     lines.append("coordinates:")
     for k, v in ds.coords.items():
-        lines.append(f"  {k} ({', '.join(v.dims)}): {span(v)}  {label(v)}".rstrip())
+        lines.append(f"  {k} ({', '.join(map(str, v.dims))}): {span(v)}  {label(v)}".rstrip())
     lines.append("data variables:")
     for k, v in ds.data_vars.items():
-        lines.append(f"  {k} ({', '.join(v.dims)}) {v.dtype}: {span(v)}  {label(v)}".rstrip())
+        lines.append(f"  {k} ({', '.join(map(str, v.dims))}) {v.dtype}: {span(v)}  {label(v)}".rstrip())
     shown = [k for k in SUMMARY_ATTRS if k in a and k not in PROVENANCE and k != "title"]
     if shown:
         lines.append("parameters: " + ", ".join(f"{k}={a[k]}" for k in shown))

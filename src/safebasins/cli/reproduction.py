@@ -13,7 +13,7 @@ __all__ = ["verify_reproduction"]
 @click.argument("reference", metavar="ARCHIVE_OR_DIR", type=click.Path(path_type=Path))
 @click.argument("new", metavar="NEW_DIR", type=click.Path(path_type=Path))
 @click.option("--quiet", is_flag=True, help="Print only the datasets that are not identical, and the summary.")
-def verify_reproduction(reference, new, quiet):
+def verify_reproduction(reference: Path, new: Path, quiet: bool) -> None:
     """Check a new run against a results archive, dataset by dataset, with the tolerances two
     honest runs on different machines keep (docs/reproduction.md).
 

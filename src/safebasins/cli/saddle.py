@@ -47,10 +47,10 @@ __all__ = ["hilltop_saddle"]
               help="Numba threads (default: all; results do not depend on it).")
 @common_options
 @out_option("hilltop_saddle")
-def hilltop_saddle(F: tuple[float, ...], Omega: float, Psi: float, xi_max: float, damping: float, n: Any, grid: Any,
-                   cycles: int, ds_max: float, tangency: bool, steps_per_cycle: int, threads: int | None, fourier: Any,
-                   well: dict[str, Any], no_plot: bool, quiet: bool, verbose: bool, allow_expensive: bool,
-                   out: str) -> None:
+def hilltop_saddle(F: list[float], Omega: float, Psi: float, xi_max: float, damping: float, n: list[int],
+                   grid: dict[str, list[float]] | None, cycles: int, ds_max: float, tangency: bool,
+                   steps_per_cycle: int, threads: int | None, fourier: str | None, well: dict[str, Any],
+                   no_plot: bool, quiet: bool, verbose: bool, allow_expensive: bool, out: str) -> None:
     """The hilltop saddle's orbit and manifolds over escape charts of a damped well.
 
     The saddle's T-periodic orbit by multiple shooting (Newton on the stroboscopic map, DOP853),
