@@ -51,6 +51,11 @@ def test_escape_fate_counted_from_the_data(shock: xr.Dataset) -> None:
     line = [n for n in notes(fig) if n.startswith("Attractor 0, energy norm")][0]
     assert "at once (H0 > ξ_max) at 1 of 2 phases, in flight within 0.5 cycles" in line
     plt.close(fig)
+    ds["escape_cycle"][0, :, 0] = [0.25, 0.75]
+    fig = figure_fatal_shock(ds)
+    line = [n for n in notes(fig) if n.startswith("Attractor 0, energy norm")][0]
+    assert line.endswith("escapes in flight, within 0.75 cycles.")
+    plt.close(fig)
 
 
 def test_missing_variable_named(shock: xr.Dataset) -> None:

@@ -150,8 +150,11 @@ def _notes(fig: Figure, ds: xr.Dataset) -> None:
             bound = int(np.sum((gap >= 0) & (gap <= spacing)))
             at_once = int(np.sum(cyc == 0))
             flight = cyc[np.isfinite(cyc) & (cyc > 0)]
-            fate = (f"the shock's trajectory escapes at once (H0 > ξ_max) at {at_once} of {phi.size} phases"
-                    + (f", in flight within {flight.max():.3g} cycles at the others" if flight.size else ""))
+            if at_once == 0:
+                fate = f"the shock's trajectory escapes in flight, within {flight.max():.3g} cycles"
+            else:
+                fate = (f"the shock's trajectory escapes at once (H0 > ξ_max) at {at_once} of {phi.size} phases"
+                        + (f", in flight within {flight.max():.3g} cycles at the others" if flight.size else ""))
             add_note(fig, f"Attractor {a}, {name} norm: MFS {_span(mfs, phi)}; LIM - MFS {gap.min():.2g} to "
                           f"{gap.max():.2g} (0 <= LIM - MFS <= node diagonal at {bound} of {phi.size} phases); "
                           f"polar grid estimate up to {100 * float(np.max(grid / mfs - 1)):.2g}% above the MFS; "
