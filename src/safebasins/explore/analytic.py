@@ -19,12 +19,20 @@ theta0 = gamma + Psi) on ``DAMPED_MANIFOLD_GRID``, without level curves.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from safebasins import theory
 from safebasins.explore.ranges import WellRanges
 from safebasins.analysis.ic_basins import mask_outline
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+#: polylines ``(xs, ys, kinds)``: vertex arrays of each boundary curve and its kind
+Polylines = tuple[list[NDArray[np.float64]], list[NDArray[np.float64]], list[str]]
 
 __all__ = ["Forcing", "ic_grid", "ic_safe", "ic_plane", "manifold", "pictures", "level_values", "IC_GRID",
            "MANIFOLD_GRID", "DAMPED_IC_GRID", "DAMPED_MANIFOLD_GRID"]
@@ -53,24 +61,25 @@ class Forcing:
     damping: float = 0.0
 
 
-def ic_grid(r: WellRanges, n: int):
+def ic_grid(r: WellRanges, n: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The axes ``(q0, p0)`` of an ``n x n`` grid over the well's window."""
     return np.linspace(*r.q_window, n), np.linspace(*r.p_window, n)
 
 
-def ic_safe(r: WellRanges, f: Forcing, n: int):
+def ic_safe(r: WellRanges, f: Forcing, n: int) -> NDArray[np.bool_]:
     """Slow-flow safe mask on the ``n x n`` grid, shape (q0, p0) (True = safe)."""
     q0, p0 = ic_grid(r, n)
     return ~theory.slow_flow_escapes(q0[:, None], p0[None, :], F=f.F, Omega=f.Omega, Psi=f.Psi, xi_max=f.xi_max,
                                      well=r.well, damping=f.damping)
 
 
-def _polylines(boundaries):
+def _polylines(boundaries: xr.Dataset) -> Polylines:
     """Vertex lists of each boundary curve on the IC plane (NaN rows kept as breaks)."""
     index = boundaries["curve_index"].values
     q, p = boundaries["q0_vertex"].values, boundaries["p0_vertex"].values
     kinds = [str(k) for k in boundaries["kind"].values] if "kind" in boundaries else []
-    xs, ys = [], []
+    xs: list[NDArray[np.float64]] = []
+    ys: list[NDArray[np.float64]] = []
     for k in range(len(kinds)):
         rows = index == k
         xs.append(q[rows])
@@ -78,7 +87,7 @@ def _polylines(boundaries):
     return xs, ys, kinds
 
 
-def _orbit(r: WellRanges, xi):
+def _orbit(r: WellRanges, xi: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The closed unforced orbit H0 = xi (eq 7) inside the well, as a polyline."""
     q_lo, q_hi = (float(v) for v in r.well.turning_points(xi))
     q = q_lo + (q_hi - q_lo) * 0.5 * (1.0 - np.cos(np.linspace(0.0, np.pi, 200)))
@@ -86,7 +95,7 @@ def _orbit(r: WellRanges, xi):
     return np.concatenate([q, q[::-1]]), np.concatenate([p, -p[::-1]])
 
 
-def ic_plane(r: WellRanges, f: Forcing, n: int) -> dict:
+def ic_plane(r: WellRanges, f: Forcing, n: int) -> dict[str, Any]:
     """The IC-plane picture: ``safe`` (q0, p0), ``boundaries`` (xs, ys, kinds), ``orbit`` (q, p).
     Damped (``f.damping > 0``): on at most ``DAMPED_IC_GRID`` points per axis, the boundaries the
     outline of the safe mask."""
@@ -100,7 +109,7 @@ def ic_plane(r: WellRanges, f: Forcing, n: int) -> dict:
     return {"safe": safe, "boundaries": _polylines(bounds), "orbit": _orbit(r, f.xi_max)}
 
 
-def level_values(C, n_levels=N_LEVELS):
+def level_values(C: ArrayLike, n_levels: int = N_LEVELS) -> NDArray[np.float64]:
     """Evenly spaced levels strictly inside the range of C (the level C = 0 of the limiting
     phase trajectory through the well bottom is drawn on its own)."""
     lo, hi = float(np.nanmin(C)), float(np.nanmax(C))
@@ -109,7 +118,7 @@ def level_values(C, n_levels=N_LEVELS):
     return np.linspace(lo, hi, n_levels + 2)[1:-1]
 
 
-def manifold(r: WellRanges, f: Forcing, n_gamma: int, n_xi: int) -> dict:
+def manifold(r: WellRanges, f: Forcing, n_gamma: int, n_xi: int) -> dict[str, Any]:
     """The resonance-manifold picture over ``gamma`` in [-pi, pi], ``xi`` in [0, xi_top]:
     ``C`` and ``escapes`` (xi, gamma), ``levels`` of C, the axes ``gamma`` and ``xi``.  Damped
     (``f.damping > 0``): ``escapes`` of each point's damped slow trajectory on at most
@@ -131,6 +140,6 @@ def manifold(r: WellRanges, f: Forcing, n_gamma: int, n_xi: int) -> dict:
     return {"gamma": gamma, "xi": xi, "C": C, "escapes": escapes, "levels": level_values(C)}
 
 
-def pictures(r: WellRanges, f: Forcing) -> tuple[dict, dict]:
+def pictures(r: WellRanges, f: Forcing) -> tuple[dict[str, Any], dict[str, Any]]:
     """Both pictures of one point of the sliders, at the explorer's resolution: ``(ic_plane, manifold)``."""
     return ic_plane(r, f, IC_GRID), manifold(r, f, *MANIFOLD_GRID)

@@ -18,16 +18,29 @@ from __future__ import annotations
 import logging
 import threading
 import time
+from collections.abc import Mapping
 from functools import partial
+from typing import TYPE_CHECKING, Any
 
+import numpy as np
 from bokeh.layouts import column, row
-from bokeh.models import Div
+from numpy.typing import NDArray
 
 from safebasins.explore import analytic, numeric
 from safebasins.explore.controls import WIDTH, forcing, make_controls, set_ranges
 from safebasins.explore.figures import Figures, key
 from safebasins.explore.ranges import EXPRESSION, well_names, well_ranges
 from safebasins.explore.state import to_query, view
+
+if TYPE_CHECKING:
+    from bokeh.document import Document
+    from bokeh.models.widgets.markups import Div
+    from bokeh.server.callbacks import TimeoutCallback
+
+    from safebasins.explore.analytic import Forcing
+    from safebasins.explore.ranges import WellRanges
+else:  # bokeh.models re-exports Div through a computed __all__, which mypy cannot read
+    from bokeh.models import Div
 
 __all__ = ["Explorer", "make_document", "REDRAW_DELAY_MS", "HEADER"]
 
@@ -48,7 +61,7 @@ def error_text(exc: Exception) -> str:
     return str(exc) if isinstance(exc, ValueError) else f"{type(exc).__name__}: {exc}"
 
 
-def _query_arguments(doc) -> dict:
+def _query_arguments(doc: Document) -> dict[str, Any]:
     """The page request's query arguments (none outside a server session); Bokeh's own
     (``bokeh-...``) left out."""
     context = getattr(doc, "session_context", None)
@@ -62,7 +75,7 @@ class Explorer:
     (any form of :func:`safebasins.explore.ranges.well_ranges`) and the point ``values``
     (parameter -> value; missing: the well's defaults), both overridden by the page's query."""
 
-    def __init__(self, doc, well="quartic", values=None):
+    def __init__(self, doc: Document, well: object = "quartic", values: Mapping[str, Any] | None = None) -> None:
         self.doc = doc
         problem = None
         try:
@@ -77,7 +90,7 @@ class Explorer:
         self.figures = Figures(self.ranges, *analytic.pictures(self.ranges, f), f.xi_max, f.damping)
         self.key = Div(name="key", text=key(f.damping), sizing_mode="stretch_width")
         self.version = 0          # bumped by every parameter change: a numeric run checks it
-        self.pending = None       # the scheduled redraw
+        self.pending: TimeoutCallback | None = None       # the scheduled redraw
         self.running = False
         self.setting_well = False  # the menu is being set to match a well typed in
         c = self.controls
@@ -99,7 +112,7 @@ class Explorer:
                             sizing_mode="stretch_width", name="layout"))
 
     # ------------------------------------------------------------------ wells
-    def on_well(self, attr, old, new):
+    def on_well(self, attr: str, old: str, new: str) -> None:
         if self.setting_well:
             return
         if new == EXPRESSION:
@@ -111,7 +124,7 @@ class Explorer:
         else:
             self.set_well(self.other_wells.get(new, new))
 
-    def on_expression(self, attr, old, new):
+    def on_expression(self, attr: str, old: str, new: str) -> None:
         if new.strip() and self.set_well({"expression": new.strip()}):
             self.setting_well = True
             try:
@@ -119,7 +132,7 @@ class Explorer:
             finally:
                 self.setting_well = False
 
-    def set_well(self, well) -> bool:
+    def set_well(self, well: object) -> bool:
         """Show the well ``well`` at its defaults; False (the error shown under the well menu, the
         page unchanged) when it does not resolve."""
         try:
@@ -134,22 +147,22 @@ class Explorer:
         self.changed()
         return True
 
-    def well_error(self, text):
+    def well_error(self, text: str) -> None:
         """The error of a well under the well menu (hidden when there is none)."""
         self.controls.well_error.update(text=text, visible=bool(text))
 
     # ------------------------------------------------------------------ analytic pictures
-    def on_parameter(self, attr, old, new):
+    def on_parameter(self, attr: str, old: Any, new: Any) -> None:
         self.changed()
 
-    def changed(self):
+    def changed(self) -> None:
         """A parameter changed: invalidate a numeric result and schedule one redraw."""
         self.version += 1
         self.controls.iou.text = ""
         if self.pending is None:
             self.pending = self.doc.add_timeout_callback(self.redraw, REDRAW_DELAY_MS)
 
-    def redraw(self):
+    def redraw(self) -> None:
         self.pending = None
         r, f = self.ranges, forcing(self.controls)
         t0 = time.perf_counter()
@@ -164,17 +177,17 @@ class Explorer:
         self.status(f"{'damped ' if f.damping > 0 else ''}slow flow redrawn in "
                     f"{1e3 * (time.perf_counter() - t0):.0f} ms")
 
-    def link(self, f):
+    def link(self, f: Forcing) -> None:
         """The links to this view: its static picture and the live page at this state."""
         query = to_query(self.ranges, f)
         self.controls.snapshot.text = (f'<a href="snapshot?{query}" target="_blank">Static picture of this view</a>'
                                        f' &middot; <a href="?{query}">link to this view</a>')
 
-    def status(self, text):
+    def status(self, text: str) -> None:
         self.controls.status.text = text
 
     # ------------------------------------------------------------------ numerics
-    def on_run(self):
+    def on_run(self) -> None:
         if self.running:
             return
         c, r, f = self.controls, self.ranges, forcing(self.controls)
@@ -186,7 +199,7 @@ class Explorer:
         self.status(f"integrating {n} x {n} initial conditions for {cycles} forcing cycles")
         threading.Thread(target=self.integrate, args=(r, f, n, cycles, token), daemon=True).start()
 
-    def integrate(self, r, f, n, cycles, token):
+    def integrate(self, r: WellRanges, f: Forcing, n: int, cycles: int, token: int) -> None:
         """The numeric run (background thread): every document change goes through a next-tick callback."""
         t0 = time.perf_counter()
         try:
@@ -200,10 +213,11 @@ class Explorer:
         text = None if safe is None else (f"{n} x {n} ICs, {cycles} cycles, {time.perf_counter() - t0:.1f} s")
         self.doc.add_next_tick_callback(partial(self.finished, (r, safe, n, cycles, token), value, text))
 
-    def progress_later(self, done, total):
+    def progress_later(self, done: int, total: int) -> None:
         self.doc.add_next_tick_callback(partial(self.controls.progress.update, value=done, max=total))
 
-    def finished(self, result, value, text):
+    def finished(self, result: tuple[WellRanges, NDArray[np.bool_] | None, int, int, int] | None,
+                 value: float | None, text: str | None) -> None:
         c = self.controls
         self.running = False
         c.run.disabled = False
@@ -212,7 +226,7 @@ class Explorer:
             self.status(text or "numeric run abandoned: the parameters changed")
             return
         r, safe, n, cycles, token = result
-        if token != self.version:
+        if token != self.version or safe is None:   # (a chart is abandoned, None, only for a newer version)
             self.status("numeric run abandoned: the parameters changed")
             return
         self.figures.show_numeric(r, safe)
@@ -221,7 +235,7 @@ class Explorer:
         self.status(f"numerics: {text}")
 
 
-def make_document(doc, well="quartic", values=None):
+def make_document(doc: Document, well: object = "quartic", values: Mapping[str, Any] | None = None) -> None:
     """Bokeh application handler: one :class:`Explorer` per browser session (at the well and point
     of the command line: bind them with ``functools.partial``)."""
     Explorer(doc, well, values)

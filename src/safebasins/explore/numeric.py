@@ -8,7 +8,10 @@ at ``t_eval = cycles``); the agreement is the intersection over union
 """
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
+from numpy.typing import NDArray
 
 from safebasins import numerics
 from safebasins.analysis.agreement import iou
@@ -23,7 +26,9 @@ GRID_SIZES = (41, 61, 81, 101, 151)
 CYCLES = (100, 300, 1000, 3000)
 
 
-def numeric_safe(r: WellRanges, f: Forcing, n: int, cycles: int, *, blocks: int = 10, progress=None, stop=None):
+def numeric_safe(r: WellRanges, f: Forcing, n: int, cycles: int, *, blocks: int = 10,
+                 progress: Callable[[int, int], object] | None = None,
+                 stop: Callable[[], bool] | None = None) -> NDArray[np.bool_] | None:
     """Numeric safe mask (q0, p0) on the ``n x n`` grid, integrated in ``blocks`` row blocks.
 
     ``progress(done, blocks)`` is called after each block; ``stop()`` is asked before each block
@@ -43,6 +48,6 @@ def numeric_safe(r: WellRanges, f: Forcing, n: int, cycles: int, *, blocks: int 
     return safe
 
 
-def agreement(analytic_safe, numeric_safe_mask) -> float:
+def agreement(analytic_safe: NDArray[np.bool_], numeric_safe_mask: NDArray[np.bool_]) -> float:
     """Intersection over union of the analytic and numeric safe masks."""
     return float(iou(analytic_safe, numeric_safe_mask))

@@ -108,7 +108,7 @@ class WellRanges:
                 f"static escape force {self.force:.3g}")
 
 
-def well_ranges(well="quartic") -> WellRanges:
+def well_ranges(well: object = "quartic") -> WellRanges:
     """Sliders and windows of a well given as a name, ``{"expression": ...}`` or
     ``{"polynomial": [...]}``; ValueError naming ``well`` (or the spec's key) if it is not one."""
     spec = wells.spec_of(well)

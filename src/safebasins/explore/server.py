@@ -4,9 +4,15 @@ the query of :mod:`safebasins.explore.state`), both starting from the command li
 from __future__ import annotations
 
 import socket
+from collections.abc import Callable, Mapping
 from functools import partial
+from typing import TYPE_CHECKING, Any
 
 from safebasins.explore.state import view
+
+if TYPE_CHECKING:
+    from bokeh.server.server import Server
+    from tornado.web import RequestHandler
 
 __all__ = ["check_host", "free_port", "check_port", "make_server", "serve", "SNAPSHOT_PATH"]
 
@@ -43,7 +49,7 @@ def check_port(host: str, port: int) -> int:
     return port
 
 
-def snapshot_handler():
+def snapshot_handler() -> type[RequestHandler]:
     """The tornado handler of ``/snapshot?<query>``: the static page of the query's view (the
     command line's well and point where the query leaves them out); a bad query is answered 400
     with the error in plain text."""
@@ -53,14 +59,14 @@ def snapshot_handler():
     from safebasins.explore.app import error_text  # noqa: PLC0415 - imports bokeh, an optional extra
     from safebasins.explore.snapshot import static_html  # noqa: PLC0415 - imports bokeh, an optional extra
 
-    def page(well, values, arguments):
+    def page(well: object, values: Mapping[str, Any] | None, arguments: Mapping[str, Any]) -> str:
         return static_html(*view(well, values, arguments))
 
     class SnapshotHandler(RequestHandler):
-        def initialize(self, well, values):
+        def initialize(self, well: object, values: Mapping[str, Any] | None) -> None:
             self.well, self.values = well, values
 
-        async def get(self):
+        async def get(self) -> None:
             try:
                 html = await IOLoop.current().run_in_executor(None, page, self.well, self.values,
                                                               dict(self.request.arguments))
@@ -75,7 +81,8 @@ def snapshot_handler():
     return SnapshotHandler
 
 
-def make_server(host: str = "127.0.0.1", port: int | None = None, well="quartic", values=None):
+def make_server(host: str = "127.0.0.1", port: int | None = None, well: object = "quartic",
+                values: Mapping[str, Any] | None = None) -> Server:
     """A started-but-not-running :class:`bokeh.server.server.Server` serving the explorer at ``/``
     and its static pictures at ``/snapshot``, starting at the well ``well`` and the point
     ``values`` (parameter -> value, :mod:`safebasins.explore.state`; missing: the well's defaults).
@@ -96,8 +103,9 @@ def make_server(host: str = "127.0.0.1", port: int | None = None, well="quartic"
     return server
 
 
-def serve(host: str = "127.0.0.1", port: int | None = None, open_browser: bool = True, announce=print,
-          well="quartic", values=None):
+def serve(host: str = "127.0.0.1", port: int | None = None, open_browser: bool = True,
+          announce: Callable[[str], object] = print, well: object = "quartic",
+          values: Mapping[str, Any] | None = None) -> None:
     """Run the explorer until interrupted (Ctrl-C); ``announce`` receives the URL.  The interrupt
     (``KeyboardInterrupt``) is raised again once the server has stopped, so that a command that
     was interrupted does not exit as if it had completed (``safebasins explore`` exits 130)."""

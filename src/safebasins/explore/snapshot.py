@@ -19,11 +19,11 @@ import shutil
 import subprocess
 import tempfile
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from bokeh.embed import file_html
 from bokeh.layouts import column, row
-from bokeh.models import Div
 from bokeh.resources import INLINE
 from PIL import Image
 
@@ -32,6 +32,12 @@ from safebasins.explore.analytic import Forcing
 from safebasins.explore.figures import Figures, key
 from safebasins.explore.ranges import WellRanges
 from safebasins.io.files import atomic_path
+
+if TYPE_CHECKING:
+    from bokeh.models import Column
+    from bokeh.models.widgets.markups import Div
+else:  # bokeh.models re-exports Div through a computed __all__, which mypy cannot read
+    from bokeh.models import Div
 
 __all__ = ["static_layout", "static_html", "write_html", "write_png", "find_chromium", "ink_fraction",
            "WINDOW", "CHROMIUM_NAMES"]
@@ -52,7 +58,7 @@ def state_text(r: WellRanges, f: Forcing) -> str:
             f"damping beta = {f.damping:.6g}")
 
 
-def static_layout(r: WellRanges, f: Forcing):
+def static_layout(r: WellRanges, f: Forcing) -> Column:
     """The static page's layout: a header naming the state, both figures, their key."""
     figures = Figures(r, *analytic.pictures(r, f), f.xi_max, f.damping)
     header = Div(name="state", text=f"<b>safebasins explorer</b>: {state_text(r, f)}", sizing_mode="stretch_width")
@@ -65,7 +71,7 @@ def static_html(r: WellRanges, f: Forcing) -> str:
     return file_html(static_layout(r, f), INLINE, title=f"safebasins explorer: {r.label}")
 
 
-def write_html(path, r: WellRanges, f: Forcing) -> Path:
+def write_html(path: str | os.PathLike[str], r: WellRanges, f: Forcing) -> Path:
     """Write the static page to ``path`` (atomically)."""
     path = Path(path)
     text = static_html(r, f)
@@ -74,7 +80,7 @@ def write_html(path, r: WellRanges, f: Forcing) -> Path:
     return path
 
 
-def find_chromium(browser=None) -> str:
+def find_chromium(browser: str | os.PathLike[str] | None = None) -> str:
     """The Chromium (or Chrome) executable: ``browser`` if given, else the first of
     ``CHROMIUM_NAMES`` on PATH; ValueError naming ``browser`` when there is none."""
     if browser is not None:
@@ -90,14 +96,15 @@ def find_chromium(browser=None) -> str:
                      "install one, name it with --browser, or write the HTML page (--export) and open it")
 
 
-def ink_fraction(png) -> float:
+def ink_fraction(png: str | os.PathLike[str]) -> float:
     """Fraction of the picture's pixels that are not (near) white."""
     with Image.open(png) as im:
         a = np.asarray(im.convert("L"))
     return float((a < 245).mean())
 
 
-def write_png(path, r: WellRanges, f: Forcing, browser=None, window=WINDOW) -> Path:
+def write_png(path: str | os.PathLike[str], r: WellRanges, f: Forcing, browser: str | os.PathLike[str] | None = None,
+              window: tuple[int, int] = WINDOW) -> Path:
     """Write a PNG of the static page, ``window`` (width, height) px, taken by a headless Chromium
     (:func:`find_chromium`); RuntimeError if the browser fails or returns a blank picture."""
     exe = find_chromium(browser)

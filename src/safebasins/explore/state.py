@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping
+from typing import Any
 from urllib.parse import urlencode
 
 from safebasins.core.checks import check_finite, check_nonnegative, check_positive, check_scalar
@@ -21,7 +22,7 @@ __all__ = ["PARAMETERS", "forcing_of", "to_query", "from_query", "view"]
 PARAMETERS = ("Omega", "F", "Psi", "xi_max", "damping")
 
 
-def forcing_of(r: WellRanges, values: Mapping | None = None) -> Forcing:
+def forcing_of(r: WellRanges, values: Mapping[str, Any] | None = None) -> Forcing:
     """The point ``values`` (a missing or None value: the well's default) on the well ``r``,
     checked: F >= 0, Omega > 0, Psi finite, xi_max in (0, E_b) (the slow flow is singular at the
     barrier energy), damping >= 0; ValueError naming the parameter."""
@@ -39,7 +40,7 @@ def forcing_of(r: WellRanges, values: Mapping | None = None) -> Forcing:
                    damping=check_scalar("damping", v["damping"], check_nonnegative))
 
 
-def _well_text(spec: dict) -> str:
+def _well_text(spec: dict[str, Any]) -> str:
     return spec["name"] if set(spec) == {"name"} else json.dumps(spec, separators=(",", ":"))
 
 
@@ -48,18 +49,19 @@ def to_query(r: WellRanges, f: Forcing) -> str:
     return urlencode({"well": _well_text(r.spec), **{name: repr(float(getattr(f, name))) for name in PARAMETERS}})
 
 
-def from_query(arguments: Mapping) -> tuple[object, dict]:
+def from_query(arguments: Mapping[str, Any]) -> tuple[object, dict[str, float]]:
     """``(well, values)`` of query ``arguments`` (a mapping of names to a value or a list of
     values, str or bytes: tornado's ``request.arguments``); the well is None when absent, its
     form not yet resolved (:func:`safebasins.explore.ranges.well_ranges` does that).  ValueError
     naming the key for an unknown key or a value that is not a number."""
-    def one(key):
+    def one(key: str) -> str:
         value = arguments[key]
         if isinstance(value, (list, tuple)):
             value = value[-1]
         return value.decode() if isinstance(value, bytes) else str(value)
 
-    well, values = None, {}
+    well: object = None
+    values: dict[str, float] = {}
     for key in arguments:
         if key == "well":
             text = one(key).strip()
@@ -80,7 +82,8 @@ def from_query(arguments: Mapping) -> tuple[object, dict]:
     return well, values
 
 
-def view(well="quartic", values: Mapping | None = None, arguments: Mapping | None = None) -> tuple[WellRanges, Forcing]:
+def view(well: object = "quartic", values: Mapping[str, Any] | None = None,
+         arguments: Mapping[str, Any] | None = None) -> tuple[WellRanges, Forcing]:
     """The well and point of a page: those of the query ``arguments`` over the well ``well`` and the
     point ``values`` (of the command line); a query that names a well starts from its defaults."""
     q_well, q_values = from_query(arguments or {})
