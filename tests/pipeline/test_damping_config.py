@@ -57,7 +57,7 @@ def test_damped_chart_tiles_integrate_the_damped_equation(base):
 
     from safebasins.numerics import escape_chart
     from safebasins.pipeline.registry import Job
-    from safebasins.pipeline.tiles import chart_tile
+    from safebasins.pipeline.registry import chart_tile
     from safebasins.pipeline.values import base_well, grid_axes
 
     cfg = merged(base, {"damped": {"escape_equation": {"grid": {"n": 9}, "cycles": 40, "t_eval": [20, 40]}}})

@@ -9,7 +9,7 @@ from safebasins.pipeline.cost import DAMPED_BASIN_EVALUATIONS, analytic_cost
 from safebasins.pipeline.kinds.extras import build_erosion_analytic
 from safebasins.pipeline.plan import plan
 from safebasins.pipeline.registry import Job
-from safebasins.pipeline.tiles import chart_tile
+from safebasins.pipeline.registry import chart_tile
 from tests.pipeline.test_config import base, merged  # noqa: F401  (the fixture)
 
 BLOCK = {"kind": "erosion", "damping": 0.05, "F": [0.0, 0.045], "Omega": 0.85, "xi_max": [0.18],

@@ -12,7 +12,6 @@ from __future__ import annotations
 import os
 import zlib
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -21,23 +20,13 @@ from safebasins.pipeline import values
 from safebasins.pipeline.config import experiment_blocks, load_yaml, merge_config, validate_config
 from safebasins.pipeline.validation import ConfigError, fail
 from safebasins.pipeline.registry import (KINDS, PARAMS_DIR, PARTS_DIR, Experiment, FigureSpec, Product,
-                                          params_path)
+                                          ResolveContext, params_path)
 
 if TYPE_CHECKING:
     from safebasins.pipeline.catalog import Declaration
     from safebasins.pipeline.registry import Kind, Params
 
-__all__ = ["Plan", "ResolveContext", "plan", "tile_path", "load_config"]
-
-
-@dataclass(frozen=True)
-class ResolveContext:
-    """Global settings a kind's ``resolve`` may use."""
-
-    fourier: str         # the config's fourier for the quartic; "exact" for every other well
-    well: dict[str, Any]  # the experiment's well spec (safebasins.wells.spec_of)
-    steps_per_cycle: int
-    seed: int            # the config seed plus this experiment's offset
+__all__ = ["Plan", "plan", "tile_path", "load_config"]
 
 
 def tile_path(experiment: str, task: int, tile: int, tiles: int) -> str:

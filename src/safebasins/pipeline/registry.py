@@ -24,17 +24,19 @@ from dataclasses import dataclass, field
 from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any, ClassVar, TypeAlias, TypeVar
 
+import numpy as np
+
+from safebasins.pipeline.values import base_well, damping, grid_axes, tile_slice
 from safebasins.pipeline.well_defaults import WellDefault
 
 if TYPE_CHECKING:
-    import numpy as np
     import xarray as xr
     from numpy.typing import NDArray
 
-    from safebasins.pipeline.plan import ResolveContext
     from safebasins.pipeline.validation import CheckContext
 
-__all__ = ["Kind", "Job", "Product", "FigureSpec", "Experiment", "KINDS", "register", "STAGES", "Block", "Params",
+__all__ = ["Kind", "Job", "ResolveContext", "chart_tile", "Product", "FigureSpec", "Experiment", "KINDS", "register",
+           "STAGES", "Block", "Params",
            "Inputs", "Build", "Contract", "FigureInputs", "ChartICs"]
 
 #: dataset stages and their directories under results/data
@@ -42,6 +44,16 @@ STAGES = {"analytic": "results/data/analytic", "numeric": "results/data/numeric"
 PARAMS_DIR = "results/params"
 PARTS_DIR = "results/data/numeric/parts"
 FIGURE_DIR = "results/figures"
+
+
+@dataclass(frozen=True)
+class ResolveContext:
+    """Global settings a kind's ``resolve`` may use."""
+
+    fourier: str         # the config's fourier for the quartic; "exact" for every other well
+    well: dict[str, Any]  # the experiment's well spec (safebasins.wells.spec_of)
+    steps_per_cycle: int
+    seed: int            # the config seed plus this experiment's offset
 
 
 #: one experiment's config block (YAML data, the schema's defaults filled in)
@@ -185,8 +197,6 @@ class Kind:
     def compute_tile(self, params: Params, task: int, tile: int, tiles: int, job: Job) -> xr.Dataset:
         """One job of the ``chart_tile`` rule: by default tile ``tile`` of ``tiles`` (a block of q0
         rows or samples) of the escape chart of task ``task``."""
-        from safebasins.pipeline.tiles import chart_tile
-
         return chart_tile(self, params, task, tile, tiles, job)
 
     def cost(self, params: Params) -> int:
@@ -206,8 +216,6 @@ class GridChartKind(Kind):
     """A kind whose chart tasks all integrate the experiment's (q0, p0) grid ``params["grid"]``."""
 
     def chart_ics(self, params: Params) -> ChartICs:
-        from safebasins.pipeline.values import grid_axes
-
         q0, p0 = grid_axes(params["grid"])
         return q0, p0, True
 
@@ -248,3 +256,33 @@ class Experiment:
 
     def dataset_files(self) -> list[str]:
         return [p.path for p in self.products]
+
+
+def chart_tile(kind: Kind, params: Params, k: int, tile: int, tiles: int, job: Job) -> xr.Dataset:
+    """The default tile job of escape-chart tasks (rule ``chart_tile``, :meth:`Kind.compute_tile`):
+    tile ``tile`` of ``tiles`` of task ``k``.  Grid tasks: a contiguous block of q0 rows x all p0
+    (dims q0, p0); paired ICs: a contiguous block of the samples (dim ``sample``, global index).  A
+    task may carry its own forcing phase ``Psi`` or frequency ``Omega``.  Each trajectory is
+    independent: the gathered chart is the same for any tile count."""
+    from safebasins.numerics import escape_chart
+
+    task = kind.tasks(params)[k]
+    Psi = task.get("Psi", params.get("Psi"))
+    Omega = task.get("Omega", params.get("Omega"))
+    if Omega is None or Psi is None:
+        raise ValueError(f"experiment {params['experiment']!r}, chart task {k}: no forcing "
+                         f"{'frequency Omega' if Omega is None else 'phase Psi'} in the task or the parameters")
+    q0, p0, grid = kind.chart_ics(params)
+    sl = tile_slice(q0.size, tiles, tile)
+    q0 = q0[sl]
+    p0 = p0 if grid else p0[sl]
+    print(f"{params['experiment']} task {k} tile {tile}/{tiles}: F={task['F']} Omega={Omega} Psi={Psi} "
+          f"xi_max={task['xi_max']} q_max={task['q_max']} cycles={params['cycles']} "
+          f"ICs={q0.size}x{p0.size if grid else 1}", flush=True)
+    ds = escape_chart(q0, p0, task["F"], Omega, Psi, xi_max=tuple(task["xi_max"]), q_max=tuple(task["q_max"]),
+                      cycles=params["cycles"], steps_per_cycle=params["steps_per_cycle"], threads=job.threads,
+                      grid=grid, backend=job.backend, well=base_well(params),
+                      damping=damping(params))
+    if not grid:
+        ds = ds.assign_coords(sample=np.arange(sl.start, sl.stop))
+    return ds

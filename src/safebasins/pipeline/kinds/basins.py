@@ -26,7 +26,7 @@ from safebasins.pipeline.registry import (Block, Build, Contract, FigureInputs, 
 if TYPE_CHECKING:
     import xarray as xr
 
-    from safebasins.pipeline.plan import ResolveContext
+    from safebasins.pipeline.registry import ResolveContext
     from safebasins.pipeline.validation import CheckContext
 
 N_POINTS = {"type": "integer", "minimum": 16, "default": 2000}

@@ -18,7 +18,7 @@ from safebasins.pipeline.registry import (Block, ChartICs, FigureInputs, GridCha
 if TYPE_CHECKING:
     import xarray as xr
 
-    from safebasins.pipeline.plan import ResolveContext
+    from safebasins.pipeline.registry import ResolveContext
     from safebasins.pipeline.validation import CheckContext
 
 Q_MAX = {"type": "number", "exclusiveMinimum": 0, "maximum": 1}

@@ -18,7 +18,7 @@ from safebasins.pipeline.registry import (Block, FigureInputs, GridChartKind, In
 if TYPE_CHECKING:
     import xarray as xr
 
-    from safebasins.pipeline.plan import ResolveContext
+    from safebasins.pipeline.registry import ResolveContext
     from safebasins.pipeline.validation import CheckContext
 
 F_LIST = {"type": "array", "minItems": 2, "items": {"$ref": "#/$defs/forcing"}}

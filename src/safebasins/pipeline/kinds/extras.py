@@ -21,7 +21,7 @@ from safebasins.pipeline.registry import (Block, FigureInputs, GridChartKind, In
 if TYPE_CHECKING:
     import xarray as xr
 
-    from safebasins.pipeline.plan import ResolveContext
+    from safebasins.pipeline.registry import ResolveContext
     from safebasins.pipeline.validation import CheckContext
 
 FOURIER_LIST = {"description": "first-harmonic variants of the analytic products (\"paper\", \"exact\")",

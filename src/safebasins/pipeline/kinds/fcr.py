@@ -17,7 +17,7 @@ from safebasins.pipeline.registry import (Block, Contract, FigureInputs, Inputs,
 if TYPE_CHECKING:
     import xarray as xr
 
-    from safebasins.pipeline.plan import ResolveContext
+    from safebasins.pipeline.registry import ResolveContext
     from safebasins.pipeline.validation import CheckContext
     from safebasins.wells.base import Well
 

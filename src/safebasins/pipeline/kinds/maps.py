@@ -19,7 +19,7 @@ from safebasins.pipeline import well_defaults as WD
 from safebasins.pipeline.registry import Block, FigureInputs, Inputs, Job, Kind, Params, Product, dataset_path, register
 
 if TYPE_CHECKING:
-    from safebasins.pipeline.plan import ResolveContext
+    from safebasins.pipeline.registry import ResolveContext
     from safebasins.pipeline.validation import CheckContext
 
 MEASURES = ("GIM", "LIM", "IF")

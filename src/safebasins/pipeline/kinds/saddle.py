@@ -13,7 +13,7 @@ from safebasins.pipeline.registry import Block, FigureInputs, Inputs, Job, Kind,
 if TYPE_CHECKING:
     import xarray as xr
 
-    from safebasins.pipeline.plan import ResolveContext
+    from safebasins.pipeline.registry import ResolveContext
     from safebasins.pipeline.validation import CheckContext
 
 POSITIVE = {"type": "number", "exclusiveMinimum": 0}
