@@ -565,7 +565,8 @@ def cuda_device() -> SimpleNamespace:
     if not cuda_config.ENABLE_CUDASIM:
         from numba.cuda import libdevice  # noqa: PLC0415  (as numba.cuda; not there under the simulator)
 
-        prims = {"fma": cuda.fma, "mul": libdevice.dmul_rn, "as_bits": libdevice.double_as_longlong,
+        # libdevice's fma (fma.rn.f64): numba-cuda's cuda.fma is a stub, typed only as numba.cuda.fma
+        prims = {"fma": libdevice.fma, "mul": libdevice.dmul_rn, "as_bits": libdevice.double_as_longlong,
                  "from_bits": libdevice.longlong_as_double}
     return compile_code(_MODULES, cuda.jit(device=True), prims)
 
