@@ -3,6 +3,7 @@ Euler-Maruyama, in one process (docs/noise.md).
 
     python benchmarks/bench_noise.py            # quick: 4096 paths x 200 cycles x 32 steps
     python benchmarks/bench_noise.py --full     # 16384 paths x 400 cycles
+    python benchmarks/bench_noise.py --gpu      # the CUDA backend only (skipped without a CUDA GPU)
 
 Trajectory-steps per second on one thread, five interleaved rounds (the best of each is kept), for the quartic
 at F = 0.02, Omega = 0.8, ICs near the bottom of the well (nothing escapes: every trajectory runs
@@ -19,11 +20,26 @@ Omega = 1.3, two cycles; closed-form Gaussian moments) the exact moments of both
 from their linear recursions; the steps per cycle Euler-Maruyama needs for the splitting's error
 in Var p at 32 steps per cycle, times the per-step speed ratio, is the time ratio at equal weak
 accuracy.
+
+--gpu (numerics.cuda_noise on a CUDA GPU; numba-cuda 0.30.4 with numpy >= 2.5 needs
+``numpy.row_stack = numpy.vstack`` in a sitecustomize.py, bench_gpu.py):
+
+* bitwise: escape steps of the GPU and the CPU lanes (all threads) for every path of three
+  ensembles with escapes at t = 0, later and never: the quartic at Fig 21's forcing under white
+  noise; the quartic, damped, coloured noise, RK4; the pendulum, damped, white noise (its force
+  and energy call wells.elementary's sin and cos);
+* speed: the dense job above (nothing escapes) on the GPU, noisy kernel against the deterministic
+  engine's kernel (cuda_engine) and the CPU lanes on every core;
+* PTX of the quartic's kernel: f64 instruction counts and the plain (contractible) ``mul.f64``
+  whose result feeds an add or subtract, except exact scalings by a power of two (must be 0;
+  ``mul.rn.f64``, wells.compiled.mul, is never contracted).
 """
 from __future__ import annotations
 
 import argparse
+import collections
 import math
+import re
 import time
 
 import numba
@@ -34,7 +50,9 @@ from _report import machine, report
 
 from scipy.integrate import solve_ivp
 
-from safebasins.numerics import escape_chart, noise_kernels, schemes
+from safebasins.numerics import engine, escape_chart, noise_kernels, schemes
+from safebasins.numerics.noise import energy_shift
+from safebasins.numerics.problem import ensemble_problem
 from safebasins.numerics.scheme_code import scheme_code
 from safebasins.wells.compiled import polynomial_code, quartic_code
 
@@ -126,10 +144,129 @@ def equal_accuracy_steps(S_split=32):
     return target, hi
 
 
+def _noisy_args(q0, p0, paths, F, Omega, Psi, xi, cycles, sigma, *, tau=0.0, well=None, damping=0.0,
+                integrator="srkn6b", seed=3):
+    """(args, keywords) of noise_kernels.escape_steps / cuda_noise.escape_steps, as escape_probability forms them."""
+    pb = ensemble_problem(q0, p0, np.zeros(q0.size, np.int64), [Omega], [F], Psi, xi_max=[xi], cycles=cycles,
+                          steps_per_cycle=S, integrator=integrator, well=well, damping=damping)
+    h = float(pb.step_sizes()[0])
+    args = (pb.code, pb.scheme, q0, p0, paths, pb.coefficients(), pb.sine_table(), F, float(pb.thrE2[0]), cycles,
+            noise_kernels.step_noise(sigma, h, tau), seed)
+    return args, dict(shift=energy_shift(sigma, h, "shift", tau))
+
+
+def _grid(qa, pa):
+    Q, P = np.meshgrid(qa, pa, indexing="ij")
+    return Q.ravel(), P.ravel()
+
+
+def contractible_pairs(ptx):
+    """(f64 instruction counts of PTX text, plain mul.f64 results feeding an add/sub, those of them
+    that scale by a power-of-two immediate).  A plain mul.f64 may be contracted with the add by
+    ptxas; a product by a power of two is exact (short of underflow), so contracting it cannot
+    change a result (the 53-bit uniforms' 2^-53, Payne-Hanek's 2^-48 and 2^-96); any other pair
+    could round differently from the CPU."""
+    ops, plain, exact, uses = collections.Counter(), set(), set(), []
+    for line in ptx.splitlines():
+        m = re.match(r"\s*((?:fma|mul|add|sub)\.[\w.]*f64)\s+(%fd\d+),\s*(.*);", line)
+        if m:
+            op, dst, srcs = m.groups()
+            ops[op] += 1
+            if op == "mul.f64":
+                plain.add(dst)
+                if any(int(x, 16) & (2 ** 52 - 1) == 0 for x in re.findall(r"0d([0-9A-Fa-f]{16})", srcs)):
+                    exact.add(dst)
+            elif op.startswith(("add", "sub")):
+                uses.extend(re.findall(r"%fd\d+", srcs))
+    return dict(ops), sum(u in plain for u in uses), sum(u in exact for u in uses)
+
+
+def gpu_section():
+    """The CUDA backend against the CPU lanes (module docstring)."""
+    if engine.resolve_backend("auto") != "cuda":
+        print("--gpu: skipped: no CUDA GPU (numba-cuda sees none)")
+        return
+    from numba import cuda  # noqa: PLC0415  (numba.cuda only where a GPU is there: its import costs ~1 s)
+
+    from safebasins.numerics import cuda_engine, cuda_noise  # noqa: PLC0415  (they import numba.cuda)
+    dev = cuda.get_current_device()
+    name = dev.name.decode() if isinstance(dev.name, bytes) else str(dev.name)
+    print(f"machine: {machine()}; GPU {name} ({dev.MULTIPROCESSOR_COUNT} SMs); numba threads "
+          f"{numba.get_num_threads()}", flush=True)
+    jobs = [
+        ("quartic, Fig 21 forcing, white noise", _grid(np.linspace(-1, 1, 48), np.linspace(-0.75, 0.75, 48)),
+         dict(paths=32, F=0.0876, Omega=0.95, Psi=math.pi, xi=0.25, cycles=30, sigma=0.02)),
+        ("quartic, damped, coloured noise, RK4", _grid(np.linspace(-1, 1, 48), np.linspace(-0.75, 0.75, 48)),
+         dict(paths=32, F=0.06, Omega=0.9, Psi=0.3, xi=0.2, cycles=30, sigma=0.05, tau=2.0, damping=0.05,
+              integrator="rk4")),
+        ("pendulum, damped, white noise", _grid(np.linspace(-3, 3, 32), np.linspace(-2, 2, 32)),
+         dict(paths=32, F=0.2, Omega=0.9, Psi=0.4, xi=1.0, cycles=20, sigma=0.1, well="pendulum", damping=0.05)),
+    ]
+    for title, (q0, p0), kw in jobs:
+        args, skw = _noisy_args(q0, p0, **kw)
+        t = time.perf_counter()
+        cpu = noise_kernels.escape_steps(*args, **skw, n_tasks=numba.get_num_threads())
+        t_cpu = time.perf_counter() - t
+        t = time.perf_counter()
+        tm = {}
+        gpu = cuda_noise.escape_steps(*args, **skw, timing=tm)
+        t_gpu = time.perf_counter() - t
+        print(f"bitwise, {title}: {q0.size} ICs x {kw['paths']} paths x {kw['cycles']} cycles: "
+              f"{int((cpu != gpu).sum())} of {cpu.size} escape steps differ; escaped at t = 0 {int((cpu == 0).sum())}, "
+              f"later {int((cpu > 0).sum())}, never {int((cpu < 0).sum())} (first calls, compile included: CPU "
+              f"{t_cpu:.1f} s, GPU {t_gpu:.1f} s, kernel {tm['kernel_s']:.3f} s)", flush=True)
+
+    # speed: the dense job (nothing escapes), 4096 ICs x 32 paths
+    rng = np.random.default_rng(1)
+    n_ic, paths, cycles = 4096, 32, 500
+    q0, p0 = rng.uniform(-0.05, 0.05, n_ic), rng.uniform(-0.05, 0.05, n_ic)
+    args, skw = _noisy_args(q0, p0, paths, F, OMEGA, PSI, XI, cycles, SIGMA)
+    runs = []
+    for _ in range(3):
+        tm = {}
+        out = cuda_noise.escape_steps(*args, **skw, timing=tm)
+        runs.append(tm["kernel_s"])
+    steps = int(np.where(out < 0, cycles * S, out).sum())      # a few paths escape over the long horizon
+    det_steps = n_ic * paths * cycles * S
+    qd, pd = np.repeat(q0, paths), np.repeat(p0, paths)
+    det = ensemble_problem(qd, pd, np.zeros(qd.size, np.int64), [OMEGA], [F], PSI, xi_max=[XI], cycles=cycles,
+                           steps_per_cycle=S)
+    druns = []
+    for _ in range(3):
+        tm = {}
+        dE, _ = cuda_engine.run_cuda(det, timing=tm)
+        druns.append(tm["kernel_s"])
+    assert (dE < 0).all(), "a deterministic trajectory escaped: steps not exact"
+    sub = 256                                # the CPU lanes on every core, 256 of the ICs
+    cargs, _ = _noisy_args(q0[:sub], p0[:sub], paths, F, OMEGA, PSI, XI, cycles, SIGMA)
+    t = time.perf_counter()
+    cout = noise_kernels.escape_steps(*cargs, **skw, n_tasks=numba.get_num_threads())
+    r_cpu = int(np.where(cout < 0, cycles * S, cout).sum()) / (time.perf_counter() - t)
+    r_gpu, r_det = steps / min(runs), det_steps / min(druns)
+    print(f"speed, dense quartic job {n_ic} ICs x {paths} paths x {cycles} cycles x {S} steps: GPU noisy "
+          f"{r_gpu:.3e} trajectory-steps/s (kernel {min(runs):.3f} s), GPU deterministic engine {r_det:.3e} "
+          f"(kernel {min(druns):.3f} s): noisy / deterministic = {r_gpu / r_det:.3f}; CPU noisy lanes "
+          f"({numba.get_num_threads()} threads) {r_cpu:.3e}: GPU / CPU = {r_gpu / r_cpu:.1f}; "
+          f"{int((out >= 0).sum())} of {out.size} noisy paths escaped (steps counted to escape)", flush=True)
+    report("noise_gpu_vs_deterministic_gpu", round(r_gpu / r_det, 3),
+           f"noisy / deterministic trajectory-steps per second on the GPU ({name})",
+           f"{n_ic} ICs x {paths} paths x {cycles} cycles x {S} steps")
+
+    code, sc = quartic_code(), scheme_code("srkn6b")
+    asm = cuda_noise.noise_kernel(code.key, sc.key).inspect_asm()
+    ops, pairs, exact = contractible_pairs(next(iter(asm.values())) if isinstance(asm, dict) else asm)
+    print(f"PTX of the quartic's noisy kernel: {ops}; plain mul.f64 feeding an add/sub: {pairs}, of which {exact} "
+          f"exact scalings by a power of two (the others, {pairs - exact}, must be 0)")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--full", action="store_true")
+    ap.add_argument("--gpu", action="store_true", help="the CUDA backend only (skipped without a CUDA GPU)")
     args = ap.parse_args()
+    if args.gpu:
+        gpu_section()
+        return
     n, cycles = (16384, 400) if args.full else (4096, 200)
     numba.set_num_threads(1)
     rng = np.random.default_rng(1)
