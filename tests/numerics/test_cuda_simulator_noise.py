@@ -9,7 +9,8 @@ coloured noise, undamped and damped, the quartic (|q| tracking) and the pendulum
 tracking; its force and energy call wells.elementary's sin and cos), SRKN6b and RK4, a seed above
 2^32 (both words of the Philox key), a displacement bound pair; in every case some paths escape at
 the initial condition, some later and some not within the horizon.  Few initial conditions,
-paths and cycles of 8 steps: the simulator runs every operation as Python.
+paths and cycles of 8 steps, few simulator threads (each takes several trajectories): the
+simulator runs every operation as Python, every thread as a Python thread.
 """
 from __future__ import annotations
 
@@ -17,6 +18,7 @@ import json
 import math
 import os
 import pickle
+import re
 import subprocess
 import sys
 import time
@@ -30,6 +32,7 @@ from safebasins.numerics import noise_kernels, steps
 from safebasins.numerics.noise import energy_shift, escape_probability
 from safebasins.numerics.problem import ensemble_problem
 from safebasins.wells.compiled import fma
+from tests.numerics.test_cuda_optional import INSTALL, without_numba_cuda  # noqa: F401  (a fixture)
 
 ROOT = Path(__file__).resolve().parents[2]
 STEPS = 8          # steps per forcing cycle
@@ -55,7 +58,7 @@ def _cases() -> dict[str, dict[str, Any]]:
         "quartic/coloured": dict(quartic, noise=0.05, noise_time=1.5, seed=11),
         "quartic/coloured/damped/rk4": dict(quartic, noise=0.08, noise_time=1.0, damping=0.05, integrator="rk4",
                                             seed=5),
-        "quartic/white/bounds": dict(quartic, noise=0.05, bounds=[-0.7, 0.6], seed=3, block=4),
+        "quartic/white/bounds": dict(quartic, noise=0.05, bounds=[-0.7, 0.6], seed=3, block=2, grid=2),
         "pendulum/white": dict(pendulum, noise=0.2, seed=1),
         "pendulum/coloured/damped": dict(pendulum, noise=0.3, noise_time=1.2, damping=0.1, seed=9),
     }
@@ -114,7 +117,7 @@ def child() -> None:
     for name, case in job["cases"].items():
         args, kw = _arguments(case)
         t = time.perf_counter()
-        steps = cuda_noise.escape_steps(*args, **kw, block=case.get("block", 8), grid=2)
+        steps = cuda_noise.escape_steps(*args, **kw, block=case.get("block", 4), grid=case.get("grid", 1))
         out[name] = dict(steps=steps.tolist(), dtype=str(steps.dtype), seconds=round(time.perf_counter() - t, 2))
     ds = escape_probability(**API, backend="cuda")
     Path(job["api"]).write_bytes(pickle.dumps(ds))
@@ -179,6 +182,13 @@ def test_cuda_backend_without_a_gpu_is_an_explicit_error() -> None:
         escape_probability(**API, backend="cuda")
     xr.testing.assert_identical(_without_call(escape_probability(**API, backend="auto")),
                                 _without_call(escape_probability(**API, backend="cpu")))
+
+
+def test_cuda_without_numba_cuda_names_the_extra(without_numba_cuda: None) -> None:
+    import pytest
+
+    with pytest.raises(ImportError, match=re.escape(INSTALL)):
+        escape_probability(**API, backend="cuda")
 
 
 if __name__ == "__main__":

@@ -50,6 +50,10 @@ __all__ = ["escape_steps", "noise_kernel"]
 
 _ONE = np.uint64(1)
 _ZERO = np.uint64(0)
+#: threads per block and blocks under the simulator: it runs every thread as a Python thread
+#: and polls them all from the launching thread, so few threads, each taking many trajectories
+SIMULATOR_BLOCK = 4
+SIMULATOR_GRID = 1
 
 
 def _device(fn: Callable[..., Any]) -> Any:
@@ -161,8 +165,8 @@ def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
     """noise_kernels.escape_steps on the GPU (the same arguments and result, bitwise): first steps
     beyond the thresholds, shape (len(q0), n_paths), int64.
 
-    block, grid: threads per block (default 128, the simulator 32) and blocks (default: as many as
-    stay resident, the simulator 2); the result does not depend on them.  timing: a dict to
+    block, grid: threads per block (default 128, the simulator 4) and blocks (default: as many as
+    stay resident, the simulator 1); the result does not depend on them.  timing: a dict to
     receive kernel_s (CUDA events; the simulator: host clock), grid, block.  RuntimeError without
     a CUDA GPU or the simulator (cuda_engine.require_cuda)."""
     cuda_engine.require_cuda()
@@ -173,10 +177,10 @@ def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
     out = np.full(N, -1, np.int64)
     if N:
         blk = (checks.check_positive_int("block", block) if block is not None else
-               (cuda_engine.SIMULATOR_BLOCK if cuda_kernels.SIMULATOR else cuda_kernels.BLOCK))
+               (SIMULATOR_BLOCK if cuda_kernels.SIMULATOR else cuda_kernels.BLOCK))
         kernel = noise_kernel(code.key, scheme.key)
         nblk = (checks.check_positive_int("grid", grid) if grid is not None else
-                cuda_engine.launch_grid(kernel, N, blk, 0))
+                SIMULATOR_GRID if cuda_kernels.SIMULATOR else cuda_engine.launch_grid(kernel, N, blk, 0))
         wp = code.wpar if wpar is None else np.ascontiguousarray(wpar, dtype=float)
         d_out = cuda.to_device(out)
         args = (cuda.to_device(q), cuda.to_device(p), int(n_paths), cuda.to_device(np.ascontiguousarray(coef).ravel()),
