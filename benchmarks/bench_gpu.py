@@ -18,8 +18,8 @@ flags, cores, GPU name and SMs) and
 --wells adds (c): the kernel per compiled well (wells/compiled.py) on the GPU: the dense job
 (F = 0, nothing escapes) in the quartic (|q| tracking; signed tracking with asymmetric bounds),
 the cubic V = q^2/2 - q^3/3 (degree-4 polynomial class), a degree-6 well (degree-8 class) and the
-pendulum (an expression well: libdevice sin/cos on the GPU, glibc on the CPU, so its escape
-steps may differ in rare threshold-grazing trajectories), trajectory-steps/s and the ratio to the
+pendulum (an expression well: sin/cos from wells.elementary, the same bits on both targets; every
+named well: bench_gpu_wells.py), trajectory-steps/s and the ratio to the
 quartic, PTX contractible pairs of each kernel, and a --wells-n x --wells-n cubic chart
 (energy + asymmetric bounds, --wells-cycles cycles) whose escape steps are compared with the CPU
 engine's (must be equal).
@@ -221,7 +221,7 @@ def wells_section(n_dense, cycles, chart_n, chart_cycles, cpu_rows, integrator="
             ("quartic, asymmetric bounds (signed tracking)", None, dict(xi_max=[0.25], q_bounds=[[-0.9, 1.0]])),
             ("cubic (degree-4 class)", CUBIC, dict(xi_max=[1.0 / 6.0], q_bounds=[[-0.5, 1.0]])),
             ("sextic (degree-8 class)", SEXTIC, dict(xi_max=[0.2], q_max=[1.0])),
-            ("pendulum (expression, libdevice vs glibc sin/cos)", PENDULUM, dict(xi_max=[1.9], q_max=[3.0]))]
+            ("pendulum (expression, wells.elementary sin/cos)", PENDULUM, dict(xi_max=[1.9], q_max=[3.0]))]
     out = dict(integrator=integrator, n=n_dense, cycles=cycles, steps_per_cycle=S, dense={}, ptx=[])
     steps_n = n_dense * cycles * S
     for name, well, thr in jobs:
