@@ -17,18 +17,21 @@ extras          beyond the paper: erosion, phase-invariant basin, first harmonic
 captions        report captions with numbers read from the data
 notebooks       the papermill notebook of a figure (scripts/make_notebooks.py, rule figure_notebook)
 """
+from __future__ import annotations
+
 import importlib
+from typing import Any
 
 __all__ = ["plot_escape_chart", "plot_basin", "plot_fcr", "plot_integrity_map", "save_figure", "MissingData"]
 _HOME = {"plot_escape_chart": "api", "plot_basin": "api", "plot_fcr": "api", "plot_integrity_map": "api",
          "save_figure": "style", "MissingData": "data"}
 
 
-def __getattr__(name):  # exported lazily: `import safebasins.plotting.data` stays light (no pyplot)
+def __getattr__(name: str) -> Any:  # exported lazily: `import safebasins.plotting.data` stays light (no pyplot)
     if name in _HOME:
         return getattr(importlib.import_module(f"safebasins.plotting.{_HOME[name]}"), name)
     raise AttributeError(f"module 'safebasins.plotting' has no attribute {name!r}")
 
 
-def __dir__():
+def __dir__() -> list[str]:
     return sorted([*globals(), *__all__])

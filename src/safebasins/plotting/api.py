@@ -11,9 +11,9 @@ with :func:`safebasins.plotting.style.save_figure` to keep the datasets' provena
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import matplotlib.pyplot as plt
-from matplotlib.axes import Axes
-from matplotlib.figure import Figure
 import numpy as np
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
@@ -30,18 +30,29 @@ from safebasins.plotting.basins import draw_ic_basin
 from safebasins.plotting.fcr import (CURVE_COLORS, CURVE_MARKERS, bracket_handle, curve_labels, draw_fcr,
                                      draw_fcr_numeric, ic_text, mechanism_key, mechanism_legend_handles, omega_margins)
 
+if TYPE_CHECKING:
+    from collections.abc import Iterable
+
+    import numpy.typing as npt
+    import xarray as xr
+    from matplotlib.artist import Artist
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Polygon
+    from matplotlib.typing import ColorType
+
 __all__ = ["plot_escape_chart", "plot_basin", "plot_fcr", "plot_integrity_map"]
 
 FORCING = ("F", "Omega", "Psi")
 
 
-def _attrs_text(ds, names):
+def _attrs_text(ds: xr.Dataset, names: Iterable[str]) -> str:
     """``F = 0.01, Omega = 0.9, ...`` of the attributes a dataset has (parameters it does not
     carry are left out, never guessed)."""
     return param_text({k: ds.attrs[k] for k in names if k in ds.attrs})
 
 
-def plot_escape_chart(chart: DataSource, *, t_eval: float | None = None, xi_max: float | None = None,
+def plot_escape_chart(chart: DataSource, *, t_eval: float | None = None, xi_max: npt.ArrayLike | None = None,
                       basin: DataSource | None = None, ax: Axes | None = None) -> Figure:
     """Draw the numeric safe basins of an escape chart, optionally with analytic boundaries.
 
@@ -124,16 +135,17 @@ def plot_escape_chart(chart: DataSource, *, t_eval: float | None = None, xi_max:
     return fig
 
 
-def _stack_dim(basin):
+def _stack_dim(basin: xr.Dataset) -> str | None:
     """The dimension a basin dataset is stacked over (``xi_max``, ``F``), or None."""
-    extra = [d for d in var(basin, "q0_vertex").dims if d != "vertex"]
+    extra = [str(d) for d in var(basin, "q0_vertex").dims if d != "vertex"]
     if len(extra) > 1:
         raise ValueError(f"{source(basin)}: q0_vertex has dimensions {extra} besides 'vertex': select one basin")
     return extra[0] if extra else None
 
 
-def _draw_basin_slice(ax, b, *, color=SB_EDGE, ls="-"):
-    lines = []
+def _draw_basin_slice(ax: Axes, b: xr.Dataset, *, color: ColorType = SB_EDGE,
+                      ls: str = "-") -> list[Line2D | Polygon]:
+    lines: list[Line2D | Polygon] = []
     for xs, ys, _kind in boundary_polylines(b, "q0_vertex", "p0_vertex"):
         lines += plot_curve(ax, xs, ys, color=color, ls=ls, lw=1.8, zorder=6, **IC_LINE)
     return lines
@@ -187,6 +199,7 @@ def plot_basin(basin: DataSource, *, ax: Axes | None = None) -> Figure:
     has_well = "well" in basin.attrs
     damped = float(basin.attrs.get("damping", 0.0)) > 0
     flow = "damped slow flow" if damped else "slow flow"
+    handles: list[Artist]
     if dim is None:
         draw_ic_basin(ax, basin, well=has_well and "xi_max" in basin.attrs)
         handles = [Line2D([], [], color=SB_EDGE, lw=1.8, label="safe-basin boundary (" + (
@@ -222,7 +235,7 @@ def plot_basin(basin: DataSource, *, ax: Axes | None = None) -> Figure:
     return fig
 
 
-def _curves(ds):
+def _curves(ds: xr.Dataset | None) -> list[xr.Dataset]:
     if ds is None:
         return []
     return [ds.isel(curve=i) for i in range(ds.sizes["curve"])] if "curve" in ds.dims else [ds]
@@ -264,25 +277,28 @@ def plot_fcr(analytic: DataSource | None = None, numeric: DataSource | None = No
     >>> fig = plot_fcr(ana, num)
     """
     analytic, numeric = open_dataset(analytic), open_dataset(numeric)
-    if analytic is None and numeric is None:
+    ref = analytic if analytic is not None else numeric
+    if ref is None:
         raise ValueError("give at least one of analytic (theory.critical_forcing) and numeric "
                          "(numerics.critical_forcing_numeric)")
     for ds in (analytic, numeric):
-        for name in ("F_cr", "Omega") if ds is not None else ():
-            var(ds, name)
+        if ds is not None:
+            for name in ("F_cr", "Omega"):
+                var(ds, name)
     own = ax is None
     fig, ax = new_axes(ax, figsize=(6.6, 4.8))
     data.attach(fig, analytic, numeric)
-    ref = analytic if analytic is not None else numeric
     labels, const = curve_labels(ref.expand_dims("curve") if "curve" not in ref.dims else ref)
     several = "curve" in ref.dims and ref.sizes["curve"] > 1
     colors = CURVE_COLORS if several else ["k"]
-    handles, texts, mechs = [], [], set()
+    handles: list[Artist | tuple[Artist, ...]] = []
+    texts: list[str] = []
+    mechs: set[int] = set()
     if analytic is not None:
         mechs, _ = draw_fcr(ax, analytic, color_by="curve" if several else "mechanism", colors=colors, legend=False)
         hs = mechanism_legend_handles(mechs, by_mechanism_color=not several)
         handles += hs
-        texts += [h.get_label() for h in hs]
+        texts += [str(h.get_label()) for h in hs]
     n_bracket = 0
     nums = _curves(numeric)
     for i, b in enumerate(nums):
@@ -295,7 +311,7 @@ def plot_fcr(analytic: DataSource | None = None, numeric: DataSource | None = No
                           marker=CURVE_MARKERS[i % len(CURVE_MARKERS)] if nums else None) for i in
                    range(len(labels))] + handles
         texts = list(labels) + texts
-    if nums:
+    if nums and numeric is not None:
         cyc = f" ({fmt_value(numeric.attrs['cycles'])} EC)" if "cycles" in numeric.attrs else ""
         handles.append(Line2D([], [], ls="none", marker="o", mfc="k" if several else "tab:orange", mec="k", ms=5))
         texts.append("numeric bisection" + cyc)

@@ -7,13 +7,11 @@ to a netCDF file holding it).  The caption sentences are computed from it (:func
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import matplotlib.pyplot as plt
 import numpy as np
-import xarray as xr
 from matplotlib.colors import ListedColormap
-from matplotlib.figure import Figure
 
 from safebasins.analysis.basin_measures import PUY_BIAS
 from safebasins.analysis.boundary_measures import WADA_FLAGS
@@ -21,12 +19,19 @@ from safebasins.plotting.captions import add_note
 from safebasins.plotting.data import open_dataset, param, var
 from safebasins.plotting.style import LABELS, param_text
 
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
+
+    from safebasins.plotting.data import DataSource
+
 __all__ = ["figure_basin_measures"]
 
 #: escaped white, then one colour per attractor
 BASIN_COLOURS = ["white", "#4a7fb5", "#e08a3c", "#5aa469", "#b65fa0", "#8c8c8c"]
-LABELLING_STYLE = {"escape": dict(color="black", marker="o"), "attractors": dict(color="tab:red", marker="s")}
-MELNIKOV_STYLE = dict(color="0.3", ls="--", lw=1.0)
+LABELLING_STYLE: dict[str, dict[str, Any]] = {"escape": dict(color="black", marker="o"),
+                                               "attractors": dict(color="tab:red", marker="s")}
+MELNIKOV_STYLE: dict[str, Any] = dict(color="0.3", ls="--", lw=1.0)
 
 
 def _decision(ds: xr.Dataset, k: int) -> str:
@@ -34,7 +39,7 @@ def _decision(ds: xr.Dataset, k: int) -> str:
     return {1: "Wada", 0: "not Wada", -1: "no Wada test"}[flag]
 
 
-def figure_basin_measures(measures: Any, *, title: str | None = None) -> Figure:
+def figure_basin_measures(measures: DataSource, *, title: str | None = None) -> Figure:
     """Top: the basins at each F (white: escaped; colours: the attractors); bottom: (left) the
     fractal test's S_bb +- its standard error for the escape and the attractor labellings against
     the smooth-boundary band and log 2, (right) the uncertainty exponent alpha +- its error, alpha

@@ -10,6 +10,7 @@ Reads ``basin_<experiment>.nc`` datasets (docs/contracts.md): boundary vertices 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -25,6 +26,17 @@ from safebasins.plotting.data import open_dataset, param, var
 from safebasins.plotting.style import LABELS, SB_EDGE, SB_FACE, TRUNC_COLOR, fmt_value, param_text, pi_ticks
 from safebasins.analysis.safe import is_safe
 
+if TYPE_CHECKING:
+    from collections.abc import Collection, Iterable, Sequence
+
+    import numpy.typing as npt
+    import xarray as xr
+    from matplotlib.artist import Artist
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from safebasins.plotting.data import DataSource
+
 UNCONFIRMED_COLOR = "tab:orange"  # analytic-safe ICs the numerics do not keep (hatched)
 UNCONFIRMED_EDGE = "#a04000"      # boundary of a part not confirmed (dotted; darker: visible on the hatch)
 #: one rule for Figs 5-9: a connected part of the analytic basin is confirmed when at least this
@@ -38,13 +50,13 @@ BEYOND_COLOR = "0.93"  # xi above the barrier energy: no orbit of the well
 class Check:
     """What the stored numeric check says about the analytic basin (:func:`numeric_check`)."""
     cycles: float
-    regions: list                                  # [(size, kept fraction), ...], part 1 = largest
-    refuted: list                                  # part numbers (1-based) below CONFIRMED_FROM
-    escaping: object                               # bool DataArray (q0, p0): analytic safe, numerics escape
-    curves: set = field(default_factory=set)       # boundary curves that border refuted parts only
+    regions: list[tuple[int, float]]               # [(size, kept fraction), ...], part 1 = largest
+    refuted: list[int]                             # part numbers (1-based) below CONFIRMED_FROM
+    escaping: xr.DataArray                         # bool (q0, p0): analytic safe, numerics escape
+    curves: set[int] = field(default_factory=set)  # boundary curves that border refuted parts only
 
 
-def numeric_check(ds):
+def numeric_check(ds: xr.Dataset) -> Check | None:
     """The numeric check of a basin dataset, or None where it has none (no ``region``).
 
     A part whose kept fraction is below :data:`CONFIRMED_FROM` is *refuted*; its boundary
@@ -73,7 +85,7 @@ def numeric_check(ds):
     return out
 
 
-def unconfirmed_parts(ds):
+def unconfirmed_parts(ds: xr.Dataset) -> tuple[set[int], xr.DataArray | None, list[tuple[int, float]]]:
     """``(refuted boundary curves, mask of the refuted parts or None, [(size, kept fraction), ...])``."""
     chk = numeric_check(ds)
     if chk is None:
@@ -82,7 +94,7 @@ def unconfirmed_parts(ds):
 
 
 # ------------------------------------------------------------------ the resonance manifold (left panel)
-def cut_width(ds):
+def cut_width(ds: xr.Dataset) -> float:
     """How far the gamma window must reach beyond +-pi so that no safe part crossing the cut
     gamma = +-pi of the cylinder is drawn in two halves (0 when none does).  A part touching
     both edges of the -pi..pi window (a band around the cylinder) needs nothing."""
@@ -98,7 +110,8 @@ def cut_width(ds):
     return min(width, np.pi / 2)
 
 
-def _periodic_window(g, arrays, w):
+def _periodic_window(g: npt.NDArray[np.float64], arrays: Sequence[npt.NDArray[Any]],
+                     w: float) -> tuple[npt.NDArray[np.float64], list[npt.NDArray[Any]]]:
     """Periodic gamma columns (axis 1 of ``arrays``, gamma from -pi) over [-pi - w, pi + w]."""
     n = g.size - 1 if np.isclose(g[-1] - g[0], 2 * np.pi) else g.size  # drop a duplicated end point
     gg, aa = g[:n], [a[:, :n] for a in arrays]
@@ -107,7 +120,8 @@ def _periodic_window(g, arrays, w):
             [np.concatenate([a[:, lo], a, a[:, hi]], axis=1) for a in aa])
 
 
-def draw_rm_portrait(ax, ds, *, n_levels=24, show_saddle=True, unconfirmed=()):
+def draw_rm_portrait(ax: Axes, ds: xr.Dataset, *, n_levels: int = 24, show_saddle: bool = True,
+                     unconfirmed: Collection[int] = ()) -> float:
     """Left panel of Figs 5-9: level curves of C on (gamma, xi), truncation level dashed, safe
     basin grey with red boundary.  The gamma window is -pi..pi, widened just enough that a part
     cut by gamma = +-pi is drawn whole (:func:`cut_width`; the cut marked by dotted verticals).
@@ -131,7 +145,8 @@ def draw_rm_portrait(ax, ds, *, n_levels=24, show_saddle=True, unconfirmed=()):
     shifts = (-2 * np.pi, 0.0, 2 * np.pi) if w > 0 else (0.0,)
     for k, (xs, ys, _kind) in enumerate(boundary_polylines(ds, "gamma", "xi")):
         xs, ys = break_wraps((xs + np.pi) % (2 * np.pi) - np.pi, ys)
-        st = dict(color=UNCONFIRMED_EDGE, lw=1.6, ls=":") if k in unconfirmed else dict(color=SB_EDGE, lw=1.8)
+        st: dict[str, Any] = (dict(color=UNCONFIRMED_EDGE, lw=1.6, ls=":") if k in unconfirmed
+                              else dict(color=SB_EDGE, lw=1.8))
         for s in shifts:
             ax.plot(xs + s, ys, zorder=6, **st)
     ax.axhline(xi_max, color=TRUNC_COLOR, ls="--", lw=2.2, zorder=7)
@@ -158,7 +173,8 @@ def draw_rm_portrait(ax, ds, *, n_levels=24, show_saddle=True, unconfirmed=()):
 
 
 # ------------------------------------------------------------------ the IC plane (right panel; plot_basin)
-def draw_ic_basin(ax, ds, *, well=True, unconfirmed=(), escaping=None):
+def draw_ic_basin(ax: Axes, ds: xr.Dataset, *, well: bool = True, unconfirmed: Collection[int] = (),
+                  escaping: xr.DataArray | None = None) -> None:
     """The analytic safe basin of one basin dataset on (q0, p0): grey where ``escapes`` is False
     (when the dataset has the mask), boundary curves red, the well edge dashed.  Curves in
     ``unconfirmed`` are dotted (UNCONFIRMED_EDGE) and the ICs of ``escaping`` (analytic safe,
@@ -184,8 +200,8 @@ def draw_ic_basin(ax, ds, *, well=True, unconfirmed=(), escaping=None):
     ax.set_ylabel(LABELS["p0"])
 
 
-def _basin_legend_handles(xi_max=None, *, saddle=False):
-    h = [Patch(facecolor=SB_FACE, edgecolor=SB_EDGE, lw=1.5, label="safe basin (theory)")]
+def _basin_legend_handles(xi_max: float | None = None, *, saddle: bool = False) -> list[Artist]:
+    h: list[Artist] = [Patch(facecolor=SB_FACE, edgecolor=SB_EDGE, lw=1.5, label="safe basin (theory)")]
     if xi_max is not None:
         h.append(Line2D([], [], color=TRUNC_COLOR, ls="--", lw=2.2,
                         label=rf"truncation $\xi = \xi_{{max}}$ = {fmt_value(xi_max)}"))
@@ -195,7 +211,7 @@ def _basin_legend_handles(xi_max=None, *, saddle=False):
     return h
 
 
-def basin_kinds(ds, skip=(), only=None):
+def basin_kinds(ds: xr.Dataset, skip: Collection[int] = (), only: Collection[int] | None = None) -> list[str]:
     """Kinds of the boundary curves (those in ``skip`` left out; with ``only``, just those)."""
     return sorted({str(k) for i, k in enumerate(np.asarray(var(ds, "kind")))
                    if str(k) and i not in skip and (only is None or i in only)})
@@ -206,11 +222,12 @@ PAPER_TYPES = {"island": "maximum type (SBMT), island", "peninsula": "maximum ty
                "saddle": "saddle type (SBST)"}
 
 
-def _types(kinds):
+def _types(kinds: Iterable[str]) -> str:
     return " + ".join(PAPER_TYPES.get(k, k) for k in kinds)
 
 
-def figure_rm_basin(analytic, *, title=None, figsize=(11.5, 4.6)):
+def figure_rm_basin(analytic: DataSource, *, title: str | None = None,
+                    figsize: tuple[float, float] = (11.5, 4.6)) -> Figure:
     """Figs 5-9: (left) RM portrait with SB, (right) SB on the IC plane.  With a numeric check
     in the dataset, the analytic-safe ICs that escape in the numerics are hatched and the parts
     that fewer than CONFIRMED_FROM of their ICs survive are drawn dotted (one rule for Figs 5-9)."""
@@ -230,7 +247,7 @@ def figure_rm_basin(analytic, *, title=None, figsize=(11.5, 4.6)):
         h1.append(Patch(facecolor=BEYOND_COLOR, label=rf"$\xi$ > {fmt_value(E_b)}: above the barrier energy"))
     if widened:
         h1.append(Line2D([], [], color="0.3", ls=":", lw=0.8, label=r"$\gamma = \pm\pi$: one line of the cylinder"))
-    h2 = [Patch(facecolor=SB_FACE, edgecolor=SB_EDGE, lw=1.5, label="safe basin (theory)"),
+    h2: list[Artist] = [Patch(facecolor=SB_FACE, edgecolor=SB_EDGE, lw=1.5, label="safe basin (theory)"),
           Line2D([], [], color="0.35", ls=(0, (4, 2)), lw=0.9, label=r"well edge $H_0 = \xi_{max}$")]
     if chk is not None:
         cyc = fmt_value(chk.cycles)
@@ -254,9 +271,9 @@ def figure_rm_basin(analytic, *, title=None, figsize=(11.5, 4.6)):
     return fig
 
 
-def _parts_text(chk):
+def _parts_text(chk: Check) -> list[str]:
     """Each part of the basin with its size and kept fraction; beyond three, the rest summed."""
-    def one(i, n, f):
+    def one(i: int, n: int, f: float) -> str:
         verdict = "confirmed" if f >= CONFIRMED_FROM else "not confirmed"
         return f"part {i + 1}: {n:,} ICs, {100 * f:.1f}% stay ({verdict})"
 
@@ -276,7 +293,8 @@ def _parts_text(chk):
     return shown
 
 
-def _rm_notes(fig, ds, kinds, refuted, chk, widened):
+def _rm_notes(fig: Figure, ds: xr.Dataset, kinds: Sequence[str], refuted: Sequence[str], chk: Check | None,
+              widened: float) -> None:
     """Caption notes of Figs 5-9, read from the basin dataset."""
     all_kinds = [str(k) for k in np.asarray(var(ds, "kind"))]
     sg, sx = float(param(ds, "saddle_gamma")), float(param(ds, "saddle_xi"))
@@ -304,7 +322,7 @@ def _rm_notes(fig, ds, kinds, refuted, chk, widened):
                       "the strips beyond ±π repeat the other end of the cylinder.")
 
 
-def _refuted_note(fig, ds, chk):
+def _refuted_note(fig: Figure, ds: xr.Dataset, chk: Check) -> None:
     """Where the refuted boundary curves lie on the manifold; near the separatrix, why."""
     idx = np.asarray(var(ds, "curve_index"), float)
     x = np.asarray(var(ds, "xi"), float)

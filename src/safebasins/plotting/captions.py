@@ -11,33 +11,43 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING, SupportsInt
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable, Sequence
+
+    import numpy.typing as npt
+    from matplotlib.figure import Figure
+
+    from safebasins.plotting.data import DataItem, DataItems
 
 __all__ = ["add_note", "notes", "caption_rst", "write_caption", "count", "fmt_range"]
 
 _ATTR = "_safebasins_notes"
 
 
-def add_note(fig, text):
-    """Attach one sentence about the data to a Figure (shown in its report caption)."""
+def add_note(fig: Figure, text: str | None) -> Figure:
+    """Attach one sentence about the data to a Figure (shown in its report caption; None: nothing)."""
     if text:
-        getattr(fig, _ATTR, None) or setattr(fig, _ATTR, [])
+        if not getattr(fig, _ATTR, None):
+            setattr(fig, _ATTR, [])
         getattr(fig, _ATTR).append(str(text).strip())
     return fig
 
 
-def notes(fig) -> list[str]:
+def notes(fig: Figure) -> list[str]:
     return list(getattr(fig, _ATTR, None) or [])
 
 
-def count(n, one, many=None):
+def count(n: SupportsInt, one: str, many: str | None = None) -> str:
     """``count(3, "orbit")`` -> ``"3 orbits"``."""
     n = int(n)
     return f"{n:,} {one if n == 1 else (many or one + 's')}"
 
 
-def fmt_range(values, fmt="{:.4g}"):
+def fmt_range(values: npt.ArrayLike, fmt: str = "{:.4g}") -> str:
     """``"a-b"`` of the finite values (one value: ``"a"``)."""
     v = np.asarray(values, float).ravel()
     v = v[np.isfinite(v)]
@@ -47,20 +57,25 @@ def fmt_range(values, fmt="{:.4g}"):
     return lo if lo == hi else f"{lo}-{hi}"
 
 
-def _rst_escape(text):
+def _rst_escape(text: str) -> str:
     return text.replace("*", r"\*").replace("`", r"\`").replace("|", r"\|")
 
 
-def caption_rst(*, label, look, paper=None, shows=None, data_notes=(), notebook=None, datasets=()):
+def caption_rst(*, label: str, look: str, paper: str | None = None, shows: str | None = None,
+                data_notes: Sequence[str] = (), notebook: str | os.PathLike[str] | None = None,
+                datasets: Iterable[str | os.PathLike[str] | None] = ()) -> str:
     """The report caption (reStructuredText inside a Jinja2 ``raw`` block).
 
     label : "Fig. 18" (report label); paper : the paper's caption (quoted), or shows : what a
     figure beyond the paper shows (exactly one of the two); look : what is drawn; data_notes :
     sentences read from the datasets.
     """
-    if (paper is None) == (shows is None):
+    if paper is not None and shows is None:
+        lead = f"**Paper:** {_rst_escape(paper)}"
+    elif shows is not None and paper is None:
+        lead = f"**Shows:** {_rst_escape(shows)}"
+    else:
         raise ValueError("give exactly one of paper (the paper's caption) and shows (a figure beyond the paper)")
-    lead = f"**Paper:** {_rst_escape(paper)}" if paper is not None else f"**Shows:** {_rst_escape(shows)}"
     parts = [f"{label}. {lead}", f"**Drawn:** {_rst_escape(look)}"]
     if data_notes:
         parts.append("**In our data:**\n\n" + "\n".join(f"- {_rst_escape(n)}" for n in data_notes))
@@ -71,11 +86,13 @@ def caption_rst(*, label, look, paper=None, shows=None, data_notes=(), notebook=
     return "{% raw %}\n" + "\n\n".join(parts) + "\n{% endraw %}\n"
 
 
-def write_caption(path, fig, *, label, look, paper=None, shows=None, notebook=None, datasets=()):
+def write_caption(path: str | os.PathLike[str] | None, fig: Figure, *, label: str, look: str, paper: str | None = None,
+                  shows: str | None = None, notebook: str | os.PathLike[str] | None = None,
+                  datasets: Iterable[DataItems] = ()) -> str | None:
     """Write the caption of ``fig`` (its :func:`notes`) to ``path`` (parent folders created)."""
     if not path:
         return None
-    flat = []
+    flat: list[DataItem] = []
     for d in datasets:
         flat += list(d) if isinstance(d, (list, tuple)) else [d]
     text = caption_rst(label=label, paper=paper, shows=shows, look=look, data_notes=notes(fig), notebook=notebook,

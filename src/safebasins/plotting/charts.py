@@ -7,6 +7,8 @@ Safe basin for a threshold and an evaluation time: :func:`safebasins.analysis.sa
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.legend_handler import HandlerTuple
@@ -22,11 +24,23 @@ from safebasins.plotting import data
 from safebasins.plotting.data import load_params, open_dataset, param, source, var
 from safebasins.plotting.style import LABELS, LAYOUT, SYMBOLS, fmt_value, grey_levels, param_text
 
+if TYPE_CHECKING:
+    import os
+    from collections.abc import Sequence
+
+    import numpy.typing as npt
+    import xarray as xr
+    from matplotlib.artist import Artist
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from safebasins.plotting.data import DataSource
+
 LINE_STYLES = ["-", "--", "-.", ":", (0, (5, 1, 1, 1, 1, 1))]
 THEORY_COLORS = ["tab:red", "tab:blue", "tab:green", "tab:orange", "tab:purple", "tab:brown", "tab:pink"]
 
 
-def resolution(chart) -> str:
+def resolution(chart: xr.Dataset) -> str:
     return f"{chart.sizes['q0']}x{chart.sizes['p0']}"
 
 
@@ -34,10 +48,11 @@ def resolution(chart) -> str:
 # Figs 13-17: nested numeric safe basins, theory boundaries, IoU
 # --------------------------------------------------------------------------------------------
 #: escape-time variable of a chart per criterion and the dimension of its thresholds
-CRITERIA = {"energy": ("escape_cycle_energy", "xi_max"), "displacement": ("escape_cycle_displacement", "q_max")}
+CRITERIA: dict[str, tuple[str, str]] = {"energy": ("escape_cycle_energy", "xi_max"),
+                                         "displacement": ("escape_cycle_displacement", "q_max")}
 
 
-def chart_scan(chart, criterion="energy"):
+def chart_scan(chart: xr.Dataset, criterion: str = "energy") -> str:
     """The scanned parameter of a chart: its attribute ``scan`` (pipeline charts), else ``F`` for
     a chart stacked over F, else the thresholds of the criterion (``xi_max`` / ``q_max``)."""
     if "scan" in chart.attrs:
@@ -50,12 +65,13 @@ def chart_scan(chart, criterion="energy"):
     return "F" if "F" in dims else thr
 
 
-def scan_masks(chart, scan, t_eval, criterion="energy"):
+def scan_masks(chart: xr.Dataset, scan: str, t_eval: float,
+               criterion: str = "energy") -> tuple[npt.NDArray[np.float64], list[xr.DataArray]]:
     """-> (values of the scanned parameter, safe masks over (q0, p0), one per value)."""
     name, _ = CRITERIA[criterion]
     ec = var(chart, name)
     vals = np.atleast_1d(np.asarray(var(chart, scan), float))
-    masks = []
+    masks: list[xr.DataArray] = []
     for i in range(vals.size):
         e = ec.isel({scan: i}) if scan in ec.dims else ec
         # squeeze the other singleton dims (xi_max in an F stack)
@@ -67,14 +83,15 @@ def scan_masks(chart, scan, t_eval, criterion="energy"):
     return vals, masks
 
 
-def draw_nested_safe(ax, masks, *, order=None, greys=None):
+def draw_nested_safe(ax: Axes, masks: Sequence[xr.DataArray], *, order: Sequence[int] | None = None,
+                     greys: Sequence[str] | None = None) -> dict[int, str]:
     """Paint safe masks so that lighter regions include darker ones: the largest basin is
     painted first (lightest), smaller ones on top (darker). Returns {index: grey}."""
     n = len(masks)
     if order is None:
         order = sorted(range(n), key=lambda i: -int(np.asarray(masks[i]).sum()))
     greys = greys or grey_levels(n)
-    shade = {}
+    shade: dict[int, str] = {}
     for rank, i in enumerate(order):
         q, p, Z = xy_grid(masks[i])
         safe_fill(ax, q, p, Z.astype(bool), color=greys[rank], zorder=1 + rank * 0.01)
@@ -82,11 +99,13 @@ def draw_nested_safe(ax, masks, *, order=None, greys=None):
     return shade
 
 
-def theory_slices(basins, scan, vals, *, strict=True):
+def theory_slices(basins: xr.Dataset, scan: str, vals: npt.NDArray[np.float64], *,
+                  strict: bool = True) -> list[xr.Dataset | None]:
     """Slices of a boundary stack matching the numeric parameter values.  ``strict``: a missing
     value is a ValueError (the analytic and numeric datasets of a figure describe the same
     scan); otherwise it is None.  A single basin (not stacked over ``scan``) matches the value
     of its attribute ``scan``."""
+    out: list[xr.Dataset | None]
     if scan not in basins.dims:
         v0 = float(param(basins, scan))
         out = [basins if np.isclose(v0, v, rtol=1e-6, atol=1e-12) else None for v in vals]
@@ -104,7 +123,7 @@ def theory_slices(basins, scan, vals, *, strict=True):
     return out
 
 
-def _resample(xs, ys, n=400):
+def _resample(xs: npt.NDArray[np.float64], ys: npt.NDArray[np.float64], n: int = 400) -> npt.NDArray[np.float64]:
     """Points of a polyline (NaN gaps dropped) resampled to about ``n`` points by arc length."""
     ok = np.isfinite(xs) & np.isfinite(ys)
     x, y = xs[ok], ys[ok]
@@ -115,15 +134,16 @@ def _resample(xs, ys, n=400):
     return np.c_[np.interp(t, d, x), np.interp(t, d, y)]
 
 
-def coincident_groups(curves, tol):
+def coincident_groups(curves: Sequence[tuple[int, npt.ArrayLike, npt.ArrayLike]],
+                      tol: float) -> list[tuple[list[int], float]]:
     """Groups of polylines (``curves``: [(slice, xs, ys), ...]) of different slices that run
     along each other (every point of each within ``tol`` of the other): [([i, j, ...], largest
     distance), ...]."""
     pts = [_resample(np.asarray(x, float), np.asarray(y, float)) for _, x, y in curves]
     parent = list(range(len(curves)))
-    dist = {}
+    dist: dict[int, float] = {}
 
-    def root(i):
+    def root(i: int) -> int:
         while parent[i] != i:
             i = parent[i]
         return i
@@ -137,7 +157,7 @@ def coincident_groups(curves, tol):
                 ri, rj = root(i), root(j)
                 parent[rj] = ri
                 dist[ri] = max(dist.get(ri, 0.0), dist.pop(rj, 0.0), d)
-    groups = {}
+    groups: dict[int, list[int]] = {}
     for i in range(len(curves)):
         groups.setdefault(root(i), []).append(i)
     return [(g, dist.get(r, 0.0)) for r, g in groups.items() if len(g) > 1]
@@ -148,13 +168,14 @@ def coincident_groups(curves, tol):
 COINCIDE_PIXELS = 2.5
 
 
-def basin_damping(ds):
+def basin_damping(ds: xr.Dataset | None) -> float:
     """The damping beta of a dataset (attribute ``damping``; 0 without it: the undamped equation)."""
     return float(ds.attrs.get("damping", 0.0)) if ds is not None else 0.0
 
 
-def draw_nested_chart(ax, chart, *, scan, t_eval, basins=None, criterion="energy", boundary_only=True,
-                      strict=True, show_iou=True):
+def draw_nested_chart(ax: Axes, chart: xr.Dataset, *, scan: str, t_eval: float, basins: xr.Dataset | None = None,
+                      criterion: str = "energy", boundary_only: bool = True, strict: bool = True,
+                      show_iou: bool = True) -> tuple[npt.NDArray[np.float64], list[tuple[list[float], float]]]:
     """Numeric safe basins of a chart nested by ``scan`` (lighter contains darker) with the
     analytic boundaries of ``basins`` (optional) as curves, legend on the right; a damped basin's
     boundaries are the outline of its safe mask (attribute ``boundary = "mask_outline"``,
@@ -167,12 +188,13 @@ def draw_nested_chart(ax, chart, *, scan, t_eval, basins=None, criterion="energy
                          f"basin {basin_damping(basins)} (attribute damping; none = 0)")
     vals, masks = scan_masks(chart, scan, t_eval, criterion)
     shade = draw_nested_safe(ax, masks)
-    theory = theory_slices(basins, scan, vals, strict=strict) if basins is not None else [None] * len(vals)
+    theory: list[xr.Dataset | None] = (theory_slices(basins, scan, vals, strict=strict) if basins is not None
+                                       else [None] * len(vals))
     iou = np.atleast_1d(np.asarray(chart["iou"], float)) if show_iou and "iou" in chart.variables else None
     q = np.asarray(var(chart, "q0"), float)
     p = np.asarray(var(chart, "p0"), float)
     style = {i: (THEORY_COLORS[i % len(THEORY_COLORS)], LINE_STYLES[i % len(LINE_STYLES)]) for i in range(len(vals))}
-    curves = []
+    curves: list[tuple[int, npt.NDArray[np.float64], npt.NDArray[np.float64]]] = []
     for i, th in enumerate(theory):
         if th is None:
             continue
@@ -187,7 +209,7 @@ def draw_nested_chart(ax, chart, *, scan, t_eval, basins=None, criterion="energy
         if k not in grouped:
             col, ls = style[i]
             plot_curve(ax, xs, ys, color=col, ls=ls, lw=1.6, zorder=6)
-    shared = []
+    shared: list[tuple[list[float], float]] = []
     seg = 3.0  # dash length (in line widths): each member draws every n-th segment in its colour
     for g, d in groups:
         members = sorted(g, key=lambda k: vals[curves[k][0]])
@@ -199,7 +221,8 @@ def draw_nested_chart(ax, chart, *, scan, t_eval, basins=None, criterion="energy
         shared.append((sorted({float(vals[curves[k][0]]) for k in members}), d / px if px else 0.0))
     drawn = {i for i, _, _ in curves}
     outline = basins is not None and basin_damping(basins) > 0
-    hs, ls_ = [], []
+    hs: list[Artist | tuple[Artist, ...]] = []
+    ls_: list[str] = []
     for i in np.argsort(vals):  # legend in parameter order
         col, ls = style[i]
         lab = f"{SYMBOLS.get(scan, scan)} = {fmt_value(vals[i])}"
@@ -227,12 +250,14 @@ def draw_nested_chart(ax, chart, *, scan, t_eval, basins=None, criterion="energy
     return vals, shared
 
 
-def agreement_time(chart):
+def agreement_time(chart: xr.Dataset) -> float:
     """The evaluation time of a chart's stored agreement (``agreement_t_eval``), else its horizon."""
     return float(param(chart, "agreement_t_eval") if "agreement_t_eval" in chart.attrs else param(chart, "cycles"))
 
 
-def figure_nested_basins(analytic, numeric, *, title=None, t_eval=None, figsize=(9.6, 5.6), boundary_only=True):
+def figure_nested_basins(analytic: DataSource | None, numeric: DataSource, *, title: str | None = None,
+                         t_eval: float | None = None, figsize: tuple[float, float] = (9.6, 5.6),
+                         boundary_only: bool = True) -> Figure:
     """Figs 13-17: numeric safe basins shaded by the scanned parameter (attribute ``scan``, else
     :func:`chart_scan`: lighter regions include darker ones, white = escape for every value),
     theory boundaries as curves, the stored IoU in the legend.  ``t_eval`` defaults to the
@@ -285,7 +310,8 @@ def figure_nested_basins(analytic, numeric, *, title=None, t_eval=None, figsize=
 # --------------------------------------------------------------------------------------------
 # Fig 19: relative difference of the two escape criteria
 # --------------------------------------------------------------------------------------------
-def figure_criteria(numeric, *, title=None, figsize=(6.4, 4.4)):
+def figure_criteria(numeric: DataSource, *, title: str | None = None,
+                    figsize: tuple[float, float] = (6.4, 4.4)) -> Figure:
     ds = open_dataset(numeric)
     rd = var(ds, "rel_diff").transpose("F", "repeat")
     F = np.asarray(var(ds, "F"), float)
@@ -315,19 +341,19 @@ def figure_criteria(numeric, *, title=None, figsize=(6.4, 4.4)):
 # --------------------------------------------------------------------------------------------
 # Figs 20-22: DSB / ESB charts and area vs t_eval
 # --------------------------------------------------------------------------------------------
-def has_dsb(chart):
+def has_dsb(chart: xr.Dataset) -> bool:
     """Whether a chart has a displacement threshold (a DSB; the energy criterion alone for a well
     other than the quartic, whose escape is over its own barriers)."""
     return "escape_cycle_displacement" in chart.variables and chart.sizes.get("q_max", 0) > 0
 
 
-def chart_thresholds(chart):
+def chart_thresholds(chart: xr.Dataset) -> tuple[float, float | None]:
     """The (first) energy and displacement thresholds of a chart (displacement None without one)."""
     qm = float(np.asarray(var(chart, "q_max")).ravel()[0]) if has_dsb(chart) else None
     return float(np.asarray(var(chart, "xi_max")).ravel()[0]), qm
 
 
-def draw_dsb_esb(ax, chart, t_eval):
+def draw_dsb_esb(ax: Axes, chart: xr.Dataset, t_eval: float) -> None:
     """DSB (displacement criterion) grey, ESB (energy criterion) black on top (the ESB alone for a
     chart without displacement threshold)."""
     esb = var(chart, "escape_cycle_energy").isel(xi_max=0)
@@ -344,19 +370,19 @@ def draw_dsb_esb(ax, chart, t_eval):
     ax.set_title(rf"$t_{{eval}}$ = {t_eval:,.0f} EC")
 
 
-def _t_evals(params, t_evals):
+def _t_evals(params: str | os.PathLike[str], t_evals: npt.ArrayLike | None) -> list[float]:
     """Evaluation times: explicit, else the experiment's parameter file ``t_eval``."""
     vals = load_params(params)["t_eval"] if t_evals is None else t_evals
     return [float(t) for t in np.atleast_1d(vals)]
 
 
-def ec(t):
+def ec(t: float) -> str:
     """A time in forcing cycles for captions: "11,000 EC", "145 EC", "9,697 EC"."""
     t = float(t)
     return f"{t:,.0f} EC" if abs(t) >= 10 or t == round(t) else f"{t:.3g} EC"
 
 
-def _area_curves(chart, t):
+def _area_curves(chart: xr.Dataset, t: npt.ArrayLike) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
     """Safe pixels of the energy (ESB) and displacement (DSB; NaN without one) criteria at
     evaluation times t."""
     area = safe_area(chart, np.asarray(t, float))
@@ -365,21 +391,21 @@ def _area_curves(chart, t):
                 else np.full(nE.shape, np.nan))
 
 
-def _last_escape(chart, name, dim):
+def _last_escape(chart: xr.Dataset, name: str, dim: str) -> float:
     """Latest finite escape time of a criterion on the chart (NaN if nothing escapes)."""
     e = np.asarray(var(chart, name).isel({dim: 0}), float)
     e = e[np.isfinite(e)]
     return float(e.max()) if e.size else np.nan
 
 
-def settle_time(t, n, frac=0.01):
+def settle_time(t: npt.ArrayLike, n: npt.ArrayLike, frac: float = 0.01) -> float:
     """First t from which the area n(t) stays within ``frac`` of its final value."""
     t, n = np.asarray(t, float), np.asarray(n, float)
     off = np.flatnonzero(np.abs(n - n[-1]) > frac * max(n[-1], 1.0))
     return float(t[0]) if not off.size else float(t[min(off[-1] + 1, t.size - 1)])
 
 
-def _esb_notes(fig, chart, t_evals):
+def _esb_notes(fig: Figure, chart: xr.Dataset, t_evals: Sequence[float]) -> None:
     """Caption notes of a chart with the energy criterion only."""
     nE, _ = _area_curves(chart, t_evals)
     esc = np.asarray(var(chart, "escape_cycle_energy").isel(xi_max=0), float)
@@ -391,7 +417,8 @@ def _esb_notes(fig, chart, t_evals):
                   f"{ec(_last_escape(chart, 'escape_cycle_energy', 'xi_max'))}.")
 
 
-def figure_dsb_esb(numeric, params, *, t_evals=None, title=None, figsize=None):
+def figure_dsb_esb(numeric: DataSource, params: str | os.PathLike[str], *, t_evals: npt.ArrayLike | None = None,
+                   title: str | None = None, figsize: tuple[float, float] | None = None) -> Figure:
     """Figs 20-21: DSB grey / ESB black at the first (left) and last (right) t_eval."""
     chart = open_dataset(numeric)
     t_evals = _t_evals(params, t_evals)
@@ -445,7 +472,9 @@ def figure_dsb_esb(numeric, params, *, t_evals=None, title=None, figsize=None):
 PAPER_SHRINK_EC = 2000.0
 
 
-def figure_area_vs_time(numeric, params, *, t_evals=None, title=None, figsize=(11.5, 4.6), n_log=300):
+def figure_area_vs_time(numeric: DataSource, params: str | os.PathLike[str], *, t_evals: npt.ArrayLike | None = None,
+                        title: str | None = None, figsize: tuple[float, float] = (11.5, 4.6),
+                        n_log: int = 300) -> Figure:
     """Fig 22: ln(SB area in pixels) vs t_eval, DSB dashed, ESB solid.  Left, as in the paper: a
     linear time axis with a point per configured t_eval; right: a logarithmic time axis from one
     cycle (so that the early transient shows), the configured t_eval plus ``n_log`` log-spaced

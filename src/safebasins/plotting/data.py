@@ -9,7 +9,8 @@ figure: what the public plotting functions document).
 from __future__ import annotations
 
 import os
-from typing import TypeAlias
+from collections.abc import Iterable, Iterator
+from typing import TYPE_CHECKING, Any, TypeAlias, TypeGuard, overload
 
 import numpy as np
 import xarray as xr
@@ -18,11 +19,31 @@ import yaml
 from safebasins.io.netcdf import read
 from safebasins.wells import NAMED_WELLS, from_attrs
 
+if TYPE_CHECKING:
+    from collections.abc import Mapping
+
+    from matplotlib.figure import Figure
+
+    from safebasins.wells.base import Well
+
 #: what the figure functions read: a dataset, or the path of its netCDF file
 DataSource: TypeAlias = "xr.Dataset | str | os.PathLike[str]"
+#: what a figure is drawn from, for its provenance: a Dataset or DataArray, the path of a netCDF
+#: file or of a parameter file (.yaml, skipped: the datasets hold the parameters), or None
+DataItem: TypeAlias = "xr.Dataset | xr.DataArray | str | os.PathLike[str] | None"
+#: one :data:`DataItem` or a list (tuple) of them (a figure reading several files for one input)
+DataItems: TypeAlias = "DataItem | list[DataItem] | tuple[DataItem, ...]"
 
 
-def open_dataset(src):
+@overload
+def open_dataset(src: None) -> None: ...
+@overload
+def open_dataset(src: xr.DataArray) -> xr.DataArray: ...
+@overload
+def open_dataset(src: DataSource) -> xr.Dataset: ...
+@overload
+def open_dataset(src: DataSource | None) -> xr.Dataset | None: ...
+def open_dataset(src: DataSource | xr.DataArray | None) -> xr.Dataset | xr.DataArray | None:
     """Path -> fully loaded Dataset (file closed again; its path kept in ``encoding["source"]``);
     a Dataset passes through; None stays None.  A corrupted or truncated file is a
     :class:`~safebasins.io.netcdf.NetCDFFileError` naming it."""
@@ -36,22 +57,22 @@ def open_dataset(src):
 class MissingData(KeyError, ValueError):
     """A dataset lacks a variable, coordinate or attribute a figure needs (the message names it)."""
 
-    def __str__(self):  # KeyError would print the message quoted
+    def __str__(self) -> str:  # KeyError would print the message quoted
         return str(self.args[0]) if self.args else ""
 
 
-def source(ds) -> str:
+def source(ds: xr.Dataset | xr.DataArray) -> str:
     return ds.encoding.get("source", "<dataset>")
 
 
-def var(ds, name):
+def var(ds: xr.Dataset, name: str) -> xr.DataArray:
     """Data variable or coordinate ``name``; MissingData naming the dataset if absent."""
     if name not in ds.variables:
         raise MissingData(f"{source(ds)}: no variable {name!r} (it has {sorted(map(str, ds.variables))})")
     return ds[name]
 
 
-def param(ds, name):
+def param(ds: xr.Dataset, name: str) -> Any:
     """A parameter of a dataset: its global attribute, or its coordinate when the dataset is
     stacked over it with a single value (docs/contracts.md).  MissingData naming both if absent."""
     if name in ds.attrs:
@@ -62,7 +83,7 @@ def param(ds, name):
     raise MissingData(f"{source(ds)}: no attribute or single-valued coordinate {name!r}")
 
 
-def well(ds):
+def well(ds: xr.Dataset) -> Well:
     """The potential well of a dataset (its ``well`` attributes, safebasins.wells.spec_attrs)."""
     if "well" not in ds.attrs:
         raise MissingData(f"{source(ds)}: no attribute 'well' (datasets name their potential well)")
@@ -75,7 +96,7 @@ PROVENANCE = ("title", "safebasins_version", "git_commit", "config_hash", "well"
 _PROVENANCE_ATTR = "_safebasins_datasets"
 
 
-def attach(fig, *datasets):
+def attach(fig: Figure, *datasets: DataItem) -> Figure:
     """Remember the datasets a Figure was drawn from (their provenance goes into the saved file,
     :func:`safebasins.plotting.style.save_figure`)."""
     have = getattr(fig, _PROVENANCE_ATTR, None)
@@ -86,20 +107,26 @@ def attach(fig, *datasets):
     return fig
 
 
-def _flat(datasets):
+def _is_params_file(d: DataItem) -> TypeGuard[str | os.PathLike[str]]:
+    """Whether ``d`` names a parameter file (results/params/<experiment>.yaml), not a dataset."""
+    return isinstance(d, (str, os.PathLike)) and os.fspath(d).endswith((".yaml", ".yml"))
+
+
+def _flat(datasets: Iterable[DataItems]) -> Iterator[xr.Dataset | xr.DataArray | str | os.PathLike[str]]:
     for d in datasets:
         if isinstance(d, (list, tuple)):
             yield from _flat(d)
-        elif d is not None and not str(d).endswith((".yaml", ".yml")):  # parameter files: the datasets hold them
+        elif d is not None and not _is_params_file(d):  # parameter files: the datasets hold them
             yield d
 
 
-def provenance(*datasets, fig=None) -> dict:
+def provenance(*datasets: DataItems, fig: Figure | None = None) -> dict[str, str]:
     """Text metadata of a saved figure: ``Source`` (the dataset files) and every attribute of
     :data:`PROVENANCE` the datasets carry (paths, Datasets or lists of them; those attached to
     ``fig`` with :func:`attach` too).  A value the datasets disagree on lists each one, one a line."""
     items = list(_flat([*datasets, *(getattr(fig, _PROVENANCE_ATTR, None) or [])]))
-    out, sources = {}, []
+    out: dict[str, list[str]] = {}
+    sources: list[str] = []
     for d in items:
         attrs = _attrs_of(d)
         src = (source(d) if isinstance(d, xr.Dataset) else "<data array>" if isinstance(d, xr.DataArray)
@@ -118,14 +145,14 @@ def provenance(*datasets, fig=None) -> dict:
     return meta
 
 
-def _attrs_of(d):
+def _attrs_of(d: xr.Dataset | xr.DataArray | str | os.PathLike[str]) -> dict[Any, Any]:
     if isinstance(d, (xr.Dataset, xr.DataArray)):
         return d.attrs
     with xr.open_dataset(d) as ds:
         return dict(ds.attrs)
 
 
-def well_text(attrs) -> str | None:
+def well_text(attrs: Mapping[Any, Any]) -> str | None:
     """How a figure names the potential well of a dataset (its ``well`` attributes): a named well by
     its description (``well: pendulum, the pendulum / ship roll V = 1 - cos q, ...``), an expression
     well by its formula, a polynomial by V(q); None for the paper's quartic (every figure's default)
@@ -144,9 +171,9 @@ def well_text(attrs) -> str | None:
         return f"well: {name}"
 
 
-def well_texts(*datasets, fig=None) -> list[str]:
+def well_texts(*datasets: DataItems, fig: Figure | None = None) -> list[str]:
     """:func:`well_text` of every distinct well among the datasets (and those attached to ``fig``)."""
-    out = []
+    out: list[str] = []
     for d in _flat([*datasets, *(getattr(fig, _PROVENANCE_ATTR, None) or [])]):
         t = well_text(_attrs_of(d))
         if t and t not in out:
@@ -154,7 +181,7 @@ def well_texts(*datasets, fig=None) -> list[str]:
     return out
 
 
-def load_params(src):
+def load_params(src: str | os.PathLike[str]) -> dict[str, Any]:
     """Resolved parameter file (results/params/<experiment>.yaml) -> dict."""
     with open(src) as fh:
         return yaml.safe_load(fh)
@@ -169,15 +196,15 @@ HEADLINE = ("iou", "pixel_agreement", "F_GIM", "F_LIM", "F_IF", "xi_true", "GIM_
             "GIM_continuous", "GIM_closed", "LIM_closed", "rms_rel_error", "mean_abs_rel_error", "mean_iou")
 
 
-def describe(**datasets):
+def describe(**datasets: DataSource | list[DataSource] | tuple[DataSource, ...] | None) -> str:
     """Text summary of the datasets a figure reads (paths, lists of paths, Datasets or parameter
     files): dims, variables, parameters, provenance and headline numbers."""
-    lines = []
+    lines: list[str] = []
     for name, src in datasets.items():
         for s in (src if isinstance(src, (list, tuple)) else [src]):
             if s is None:
                 continue
-            if str(s).endswith((".yaml", ".yml")):
+            if _is_params_file(s):
                 lines.append(f"[{name}] {s}")
                 for k, v in load_params(s).items():
                     if k != "tasks":

@@ -15,6 +15,7 @@ notebook applies the style and saves it.
 from __future__ import annotations
 
 import re
+from typing import TYPE_CHECKING, Any
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -33,32 +34,49 @@ from safebasins.plotting.fcr import curve_labels, ic_text
 from safebasins.plotting.style import LABELS, fmt_value, param_text
 from safebasins.plotting.style import pi_ticks
 
+if TYPE_CHECKING:
+    from collections.abc import Mapping, Sequence
+
+    import numpy.typing as npt
+    import xarray as xr
+    from matplotlib.artist import Artist
+    from matplotlib.axes import Axes
+    from matplotlib.colorbar import Colorbar
+    from matplotlib.figure import Figure
+    from matplotlib.typing import ColorType
+
+    from safebasins.plotting.data import DataSource
+
+    #: a group of paired bars: its title and (tick label, paper value, exact value) per bar
+    BarGroup = tuple[str, list[tuple[str, float, float]]]
+
 __all__ = ["figure_erosion", "figure_true_basin", "figure_fourier", "shade"]
 
 MEASURE_LABELS = {"GIM": "GIM (safe area)", "LIM": "LIM (disk at the well bottom)", "IF": "IF (largest disk)"}
-FOURIER_STYLE = {"paper": dict(ls="-", marker="o", label="paper G (eq 20)"),
+FOURIER_STYLE: dict[str, dict[str, Any]] = {"paper": dict(ls="-", marker="o", label="paper G (eq 20)"),
                  "exact": dict(ls="--", marker="s", label="exact first harmonic")}
 FOURIER_COLOR = {"paper": "tab:blue", "exact": "tab:orange"}
 LIM_COLOR, IF_COLOR, XI_TRUE_COLOR = "crimson", "#7b3fa0", "black"
 
 
-def shade(color, frac):
+def shade(color: ColorType, frac: float) -> tuple[float, ...]:
     """Mix ``color`` with white: frac = 1 -> the colour, frac = 0 -> white."""
     c = np.asarray(to_rgb(color))
     return tuple(1 - frac * (1 - c))
 
 
-def _values(ds, dim):
+def _values(ds: xr.Dataset, dim: str) -> list[Any]:
     return list(ds[dim].values) if dim in ds.dims else [None]
 
 
-def _sel(da, **kw):
+def _sel(da: xr.DataArray, **kw: Any) -> xr.DataArray:
     kw = {k: v for k, v in kw.items() if v is not None and k in da.dims}
     return da.sel(**kw) if kw else da
 
 
-def figure_erosion(analytic=None, numeric=None, *, measures=("GIM", "LIM", "IF"), xi_max=None,
-                   t_eval=None, title=None):
+def figure_erosion(analytic: DataSource | None = None, numeric: DataSource | None = None, *,
+                   measures: Sequence[str] = ("GIM", "LIM", "IF"), xi_max: npt.ArrayLike | None = None,
+                   t_eval: npt.ArrayLike | None = None, title: str | None = None) -> Figure:
     """GIM / LIM / IF versus F: analytic lines vs numeric markers, several t_eval shades.
 
     Parameters
@@ -72,14 +90,14 @@ def figure_erosion(analytic=None, numeric=None, *, measures=("GIM", "LIM", "IF")
         Subsets to draw (default: all).
     """
     analytic, numeric = open_dataset(analytic), open_dataset(numeric)
-    if analytic is None and numeric is None:
-        raise ValueError("give at least one of analytic, numeric")
     ref = analytic if analytic is not None else numeric
+    if ref is None:
+        raise ValueError("give at least one of analytic, numeric")
     xis = list(np.atleast_1d(xi_max)) if xi_max is not None else _values(ref, "xi_max")
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     fig, axes = plt.subplots(1, len(measures), figsize=(4.0 * len(measures), 3.9), sharey=True,
                              squeeze=False)
-    handles = []
+    handles: list[Artist | tuple[Artist, ...]] = []
     for a, m in enumerate(measures):
         ax = axes[0, a]
         for i, x in enumerate(xis):
@@ -110,7 +128,7 @@ def figure_erosion(analytic=None, numeric=None, *, measures=("GIM", "LIM", "IF")
             key = f or param(analytic, "fourier")
             handles.append(Line2D([], [], color="0.2", ls=FOURIER_STYLE[key]["ls"],
                                   label=f"analytic, {FOURIER_STYLE[key]['label']}"))
-    labels = [h.get_label() for h in handles]
+    labels = [str(h.get_label()) for h in handles if not isinstance(h, tuple)]  # no tuple yet: one label each
     if numeric is not None:
         ts = list(np.atleast_1d(t_eval)) if t_eval is not None else _values(numeric, "t_eval")
         for k, t in enumerate(ts):
@@ -123,24 +141,27 @@ def figure_erosion(analytic=None, numeric=None, *, measures=("GIM", "LIM", "IF")
                                  for i in range(len(xis))))
             labels.append(lab)
     ncol = len(handles) if len(handles) <= 4 else (len(handles) + 1) // 2
-    fig.legend(handles, labels, handler_map={tuple: HandlerTuple(ndivide=None, pad=0.1)}, loc="lower center",
-               ncol=ncol, fontsize=7.5, frameon=False, bbox_to_anchor=(0.5, 0.0), columnspacing=1.5)
+    # matplotlib's stubs let Axes.legend take tuple handles (drawn by HandlerTuple), not Figure.legend, which does
+    fig.legend(handles, labels, handler_map={tuple: HandlerTuple(ndivide=None, pad=0.1)},  # type: ignore[call-overload]
+               loc="lower center", ncol=ncol, fontsize=7.5, frameon=False, bbox_to_anchor=(0.5, 0.0),
+               columnspacing=1.5)
     par = {k: param(ref, k) for k in ("Omega", "Psi")}
     if "damping" in ref.attrs:          # a damped profile (both sides integrate the damped equation)
         par["damping"] = param(ref, "damping")
     fig.suptitle(title or ("Damped erosion profiles: " if "damping" in par else "Erosion profiles: ")
                  + param_text(par), fontsize=10)
     fig.tight_layout(rect=(0, 0.04 + 0.045 * -(-len(handles) // ncol), 1, 1))
-    _erosion_notes(fig, analytic, numeric, measures)
+    _erosion_notes(fig, ref, analytic, numeric, measures)
     return fig
 
 
-def _erosion_notes(fig, analytic, numeric, measures):
-    """Caption notes: grids and the first F at which each measure falls to the stored level."""
-    def crossings(ds, **sel):
+def _erosion_notes(fig: Figure, ref: xr.Dataset, analytic: xr.Dataset | None, numeric: xr.Dataset | None,
+                   measures: Sequence[str]) -> None:
+    """Caption notes: grids and the first F at which each measure falls to the stored level (``ref``: the
+    analytic dataset, else the numeric one)."""
+    def crossings(ds: xr.Dataset, **sel: Any) -> str:
         return ", ".join(f"F_{m} = {float(_sel(var(ds, f'F_{m}'), **sel)):.4g}" for m in measures)
 
-    ref = analytic if analytic is not None else numeric
     if "damping" in ref.attrs:
         und = int(np.asarray(analytic["n_undecided"]).sum()) if analytic is not None and "n_undecided" in analytic \
             else 0
@@ -166,7 +187,7 @@ def _erosion_notes(fig, analytic, numeric, measures):
                 for t in _values(numeric, "t_eval")) + ".")
 
 
-def _draw_basin_panel(ax, ds, sel, label):
+def _draw_basin_panel(ax: Axes, ds: xr.Dataset, sel: Mapping[str, Any], label: str) -> None:
     safe = _sel(ds["safe"], **sel)
     true = _sel(ds["true_safe"], **sel)
     q, p = ds["q0"].values, ds["p0"].values
@@ -211,7 +232,7 @@ def _draw_basin_panel(ax, ds, sel, label):
     ax.set_aspect("equal", adjustable="box")
 
 
-def _phase_colorbar(fig, cax):
+def _phase_colorbar(fig: Figure, cax: Axes) -> Colorbar:
     """Colour scale of the per-phase outlines: the forcing phase Psi over one period."""
     cb = fig.colorbar(ScalarMappable(norm=Normalize(0, 2 * np.pi), cmap="twilight"), cax=cax)
     cb.set_label(r"forcing phase $\Psi$ of the per-phase outlines")
@@ -219,8 +240,9 @@ def _phase_colorbar(fig, cax):
     return cb
 
 
-def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, fourier="paper", title=None,
-                      ):
+def figure_true_basin(analytic: DataSource | None = None, numeric: DataSource | None = None, *,
+                      xi_max: float | None = None, t_eval: float | None = None, fourier: str = "paper",
+                      title: str | None = None) -> Figure:
     """Per-phase safe basins (faint outlines coloured by Psi, light grey union) and the
     phase-invariant basin (green) with its LIM (red dashed) and IF (purple) disks; analytic
     and/or numeric panels."""
@@ -232,7 +254,7 @@ def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, 
     data.attach(fig, analytic, numeric)
     for ax, (ds, lab) in zip(axes[0], panels):
         x = xi_max if xi_max is not None else (float(ds["xi_max"][0]) if "xi_max" in ds.dims else None)
-        sel = {"xi_max": x, "fourier": fourier}
+        sel: dict[str, Any] = {"xi_max": x, "fourier": fourier}
         if "t_eval" in ds.dims:
             sel["t_eval"] = t_eval if t_eval is not None else float(ds["t_eval"][-1])
             lab = f"{lab}, $t_{{eval}}$ = {sel['t_eval']:g} EC"
@@ -245,7 +267,7 @@ def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, 
                 draw_well(ax, xt, data.well(analytic), color=XI_TRUE_COLOR, ls=":", lw=1.4, zorder=9)
     axes[0, 0].set_ylabel(LABELS["p0"])
     ref = panels[0][0]
-    handles = [Patch(color="0.9", label="safe for some phase"),
+    handles: list[Artist] = [Patch(color="0.9", label="safe for some phase"),
                Line2D([], [], color=plt.get_cmap("twilight")(0.3), lw=0.8,
                       label=r"per-phase basins (colour: $\Psi$)"),
                Patch(color="tab:green", alpha=0.55, label="safe for all sampled phases"),
@@ -256,13 +278,13 @@ def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, 
                               label=r"analytic $H_0 = \xi_{true}$ (all $\Psi$)"))
     fig.legend(handles=handles, loc="lower center", ncol=3, fontsize=7.5, frameon=False,
                bbox_to_anchor=(0.5, 0.0), columnspacing=1.5)
-    par = {"F": param(ref, "F"), "Omega": param(ref, "Omega")}
+    par: dict[str, Any] = {"F": param(ref, "F"), "Omega": param(ref, "Omega")}
     if xi_max is not None or "xi_max" in ref.dims:
         par["xi_max"] = float(xi_max if xi_max is not None else ref["xi_max"][0])
     head = "Phase-invariant safe basin" + (": " + param_text(par) if any(v is not None for v in par.values()) else "")
     fig.suptitle(title or head, fontsize=10)
     fig.subplots_adjust(left=0.08, right=0.88, top=0.84, bottom=0.2, wspace=0.22)
-    _phase_colorbar(fig, fig.add_axes([0.905, 0.3, 0.014, 0.5]))
+    _phase_colorbar(fig, fig.add_axes((0.905, 0.3, 0.014, 0.5)))
     for ds, lab in panels:
         x = xi_max if xi_max is not None else (float(ds["xi_max"][0]) if "xi_max" in ds.dims else None)
         sel = {"xi_max": x, "fourier": fourier}
@@ -289,18 +311,18 @@ def figure_true_basin(analytic=None, numeric=None, *, xi_max=None, t_eval=None, 
     return fig
 
 
-def _source_name(ds, k):
+def _source_name(ds: xr.Dataset, k: int) -> str:
     """"Fig 10" from the dataset's ``source_experiment`` attribute (else "set k+1")."""
     src = str(param(ds, "source_experiment"))
     m = re.fullmatch(r"fig(\d+)", src)
     return f"Fig {int(m.group(1))}" if m else (src or f"set {k + 1}")
 
 
-def _compact(txt):
+def _compact(txt: str) -> str:
     return txt.replace(" = ", "=")
 
 
-def _curve_labels(ds):
+def _curve_labels(ds: xr.Dataset) -> tuple[list[str], str]:
     """Short label per curve of an F_cr comparison (the parameters that vary between its curves,
     e.g. "ξini=0.05") and the title text of the constant ones."""
     if "curve" in ds.dims:
@@ -312,26 +334,29 @@ def _curve_labels(ds):
     return [_compact(t) for t in labels], _compact(ic_text(const))
 
 
-def _curves(ds):
+def _curves(ds: xr.Dataset) -> list[xr.Dataset]:
     return [ds.isel(curve=c) for c in range(ds.sizes["curve"])] if "curve" in ds.dims else [ds]
 
 
-def _rms(x):
-    x = np.ravel(np.asarray(x, float))
-    x = x[np.isfinite(x)]
-    return float(np.sqrt(np.mean(x ** 2))) if x.size else np.nan
+def _rms(x: npt.ArrayLike) -> float:
+    v = np.ravel(np.asarray(x, float))
+    v = v[np.isfinite(v)]
+    return float(np.sqrt(np.mean(v ** 2))) if v.size else np.nan
 
 
-def _grouped_bars(ax, groups, ylabel, *, ymax, fmt="{:.2f}"):
+def _grouped_bars(ax: Axes, groups: Sequence[BarGroup], ylabel: str, *, ymax: float,
+                  fmt: str = "{:.2f}") -> dict[str, list[float]]:
     """Paired bars (paper, exact) grouped by source figure: ``groups`` = [(title, [(tick, paper,
     exact), ...]), ...]. Group titles sit inside the axes above ``ymax``, dotted separators
     between groups. Returns the (paper, exact) values."""
-    w, x0, ticks, labels = 0.4, 0, [], []
-    allv = {"paper": [], "exact": []}
+    w = 0.4
+    x0: float = 0
+    ticks: list[float] = []
+    labels: list[str] = []
+    allv: dict[str, list[float]] = {"paper": [], "exact": []}
     for g, (head, bars) in enumerate(groups):
         x = x0 + np.arange(len(bars))
-        for s, f, i in ((-1, "paper", 1), (1, "exact", 2)):
-            v = [b[i] for b in bars]
+        for s, f, v in ((-1, "paper", [b[1] for b in bars]), (1, "exact", [b[2] for b in bars])):
             allv[f] += v
             ax.bar(x + s * w / 2, v, width=w, color=FOURIER_COLOR[f],
                    label=FOURIER_STYLE[f]["label"] if g == 0 else None)
@@ -350,7 +375,9 @@ def _grouped_bars(ax, groups, ylabel, *, ymax, fmt="{:.2f}"):
     return allv
 
 
-def figure_fourier(fcr=None, iou=None, *, title=None):
+def figure_fourier(fcr: DataSource | list[DataSource] | tuple[DataSource, ...] | None = None,
+                   iou: DataSource | list[DataSource] | tuple[DataSource, ...] | None = None, *,
+                   title: str | None = None) -> Figure:
     """Paper vs exact first harmonic against the numerics.
 
     Top row: relative F_cr error versus Omega, one panel per F_cr dataset (source figure), paper G
@@ -371,14 +398,14 @@ def figure_fourier(fcr=None, iou=None, *, title=None):
     if not fcrs and not ious:
         raise ValueError("give at least one of fcr, iou")
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    summary = []
+    summary: list[str] = []
     nf = len(fcrs)
     fig = plt.figure(figsize=(max(11.0, 3.7 * nf), 3.3 * (bool(fcrs) + bool(ious or fcrs)) + 0.9))
     rows = int(bool(fcrs)) + 1
     gs = fig.add_gridspec(rows, 1, height_ratios=[1.0] * rows, hspace=0.45)
     if fcrs:
         top = gs[0].subgridspec(1, nf, wspace=0.08)
-        ax0 = None
+        ax0: Axes | None = None
         for k, ds in enumerate(fcrs):
             ax = fig.add_subplot(top[0, k], sharey=ax0)
             ax0 = ax0 or ax
@@ -414,16 +441,16 @@ def figure_fourier(fcr=None, iou=None, *, title=None):
     if fcrs:
         ax = fig.add_subplot(bottom[0, bi])
         bi += 1
-        groups = []
+        groups: list[BarGroup] = []
         for k, ds in enumerate(fcrs):
-            bars = []
+            bars: list[tuple[str, float, float]] = []
             for d, lab in zip(_curves(ds), _curve_labels(ds)[0]):
                 r = {f: _rms(d["rel_error"].sel(fourier=f).values) if f in d["fourier"].values else np.nan
                      for f in ("paper", "exact")}
                 bars.append((lab, 100 * r["paper"], 100 * r["exact"]))
             groups.append((_source_name(ds, k), bars))
-        allv = [v for g in groups for b in g[1] for v in b[1:] if np.isfinite(v)]
-        _grouped_bars(ax, groups, r"RMS rel. $F_{cr}$ error (%)", ymax=1.18 * max(allv or [1.0]))
+        finite = [v for g in groups for b in g[1] for v in b[1:] if np.isfinite(v)]
+        _grouped_bars(ax, groups, r"RMS rel. $F_{cr}$ error (%)", ymax=1.18 * max(finite or [1.0]))
         ax.legend(loc="upper left", bbox_to_anchor=(0.0, 0.9), fontsize=7, framealpha=0.9)
         ax.set_title(r"critical forcing: RMS error per curve over $\Omega$", fontsize=9)
     if ious:
@@ -432,7 +459,7 @@ def figure_fourier(fcr=None, iou=None, *, title=None):
         for k, ds in enumerate(ious):
             it = ds["iou"]
             others = [dd for dd in it.dims if dd != "fourier"]
-            shown = [dd for dd in others if it.sizes[dd] > 1]
+            shown = [str(dd) for dd in others if it.sizes[dd] > 1]
             st = it.stack(_pos=others) if others else it.expand_dims(_pos=[0])
             fixed = {kk: ds.attrs[kk] for kk in ("Omega", "Psi", "F") if kk in ds.attrs and kk not in shown}
             fixed.update({dd: float(it[dd][0]) for dd in others if dd not in shown and dd in ("xi_max", "F")})
@@ -451,8 +478,8 @@ def figure_fourier(fcr=None, iou=None, *, title=None):
         ax.set_title("safe basins: IoU per chart", fontsize=9)
         if not fcrs:
             ax.legend(loc="lower left", fontsize=7, framealpha=0.9)
-        summary.append("mean IoU: paper {:.3f}, exact {:.3f}".format(np.nanmean(allv["paper"]),
-                                                                    np.nanmean(allv["exact"])))
+        summary.append("mean IoU: paper {:.3f}, exact {:.3f}".format(float(np.nanmean(allv["paper"])),
+                                                                    float(np.nanmean(allv["exact"]))))
     for line in summary:
         add_note(fig, line.replace(r"$F_{cr}$", "F_cr") + " (over the figures' numeric points / charts).")
     head = title or "First harmonic: paper's truncated G (eq 20) vs exact, against the numerics"
@@ -461,6 +488,6 @@ def figure_fourier(fcr=None, iou=None, *, title=None):
     return fig
 
 
-def _n_iou(ds):
+def _n_iou(ds: xr.Dataset) -> int:
     it = ds["iou"]
     return int(np.prod([it.sizes[d] for d in it.dims if d != "fourier"]))

@@ -7,25 +7,30 @@ netCDF file holding it).  The caption sentences are computed from it (:func:`add
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import matplotlib.pyplot as plt
 import numpy as np
-import numpy.typing as npt
-import xarray as xr
-from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from safebasins.plotting.captions import add_note
 from safebasins.plotting.data import open_dataset, param, var, well
 from safebasins.plotting.style import LABELS, param_text, pi_ticks
 
+if TYPE_CHECKING:
+    import numpy.typing as npt
+    import xarray as xr
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from safebasins.plotting.data import DataSource
+
 __all__ = ["figure_fatal_shock"]
 
 #: one colour per attractor (ordered by the amplitude of the response)
 ATTRACTOR_COLOURS = ["tab:blue", "tab:red", "tab:green", "tab:purple", "tab:brown"]
 #: line style of each norm in the MFS panel
-NORM_STYLE = {"energy": dict(ls="-", marker="o"), "weighted": dict(ls="--", marker="^")}
+NORM_STYLE: dict[str, dict[str, Any]] = {"energy": dict(ls="-", marker="o"), "weighted": dict(ls="--", marker="^")}
 
 
 def _colour(a: int) -> str:
@@ -42,7 +47,7 @@ def _phase_text(phi: float) -> str:
     return "0" if r == 0 else "π" if r == 1 else f"{r:.3g}π"
 
 
-def figure_fatal_shock(shock: Any, *, title: str | None = None) -> Figure:
+def figure_fatal_shock(shock: DataSource, *, title: str | None = None) -> Figure:
     """(a) The phase plane: the escape level H0 = xi_max (dashed), each attractor's state at the shock
     phases (dots, joined in phase order) and its minimal fatal shock in the energy norm (arrows to the
     escaping state, a cross); (b) the MFS over the shock phase per attractor (solid: energy norm;
@@ -80,7 +85,7 @@ def figure_fatal_shock(shock: Any, *, title: str | None = None) -> Figure:
     return fig
 
 
-def _phase_plane(ax: Any, ds: xr.Dataset) -> None:
+def _phase_plane(ax: Axes, ds: xr.Dataset) -> None:
     """Panel (a): escape level, attractor states and their energy-norm fatal shocks."""
     w = well(ds)
     xi = float(param(ds, "xi_max"))

@@ -6,6 +6,8 @@ Reads ``critical_forcing`` datasets stacked over ``curve`` (coordinates ``xi_max
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.legend_handler import HandlerTuple
@@ -16,8 +18,23 @@ from safebasins.plotting.captions import add_note, count, fmt_range
 from safebasins.plotting.data import open_dataset, param, var
 from safebasins.plotting.style import LABELS, SYMBOLS, add_footnote, fmt_value, param_text, plain_text
 
+if TYPE_CHECKING:
+    from collections.abc import Iterable, Mapping, Sequence
+
+    import numpy.typing as npt
+    import xarray as xr
+    from matplotlib.artist import Artist
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+    from matplotlib.typing import ColorType, LegendLocType
+
+    from safebasins.plotting.data import DataSource
+
+    #: errors on one side of an F_cr curve: (median, max, Omega at max, numeric F_cr at max)
+    SideError = tuple[float, float, float, float]
+
 # mechanism flags of theory.critical_forcing: "none MM_0 MM_pi SM SMM"
-MECHANISMS = {
+MECHANISMS: dict[int, dict[str, str]] = {
     1: dict(name="MM_0", label=r"MM ($\gamma^*=0$)", ls="-.", color="tab:purple"),
     2: dict(name="MM_pi", label=r"MM ($\gamma^*=\pi$)", ls="--", color="tab:green"),
     3: dict(name="SM", label="SM", ls="-", color="tab:blue"),
@@ -33,7 +50,7 @@ MECHANISM_WORDS = {
 }
 
 
-def mechanism_key(mechanisms) -> str:
+def mechanism_key(mechanisms: Iterable[int]) -> str:
     """What the abbreviations of the mechanisms drawn (MECHANISMS codes) stand for: the key written
     under every figure whose legend names them ("" for none)."""
     abbr = dict.fromkeys(MECHANISMS[m]["label"].split()[0] for m in sorted(mechanisms) if m in MECHANISMS)
@@ -41,10 +58,11 @@ def mechanism_key(mechanisms) -> str:
 CURVE_COORDS = ("xi_max", "xi_ini", "gamma_ini", "Psi", "damping")
 
 
-def curve_labels(ds, dim="curve"):
+def curve_labels(ds: xr.Dataset, dim: str = "curve") -> tuple[list[str], dict[str, Any]]:
     """Legend labels from the coordinates that vary along ``dim``; constants -> title dict."""
     n = ds.sizes.get(dim, 1)
-    varying, constant = [], {}
+    varying: list[str] = []
+    constant: dict[str, Any] = {}
     for c in CURVE_COORDS:
         if c in ds.coords and dim in ds[c].dims:
             vals = np.asarray(ds[c], float)
@@ -63,14 +81,14 @@ def curve_labels(ds, dim="curve"):
     return labels, constant
 
 
-def _symbols(label):
+def _symbols(label: str) -> str:
     """"xi_ini = 0.05" (a stored curve label) -> "$\\xi_{ini}$ = 0.05"."""
     for name in ("xi_ini", "gamma_ini", "xi_max", "Psi", "damping"):
         label = label.replace(f"{name} =", f"{SYMBOLS[name]} =")
     return label
 
 
-def ic_text(const):
+def ic_text(const: Mapping[str, Any]) -> str:
     """Title text for the constant curve parameters; the zero IC is named as such."""
     const = dict(const)
     if "xi_ini" in const and float(const["xi_ini"]) == 0.0:
@@ -81,7 +99,7 @@ def ic_text(const):
     return param_text(const)
 
 
-def _runs(values):
+def _runs(values: npt.ArrayLike) -> list[tuple[Any, int, int]]:
     """Split an index range into runs of equal value: [(value, start, stop_exclusive), ...]."""
     values = np.asarray(values)
     if values.size == 0:
@@ -92,14 +110,15 @@ def _runs(values):
     return [(values[s], s, e) for s, e in zip(starts, stops)]
 
 
-def _mechanism_array(da):
+def _mechanism_array(da: npt.ArrayLike) -> npt.NDArray[np.int_]:
     m = np.asarray(da, dtype=float)
     m = np.where(np.isfinite(m), m, 0).astype(int)
     return m
 
 
-def draw_fcr_curve(ax, Omega, F_cr, mechanism=None, *, color=None, by_mechanism_color=False,
-                   lw=1.8, label=None, zorder=3):
+def draw_fcr_curve(ax: Axes, Omega: npt.ArrayLike, F_cr: npt.ArrayLike, mechanism: npt.ArrayLike | None = None, *,
+                   color: ColorType | None = None, by_mechanism_color: bool = False, lw: float = 1.8,
+                   label: str | None = None, zorder: float = 3) -> set[int]:
     """One F_cr(Omega) curve split into runs of equal mechanism, styled per MECHANISMS.
 
     Consecutive runs share their junction point so the curve stays continuous."""
@@ -107,7 +126,7 @@ def draw_fcr_curve(ax, Omega, F_cr, mechanism=None, *, color=None, by_mechanism_
     F_cr = np.asarray(F_cr, float)
     mech = np.full(F_cr.shape, 3) if mechanism is None else _mechanism_array(mechanism)
     mech = np.where(np.isfinite(F_cr), mech, 0)
-    drawn = set()
+    drawn: set[int] = set()
     first = True
     for m, s, e in _runs(mech):
         if m == 0:
@@ -122,23 +141,24 @@ def draw_fcr_curve(ax, Omega, F_cr, mechanism=None, *, color=None, by_mechanism_
     return drawn
 
 
-def mechanism_legend_handles(mechanisms, *, by_mechanism_color=False):
+def mechanism_legend_handles(mechanisms: Iterable[int], *, by_mechanism_color: bool = False) -> list[Line2D]:
     return [Line2D([], [], color=MECHANISMS[m]["color"] if by_mechanism_color else "k",
                    ls=MECHANISMS[m]["ls"], lw=1.8, label=MECHANISMS[m]["label"])
             for m in sorted(mechanisms)]
 
 
 #: thin lines of the branches where they do not set F_cr
-THIN = dict(lw=1.0, alpha=0.7)
+THIN: dict[str, Any] = dict(lw=1.0, alpha=0.7)
 
 
-def _mechanism_of(d):
+def _mechanism_of(d: xr.Dataset) -> xr.DataArray | None:
     """The ``mechanism`` variable of one curve, or None where a dataset has none (drawn as one run)."""
     return var(d, "mechanism") if "mechanism" in d.variables else None
 
 
-def draw_fcr(ax, ds, *, color_by="curve", show_branches=False, colors=None, lw=1.8,
-             legend=True, legend_loc="best"):
+def draw_fcr(ax: Axes, ds: xr.Dataset, *, color_by: str = "curve", show_branches: bool = False,
+             colors: Sequence[ColorType] | None = None, lw: float = 1.8, legend: bool = True,
+             legend_loc: LegendLocType = "best") -> tuple[set[int], set[int]]:
     """All curves of a critical_forcing dataset stacked over ``curve`` (or a single curve).
 
     ``color_by="curve"``: one colour per curve, line style = mechanism (Figs 1, 2, 4);
@@ -158,8 +178,8 @@ def draw_fcr(ax, ds, *, color_by="curve", show_branches=False, colors=None, lw=1
     # the damped theory has neither mechanisms nor branches: one line style, no mechanism legend
     show_branches = show_branches and all(v in ds.variables for v in BRANCHES.values())
     has_mechanism = "mechanism" in ds.variables
-    mechs_seen = set()
-    curve_handles = []
+    mechs_seen: set[int] = set()
+    curve_handles: list[Line2D] = []
     for i in range(n):
         d = ds.isel(curve=i)
         col = colors[i % len(colors)]
@@ -182,7 +202,8 @@ def draw_fcr(ax, ds, *, color_by="curve", show_branches=False, colors=None, lw=1
         by_color = color_by == "mechanism"
         if show_branches:
             # one entry per branch that exists: thick where it sets F_cr, thin where it lies below F_cr
-            handles, labels = [], []
+            handles: list[Artist | tuple[Artist, ...]] = []
+            labels = []
             for m in sorted(mechs_seen | branches):
                 st = MECHANISMS[m]
                 c = st["color"] if by_color else "k"
@@ -195,27 +216,27 @@ def draw_fcr(ax, ds, *, color_by="curve", show_branches=False, colors=None, lw=1
                     handles.append(thin)
                     labels.append(st["label"] + r": below $F_{cr}$ everywhere")
             if color_by == "curve" and n > 1:
-                handles = curve_handles + handles
-                labels = [h.get_label() for h in curve_handles] + labels
+                handles = [*curve_handles, *handles]
+                labels = [str(h.get_label()) for h in curve_handles] + labels
             ax.legend(handles, labels, handler_map={tuple: HandlerTuple(ndivide=None, pad=0.3)}, loc=legend_loc,
                       title="thick: sets $F_{cr}$ (the largest branch)\nthin: branch below $F_{cr}$",
                       title_fontsize=8)
         else:
-            handles = mechanism_legend_handles(mechs_seen, by_mechanism_color=by_color)
+            mech_handles = mechanism_legend_handles(mechs_seen, by_mechanism_color=by_color)
             if color_by == "curve" and n > 1:
-                handles = curve_handles + [Line2D([], [], ls="none", label="")] + handles
-            ax.legend(handles=handles, loc=legend_loc)
+                mech_handles = curve_handles + [Line2D([], [], ls="none", label="")] + mech_handles
+            ax.legend(handles=mech_handles, loc=legend_loc)
     return mechs_seen, branches
 
 
-def omega_margins(ax, Omega, frac=0.025):
+def omega_margins(ax: Axes, Omega: npt.ArrayLike, frac: float = 0.025) -> None:
     """x limits of an F_cr axes with a margin, so that the markers at the ends are not clipped."""
     lo, hi = float(np.nanmin(Omega)), float(np.nanmax(Omega))
     pad = frac * (hi - lo) if hi > lo else 0.05
     ax.set_xlim(lo - pad, hi + pad)
 
 
-def _fcr_ylim(ax, arrays, top=None, pad=1.08):
+def _fcr_ylim(ax: Axes, arrays: Iterable[npt.ArrayLike], top: float | None = None, pad: float = 1.08) -> None:
     if top is not None:
         ax.set_ylim(0, top)
         return
@@ -225,8 +246,9 @@ def _fcr_ylim(ax, arrays, top=None, pad=1.08):
         ax.set_ylim(0, pad * vals.max())
 
 
-def figure_fcr(analytic, *, color_by="curve", show_branches=False, F_max=None, title=None,
-               figsize=(6.4, 4.6)):
+def figure_fcr(analytic: DataSource, *, color_by: str = "curve", show_branches: bool = False,
+               F_max: float | None = None, title: str | None = None,
+               figsize: tuple[float, float] = (6.4, 4.6)) -> Figure:
     """Figs 1-4: theoretical F_cr(Omega) curves, mechanisms distinguished by line style."""
     ds = open_dataset(analytic)
     if "curve" not in ds.dims:
@@ -248,14 +270,14 @@ def figure_fcr(analytic, *, color_by="curve", show_branches=False, F_max=None, t
     return fig
 
 
-def _mechanism_text(m, color_by):
+def _mechanism_text(m: int, color_by: str | None) -> str:
     st = MECHANISMS[m]
     style = {"-": "solid", "--": "dashed", "-.": "dash-dot", ":": "dotted"}[st["ls"]]
     name = st["label"].replace("$\\gamma^*=0$", "γ* = 0").replace("$\\gamma^*=\\pi$", "γ* = π")
     return f"{name} {style}" + (f" {st['color'].removeprefix('tab:')}" if color_by == "mechanism" else "")
 
 
-def _fcr_notes(fig, ds, seen, branches, color_by):
+def _fcr_notes(fig: Figure, ds: xr.Dataset, seen: set[int], branches: set[int], color_by: str) -> None:
     """Caption notes of Figs 1-4: the line styles drawn and each curve's minimum (read from the data)."""
     labels, _ = curve_labels(ds)
     if seen:
@@ -265,7 +287,7 @@ def _fcr_notes(fig, ds, seen, branches, color_by):
     if branches:
         _branch_notes(fig, ds, seen, branches, color_by)
     Om = np.asarray(ds["Omega"], float)
-    parts = []
+    parts: list[str] = []
     for i in range(ds.sizes["curve"]):
         d = ds.isel(curve=i)
         F = np.asarray(var(d, "F_cr"), float)
@@ -281,11 +303,11 @@ def _fcr_notes(fig, ds, seen, branches, color_by):
     add_note(fig, "; ".join(parts) + ".")
 
 
-def _name(m):
+def _name(m: int) -> str:
     return _mechanism_text(m, None).rsplit(" ", 1)[0]
 
 
-def _branch_notes(fig, ds, seen, branches, color_by):
+def _branch_notes(fig: Figure, ds: xr.Dataset, seen: set[int], branches: set[int], color_by: str) -> None:
     """Which branch is operative (sets F_cr) and where the others lie below it, from the data."""
     add_note(fig, "F_cr is the largest branch at each Ω, not the smallest: each branch is a lower bound that F must "
                   "exceed for the level curve of C through the IC to pass one obstacle (the tangency with ξ = ξ_max at "
@@ -303,7 +325,7 @@ def _branch_notes(fig, ds, seen, branches, color_by):
         d = ds.isel(curve=i)
         F = np.asarray(var(d, "F_cr"), float)
         mech = _mechanism_array(var(d, "mechanism"))
-        parts = []
+        parts: list[str] = []
         for m in sorted(branches):
             b = np.asarray(var(d, BRANCHES[m]), float)
             below = np.isfinite(b) & np.isfinite(F) & (mech != m)
@@ -319,7 +341,7 @@ def _branch_notes(fig, ds, seen, branches, color_by):
                                                    else "") + ": " + "; ".join(parts) + ".")
 
 
-def _extent(ds, name):
+def _extent(ds: xr.Dataset, name: str) -> str:
     """Omega range where variable ``name`` is finite (any curve)."""
     v = np.asarray(ds[name], float).reshape(-1, ds.sizes["Omega"])
     Om = np.asarray(ds["Omega"], float)[np.isfinite(v).any(axis=0)]
@@ -331,7 +353,8 @@ CURVE_COLORS = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", 
 CURVE_MARKERS = ["o", "s", "^", "D", "v", "P", "X", "<"]
 
 
-def draw_fcr_numeric(ax, num, *, color="k", marker="o", label=None, bracket=True, ms=5.0):
+def draw_fcr_numeric(ax: Axes, num: xr.Dataset, *, color: ColorType = "k", marker: str = "o", label: str | None = None,
+                     bracket: bool = True, ms: float = 5.0) -> int:
     """Numeric bisection F_cr (markers) and, where escape is non-monotone in F, the bracket
     F_escape_low .. F_escape_all: a black bar with caps and a black ring around the marker (the
     bracket is often only a few 1e-3 tall)."""
@@ -352,13 +375,13 @@ def draw_fcr_numeric(ax, num, *, color="k", marker="o", label=None, bracket=True
     return int(sel.sum())
 
 
-def bracket_handle():
+def bracket_handle() -> tuple[Line2D, Line2D]:
     """Legend entry of the non-monotone bracket, drawn as in the axes."""
     return (Line2D([], [], color=BRACKET_COLOR, marker="_", ms=8, mew=1.6, lw=1.8),
             Line2D([], [], ls="none", marker="o", ms=10, mfc="none", mec=BRACKET_COLOR, mew=1.0))
 
 
-def _match_numeric_curve(ana, num, i):
+def _match_numeric_curve(ana: xr.Dataset, num: xr.Dataset, i: int) -> xr.Dataset | None:
     """Numeric curve matching analytic curve i (by coordinates, else by position)."""
     if "curve" not in num.dims:
         return num
@@ -373,8 +396,9 @@ def _match_numeric_curve(ana, num, i):
     return None
 
 
-def figure_fcr_comparison(analytic, numeric, *, layout="overlay", F_max=None, title=None,
-                          bracket=True, figsize=None):
+def figure_fcr_comparison(analytic: DataSource, numeric: DataSource, *, layout: str = "overlay",
+                          F_max: float | None = None, title: str | None = None, bracket: bool = True,
+                          figsize: tuple[float, float] | None = None) -> Figure:
     """Figs 10-12: theoretical F_cr(Omega) (lines) vs numeric bisection (markers).
 
     ``layout="panels"``: one panel per curve (Fig 10: one per truncation level);
@@ -392,8 +416,8 @@ def figure_fcr_comparison(analytic, numeric, *, layout="overlay", F_max=None, ti
     tol = param(num, "tol")
     if layout == "panels":
         figsize = figsize or (4.2 * n, 4.0)
-        fig, axes = plt.subplots(1, n, figsize=figsize, layout="constrained", squeeze=False)
-        axes = list(axes[0])
+        fig, grid = plt.subplots(1, n, figsize=figsize, layout="constrained", squeeze=False)
+        axes: list[Axes] = list(grid[0])
         colors, markers = ["tab:blue"] * n, ["o"] * n
     else:
         figsize = figsize or (6.8, 5.0)
@@ -402,8 +426,8 @@ def figure_fcr_comparison(analytic, numeric, *, layout="overlay", F_max=None, ti
         colors = [CURVE_COLORS[i % len(CURVE_COLORS)] for i in range(n)]
         markers = [CURVE_MARKERS[i % len(CURVE_MARKERS)] for i in range(n)]
     n_bracket = 0
-    ax_brackets = {}
-    pairs = []
+    ax_brackets: dict[int, int] = {}
+    pairs: list[tuple[str, xr.Dataset, xr.Dataset | None]] = []
     for i in range(n):
         ax = axes[i]
         a = ana.isel(curve=i)
@@ -431,6 +455,7 @@ def figure_fcr_comparison(analytic, numeric, *, layout="overlay", F_max=None, ti
         _fcr_ylim(axes[0], [ana["F_cr"], num["F_cr"]], F_max)
     bracket_label = r"non-monotone in $F$: $F_{escape,low}$ .. $F_{escape,all}$"
     for ax in dict.fromkeys(axes):
+        hs: list[Artist | tuple[Artist, ...]]
         if layout == "overlay":
             hs = [(Line2D([], [], color=colors[i], lw=1.8),
                    Line2D([], [], ls="none", marker=markers[i], ms=5, mfc=colors[i], mec="k", mew=0.5))
@@ -450,7 +475,7 @@ def figure_fcr_comparison(analytic, numeric, *, layout="overlay", F_max=None, ti
             ls_.append(bracket_label)
         ax.legend(hs, ls_, handler_map={tuple: HandlerTuple(ndivide=None, pad=0.2)}, loc="best")
     head = ic_text(const)
-    sub = []
+    sub: list[str] = []
     if cycles:
         sub.append(f"{fmt_value(cycles)} EC")
     if tol:
@@ -464,9 +489,9 @@ def figure_fcr_comparison(analytic, numeric, *, layout="overlay", F_max=None, ti
     return fig
 
 
-def _damping_notes(fig, ana, labels):
+def _damping_notes(fig: Figure, ana: xr.Dataset, labels: Sequence[str]) -> None:
     """The damped theory's minimum F_cr against the undamped one's, per curve, from the data."""
-    parts = []
+    parts: list[str] = []
     for i in range(ana.sizes["curve"]):
         a = ana.isel(curve=i)
         Om = np.asarray(a["Omega"], float)
@@ -487,15 +512,15 @@ def _damping_notes(fig, ana, labels):
 
 
 #: the undamped theory beside damped curves (theory.critical_forcing's F_cr_undamped)
-UNDAMPED_STYLE = dict(color="0.45", lw=1.0, ls="--")
+UNDAMPED_STYLE: dict[str, Any] = dict(color="0.45", lw=1.0, ls="--")
 
 
-def _draw_undamped(axes, ana, layout):
+def _draw_undamped(axes: Sequence[Axes], ana: xr.Dataset, layout: str) -> bool:
     """The undamped theory of damped curves, once per distinct curve without its damping (one line
     where every curve has the same xi_max and IC); False when the curves are undamped."""
     if "F_cr_undamped" not in ana.variables:
         return False
-    seen = set()
+    seen: set[tuple[float, ...]] = set()
     for i in range(ana.sizes["curve"]):
         a = ana.isel(curve=i)
         key = (id(axes[i]), *(float(a[c]) for c in ("xi_max", "xi_ini", "gamma_ini") if c in a.coords))
@@ -508,10 +533,11 @@ def _draw_undamped(axes, ana, layout):
 
 
 #: the two sides of an F_cr curve by the mechanism of the theory there (MECHANISMS codes)
-SIDES = {"SM": (3, 4), "MM": (1, 2)}
+SIDES: dict[str, tuple[int, int]] = {"SM": (3, 4), "MM": (1, 2)}
 
 
-def side_errors(a, Om, rel, Fn):
+def side_errors(a: xr.Dataset, Om: npt.NDArray[np.float64], rel: npt.NDArray[np.float64],
+                Fn: npt.NDArray[np.float64]) -> dict[str, SideError]:
     """Relative errors ``|theory - numeric| / numeric`` at the numeric Omega split by the mechanism of
     the theoretical curve there: {"SM": (median, max, Omega at max, F at max), "MM": ...}."""
     if "mechanism" not in a.variables:
@@ -519,7 +545,7 @@ def side_errors(a, Om, rel, Fn):
     mech = _mechanism_array(var(a, "mechanism"))
     Oa = np.asarray(a["Omega"], float)
     at = mech[np.clip(np.searchsorted(Oa, Om), 0, Oa.size - 1)]
-    out = {}
+    out: dict[str, SideError] = {}
     for side, codes in SIDES.items():
         sel = np.isin(at, codes) & np.isfinite(rel)
         if sel.any():
@@ -528,9 +554,9 @@ def side_errors(a, Om, rel, Fn):
     return out
 
 
-def _side_notes(fig, sides):
+def _side_notes(fig: Figure, sides: Sequence[tuple[str, Mapping[str, SideError]]]) -> None:
     """The error on the SM side (left of each minimum, large F) versus the MM side, read from the data."""
-    txt = []
+    txt: list[str] = []
     for lab, e in sides:
         if not e:                  # no mechanism (damped theory): no sides
             continue
@@ -551,11 +577,15 @@ def _side_notes(fig, sides):
                       "the 1:1 resonance alone), not a coding error: it was confirmed independently.")
 
 
-def _comparison_notes(fig, pairs, cycles, tol):
+def _comparison_notes(fig: Figure, pairs: Sequence[tuple[str, xr.Dataset, xr.Dataset | None]], cycles: float | None,
+                      tol: float | None) -> None:
     """Caption notes of Figs 10-12: settings, per-curve relative error, brackets, isolated dips."""
     add_note(fig, f"Numeric F_cr: bisection to {fmt_value(tol)} in F, a trajectory is safe if it does not escape "
                   f"within {fmt_value(cycles)} EC; a scan of the whole F bracket flags non-monotone escape.")
-    errs, dips, brackets, sides = [], [], [], []
+    errs: list[str] = []
+    dips: list[str] = []
+    brackets: list[str] = []
+    sides: list[tuple[str, dict[str, SideError]]] = []
     for lab, a, b in pairs:
         if b is None:
             continue

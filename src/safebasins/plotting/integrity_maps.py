@@ -3,9 +3,9 @@ the erosion fronts (datasets of the ``integrity_map`` kind and of
 :mod:`safebasins.analysis.integrity_map`, docs/contracts.md)."""
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 import matplotlib.pyplot as plt
-from matplotlib.axes import Axes
-from matplotlib.figure import Figure
 import numpy as np
 from matplotlib.lines import Line2D
 
@@ -14,13 +14,24 @@ from safebasins.plotting.captions import add_note, count
 from safebasins.plotting.data import DataSource, open_dataset, param, var
 from safebasins.plotting.style import LABELS, fmt_value, new_axes, param_text, plain_text
 
+if TYPE_CHECKING:
+    from collections.abc import Mapping
+
+    import numpy.typing as npt
+    import xarray as xr
+    from matplotlib.axes import Axes
+    from matplotlib.collections import QuadMesh
+    from matplotlib.figure import Figure
+    from matplotlib.typing import ColorType
+
 MEASURES = ("GIM", "LIM")
 #: erosion-front line styles: slow flow, numerics, the slow flow's all-phase basin
-FRONT_STYLE = {"analytic": dict(lw=1.6, ls="-"), "numeric": dict(lw=1.8, ls=":"), "all_phase": dict(lw=1.3, ls="--")}
+FRONT_STYLE: dict[str, dict[str, Any]] = {"analytic": dict(lw=1.6, ls="-"), "numeric": dict(lw=1.8, ls=":"),
+                                          "all_phase": dict(lw=1.3, ls="--")}
 FRONT_TEXT = {"analytic": "slow flow solid", "numeric": "numerics dotted", "all_phase": "all-phase slow flow dashed"}
 
 
-def symmetric_limit(*arrays):
+def symmetric_limit(*arrays: npt.ArrayLike) -> float:
     """Colour limit of a difference map: the largest ``|value|`` of the data, rounded up to two
     significant digits (never the full +-1 range, on which small differences look blank)."""
     v = np.concatenate([np.abs(np.asarray(a, float)).ravel() for a in arrays])
@@ -32,12 +43,14 @@ def symmetric_limit(*arrays):
     return float(np.ceil(top / e) * e)
 
 
-def draw_measure_map(ax, da, *, label, diverging=False, limit=None, cbar=True):
+def draw_measure_map(ax: Axes, da: xr.DataArray, *, label: str, diverging: bool = False, limit: float | None = None,
+                     cbar: bool = True) -> QuadMesh:
     """One measure over (Omega, F) as a pcolormesh with a labelled colourbar: viridis on 0..1,
     or, ``diverging``, RdBu on a symmetric scale from the data (``limit`` to share one)."""
     Om = np.asarray(da["Omega"], float)  # the dims of a measure over the control plane
     F = np.asarray(da["F"], float)
     Z = np.asarray(da.transpose("F", "Omega"), float)
+    kw: dict[str, Any]
     if diverging:
         lim = limit if limit is not None else symmetric_limit(Z)
         kw = dict(cmap="RdBu", vmin=-lim, vmax=lim)
@@ -53,17 +66,18 @@ def draw_measure_map(ax, da, *, label, diverging=False, limit=None, cbar=True):
     return mesh
 
 
-def draw_front(ax, ds, name, *, color="w", style="analytic"):
+def draw_front(ax: Axes, ds: xr.Dataset, name: str, *, color: ColorType = "w", style: str = "analytic") -> list[Line2D]:
     """An erosion front ``name`` (F over Omega) of a dataset."""
     return ax.plot(np.asarray(var(ds, "Omega"), float), np.asarray(var(ds, name), float), color=color,
                    **FRONT_STYLE[style])
 
 
-def _all_phase(m):
+def _all_phase(m: str) -> str:
     return f"F_{m}_true"
 
 
-def figure_integrity_map(analytic, numeric, *, t_eval=None, title=None):
+def figure_integrity_map(analytic: DataSource, numeric: DataSource, *, t_eval: float | None = None,
+                         title: str | None = None) -> Figure:
     """Rows: analytic, numeric (at ``t_eval``, default the last), numeric - analytic; columns: GIM,
     LIM.  Erosion fronts (F at which the measure falls to the stored level): slow flow solid and
     numerics dotted on every panel, the slow flow's all-phase basin dashed on the top row."""
@@ -103,7 +117,8 @@ def figure_integrity_map(analytic, numeric, *, t_eval=None, title=None):
     return fig
 
 
-def _map_notes(fig, an, nu, nu_t, t, level, shown):
+def _map_notes(fig: Figure, an: xr.Dataset, nu: xr.Dataset, nu_t: xr.Dataset, t: float, level: float,
+               shown: Mapping[str, Any]) -> None:
     """Caption notes: grid, the differences and the fronts, read from the datasets."""
     Om, F = np.asarray(var(an, "Omega"), float), np.asarray(var(an, "F"), float)
     ts = np.asarray(var(nu, "t_eval"), float)
@@ -138,7 +153,7 @@ def plot_integrity_map(ds: DataSource, *, measure: str = "GIM", ax: Axes | None 
 
     Parameters
     ----------
-    ds : xarray.Dataset
+    ds : xarray.Dataset or path
         From :func:`safebasins.analysis.integrity_map.integrity_map_analytic` or
         :func:`~safebasins.analysis.integrity_map.integrity_map_numeric` (or the pipeline's
         ``integrity_map_analytic.nc`` / ``_numeric.nc``): the variable ``measure`` over
@@ -169,6 +184,7 @@ def plot_integrity_map(ds: DataSource, *, measure: str = "GIM", ax: Axes | None 
     >>> ds = integrity_map_analytic([0.8, 0.9, 1.0], [0.0, 0.02, 0.04], np.pi, 0.18, q0, p0)
     >>> fig = plot_integrity_map(ds, measure="LIM")
     """
+    ds = open_dataset(ds)
     da = var(ds, measure)
     for d in ("Omega", "F"):
         var(ds, d)

@@ -11,6 +11,8 @@ number, one colour per island chain (labelled ``1:k``, the k-periodic solution),
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.lines import Line2D
@@ -21,25 +23,34 @@ from safebasins.plotting import data
 from safebasins.plotting.data import open_dataset, param, var
 from safebasins.plotting.style import LABELS, fmt_value, param_text
 
+if TYPE_CHECKING:
+    import numpy.typing as npt
+    from matplotlib.artist import Artist
+    from matplotlib.figure import Figure
+
+    from safebasins.plotting.data import DataSource
+
 CHAIN_COLORS = ["tab:red", "tab:orange", "tab:purple", "tab:green", "tab:brown", "tab:pink", "tab:olive"]
 CHAOS_COLOR = "k"
 MAIN_CMAP = "Blues"
 
 
-def _fraction(rho, k):
+def _fraction(rho: float, k: int) -> str:
     """Rotation number of a chain as text: winding m / period k."""
     m = int(round(rho * k))
     return "0" if m == 0 else f"{m}/{k}"
 
 
-def chain_tag(rho, k):
+def chain_tag(rho: float, k: int) -> str:
     """Label of an island chain: ``m:k`` (the paper's 1:6) from its rotation number m/k about the
     centre; a chain that does not turn about the centre (m = 0) is named by its period."""
     m = int(round(rho * k)) if np.isfinite(rho) else 0
     return f"{m}:{k}" if m else f"period {k}, ρ=0"
 
 
-def figure_period_map(analytic, numeric, *, title=None, figsize=(8.2, 7.4), s=0.6, max_points=None):
+def figure_period_map(analytic: DataSource, numeric: DataSource, *, title: str | None = None,
+                      figsize: tuple[float, float] = (8.2, 7.4), s: float = 0.6,
+                      max_points: int | None = None) -> Figure:
     strobe = open_dataset(numeric)
     basin = open_dataset(analytic)
     fig, ax = plt.subplots(figsize=figsize, layout="constrained")
@@ -76,12 +87,12 @@ def figure_period_map(analytic, numeric, *, title=None, figsize=(8.2, 7.4), s=0.
     for i in np.flatnonzero((cls == 3) | unconfirmed):
         ax.scatter(q[i, sl], p[i, sl], s=s, color=CHAOS_COLOR if cls[i] == 3 else "0.45", marker=".",
                    linewidths=0, rasterized=True, zorder=3)
-    handles = []
+    handles: list[Artist] = []
     if main.any():
         handles.append(Line2D([], [], marker="o", ls="none", color=cmap(0.75), ms=4,
                               label=f"main island: {count(main.sum(), 'torus', 'tori')}, "
                                     rf"$\rho$ = {fmt_range(r_main)}"))
-    labels = []
+    labels: list[tuple[int, str, str, npt.NDArray[np.float64]]] = []
     for c in range(k_chain.size):
         col = CHAIN_COLORS[c % len(CHAIN_COLORS)]
         members = np.flatnonzero(chain == c)
@@ -122,9 +133,8 @@ def figure_period_map(analytic, numeric, *, title=None, figsize=(8.2, 7.4), s=0.
     # frame the portrait and the predicted boundary (not the whole, mostly empty, well)
     bxy = [np.asarray(b.get_xy() if hasattr(b, "get_xy") else np.c_[b.get_xdata(), b.get_ydata()], float)
            for b in blines]
-    xs = [q[np.isfinite(q)]] + [b[:, 0] for b in bxy]
-    ys = [p[np.isfinite(p)]] + [b[:, 1] for b in bxy]
-    xs, ys = np.concatenate(xs), np.concatenate(ys)
+    xs = np.concatenate([q[np.isfinite(q)]] + [b[:, 0] for b in bxy])
+    ys = np.concatenate([p[np.isfinite(p)]] + [b[:, 1] for b in bxy])
     xs, ys = xs[np.isfinite(xs)], ys[np.isfinite(ys)]
     if xs.size and ys.size:
         pad = 0.05 * max(np.ptp(xs), np.ptp(ys), 0.1)

@@ -5,20 +5,25 @@ netCDF file holding it).  The caption sentences are computed from it (:func:`add
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.figure import Figure
 
 from safebasins.plotting.captions import add_note
 from safebasins.plotting.data import open_dataset, param, var
 from safebasins.plotting.style import LABELS, param_text
 
+if TYPE_CHECKING:
+    import xarray as xr
+    from matplotlib.figure import Figure
+
+    from safebasins.plotting.data import DataSource
+
 __all__ = ["figure_escape_probability"]
 
 
-def figure_escape_probability(probability: Any, *, title: str | None = None) -> Figure:
+def figure_escape_probability(probability: DataSource, *, title: str | None = None) -> Figure:
     """One panel per evaluation time: P_escape over the (q0, p0) grid (0 white: no path escaped,
     1 black: every path escaped), with one colour bar."""
     ds = open_dataset(probability)
@@ -47,7 +52,7 @@ def figure_escape_probability(probability: Any, *, title: str | None = None) -> 
     return fig
 
 
-def _notes(fig: Figure, ds: Any) -> None:
+def _notes(fig: Figure, ds: xr.Dataset) -> None:
     """Caption sentences computed from the data."""
     P = var(ds, "P_escape")
     paths = int(param(ds, "paths"))

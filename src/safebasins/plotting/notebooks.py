@@ -10,28 +10,66 @@ the figure of an experiment declared in a config is headed by its ``title:``.
 """
 from __future__ import annotations
 
+import os
 from pathlib import Path
+from typing import TYPE_CHECKING, Protocol
 
 import nbformat
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
+
+if TYPE_CHECKING:
+    from collections.abc import Mapping
+
+
+class NotebookFigure(Protocol):
+    """What a figure's notebook is built from: the fields of
+    :class:`safebasins.pipeline.registry.FigureSpec` (a layer above: not imported here)."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def stem(self) -> str: ...
+    @property
+    def builder(self) -> str: ...
+    @property
+    def inputs(self) -> Mapping[str, object]: ...
+    @property
+    def options(self) -> Mapping[str, object]: ...
+    @property
+    def caption(self) -> str: ...
+    @property
+    def look(self) -> str: ...
+    @property
+    def label(self) -> str: ...
+    @property
+    def category(self) -> str: ...
+    @property
+    def packaged(self) -> bool: ...
+    @property
+    def png(self) -> str: ...
+    @property
+    def pdf(self) -> str: ...
+    @property
+    def notebook(self) -> str: ...
+
 
 KERNELSPEC = {"name": "python3", "display_name": "Python 3 (ipykernel)", "language": "python"}
 CAPTION_DIR = "results/captions"
 
 
-def caption_path(fig) -> str:
+def caption_path(fig: NotebookFigure) -> str:
     """The report caption the figure's notebook writes (the report shows it)."""
     return f"{CAPTION_DIR}/{fig.name}.rst"
 
 
-def _literal(v):
+def _literal(v: object) -> str:
     """Python literal for a notebook parameter."""
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_literal(x) for x in v) + "]"
     return repr(v)
 
 
-def build_notebook(fig) -> nbformat.NotebookNode:
+def build_notebook(fig: NotebookFigure) -> nbformat.NotebookNode:
     module, function = fig.builder.split(":")
     heading = (f"# {fig.label} (`{fig.stem}`)\n\n"
                f"**Caption.** {fig.caption}\n\n"
@@ -70,10 +108,10 @@ def build_notebook(fig) -> nbformat.NotebookNode:
     return nb
 
 
-def notebook_text(fig) -> str:
+def notebook_text(fig: NotebookFigure) -> str:
     return nbformat.writes(build_notebook(fig)) + "\n"
 
 
-def write_notebook(fig, path):
+def write_notebook(fig: NotebookFigure, path: str | os.PathLike[str]) -> None:
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     Path(path).write_text(notebook_text(fig))

@@ -5,19 +5,24 @@ file holding it).  The caption sentences are computed from it (:func:`add_note`)
 """
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import matplotlib.pyplot as plt
 import numpy as np
-import xarray as xr
 from matplotlib.colors import ListedColormap
-from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Rectangle
 
 from safebasins.plotting.captions import add_note
 from safebasins.plotting.data import open_dataset, param, var
 from safebasins.plotting.style import LABELS, param_text
+
+if TYPE_CHECKING:
+    import numpy.typing as npt
+    import xarray as xr
+    from matplotlib.figure import Figure
+
+    from safebasins.plotting.data import DataSource
 
 __all__ = ["figure_hilltop_saddle"]
 
@@ -28,7 +33,7 @@ BRANCH_STYLE: dict[tuple[str, str], dict[str, Any]] = {
 CHART_COLOURS = ListedColormap(["white", "0.8"])          # escaped, safe
 
 
-def _branches(ds: xr.Dataset, k: int) -> list[tuple[tuple[str, str], np.ndarray, np.ndarray]]:
+def _branches(ds: xr.Dataset, k: int) -> list[tuple[tuple[str, str], npt.NDArray[np.float64], npt.NDArray[np.float64]]]:
     """(kind, side), q, p of each manifold branch at the k-th F (NaN rows split a branch)."""
     q, p = var(ds, "q0_vertex").values[k], var(ds, "p0_vertex").values[k]
     idx = var(ds, "curve_index").values[k]
@@ -36,7 +41,7 @@ def _branches(ds: xr.Dataset, k: int) -> list[tuple[tuple[str, str], np.ndarray,
     return [((str(kinds[c]), str(sides[c])), q[idx == c], p[idx == c]) for c in range(kinds.size) if str(kinds[c])]
 
 
-def figure_hilltop_saddle(saddle: Any, *, title: str | None = None) -> Figure:
+def figure_hilltop_saddle(saddle: DataSource, *, title: str | None = None) -> Figure:
     """One panel per F: the escape chart (grey: safe over the horizon, white: escaped), the stable
     (blue) and unstable (red) manifolds of the hilltop saddle, inner branches solid and outer
     dashed, and the saddle fixed point of the stroboscopic map (black dot)."""

@@ -7,6 +7,7 @@ Inputs are the Datasets of :func:`safebasins.analysis.tangency.tangency_profile`
 from __future__ import annotations
 
 import textwrap
+from typing import TYPE_CHECKING, Any
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -17,19 +18,29 @@ from safebasins.plotting.captions import add_note
 from safebasins.plotting.data import open_dataset, param
 from safebasins.plotting.style import LABELS, param_text
 
+if TYPE_CHECKING:
+    import numpy.typing as npt
+    import xarray as xr
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from safebasins.plotting.data import DataSource
+
 __all__ = ["figure_tangency"]
 
-MEASURE_STYLE = {"GIM": dict(color="tab:blue", marker="o"), "LIM": dict(color="crimson", marker="s"),
-                 "IF": dict(color="#7b3fa0", marker="^")}
-MELNIKOV_STYLE = dict(color="black", ls="--", lw=1.0)
+MEASURE_STYLE: dict[str, dict[str, Any]] = {"GIM": dict(color="tab:blue", marker="o"),
+                                            "LIM": dict(color="crimson", marker="s"),
+                                            "IF": dict(color="#7b3fa0", marker="^")}
+MELNIKOV_STYLE: dict[str, Any] = dict(color="black", ls="--", lw=1.0)
 SAFE_CMAP = ListedColormap(["white", "#4a7fb5"])
 
 
-def _melnikov_line(ax, F_M, label=True):
+def _melnikov_line(ax: Axes, F_M: float, label: bool = True) -> None:
     ax.axvline(F_M, **MELNIKOV_STYLE, label=rf"Melnikov $F_M$ = {F_M:.4f}" if label else None)
 
 
-def figure_tangency(profile, fractality=None, *, xi_max=None, title=None):
+def figure_tangency(profile: DataSource, fractality: DataSource | None = None, *, xi_max: float | None = None,
+                    title: str | None = None) -> Figure:
     """(a) GIM / LIM / IF versus F at each t_eval (light = early, dark = the long-time basin) with
     the Melnikov threshold; (b) the uncertainty exponent alpha(F) +- its standard error, alpha = 1
     (smooth boundary) dotted; (c, d) the safe basins at the kept F (``safe``), before and after
@@ -92,7 +103,7 @@ def figure_tangency(profile, fractality=None, *, xi_max=None, title=None):
     return fig
 
 
-def unfitted_text(fractality):
+def unfitted_text(fractality: xr.Dataset) -> str | None:
     """Why alpha is NaN at some F, read from the data (None when it is fitted at every F): the fit
     needs at least two eps with MIN_UNCERTAIN uncertain base points each."""
     a = np.atleast_1d(fractality["alpha"].values)
@@ -110,12 +121,12 @@ def unfitted_text(fractality):
             "(fractality n) or a box closer to the basin boundary would resolve it.")
 
 
-def _first_below(F, y, level):
+def _first_below(F: npt.NDArray[np.float64], y: npt.NDArray[np.float64], level: float) -> float:
     below = np.flatnonzero(y < level)
     return float(F[below[0]]) if below.size else np.nan
 
 
-def _notes(fig, profile, fractality, F_M, xi):
+def _notes(fig: Figure, profile: xr.Dataset, fractality: xr.Dataset | None, F_M: float, xi: float) -> None:
     """Caption sentences computed from the data (add_note)."""
     t = float(profile["t_eval"].values[-1])
     cross = {m: float(profile[f"F_{m}"].sel(xi_max=xi, t_eval=t)) for m in ("GIM", "LIM", "IF")}
