@@ -6,7 +6,7 @@ trajectory (initial condition i, path m) runs the CPU lanes' sequence of IEEE op
 
     eta(0) = s_eta Z_1(0, m, i, tag 1);  per step n: (Z_1, Z_2) = Box-Muller of Philox (n, m, i, 0),
     eta = c1 eta + c2 Z_1, p += a Z_1, (q, p) = step(q, p; F sin + eta), p += a Z_2, eta = c1 eta + c2 Z_2,
-    escape when 2 H0 + shift |p| > 2 xi_max, q beyond a barrier or a bound (a NaN state included)
+    escape when 2 H0 + shift ``|p|`` > 2 xi_max, q beyond a barrier or a bound (a NaN state included)
 
 with every product that meets an add an explicit fma or a mul (wells.compiled.mul: never
 contracted), as cuda_kernels explains for the deterministic engine.
