@@ -57,6 +57,8 @@ VARIABLES = {
     "P_escape": ("1", "probability of escape at or before t_eval under noise (fraction of paths)"),
     "P_escape_low": ("1", "lower end of the 95% Wilson interval of P_escape"),
     "P_escape_high": ("1", "upper end of the 95% Wilson interval of P_escape"),
+    "noise": ("1", "noise amplitude sigma of dp = ... + sigma dW"),
+    "epsilon": ("1", "escape-probability level of the stochastic safe basin P_escape <= epsilon"),
     "t_survival": ("1", "time of the survival curve (forcing cycles)"),
     "survival": ("1", "fraction of paths not escaped by t_survival"),
     "first_passage_mean": ("1", "restricted mean first-passage time E[min(tau, cycles)] (forcing cycles)"),
