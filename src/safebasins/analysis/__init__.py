@@ -14,12 +14,12 @@ wada             the Wada test of three or more basins (merging method)
 basin_labels     labelled basins from escape charts and damped maps; reference_basins: known answers
 saddle           the forced hilltop saddle's periodic orbit, its manifolds and their first tangency (floquet: shooting)
 fatal_shock      the minimal fatal shock of the damped attractors, beside their LIM
-stochastic_integrity  the stochastic safe basin P_escape <= epsilon (and its Wilson-conservative variant), its
-                 GIM/LIM/IF and erosion profiles against sigma and F
+stochastic_integrity  the stochastic safe basin P_escape <= epsilon, its GIM/LIM/IF, erosion against sigma and F
 """
 from safebasins.analysis.basin_measures import basin_entropy, fractal_test  # noqa: F401
 from safebasins.analysis.wada import wada_test  # noqa: F401
 from safebasins.analysis.melnikov import melnikov_curve, melnikov_threshold  # noqa: F401
 from safebasins.analysis.saddle import hilltop_orbit, manifold_tangency, saddle_manifolds  # noqa: F401
 from safebasins.analysis.fatal_shock import minimal_fatal_shock  # noqa: F401
+from safebasins.analysis.continuation import continue_attractors  # noqa: F401
 from safebasins.analysis.stochastic_integrity import stochastic_erosion, stochastic_safe_basin  # noqa: F401
