@@ -48,7 +48,7 @@ def test_zero_noise_is_the_deterministic_erosion_bitwise(damping):
         for k in MEASURES[:8]:
             np.testing.assert_array_equal(s[k + "_conservative"].values, det[k].values, err_msg=k)
     assert 0 < float(det["GIM"].sel(F=0.06, t_eval=20)) < 1           # the comparison is not all ones
-    assert "zero_noise" in st.attrs
+    assert "zero_noise" in st.attrs and "conservative_epsilon_floor" not in st.attrs
     assert st.attrs.get("damping", 0.0) == damping
     # the noise = 0 point of a sweep in sigma is the same deterministic profile
     sw = stochastic_erosion(Q, P, 0.06, 0.9, np.pi, noise=[0.0, 0.02], epsilon=0.1, paths=40, xi_max=0.2,
@@ -162,17 +162,20 @@ def test_bad_maps_and_uncertifiable_levels_are_refused(ensemble, paired):
     for ds in (ensemble["P_escape"], chart, paired, ensemble.drop_vars("P_escape_high")):
         with pytest.raises(ValueError, match="ds"):
             stochastic_safe_basin(ds, 0.3)
-    few = escape_probability(Q[:3], P[:3], 0.0, 1.0, 0.0, noise=0.05, paths=10, xi_max=0.2, t_eval=[2])
+    few = escape_probability(Q[6:11], P[4:9], 0.0, 1.0, 0.0, noise=0.05, paths=10, xi_max=0.2, t_eval=[2])
     with pytest.raises(ValueError, match=r"epsilon.*paths >= 35"):      # floor 0.277 for 10 paths
         stochastic_safe_basin(few, 0.1)
-    assert not stochastic_safe_basin(few, 0.1, conservative=False)["safe"].isnull().any()
+    plain = stochastic_safe_basin(few, 0.1, conservative=False)                # the estimate needs no floor
+    assert np.isfinite(plain["GIM"]).all() and plain.attrs["conservative_epsilon_floor"] == certifiable_epsilon(10)
+    with pytest.raises(ValueError, match="conservative"):
+        stochastic_safe_basin(ensemble, 0.3, conservative="no")
 
 
 @pytest.mark.parametrize("change, name", [
     (dict(noise=-0.1), "noise"), (dict(noise=[0.1, 0.05]), "noise"), (dict(noise=[[0.1]]), "noise"),
     (dict(F=[-1.0]), "F"), (dict(F=[0.1, 0.1]), "F"), (dict(q0=np.array([0.0, 0.1, 0.3])), "q0"),
-    (dict(paths=0), "paths"), (dict(keep_masks="yes"), "keep_masks"), (dict(epsilon=0.01), "epsilon"),
-    (dict(epsilon=2.0), "epsilon"),
+    (dict(paths=0), "paths"), (dict(keep_masks="yes"), "keep_masks"), (dict(conservative=1), "conservative"),
+    (dict(epsilon=0.01), "epsilon"), (dict(epsilon=2.0), "epsilon"),
 ])
 def test_bad_erosion_input_is_refused_before_anything_runs(monkeypatch, change, name):
     def never(*args, **kwargs):

@@ -117,6 +117,11 @@ def _check_sweep(name: str, value: Any) -> tuple[npt.NDArray[np.float64], bool]:
     return e, a.ndim == 0
 
 
+def _check_bool(name: str, value: object) -> None:
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False, got {value!r}")
+
+
 def _check_certifiable(eps: npt.NDArray[np.float64], paths: int) -> None:
     floor = certifiable_epsilon(paths)
     if float(eps.min()) < floor:
@@ -177,6 +182,7 @@ def _basin(ds: xr.Dataset, epsilon: Any, t_eval: npt.ArrayLike | None, conservat
            bottom: tuple[float, float]) -> xr.Dataset:
     ds = _check_ensemble(ds)
     eps, eps_scalar = _check_epsilon(epsilon)
+    _check_bool("conservative", conservative)
     b = checks.check_finite("bottom", bottom)
     if b.shape != (2,):
         raise ValueError(f"bottom must be a pair (q0, p0), got {checks.value_repr(b)}")
@@ -202,10 +208,11 @@ def _basin(ds: xr.Dataset, epsilon: Any, t_eval: npt.ArrayLike | None, conservat
     out = out.transpose(*lead, ...)
     out.attrs.update({k: ds.attrs[k] for k in _CARRIED if k in ds.attrs})
     out.attrs.update(well_attrs(well))
-    out.attrs.update(kind="stochastic", method=DEFINITION, confidence=f"95% Wilson score interval (z = {WILSON_Z})",
-                     conservative_epsilon_floor=certifiable_epsilon(int(ds.attrs["paths"])))
+    out.attrs.update(kind="stochastic", method=DEFINITION, confidence=f"95% Wilson score interval (z = {WILSON_Z})")
     if deterministic:
         out.attrs["zero_noise"] = ZERO_NOISE
+    else:
+        out.attrs["conservative_epsilon_floor"] = certifiable_epsilon(int(ds.attrs["paths"]))
     return out
 
 
@@ -234,7 +241,8 @@ def stochastic_safe_basin(ds: xr.Dataset, epsilon: npt.ArrayLike, *, t_eval: npt
     ``r_global``, ``if_q0``, ``if_p0`` and the normalisers ``*_unforced`` of the unforced set
     S0(xi_max) on the same grid); with ``conservative`` the same with the suffix ``_conservative``
     (``safe_conservative``, ``GIM_conservative``, ...).  Attributes: the ensemble's (F, Omega, Psi,
-    xi_max, noise, paths, seed, scheme, well, ...), the definition and ``conservative_epsilon_floor``.
+    xi_max, noise, paths, seed, scheme, well, ...), the definition and, under noise,
+    ``conservative_epsilon_floor`` (:func:`certifiable_epsilon` of the paths).
     """
     return annotate(_basin(ds, epsilon, t_eval, conservative, bottom))
 
@@ -292,10 +300,10 @@ def stochastic_erosion(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float | Sequence
     sig, sig_scalar = _check_sweep("noise", noise)
     eps, _ = _check_epsilon(epsilon)
     paths = checks.check_positive_int("paths", paths)
+    _check_bool("conservative", conservative)
+    _check_bool("keep_masks", keep_masks)
     if conservative and (sig > 0).any():
         _check_certifiable(eps, paths)
-    if not isinstance(keep_masks, bool):
-        raise ValueError(f"keep_masks must be True or False, got {keep_masks!r}")
     w = resolve_well(well)
     t_one = t_eval if np.ndim(t_eval) == 0 else None     # a scalar t_eval: a scalar coordinate
     rows = []
