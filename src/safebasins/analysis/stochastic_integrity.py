@@ -48,7 +48,7 @@ from safebasins.core.cf import annotate
 from safebasins.numerics import escape_probability
 from safebasins.numerics.noise import WILSON_Z, wilson_interval
 from safebasins.wells import from_attrs, resolve_well, well_attrs
-from safebasins.wells.base import WellLike
+from safebasins.wells.base import Well, WellLike
 from safebasins.wells.provenance import api_provenance
 
 __all__ = ["stochastic_safe_basin", "stochastic_erosion", "certifiable_epsilon", "paths_to_certify"]
@@ -166,7 +166,7 @@ def _select_t_eval(ds: xr.Dataset, t_eval: npt.ArrayLike | None) -> xr.Dataset:
 
 
 # --------------------------------------------------------------------------- basins
-def _measures(mask: xr.DataArray, xi_max: float, well: Any, bottom: tuple[float, float], suffix: str
+def _measures(mask: xr.DataArray, xi_max: float, well: Well, bottom: tuple[float, float], suffix: str
               ) -> xr.Dataset:
     m = integrity_measures(mask, xi_max=xi_max, well=well, bottom=bottom)
     names = MEASURES + (NORMALISERS if not suffix else ())
