@@ -14,6 +14,7 @@ wada             the Wada test of three or more basins (merging method)
 basin_labels     labelled basins from escape charts and damped maps; reference_basins: known answers
 saddle           the forced hilltop saddle's periodic orbit, its manifolds and their first tangency (floquet: shooting)
 fatal_shock      the minimal fatal shock of the damped attractors, beside their LIM
+continuation     the damped attractors followed across Omega or F (arclength), their basins' GIM/LIM, the Dover cliff
 stochastic_integrity  the stochastic safe basin P_escape <= epsilon, its GIM/LIM/IF, erosion against sigma and F
 """
 from safebasins.analysis.basin_measures import basin_entropy, fractal_test  # noqa: F401

@@ -34,7 +34,8 @@ from scipy.integrate import solve_ivp
 
 from safebasins.wells.base import Well
 
-__all__ = ["forced_flow", "periodic_orbit", "PeriodicOrbit", "linear_response", "stiffness", "saddle_orbit"]
+__all__ = ["forced_flow", "periodic_orbit", "PeriodicOrbit", "linear_response", "stiffness", "saddle_orbit",
+           "shooting_step"]
 
 Array = npt.NDArray[np.float64]
 Box = tuple[tuple[float, float], tuple[float, float]]
@@ -163,8 +164,8 @@ class PeriodicOrbit:
         return (float(mu_r[iu]), vec_r[:, iu]), (float(mu_r[is_]), vec_r[:, is_])
 
 
-def _shooting_step(well: Well, F: float, Omega: float, damping: float, Psi: float, X: Array, t: Array, T: float,
-                   rtol: float, h: float) -> tuple[Array, Array]:
+def shooting_step(well: Well, F: float, Omega: float, damping: float, Psi: float, X: Array, t: Array, T: float,
+                  rtol: float, h: float) -> tuple[Array, Array]:
     """The blocks ``D phi`` (2, 2, m) and the mismatches ``phi(x_j) - x_{j+1}`` (2, m) at the nodes X."""
     m = X.shape[1]
     E = np.eye(2)
@@ -194,7 +195,7 @@ def periodic_orbit(well: Well, F: float, Omega: float, damping: float, Psi: floa
     for _ in range(max_iter):
         n_iter += 1
         try:
-            D, r = _shooting_step(well, F, Omega, damping, Psi, Xa, t, T, rtol, h)
+            D, r = shooting_step(well, F, Omega, damping, Psi, Xa, t, T, rtol, h)
         except ValueError:
             break
         res = float(np.max(np.abs(r)))
