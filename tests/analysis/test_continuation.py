@@ -188,10 +188,20 @@ def test_basin_measures_are_those_of_the_labels(escape):
         assert gims <= ds["GIM_safe"].values[k] + 1e-12
         if not (lab == -1).any():
             assert gims == pytest.approx(ds["GIM_safe"].values[k], rel=1e-12)
-    # the Dover cliff of the safe basin is the largest change of GIM_safe between neighbours
-    g = ds["GIM_safe"].values
-    i = int(np.argmax(np.abs(np.diff(g))))
-    assert (ds["safe_cliff_low"], ds["safe_cliff_high"]) == (ds["F"][i], ds["F"][i + 1])
+    # loss to escape: nodes of a basin at one F that escape at the next, counted directly
+    unforced = np.sum(CUBIC.unforced_safe(Q, P, 1.0 / 6.0))
+    lab = ds["basin"].values
+    for a in range(ds.sizes["attractor"]):
+        lost = ((lab[:-1] == a + 1) & (lab[1:] == 0)).sum(axis=(1, 2)) / unforced
+        np.testing.assert_allclose(ds["lost_to_escape"].values[1:, a], lost, rtol=1e-12)
+        k = 1 + int(np.argmax(lost))
+        assert (ds["cliff_low"].values[a], ds["cliff_high"].values[a]) == (ds["F"].values[k - 1], ds["F"].values[k])
+    assert np.isnan(ds["lost_to_escape"].values[0]).all()
+    lost_safe = ((lab[:-1] != 0) & (lab[1:] == 0)).sum(axis=(1, 2)) / unforced
+    np.testing.assert_allclose(ds["lost_safe"].values[1:], lost_safe, rtol=1e-12)
+    k = 1 + int(np.argmax(lost_safe))
+    assert float(ds["safe_cliff_drop"]) == pytest.approx(lost_safe[k - 1], rel=1e-12)
+    assert float(ds["safe_cliff_high"]) == ds["F"].values[k]
 
 
 def test_a_branch_that_leaves_the_well_ends_there():

@@ -2,13 +2,13 @@
 
 For ``q' = p, p' = -V'(q) - beta p + F sin(Omega t + Psi)`` the stroboscopic map of phase ``Psi``
 is ``P(x; lambda) = phi_{0 -> T}(x)`` (``T = 2 pi / Omega``, ``lambda`` = Omega or F).  A T-periodic
-response is a zero of
+response is a zero of::
 
     G(x, lambda) = P(x; lambda) - x                                                        (C1)
 
 and its branches are curves in ``y = (q, p, lambda)``.  Lengths are measured in the scaled
 coordinates ``z = (q, p, kappa lambda)`` (:class:`Family`).  A point is corrected by Newton's method
-on the bordered system
+on the bordered system::
 
     [ D P - I    P_lambda / kappa ] dz = - [ G              ]                              (C2)
     [        n^T                  ]        [ n . (z - z_0)  ]
@@ -20,12 +20,12 @@ vector of the 2 x 3 block ``[D P - I, P_lambda / kappa]``, the cross product of 
 (central differences in one DOP853 system), ``P_lambda`` from central differences of
 :func:`safebasins.analysis.floquet.forced_flow` in lambda (once per accepted point: a chord in the
 lambda column).  The Floquet multipliers ``mu_1, mu_2`` are the eigenvalues of ``D P``; Liouville
-(trace of the field's Jacobian = -beta) gives
+(trace of the field's Jacobian = -beta) gives::
 
     mu_1 mu_2 = det D P = exp(-beta T) < 1,                                                (C4)
 
 so a complex pair has ``|mu| = exp(-beta T / 2) < 1``: with damping a period-1 orbit loses
-stability only through a real multiplier at +1 or -1.  The test functions along a branch are
+stability only through a real multiplier at +1 or -1.  The test functions along a branch are::
 
     f_+ = det(D P - I) = (1 - mu_1)(1 - mu_2),    f_- = det(D P + I) = (1 + mu_1)(1 + mu_2)  (C5)
 
@@ -53,7 +53,7 @@ Array = npt.NDArray[np.float64]
 Parameter = Literal["Omega", "F"]
 
 #: DOP853 relative tolerance of the period map (Liouville (C4) holds to ~4e-10 with H_STATE); Newton's
-#: first iterations use RTOL_COARSE until |G| < COARSE_UNTIL (the coarse map is good to ~1e-8)
+#: first iterations use RTOL_COARSE until ``|G|`` < COARSE_UNTIL (the coarse map is good to ~1e-8)
 RTOL = 1e-11
 RTOL_COARSE = 1e-8
 COARSE_UNTIL = 1e-6
@@ -61,8 +61,8 @@ COARSE_UNTIL = 1e-6
 H_STATE = 1e-6
 #: relative central-difference step of P_lambda (only the Newton rate depends on it)
 H_PARAM = 1e-6
-#: Newton stops when |G| and the constraint are below RESIDUAL_TOL (the DOP853 map is good to ~1e-11),
-#: or when its step is below STEP_TOL (scaled) with |G| below 1e-8 (the point after that step is good to
+#: Newton stops when ``|G|`` and the constraint are below RESIDUAL_TOL (the DOP853 map is good to ~1e-11),
+#: or when its step is below STEP_TOL (scaled) with ``|G|`` below 1e-8 (the point after that step is good to
 #: ~1e-15: the error of D P is ~1e-9 relative)
 RESIDUAL_TOL = 1e-10
 STEP_TOL = 1e-9

@@ -17,8 +17,9 @@ coexist, joined through folds by an unstable (saddle) branch.  :func:`continue_a
    and measures its basin (:func:`safebasins.analysis.integrity.integrity_measures`): GIM (the
    basin's area over the unforced safe set's on the same grid), LIM (the radius of the largest disc
    centred on the attractor inside its basin, over the unforced LIM at the well bottom), and the
-   share of the IC window.  The largest fall of an attractor's GIM between neighbouring swept
-   values is its Dover cliff.
+   share of the IC window.  Where the most of an attractor's basin is lost to escape between
+   neighbouring swept values (grid nodes in its basin at one value that escape at the next, in GIM
+   units; not the nodes it hands over to another attractor) is its Dover cliff.
 """
 from __future__ import annotations
 
@@ -151,9 +152,10 @@ def continue_attractors(Omega: npt.ArrayLike, F: npt.ArrayLike, damping: float, 
 
     Parameters
     ----------
-    Omega, F : forcing frequency (> 0) and amplitude (>= 0) of ``q'' + beta q' + V'(q) = F sin(Omega t
-        + Psi)``: one of them a 1-D sweep of at least 2 increasing values (the continuation parameter
-        lambda and the values where the basins are measured), the other a scalar.
+    Omega, F : forcing frequency (> 0) and amplitude (>= 0) of
+        ``q'' + beta q' + V'(q) = F sin(Omega t + Psi)``: one of them a 1-D sweep of at least 2
+        increasing values (the continuation parameter lambda and the values where the basins are
+        measured), the other a scalar.
     damping : beta > 0 (without damping there is no attractor).
     well : the potential (None: the paper's quartic; any form of :func:`safebasins.wells.resolve_well`).
     Psi : forcing phase at the section ``t = 0`` of the stroboscopic map (radians).
@@ -184,17 +186,20 @@ def continue_attractors(Omega: npt.ArrayLike, F: npt.ArrayLike, damping: float, 
     * attractor: ``attractor_curve``, ``attractor_class`` (:data:`ATTRACTOR_CLASSES`),
       ``attractor_end_parameter`` and ``attractor_end_kind`` (attractor, end: the lambda where the
       attractor ends and why: an event kind), ``cliff_low``, ``cliff_high``, ``cliff_drop`` (the
-      neighbouring swept values with the largest fall of GIM while the attractor exists: ``GIM(low)
-      - GIM(high)``);
+      neighbouring swept values between which the most of its basin escapes, and that GIM; NaN if
+      none of it ever escapes);
     * (sweep, attractor): ``exists``, ``q_attractor``, ``p_attractor``, ``amplitude_attractor``,
       ``multiplier_modulus``, ``GIM``, ``LIM``, ``lim_radius``, ``basin_fraction`` (share of the IC
       window), ``basin_nodes``, ``matched`` (a label of the grid is this attractor's); NaN where the
       attractor does not exist at that value (``exists`` False), 0 where it exists but no grid node
-      settles on it (``matched`` False: its basin is below the grid's resolution);
-    * sweep: ``GIM_safe`` (every IC not escaping), ``n_grid_attractors`` (labels of any period up to
-      :data:`PERIOD_MAX`), ``n_unfollowed`` (labels matched by no followed attractor: period > 1 or a
-      fixed point Newton did not converge on), ``n_unsettled``; ``basin`` (sweep, q0, p0): -1 another
-      attractor, 0 escape, k + 1 followed attractor k.
+      settles on it (``matched`` False: its basin is below the grid's resolution); ``lost_to_escape``
+      (the GIM of its basin at the previous swept value whose nodes escape at this one; NaN at the first);
+    * sweep: ``GIM_safe`` (every IC not escaping), ``lost_safe`` (as ``lost_to_escape``, the whole safe
+      basin; its cliff in the scalars ``safe_cliff_low``, ``safe_cliff_high``, ``safe_cliff_drop``),
+      ``n_grid_attractors`` (labels of any period up to :data:`PERIOD_MAX`), ``n_unfollowed`` (labels
+      matched by no followed attractor: period > 1 or a fixed point Newton did not converge on),
+      ``n_unsettled``; ``basin`` (sweep, q0, p0): -1 another attractor, 0 escape, k + 1 followed
+      attractor k.
     """
     name, values, F0, Om0 = _check_sweep(Omega, F)
     beta = checks.check_damping(damping)
@@ -246,7 +251,7 @@ def _integrity(w: Well, tr: _Tracker, labels: list[xr.DataArray], q0: Array, p0:
     out = {k: np.full((n_s, n_a), np.nan) for k in ("q", "p", "amp", "mu", "GIM", "LIM", "r", "frac")}
     out["nodes"] = np.zeros((n_s, n_a))
     out["matched"] = np.zeros((n_s, n_a))
-    per_sweep = np.zeros((n_s, 4))          # GIM_safe, n labels, n unfollowed, n unsettled
+    per_sweep = np.zeros((n_s, 5))          # GIM_safe, n labels, n unfollowed, n unsettled, unforced nodes
     basin = np.zeros((n_s, q0.size, p0.size), np.int16)
     for k, lab in enumerate(labels):
         L = np.asarray(lab.values)
@@ -265,7 +270,8 @@ def _integrity(w: Well, tr: _Tracker, labels: list[xr.DataArray], q0: Array, p0:
                 owner[int(np.argmin(d))] = a
         masks = np.stack([L == j + 1 for j in range(aq.size)] + [L != 0]) if aq.size else (L != 0)[None]
         m = integrity_measures(masks, q0, p0, np.full(masks.shape[0], xi), well=w)
-        per_sweep[k] = (m["GIM"][-1], aq.size, int((owner < 0).sum()), lab.attrs.get("n_unsettled", 0))
+        per_sweep[k] = (m["GIM"][-1], aq.size, int((owner < 0).sum()), lab.attrs.get("n_unsettled", 0),
+                        m["area_unforced"][-1] / ((q0[1] - q0[0]) * (p0[1] - p0[0])))
         basin[k][L != 0] = -1
         for j in range(aq.size):
             a = int(owner[j])
@@ -285,14 +291,20 @@ def _integrity(w: Well, tr: _Tracker, labels: list[xr.DataArray], q0: Array, p0:
     return out, per_sweep, basin
 
 
-def _cliff(values: Array, gim: Array) -> tuple[float, float, float]:
-    """The neighbouring swept values with the largest fall of GIM where it is defined at both (NaN triple if none)."""
-    d = gim[:-1] - gim[1:]
-    ok = np.isfinite(d)
-    if not ok.any():
+def _lost(basin: npt.NDArray[np.int16], label: int, unforced: Array) -> Array:
+    """Per swept value (from the second), the nodes of ``label``'s basin at the previous value that escape at
+    this one, over the unforced safe set's nodes (GIM units); NaN at the first value."""
+    out = np.full(basin.shape[0], np.nan)
+    out[1:] = ((basin[:-1] == label) & (basin[1:] == 0)).sum(axis=(1, 2)) / unforced[1:]
+    return out
+
+
+def _cliff(values: Array, lost: Array) -> tuple[float, float, float]:
+    """The neighbouring swept values between which the most of a basin is lost to escape (NaN triple if none)."""
+    if not np.nanmax(lost, initial=0.0) > 0:
         return math.nan, math.nan, math.nan
-    i = int(np.flatnonzero(ok)[np.argmax(np.abs(d[ok]))])
-    return float(values[i]), float(values[i + 1]), float(d[i])
+    k = int(np.nanargmax(lost))
+    return float(values[k - 1]), float(values[k]), float(lost[k])
 
 
 def _end(curve: al.Curve, i: int, lower: bool) -> tuple[str, float]:
@@ -329,6 +341,7 @@ def _dataset(w: Well, fam: al.Family, values: Array, tr: _Tracker, labels: list[
     end_kind = np.zeros((n_a, 2), np.int8)
     cls = np.zeros(n_a, np.int8)
     cliff = np.full((n_a, 3), np.nan)
+    lost = np.full((values.size, n_a), np.nan)
     for a, (c, i, j) in enumerate(tr.runs):
         run = tr.curves[c].points[i:j + 1]
         both = [_end(tr.curves[c], i, True), _end(tr.curves[c], j, False)]
@@ -337,9 +350,11 @@ def _dataset(w: Well, fam: al.Family, values: Array, tr: _Tracker, labels: list[
         end_kind[a] = [al.EVENT_KINDS.index(e[0]) for e in both]
         res_lag = np.array([p.lag for p in run]) > 0.5 * np.pi
         cls[a] = 1 if res_lag.all() else (0 if not res_lag.any() else 2)
-        cliff[a] = _cliff(values, res["GIM"][:, a])
+        lost[:, a] = _lost(basin, a + 1, per_sweep[:, 4])
+        cliff[a] = _cliff(values, lost[:, a])
     g_safe = per_sweep[:, 0]
-    safe_cliff = _cliff(values, g_safe)
+    lost_safe = _lost(np.where(basin != 0, 1, 0).astype(np.int16), 1, per_sweep[:, 4])
+    safe_cliff = _cliff(values, lost_safe)
     exists = np.isfinite(res["q"])
     flags = {"flag_values": np.arange(len(al.EVENT_KINDS), dtype=np.int8), "flag_meanings": " ".join(al.EVENT_KINDS)}
     P, PM, E, EM, A, AE, SA, S = (("point",), ("point", "multiplier"), ("event",), ("event", "multiplier"),
@@ -384,9 +399,10 @@ def _dataset(w: Well, fam: al.Family, values: Array, tr: _Tracker, labels: list[
                                      "flag_meanings": " ".join(ATTRACTOR_CLASSES)}),
         "attractor_end_parameter": var(AE, ends, f"{lam_name} where the attractor ends"),
         "attractor_end_kind": (AE, end_kind, {"long_name": "why the attractor ends there", **flags}),
-        "cliff_low": var(A, cliff[:, 0], "lower swept value of the largest change of GIM (the Dover cliff)"),
-        "cliff_high": var(A, cliff[:, 1], "upper swept value of the largest change of GIM"),
-        "cliff_drop": var(A, cliff[:, 2], "GIM(cliff_low) - GIM(cliff_high)"),
+        "cliff_low": var(A, cliff[:, 0], "swept value before the largest loss of the basin to escape (Dover cliff)"),
+        "cliff_high": var(A, cliff[:, 1], "swept value after the largest loss of the basin to escape"),
+        "cliff_drop": var(A, cliff[:, 2], "GIM of the basin lost to escape between cliff_low and cliff_high"),
+        "lost_to_escape": var(SA, lost, "GIM of the basin at the previous swept value that escapes at this one"),
         "exists": var(SA, exists, "the attractor exists at this value"),
         "matched": var(SA, res["matched"].astype(bool), "a grid label settles on the attractor"),
         "q_attractor": var(SA, res["q"], "q of the attractor at the section"),
@@ -403,9 +419,10 @@ def _dataset(w: Well, fam: al.Family, values: Array, tr: _Tracker, labels: list[
         "n_unfollowed": var(S, per_sweep[:, 2].astype(np.int64), "labels' attractors no followed attractor matches"),
         "n_unsettled": var(S, per_sweep[:, 3].astype(np.int64), "ICs not settled within the map iterations"),
         "basin": ((name, "q0", "p0"), basin, {"long_name": "basin: -1 another attractor, 0 escape, k + 1 attractor k"}),
-        "safe_cliff_low": var((), safe_cliff[0], "lower swept value of the largest change of GIM_safe"),
-        "safe_cliff_high": var((), safe_cliff[1], "upper swept value of the largest change of GIM_safe"),
-        "safe_cliff_drop": var((), safe_cliff[2], "GIM_safe(low) - GIM_safe(high)"),
+        "lost_safe": var(S, lost_safe, "GIM of the safe basin at the previous swept value that escapes at this one"),
+        "safe_cliff_low": var((), safe_cliff[0], "swept value before the largest loss of the safe basin to escape"),
+        "safe_cliff_high": var((), safe_cliff[1], "swept value after the largest loss of the safe basin to escape"),
+        "safe_cliff_drop": var((), safe_cliff[2], "GIM of the safe basin lost to escape there"),
     }
     ds = xr.Dataset(
         data,
