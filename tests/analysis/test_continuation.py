@@ -112,6 +112,10 @@ def test_escape_equation_branches_and_events(escape):
     assert kinds.count("fold") == 2 and kinds.count("range_end") == 2 and len(kinds) == 4
     folds = np.sort(ds["event_parameter"].values[np.array(kinds) == "fold"])
     assert 0.046 < folds[0] < 0.048 and 0.068 < folds[1] < 0.070
+    for i in np.flatnonzero(np.array(kinds) == "fold"):      # an independent Jacobian has a multiplier +1
+        x = np.array([ds["event_q"].values[i], ds["event_p"].values[i]])
+        J = _jacobian(FORCE["cubic"], float(ds["event_parameter"].values[i]), OMEGA, BETA, x)
+        assert abs(np.linalg.det(J - np.eye(2))) < 1e-5
     # two attractors: the non-resonant one ends at the upper fold, the resonant one starts at the lower
     assert ds.sizes["attractor"] == 2
     ends = ds["attractor_end_parameter"].values
@@ -204,21 +208,52 @@ def test_basin_measures_are_those_of_the_labels(escape):
     assert float(ds["safe_cliff_high"]) == ds["F"].values[k]
 
 
-def test_a_branch_that_leaves_the_well_ends_there():
-    xi = 0.08          # the saddle branch's largest energy passes it near F 0.065, the resonant orbit's is above
-    ds = continue_attractors(OMEGA, (0.062, 0.07), BETA, "cubic", xi_max=xi, n_grid=9, step_max=0.3)
+def test_no_attractor_in_the_well():
+    # past the escape equation's last attractor every IC escapes: no branch, the basins all escape
+    ds = continue_attractors(OMEGA, (0.1, 0.11), BETA, "cubic", n_grid=9)
+    assert ds.sizes["point"] == ds.sizes["attractor"] == ds.sizes["event"] == 0
+    assert np.array_equal(ds["GIM_safe"].values, [0.0, 0.0]) and (ds["basin"].values == 0).all()
+    assert np.array_equal(ds["n_grid_attractors"].values, [0, 0]) and np.isnan(ds["safe_cliff_low"])
+
+
+def _jacobian(force, F, Omega, beta, x, h=1e-6):
+    """D P by central differences of the independent period map."""
+    cols = [(_period_map(force, F, Omega, beta, x + h * e) - _period_map(force, F, Omega, beta, x - h * e)) / (2 * h)
+            for e in np.eye(2)]
+    return np.stack(cols, axis=1)
+
+
+def test_period_doubling_on_the_resonant_branch():
+    # the escape equation at beta = 0.05, Omega = 0.8: the resonant attractor flips near F = 0.0649
+    ds = continue_attractors(0.8, (0.05, 0.06, 0.07), 0.05, "cubic", n_grid=21, step_max=0.3)
     kinds = np.array(_kinds(ds))
-    assert kinds.tolist().count("left_well") == 1
+    assert kinds.tolist().count("period_doubling") == 1 and ds["event_located"].values.all()
+    i = int(np.flatnonzero(kinds == "period_doubling")[0])
+    F_pd = float(ds["event_parameter"].values[i])
+    assert 0.064 < F_pd < 0.066
+    # an independent Jacobian at the located point has a multiplier -1: det(D P + I) = 0
+    x = np.array([ds["event_q"].values[i], ds["event_p"].values[i]])
+    J = _jacobian(FORCE["cubic"], F_pd, 0.8, 0.05, x)
+    assert abs(np.linalg.det(J + np.eye(2))) < 1e-5
+    a = [k for k in range(ds.sizes["attractor"]) if EVENT_KINDS[int(ds["attractor_end_kind"].values[k, 1])]
+         == "period_doubling"]
+    assert len(a) == 1 and ds["attractor_end_parameter"].values[a[0], 1] == F_pd
+    # the flip saddle's branch leaves the well: it ends on the located point where its largest H0 is E_b
+    left = np.flatnonzero(kinds == "left_well")
+    assert left.size == 1 and 0.065 < ds["event_parameter"].values[left[0]] < 0.066
+    c = ds["curve"].values == ds["event_curve"].values[left[0]]
     e = ds["energy_max"].values
-    assert np.all(e <= xi * (1 + 1e-6)) and np.all(np.isfinite(e))
-    assert e[-1] == pytest.approx(xi, rel=1e-6)         # the curve ends on the located point H0 = xi_max
-    assert not ds["stable"].values[-1]
-    F_left = float(ds["event_parameter"].values[kinds == "left_well"][0])
-    assert ds["parameter"].values[-1] == F_left and 0.064 < F_left < 0.066
-    # one attractor, ended by its fold; at F = 0.07 every IC escapes and nothing is NaN but the absent one
-    assert ds.sizes["attractor"] == 1 and EVENT_KINDS[int(ds["attractor_end_kind"].values[0, 1])] == "fold"
-    assert not ds["exists"].values[1].any() and ds["GIM_safe"].values[1] == 0
-    assert np.isnan(ds["GIM"].values[1, 0]) and ds["GIM"].values[0, 0] > 0
+    assert np.all(e <= (1 + 1e-6) / 6) and np.isfinite(e).all()
+    assert e[c][-1] == pytest.approx(1 / 6, rel=1e-6) and not ds["stable"].values[c][-1]
+    assert ds["parameter"].values[c][-1] == ds["event_parameter"].values[left[0]]
+    # just past it, a long run from the flip saddle settles on a period-2 orbit about it
+    F = F_pd + 4e-4
+    y = x + np.array([1e-3, 0.0])
+    T = 2 * np.pi / 0.8
+    sol = solve_ivp(lambda t, z: [z[1], -FORCE["cubic"](z[0]) - 0.05 * z[1] + F * np.sin(0.8 * t)], (0, 200 * T), y,
+                    method="DOP853", rtol=1e-10, atol=1e-12, t_eval=T * np.arange(198, 201))
+    X = sol.y.T
+    assert np.max(np.abs(X[2] - X[0])) < 1e-8 and np.max(np.abs(X[2] - X[1])) > 0.05
 
 
 @pytest.mark.parametrize("kwargs, words", [

@@ -140,9 +140,11 @@ class Point:
 
 @dataclasses.dataclass(frozen=True)
 class Event:
-    """Where a branch bifurcates or ends: ``kind`` one of :data:`EVENT_KINDS`; ``point`` the located orbit."""
+    """Where a branch bifurcates or ends: ``kind`` one of :data:`EVENT_KINDS`; ``point`` the located orbit
+    (``located`` False: the location failed and ``point`` is the nearest point of the branch found)."""
     kind: str
     point: Point
+    located: bool = True
 
 
 @dataclasses.dataclass
@@ -192,16 +194,19 @@ def _summary(fam: Family, y: Array) -> tuple[float, float, float, float]:
     return float(np.max(np.abs(qp[0]))), float(np.max(H)), float(abs(a)), float(np.mod(-np.angle(a), 2.0 * np.pi))
 
 
-def correct(fam: Family, y0: Array, n: Array, p_lam: Array | None = None) -> Point | None:
-    """Newton on (C2) from ``y0`` with the hyperplane ``n . (z - z_0) = 0`` (``n`` a unit vector in the
-    scaled coordinates); ``p_lam``: the lambda column (default: computed at ``y0``).  None when Newton
-    fails, leaves the domain or the flow cannot be integrated."""
+def correct(fam: Family, y0: Array, n: Array, p_lam: Array | None = None, start: Array | None = None
+            ) -> Point | None:
+    """Newton on (C2) with the hyperplane ``n . (z - z_0) = 0`` through ``y0`` (``n`` a unit vector in the
+    scaled coordinates), from ``start`` (default ``y0``); ``p_lam``: the lambda column (default: computed
+    at the first iterate).  None when Newton fails, stops contracting, leaves the domain or the flow
+    cannot be integrated."""
     S = fam.scale
-    y = np.array(y0, dtype=float)
+    y = np.array(y0 if start is None else start, dtype=float)
     A = np.zeros((3, 3))
     A[2] = n
     last: tuple[Array, Array, Array, float] | None = None   # (G, D P, dy, rtol) before the last step
     rtol = RTOL_COARSE
+    res_prev = np.inf
     for _ in range(MAX_NEWTON):
         try:
             r, D = _evaluate(fam, y, rtol)
@@ -216,6 +221,9 @@ def correct(fam: Family, y0: Array, n: Array, p_lam: Array | None = None) -> Poi
         fine = rtol == RTOL
         c = float(n @ (S * (y - y0)))
         res = float(np.max(np.abs(r)))
+        if res > 2.0 * res_prev and res > RESIDUAL_TOL:
+            return None                     # not contracting: past a fold or off the branch; a shorter step
+        res_prev = res
         if fine and res <= RESIDUAL_TOL and abs(c) <= RESIDUAL_TOL:
             return _point(fam, y, D, p_lam, res)
         A[:2, :2] = D - np.eye(2)
@@ -231,8 +239,8 @@ def correct(fam: Family, y0: Array, n: Array, p_lam: Array | None = None) -> Poi
         if fine and float(np.max(np.abs(dz))) <= STEP_TOL and res <= 1e-8:
             # G at the new y is the linearisation's remainder, O(|dz|^2 + 1e-9 |dz|)
             return _point(fam, y, D, p_lam, res)
-        if res < COARSE_UNTIL:
-            rtol = RTOL
+        if res < COARSE_UNTIL and not fine:
+            rtol, res_prev = RTOL, np.inf   # the fine map's G differs from the coarse one's by ~1e-8
     return None
 
 
@@ -256,23 +264,26 @@ def tangent(fam: Family, pt: Point, previous: Array | None, direction: float = 1
     return -t if float(t @ ref) < 0 else t
 
 
-def _locate(fam: Family, prev: Point, t: Array, ds: float, f: Callable[[Point], float], f0: float,
-            f1: float) -> Point | None:
-    """The zero of ``f`` along the corrector from ``prev`` (step ``s`` in (0, ds)), Illinois regula falsi."""
+def _locate(fam: Family, prev: Point, new: Point, t: Array, ds: float, f: Callable[[Point], float]
+            ) -> tuple[Point, bool]:
+    """The zero of ``f`` between ``prev`` and ``new`` on the corrector from ``prev`` (the hyperplane at step
+    ``s`` in (0, ds) along ``t``, Newton from the chord), by Illinois regula falsi; and whether it converged
+    (if not: the bracket's end with the smaller ``|f|``)."""
     S = fam.scale
+    f0, f1 = f(prev), f(new)
     a, fa, b, fb = 0.0, f0, ds, f1
     side = 0
     best: Point | None = None
     for _ in range(MAX_LOCATE):
         s = (a * fb - b * fa) / (fb - fa)
-        pt = correct(fam, prev.y + s * t / S, t, prev.p_lam)
+        pt = correct(fam, prev.y + s * t / S, t, prev.p_lam, start=prev.y + (s / ds) * (new.y - prev.y))
         if pt is None:
-            return best
+            break
         moved = best is None or abs(prev.s + s - best.s) > LOCATE_TOL
         best = dataclasses.replace(pt, s=prev.s + s)
         fs = f(pt)
         if fs == 0.0 or not moved:
-            break
+            return best, True
         if (fs > 0) == (fb > 0):
             b, fb = s, fs
             if side == -1:
@@ -284,8 +295,8 @@ def _locate(fam: Family, prev: Point, t: Array, ds: float, f: Callable[[Point], 
                 fb *= 0.5
             side = 1
         if b - a <= LOCATE_TOL:
-            break
-    return best
+            return best, True
+    return (prev if abs(f0) < abs(f1) else new), False
 
 
 def _at_parameter(fam: Family, a: Point, b: Point, lam: float) -> Point | None:
@@ -322,22 +333,20 @@ def _step_events(fam: Family, prev: Point, new: Point, t: Array, t_new: Array, d
     found: list[Event] = []
     if _sign_change(prev.f_plus, new.f_plus):
         kind = "fold" if _sign_change(t[2], t_new[2]) else "branch_point"
-        pt = _locate(fam, prev, t, ds, lambda p: p.f_plus, prev.f_plus, new.f_plus)
-        found.append(Event(kind, pt if pt is not None else new))
+        found.append(Event(kind, *_locate(fam, prev, new, t, ds, lambda p: p.f_plus)))
     if _sign_change(prev.f_minus, new.f_minus):
-        pt = _locate(fam, prev, t, ds, lambda p: p.f_minus, prev.f_minus, new.f_minus)
-        found.append(Event("period_doubling", pt if pt is not None else new))
+        found.append(Event("period_doubling", *_locate(fam, prev, new, t, ds, lambda p: p.f_minus)))
     found.sort(key=lambda e: e.point.s)
     if new.energy_max >= fam.xi_max:
-        g: Callable[[Point], float] = lambda p: p.energy_max - fam.xi_max
-        pt = _locate(fam, prev, t, ds, g, g(prev), g(new))
-        end = Event("left_well", pt if pt is not None and pt.energy_max <= fam.xi_max * (1 + 1e-6) else prev)
+        pt, ok = _locate(fam, prev, new, t, ds, lambda p: p.energy_max - fam.xi_max)
+        inside = pt.energy_max <= fam.xi_max * (1 + 1e-6)
+        end = Event("left_well", pt if inside else prev, ok and inside)
         return [e for e in found if e.point.s < end.point.s] + [end]
     lam = float(new.y[2])
     if not bounds[0] <= lam <= bounds[1]:
         edge = bounds[0] if lam < bounds[0] else bounds[1]
-        pt = _at_parameter(fam, prev, new, edge)
-        end = Event("range_end", pt if pt is not None else prev)
+        at = _at_parameter(fam, prev, new, edge)
+        end = Event("range_end", at) if at is not None else Event("range_end", prev, False)
         return [e for e in found if e.point.s < end.point.s] + [end]
     return found
 
@@ -405,6 +414,7 @@ def curve(fam: Family, seed: Point, bounds: tuple[float, float], ds_max: float, 
     back, ev_back = follow(fam, seed, -1.0, bounds, ds_max, max_points)
     fwd, ev_fwd = follow(fam, seed, 1.0, bounds, ds_max, max_points)
     flipped = {id(p): dataclasses.replace(p, s=-p.s) for p in back}
-    flip = [Event(e.kind, flipped.get(id(e.point), dataclasses.replace(e.point, s=-e.point.s))) for e in ev_back]
+    flip = [Event(e.kind, flipped.get(id(e.point), dataclasses.replace(e.point, s=-e.point.s)), e.located)
+            for e in ev_back]
     pts = [flipped[id(p)] for p in back[:0:-1]] + fwd
     return Curve(points=pts, events=flip[-2::-1] + ev_fwd[:-1], ends=(flip[-1], ev_fwd[-1]))

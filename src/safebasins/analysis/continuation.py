@@ -182,7 +182,8 @@ def continue_attractors(Omega: npt.ArrayLike, F: npt.ArrayLike, damping: float, 
     * event: ``event_kind`` (flags of :data:`safebasins.analysis.arclength.EVENT_KINDS`: bifurcations
       and each curve's two ends, ``left_well`` / ``range_end`` / ``step_failure`` / ``max_points`` /
       ``closed``), ``event_curve``, ``event_parameter``, ``event_q``, ``event_p``,
-      ``event_amplitude``, ``event_multiplier_real`` (event, multiplier);
+      ``event_amplitude``, ``event_multiplier_real`` (event, multiplier), ``event_located`` (False
+      where the location failed and the event's point is the nearest point of the branch);
     * attractor: ``attractor_curve``, ``attractor_class`` (:data:`ATTRACTOR_CLASSES`),
       ``attractor_end_parameter`` and ``attractor_end_kind`` (attractor, end: the lambda where the
       attractor ends and why: an event kind), ``cliff_low``, ``cliff_high``, ``cliff_drop`` (the
@@ -393,6 +394,8 @@ def _dataset(w: Well, fam: al.Family, values: Array, tr: _Tracker, labels: list[
         "event_amplitude": var(E, np.array([e.point.amplitude for _, e in evs]),
                                "largest |q| of the orbit at the event"),
         "event_multiplier_real": var(EM, ev_mu, "real parts of the multipliers at the event"),
+        "event_located": var(E, np.array([e.located for _, e in evs], bool),
+                             "the event is located (False: its location failed, the nearest point found)"),
         "attractor_curve": var(A, np.array([c for c, _, _ in tr.runs], np.int64), "curve of the attractor"),
         "attractor_class": (A, cls, {"long_name": "lag of the first harmonic below / above pi/2 on the whole "
                                                   "attractor, or both", "flag_values": np.arange(3, dtype=np.int8),
