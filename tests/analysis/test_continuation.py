@@ -3,10 +3,14 @@
 Independent routes: the quartic's branches against its closed-form harmonic balance and the damped
 slow flow's steady responses (theory.responses), the folds against the slow flow's saddle-node
 points, errors shrinking with F; every fixed point against a scipy DOP853 period map of the
-closed-form force; the multipliers' product against Liouville's exp(-beta T); long DOP853 runs
-from grid nodes inside the escape equation's hysteresis band against the attractors reported and
-the basin labels; the LIM radius against a direct nearest-node search.
+closed-form force, the located folds and period doubling against det(D P -+ I) of that map's
+central-difference Jacobian, and the period-2 orbit past the doubling against a long run; the
+multipliers' product against Liouville's exp(-beta T); long DOP853 runs from grid nodes inside the
+escape equation's hysteresis band against the attractors reported and the basin labels; the LIM
+radius and the losses to escape against direct counts on the labels.
 """
+import warnings
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -223,9 +227,12 @@ def _jacobian(force, F, Omega, beta, x, h=1e-6):
     return np.stack(cols, axis=1)
 
 
-def test_period_doubling_on_the_resonant_branch():
+def test_period_doubling_on_the_resonant_branch(capsys):
     # the escape equation at beta = 0.05, Omega = 0.8: the resonant attractor flips near F = 0.0649
-    ds = continue_attractors(0.8, (0.05, 0.06, 0.07), 0.05, "cubic", n_grid=21, step_max=0.3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")                  # quiet: no warning, no print
+        ds = continue_attractors(0.8, (0.05, 0.06, 0.07), 0.05, "cubic", n_grid=21, step_max=0.3)
+    assert capsys.readouterr() == ("", "")
     kinds = np.array(_kinds(ds))
     assert kinds.tolist().count("period_doubling") == 1 and ds["event_located"].values.all()
     i = int(np.flatnonzero(kinds == "period_doubling")[0])

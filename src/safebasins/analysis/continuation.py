@@ -60,12 +60,10 @@ _ONE = {"units": "1"}
 def _check_sweep(Omega: Any, F: Any) -> tuple[al.Parameter, Array, float, float]:
     """``(parameter, values, F, Omega)``: which of Omega and F is swept (a 1-D increasing array) and the
     other's value (a scalar)."""
-    om, f = np.asarray(Omega, dtype=float) if np.ndim(Omega) else None, np.asarray(F, dtype=float) \
-        if np.ndim(F) else None
-    if (om is None) == (f is None):
+    if (np.ndim(Omega) > 0) == (np.ndim(F) > 0):
         raise ValueError("Omega and F: exactly one must be a 1-D sweep (an array of at least 2 increasing values) "
                          f"and the other a scalar; got Omega with shape {np.shape(Omega)}, F with shape {np.shape(F)}")
-    if om is not None:
+    if np.ndim(Omega) > 0:
         vals = checks.check_1d("Omega", Omega, checks.check_positive)
         name: al.Parameter = "Omega"
         Fv, Omv = checks.check_scalar("F", F, checks.check_nonnegative), float(vals[0])
