@@ -201,9 +201,7 @@ def continue_attractors(Omega: npt.ArrayLike, F: npt.ArrayLike, damping: float, 
       attractor k.
     """
     name, values, F0, Om0 = _check_sweep(Omega, F)
-    beta = checks.check_damping(damping)
-    if not beta > 0:
-        raise ValueError(f"damping must be > 0 (without damping there is no attractor to follow), got {damping!r}")
+    beta = checks.check_positive_damping(damping, "without damping there is no attractor to follow")
     w = resolve_well(well)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
     xi = float(w.check_threshold("xi_max", w.barrier_energy if xi_max is None else xi_max))

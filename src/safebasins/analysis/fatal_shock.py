@@ -242,9 +242,7 @@ def minimal_fatal_shock(F: float, Omega: float, damping: float, well: WellLike =
     """
     F = checks.check_scalar("F", F, checks.check_nonnegative)
     Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
-    beta = checks.check_damping(damping)
-    if not beta > 0:
-        raise ValueError(f"damping must be > 0 (without damping there is no attractor to shock), got {damping!r}")
+    beta = checks.check_positive_damping(damping, "without damping there is no attractor to shock")
     w = resolve_well(well)
     phi = checks.check_1d("phases", phases, checks.check_finite)
     xi = float(w.check_threshold("xi_max", w.barrier_energy if xi_max is None else xi_max))

@@ -53,9 +53,7 @@ def saddle_chart(F_values: float | Sequence[float], Omega: float, Psi: float, xi
     ``F_tangency``, ``F_splitting``."""
     F = checks.check_1d("F_values", F_values, checks.check_nonnegative)
     Om = checks.check_scalar("Omega", Omega, checks.check_positive)
-    beta = checks.check_damping(damping)
-    if not beta > 0:
-        raise ValueError("damping: the escape charts' safe basins need damping > 0 (attractors inside the well)")
+    beta = checks.check_positive_damping(damping, "the escape charts' safe basins need attractors inside the well")
     cycles = checks.check_positive_int("cycles", cycles)
     w = resolve_well(well)
     FM = float(_threshold(Om, beta, w))

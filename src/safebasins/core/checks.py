@@ -84,6 +84,14 @@ def check_damping(damping: Any) -> float:
     return check_scalar("damping", damping, check_nonnegative)
 
 
+def check_positive_damping(damping: Any, why: str) -> float:
+    """check_damping, and damping > 0: ``why`` says what needs it (ValueError naming ``damping``)."""
+    beta = check_damping(damping)
+    if not beta > 0:
+        raise ValueError(f"damping must be > 0 ({why}), got {damping!r}")
+    return beta
+
+
 def check_scalar(name: str, value: Any, check: Check) -> float:
     """``check(name, value)`` and a 0-d result, returned as float."""
     a = check(name, value)
