@@ -9,8 +9,8 @@ import click
 
 from safebasins.cli.commands import well_label
 from safebasins.cli.options import (FINITE, NONNEG, POSITIVE, THRESHOLD, Deferred, Fields, Number, NumberList,
-                                    checked, common_options, cost_guard, engine_check, from_library, from_schema,
-                                    grid_params, joined, library_errors, no_fourier, out_option)
+                                    common_options, cost_guard, from_schema, grid_params, joined, library_errors,
+                                    no_fourier, out_option, steps_option, threads_option)
 from safebasins.cli.output import chatter, draw, finish, job, write_outputs
 from safebasins.pipeline.values import fmt
 
@@ -40,12 +40,8 @@ __all__ = ["basin_measures"]
 @click.option("--box", cls=Deferred, type=click.IntRange(min=2),
               default=from_schema("basin_measures", "measures", "box"),
               help="Box side of the basin entropy (grid steps).")
-@click.option("--steps-per-cycle", "steps_per_cycle", cls=Deferred, type=int,
-              default=from_library("safebasins.numerics:stroboscopic_map", "steps_per_cycle"),
-              callback=checked(None, engine_check("check_steps_per_cycle")),
-              help="Fixed integrator steps per forcing period (>= 4).")
-@click.option("--threads", type=int, default=None, callback=checked(None, engine_check("check_threads")),
-              help="Numba threads (default: all; results do not depend on it).")
+@steps_option("safebasins.numerics:stroboscopic_map", " (>= 4)")
+@threads_option
 @common_options
 @out_option("basin_measures")
 def basin_measures(F: list[float], Omega: float, Psi: float, xi_max: float, damping: float, n: list[int],

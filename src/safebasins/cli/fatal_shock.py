@@ -9,9 +9,9 @@ from typing import Any
 import click
 
 from safebasins.cli.commands import well_label
-from safebasins.cli.options import (FINITE, NONNEG, POSITIVE, THRESHOLD, Deferred, Number, NumberList, checked,
-                                    common_options, cost_guard, engine_check, from_library, from_schema,
-                                    library_errors, no_fourier, out_option)
+from safebasins.cli.options import (FINITE, NONNEG, POSITIVE, THRESHOLD, Deferred, Number, NumberList,
+                                    common_options, cost_guard, from_schema, library_errors, no_fourier, out_option,
+                                    steps_option, threads_option)
 from safebasins.cli.output import chatter, draw, finish, job, write_outputs
 from safebasins.pipeline.values import fmt
 
@@ -45,12 +45,8 @@ KIND = "minimal_fatal_shock"
 @click.option("--n-lim", "n_lim", cls=Deferred, type=click.IntRange(min=3),
               default=from_schema(KIND, "search", "n_lim"),
               help="Nodes per side of the LIM grid centred on the attractor (odd).")
-@click.option("--steps-per-cycle", "steps_per_cycle", cls=Deferred, type=int,
-              default=from_library("safebasins.analysis.fatal_shock:minimal_fatal_shock", "steps_per_cycle"),
-              callback=checked(None, engine_check("check_steps_per_cycle")),
-              help="Fixed integrator steps per forcing period (>= 4; the energy is checked after each step).")
-@click.option("--threads", type=int, default=None, callback=checked(None, engine_check("check_threads")),
-              help="Numba threads (default: all; results do not depend on it).")
+@steps_option("safebasins.analysis.fatal_shock:minimal_fatal_shock", " (>= 4; the energy is checked after each step)")
+@threads_option
 @common_options
 @out_option("fatal_shock")
 def fatal_shock(F: float, Omega: float, Psi: float, xi_max: float, damping: float, n_phases: int, cycles: int,

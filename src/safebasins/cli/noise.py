@@ -10,9 +10,9 @@ import click
 
 from safebasins.cli.commands import check_step, damping_text, grid_axes, well_label
 from safebasins.cli.options import (NONNEG, THRESHOLD, Deferred, Number, NumberList, checked, common_options,
-                                    cost_guard, current_well, damping_option, engine_check, forcing_options,
-                                    from_library, grid_options, grid_params, joined, lib_check, library_errors,
-                                    no_fourier, out_option)
+                                    cost_guard, current_well, damping_option, forcing_options, from_library,
+                                    grid_options, grid_params, joined, lib_check, library_errors, no_fourier,
+                                    out_option, steps_option, threads_option)
 from safebasins.cli.output import chatter, draw, finish, write_outputs
 from safebasins.pipeline.cost import NOISE_STEP_COST
 from safebasins.pipeline.values import fmt
@@ -50,12 +50,8 @@ MAX_T_EVAL = 4
               help="Horizon in forcing cycles (>= every --t-eval; the first-passage mean is restricted to it) "
                    "[default: the largest --t-eval rounded up].")
 @grid_options
-@click.option("--steps-per-cycle", "steps_per_cycle", cls=Deferred, type=int,
-              default=from_library(LIBRARY, "steps_per_cycle"),
-              callback=checked(None, engine_check("check_steps_per_cycle")),
-              help="Fixed integrator steps per forcing period (>= 4).")
-@click.option("--threads", type=int, default=None, callback=checked(None, engine_check("check_threads")),
-              help="Numba threads (default: all; results do not depend on it).")
+@steps_option(LIBRARY, " (>= 4)")
+@threads_option
 @damping_option()
 @common_options
 @out_option("escape_probability")

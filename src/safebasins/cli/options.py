@@ -488,17 +488,27 @@ def common_options(f: Cmd) -> Cmd:
     return well_option(f)
 
 
+def threads_option(f: Cmd) -> Cmd:
+    """--threads: numba threads, checked by the engine."""
+    return click.option("--threads", type=int, default=None, callback=checked(None, engine_check("check_threads")),
+                        help="Numba threads (default: all; results do not depend on it).")(f)
+
+
+def steps_option(func: str, what: str = "") -> Callable[[Cmd], Cmd]:
+    """--steps-per-cycle, its default the library function ``func``'s; ``what`` ends the help's first clause."""
+    return click.option("--steps-per-cycle", "steps_per_cycle", cls=Deferred, type=int,
+                        default=from_library(func, "steps_per_cycle"),
+                        callback=checked(None, engine_check("check_steps_per_cycle")),
+                        help=f"Fixed integrator steps per forcing period{what}.")
+
+
 def numerics_options(func: str, what: str) -> Callable[[Cmd], Cmd]:
     def deco(f: Cmd) -> Cmd:
         f = click.option("--backend", type=click.Choice(BACKENDS), default="cpu", show_default=True,
                          callback=backend_check,
                          help="Numerics backend: cpu (the reference), cuda (GPU, bitwise equal escapes), auto.")(f)
-        f = click.option("--threads", type=int, default=None, callback=checked(None, engine_check("check_threads")),
-                         help="Numba threads (default: all; results do not depend on it).")(f)
-        f = click.option("--steps-per-cycle", "steps_per_cycle", cls=Deferred, type=int,
-                         default=from_library(func, "steps_per_cycle"),
-                         callback=checked(None, engine_check("check_steps_per_cycle")),
-                         help="Fixed integrator steps per forcing period (>= 4).")(f)
+        f = threads_option(f)
+        f = steps_option(func, " (>= 4)")(f)
         return click.option("--cycles", cls=Deferred, type=int, default=from_library(func, "cycles"),
                             callback=checked("cycles", engine_check("check_cycles", "problem")),
                             help=f"Horizon in forcing cycles (EC) {what}.")(f)

@@ -10,8 +10,8 @@ import click
 
 from safebasins.cli.commands import well_label
 from safebasins.cli.options import (FINITE, NONNEG, POSITIVE, THRESHOLD, Deferred, Fields, Number, NumberList,
-                                    checked, common_options, cost_guard, engine_check, from_library, from_schema,
-                                    grid_params, joined, library_errors, no_fourier, out_option)
+                                    common_options, cost_guard, from_schema, grid_params, joined, library_errors,
+                                    no_fourier, out_option, steps_option, threads_option)
 from safebasins.cli.output import chatter, draw, finish, job, write_outputs
 from safebasins.pipeline.values import fmt
 
@@ -39,12 +39,8 @@ __all__ = ["hilltop_saddle"]
               help="Longest segment of the drawn manifolds.")
 @click.option("--tangency/--no-tangency", default=False, show_default=True,
               help="Also find the F of the manifolds' first tangency (Brent; a few minutes).")
-@click.option("--steps-per-cycle", "steps_per_cycle", cls=Deferred, type=int,
-              default=from_library("safebasins.numerics:escape_chart", "steps_per_cycle"),
-              callback=checked(None, engine_check("check_steps_per_cycle")),
-              help="Fixed integrator steps per forcing period of the charts (>= 4).")
-@click.option("--threads", type=int, default=None, callback=checked(None, engine_check("check_threads")),
-              help="Numba threads (default: all; results do not depend on it).")
+@steps_option("safebasins.numerics:escape_chart", " of the charts (>= 4)")
+@threads_option
 @common_options
 @out_option("hilltop_saddle")
 def hilltop_saddle(F: list[float], Omega: float, Psi: float, xi_max: float, damping: float, n: list[int],
