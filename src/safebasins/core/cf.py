@@ -64,6 +64,12 @@ VARIABLES = {
     "first_passage_mean": ("1", "restricted mean first-passage time E[min(tau, cycles)] (forcing cycles)"),
     "first_passage_sem": ("1", "standard error of first_passage_mean (forcing cycles)"),
     "censored_fraction": ("1", "fraction of paths not escaped within the horizon (censored first passages)"),
+    "mean_first_passage": ("1", "mean first-passage time E[tau] to xi_max (forcing cycles)"),
+    "P_escape_theory": ("1", "probability of escape at or before t_eval from the averaged (stochastic slow-flow) "
+                             "theory"),
+    "P_escape_mean_abs_difference": ("1", "mean over the initial conditions of |P_escape theory - P_escape numerics|"),
+    "P_escape_max_abs_difference": ("1", "maximum over the initial conditions of |P_escape theory - P_escape "
+                                         "numerics|"),
     "F_cr": ("1", "critical forcing amplitude"),
     "F_MM_0": ("1", "critical forcing, maximum mechanism through gamma* = 0"),
     "F_MM_pi": ("1", "critical forcing, maximum mechanism through gamma* = pi"),

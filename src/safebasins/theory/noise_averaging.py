@@ -1,0 +1,139 @@
+"""Stochastic averaging of the noisy slow flow on the 1:1 resonance (docs/noise-theory.md).
+
+With ``dp = (...) dtau + sigma dW`` the action-angle pair ``(theta, J)`` of the unforced well is
+canonical, so ``dJ/dp = dq/dtheta`` and ``dtheta/dp = -dq/dJ`` (at fixed q, resp. theta), and the
+noise's generator ``(sigma^2/2) d^2/dp^2`` is ``(sigma^2/2) div(v v^T grad)`` in ``(theta, J)`` with
+the divergence-free field ``v = (-q_J, q_theta)``.  Averaged over the fast angle it becomes
+``(sigma^2/2) div(m grad)`` in ``(gamma, J)`` with the orbit averages
+
+    m_JJ = <q_theta^2> = <p^2>/omega^2 = J/omega,
+    m_gg = <q_J^2>,          m_gJ = -<q_J q_theta>     (0 for a symmetric well),
+
+i.e. the action diffusion ``sigma^2 J/omega``, the noise-induced action drift
+``(sigma^2/2) d(J/omega)/dJ``, the phase diffusion ``sigma^2 m_gg`` and the J-gamma covariance
+``sigma^2 m_gJ``.  In the regular frame ``X + i Y = sqrt(2J) e^{i gamma}`` the same operator is
+``(sigma^2/2) div(A grad)`` with ``A = a_r e_r e_r^T + a_t e_g e_g^T`` (symmetric well),
+``a_r = 1/(2 omega)``, ``a_t = 2 J m_gg``; both tend to ``1/(2 omega(0))`` at the well bottom
+(isotropic: the linear oscillator's ``sigma^2/(2 omega)``).
+
+``q_J = omega dq/dE`` at fixed theta is taken by central differences of the well's
+``phase_point`` (any well with action-angle variables), and the averages by the trapezoidal rule
+over theta (spectrally accurate for the periodic integrand).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from safebasins.theory.types import FloatArray
+from safebasins.wells.base import Well
+
+__all__ = ["orbit_averages", "AveragedDiffusion", "averaged_diffusion", "N_THETA"]
+
+#: angles of the trapezoidal rule of the orbit averages
+N_THETA = 256
+#: relative step of the central difference in the energy (q_J = omega dq/dE at fixed theta)
+_REL_STEP = 1e-6
+
+
+def orbit_averages(well: Well, xi: ArrayLike, n_theta: int = N_THETA) -> dict[str, FloatArray]:
+    """Orbit averages of the noise terms at energies ``0 < xi < barrier_energy`` (validated by the
+    well): ``J``, ``omega``, ``m_JJ = <(dJ/dp)^2> = <p^2>/omega^2``, ``m_gg = <(dtheta/dp)^2> =
+    <q_J^2>``, ``m_gJ = <(dtheta/dp)(dJ/dp)> = -<q_J q_theta>``, and ``drift_J = <d^2J/dp^2>/2 =
+    (1 - J domega/dE)/(2 omega)`` (the noise-induced action drift per unit sigma^2), each an array
+    of the shape of xi."""
+    x = np.asarray(well.check_energy("xi", xi), float)
+    if (x <= 0).any():
+        raise ValueError("xi must be > 0 for the orbit averages (the angle is undefined at the well bottom)")
+    th = 2.0 * np.pi * np.arange(n_theta) / n_theta
+    xs = x.reshape(-1)
+    h = _REL_STEP * np.minimum(xs, well.barrier_energy - xs)
+    q, p = well.phase_point(th[:, None], xs[None, :])
+    q_hi, _ = well.phase_point(th[:, None], (xs + h)[None, :])
+    q_lo, _ = well.phase_point(th[:, None], (xs - h)[None, :])
+    om = np.asarray(well.omega(xs), float)
+    q_J = om * (q_hi - q_lo) / (2.0 * h)
+    q_th = p / om
+    # d omega/dE by the same central difference (omega(E) is smooth inside the well)
+    om_E = (np.asarray(well.omega(xs + h)) - np.asarray(well.omega(xs - h))) / (2.0 * h)
+    J = np.asarray(well.J(xs), float)
+    p2 = (p * p).mean(axis=0)
+    out = {"J": J, "omega": om, "m_JJ": p2 / om ** 2, "m_gg": (q_J * q_J).mean(axis=0),
+           "m_gJ": -(q_J * q_th).mean(axis=0), "drift_J": 0.5 * (1.0 / om - p2 * om_E / om ** 3)}
+    return {k: v.reshape(x.shape) for k, v in out.items()}
+
+
+@dataclass(frozen=True)
+class AveragedDiffusion:
+    """The averaged diffusion of one symmetric well on ``0 <= J <= J_max``: tables over the action
+    ``J_nodes`` of the energy ``H``, ``omega``, the first-harmonic amplitude over the radius
+    ``a = A / sqrt(2 J)`` (C = H - Omega J - F A cos gamma; a is smooth at J = 0, A is not) and the
+    regular frame's radial and tangential coefficients ``a_r = 1/(2 omega)``, ``a_t = 2 J m_gg``
+    (smooth at J = 0); linear interpolation in J."""
+
+    J_nodes: FloatArray
+    H: FloatArray
+    omega: FloatArray
+    a: FloatArray
+    a_r: FloatArray
+    a_t: FloatArray
+
+    @property
+    def J_max(self) -> float:
+        return float(self.J_nodes[-1])
+
+    def at(self, J: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+        """``(H, omega, A, a_r, a_t)`` at actions ``0 <= J <= J_max``."""
+        Ja = np.asarray(J, float)
+        H, om, a, a_r, a_t = (np.interp(Ja, self.J_nodes, v) for v in (self.H, self.omega, self.a, self.a_r, self.a_t))
+        return H, om, a * np.sqrt(2.0 * Ja), a_r, a_t
+
+    def m_JJ(self, J: ArrayLike) -> FloatArray:
+        """``J/omega``: the action's diffusion per unit sigma^2 (``2 J a_r``)."""
+        Ja = np.asarray(J, float)
+        out: FloatArray = 2.0 * Ja * np.interp(Ja, self.J_nodes, self.a_r)
+        return out
+
+    def m_gg(self, J: ArrayLike) -> FloatArray:
+        """``<q_J^2>``: the phase's diffusion per unit sigma^2 (``a_t / (2 J)``, J > 0)."""
+        Ja = np.asarray(J, float)
+        out: FloatArray = np.interp(Ja, self.J_nodes, self.a_t) / (2.0 * Ja)
+        return out
+
+
+def averaged_diffusion(well: Well, xi_max: float, n: int = 600, n_theta: int = N_THETA) -> AveragedDiffusion:
+    """:class:`AveragedDiffusion` of a symmetric ``well`` up to the energy ``xi_max`` (< its barrier
+    energy), on ``n`` nodes uniform in J (node 0: the well bottom, where ``a_t = a_r = 1/(2
+    omega(0))``).  A well whose first harmonic has a phase (an asymmetric well: J-gamma
+    covariance and a sheared frame) is refused, naming ``well``."""
+    xi_nodes = _xi_nodes(well, xi_max, n)
+    if np.any(np.asarray(well.harmonic_shift(xi_nodes[1:])) != 0.0):
+        raise ValueError(f"well: the averaged noise theory covers symmetric wells (q(theta) odd, no phase of the "
+                         f"first harmonic); the {well.name} well has one")
+    av = orbit_averages(well, xi_nodes[1:], n_theta)
+    J = np.concatenate([[0.0], av["J"]])
+    om = np.asarray(well.omega(xi_nodes), float)
+    a_t = np.concatenate([[np.nan], 2.0 * av["J"] * av["m_gg"]])
+    a_t[0] = 0.5 / om[0]
+    a = np.empty_like(J)
+    a[1:] = np.asarray(well.harmonic_amplitude(xi_nodes[1:]), float) / np.sqrt(2.0 * J[1:])
+    a[0] = a[1] + (a[1] - a[2]) * J[1] / (J[2] - J[1])      # extrapolated in J (a is smooth there)
+    return AveragedDiffusion(J_nodes=J, H=xi_nodes, omega=om, a=a, a_r=0.5 / om, a_t=a_t)
+
+
+def _xi_nodes(well: Well, xi_max: float, n: int) -> FloatArray:
+    """Energies of ``n`` actions uniform on ``[0, J(xi_max)]`` (Newton on dJ/dxi = 1/omega from a
+    dense table)."""
+    grid = xi_max * np.linspace(0.0, 1.0, 4001) ** 2
+    Jg = np.asarray(well.J(grid), float)
+    Jn = np.linspace(0.0, Jg[-1], n)
+    x = np.interp(Jn, Jg, grid)
+    for _ in range(3):
+        inner = (x > 0) & (x < xi_max)
+        xs = np.where(inner, x, 0.5 * xi_max)
+        x = np.where(inner, x - (np.asarray(well.J(xs)) - Jn) * np.asarray(well.omega(xs)), x)
+        x = np.clip(x, 0.0, xi_max)
+    x[0], x[-1] = 0.0, xi_max
+    return x

@@ -1,0 +1,176 @@
+"""Escape under noise from the averaged theory: escape probabilities and mean first-passage times.
+
+The slow flow of the 1:1 resonance with white noise ``sigma dW`` on the momentum, averaged over the
+fast angle (:mod:`safebasins.theory.noise_averaging`), is a diffusion in ``(gamma, J)``; its
+backward Kolmogorov equation, absorbing at ``J(xi_max)``, is solved on a polar grid of the regular
+frame (:mod:`safebasins.theory.noise_solver`).  Each initial condition ``(q0, p0)`` at tau = 0 is
+mapped to ``(theta0, xi_ini)`` of the unforced well (eqs 7, 14), ``gamma = theta0 - Psi``, as in
+:func:`~safebasins.theory.slow_flow_escapes`; ICs at or beyond ``xi_max`` or outside the well
+escape at t = 0.  docs/noise-theory.md: the derivation, the checks and the agreement with the SDE
+ensembles of :func:`safebasins.numerics.escape_probability`.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import xarray as xr
+from numpy.typing import ArrayLike
+
+from safebasins.core import cf, checks
+from safebasins.theory.noise_averaging import AveragedDiffusion, averaged_diffusion
+from safebasins.theory.noise_solver import ADVECTION, DiscGrid, generator, interpolation, march_escape, \
+    solve_first_passage
+from safebasins.theory.types import FloatArray, WellArg
+from safebasins.wells import resolve_well
+from safebasins.wells.base import Well
+from safebasins.wells.provenance import api_provenance
+
+__all__ = ["escape_probability", "mean_first_passage", "GRID_DEFAULT", "STEPS_PER_CYCLE"]
+
+#: cells ``(n_gamma, n_J)`` of the polar grid
+GRID_DEFAULT = (128, 160)
+#: BDF2 steps per forcing cycle of the time march
+STEPS_PER_CYCLE = 8
+
+MODEL_TEXT = ("averaged diffusion of the slow flow (gamma, J) under dp = ... + sigma dW: drift dC/dJ, -dC/dgamma - "
+              "beta J plus the noise-induced (sigma^2/2) d(J/omega)/dJ; diffusion sigma^2 J/omega (action), sigma^2 "
+              "<q_J^2> (phase), no J-gamma covariance (symmetric well); docs/noise-theory.md")
+
+
+def _setup(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_max: float, noise: float,
+           damping: float, well: WellArg, grid: bool | None, cells: tuple[int, int], advection: str
+           ) -> tuple[Well, dict[str, float], tuple[bool, FloatArray, FloatArray, FloatArray, FloatArray],
+                      DiscGrid, AveragedDiffusion]:
+    """Checked arguments (ValueError naming the argument before anything runs)."""
+    w = resolve_well(well)
+    par = {"F": checks.check_scalar("F", F, checks.check_nonnegative),
+           "Omega": checks.check_scalar("Omega", Omega, checks.check_positive),
+           "Psi": checks.check_scalar("Psi", Psi, checks.check_finite),
+           "xi_max": checks.check_scalar("xi_max", xi_max, w.check_analytic_threshold),
+           "noise": checks.check_scalar("noise", noise, checks.check_nonnegative),
+           "damping": checks.check_damping(damping)}
+    if par["noise"] == 0:
+        raise ValueError("noise must be > 0 for the averaged diffusion; at noise 0 the theory is the deterministic "
+                         "slow flow (theory.slow_flow_escapes)")
+    if advection not in ADVECTION:
+        raise ValueError(f"advection must be one of {ADVECTION}, got {advection!r}")
+    if (not isinstance(cells, tuple) or len(cells) != 2
+            or any(isinstance(c, bool) or not isinstance(c, (int, np.integer)) or c < 8 for c in cells)):
+        raise ValueError(f"cells must be a pair of integers >= 8 (n_gamma, n_J), got {cells!r}")
+    ics = _ic_arrays(q0, p0, grid)
+    diff = averaged_diffusion(w, par["xi_max"])
+    return w, par, ics, DiscGrid(int(cells[0]), int(cells[1]), diff.J_max), diff
+
+
+def _ic_arrays(q0: ArrayLike, p0: ArrayLike, grid: bool | None
+               ) -> tuple[bool, FloatArray, FloatArray, FloatArray, FloatArray]:
+    """``(is_grid, q axis, p axis, Q, P)``: 1-D axes make a grid (dims q0, p0) unless ``grid=False``;
+    otherwise paired points (dim sample), as the numerics' escape_probability reads them."""
+    qa = checks.check_finite("q0", q0)
+    pa = checks.check_finite("p0", p0)
+    if grid is None:
+        grid = qa.ndim == 1 and pa.ndim == 1 and _monotone(qa) and _monotone(pa)
+    if grid:
+        if qa.ndim != 1 or pa.ndim != 1 or qa.size == 0 or pa.size == 0:
+            raise ValueError(f"q0 and p0 must be non-empty 1-D axes for grid=True, got shapes {qa.shape}, {pa.shape}")
+        Q, P = np.meshgrid(qa, pa, indexing="ij")
+        return True, qa, pa, Q.ravel(), P.ravel()
+    if qa.shape != pa.shape:
+        raise ValueError(f"q0 and p0 must have the same shape for paired initial conditions (grid=False), got "
+                         f"{qa.shape} and {pa.shape}")
+    return False, qa, pa, qa.ravel(), pa.ravel()
+
+
+def _monotone(a: FloatArray) -> bool:
+    d = np.diff(a)
+    return bool(np.all(d > 0) or np.all(d < 0))
+
+
+def _slow_points(w: Well, Q: FloatArray, P: FloatArray, Psi: float, xi_max: float
+                 ) -> tuple[np.ndarray, FloatArray, FloatArray]:
+    """``(inside, gamma, J)`` of the ICs inside the well and below xi_max."""
+    H = np.asarray(w.H0(Q, P), float)
+    inside = np.asarray(w.in_well(Q), bool) & (H < xi_max)
+    theta, xi = w.angle_energy(Q[inside], P[inside])
+    return inside, np.asarray(theta, float) - Psi, np.asarray(w.J(xi), float)
+
+
+def _coords(is_grid: bool, qa: FloatArray, pa: FloatArray, Q: FloatArray, P: FloatArray
+            ) -> tuple[tuple[int, ...], tuple[str, ...], dict[str, object]]:
+    if is_grid:
+        return (qa.size, pa.size), ("q0", "p0"), {"q0": ("q0", qa, cf.attrs("q0")), "p0": ("p0", pa, cf.attrs("p0"))}
+    return (Q.size,), ("sample",), {"sample": ("sample", np.arange(Q.size), cf.attrs("sample")),
+                                    "q0": ("sample", Q, cf.attrs("q0")), "p0": ("sample", P, cf.attrs("p0"))}
+
+
+def _attrs(par: dict[str, float], w: Well, grid: DiscGrid, advection: str) -> dict[str, object]:
+    return {**par, "noise_model": MODEL_TEXT, "theory": "averaged (stochastic slow flow)",
+            "solver": (f"finite volumes on {grid.n_gamma} x {grid.n_J} cells uniform in (gamma, J) (equal-area polar "
+                       f"grid of X + iY = sqrt(2J) e^(i gamma)), {advection} advection, absorbing at J(xi_max)"),
+            "escape_criteria": f"averaged energy xi reaches xi_max = {par['xi_max']!r}", "well": w.name}
+
+
+@api_provenance
+def escape_probability(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_max: float, *,
+                       noise: float, t_eval: ArrayLike, damping: float = 0.0, well: WellArg = None,
+                       grid: bool | None = None, cells: tuple[int, int] = GRID_DEFAULT,
+                       steps_per_cycle: int = STEPS_PER_CYCLE, advection: str = "central") -> xr.Dataset:
+    """Probability of escape within each ``t_eval`` (forcing cycles) from the averaged theory.
+
+    ``q0, p0, grid``: initial conditions at tau = 0 as :func:`safebasins.numerics.escape_probability`
+    reads them (1-D axes -> dims (q0, p0), paired -> sample); ``F, Omega, Psi, xi_max``: as
+    :func:`~safebasins.theory.slow_flow_escapes`; ``noise``: sigma > 0 of ``dp = ... + sigma dW``;
+    ``damping``: beta >= 0; ``well``: a symmetric well (default the quartic).  ``cells``: the
+    polar grid ``(n_gamma, n_J)``; ``steps_per_cycle``: BDF2 steps per forcing cycle;
+    ``advection``: "central" (default) or "upwind" (monotone, numerically diffusive).
+
+    Returns a Dataset with ``P_escape`` (ic dims, t_eval) and ``first_passage_mean`` (ic dims), the
+    restricted mean ``E[min(tau, cycles)]`` in forcing cycles, ``cycles = ceil(max t_eval)`` (the
+    numerics' names and horizon); attributes: the parameters, the model and the solver.
+    """
+    w, par, (is_grid, qa, pa, Q, P), dgrid, diff = _setup(q0, p0, F, Omega, Psi, xi_max, noise, damping, well,
+                                                          grid, cells, advection)
+    te = checks.check_1d("t_eval", t_eval, checks.check_nonnegative)
+    spc = checks.check_positive_int("steps_per_cycle", steps_per_cycle)
+    cycles = max(1, math.ceil(float(te.max())))
+    inside, gamma, J = _slow_points(w, Q, P, par["Psi"], par["xi_max"])
+    M, s = generator(dgrid, diff, par["F"], par["Omega"], par["damping"], par["noise"], advection)
+    W, w_b = interpolation(dgrid, gamma, J)
+    period = 2.0 * np.pi / par["Omega"]
+    t, Pt = march_escape(M, s, W, w_b, cycles * period, cycles * spc)
+    t = t / period
+    P_in = np.stack([np.interp(te, t, col) for col in Pt.T]) if Pt.shape[1] else np.zeros((0, te.size))
+    surv = 1.0 - Pt
+    fp_in = np.sum(0.5 * (surv[1:] + surv[:-1]) * np.diff(t)[:, None], axis=0)
+    P_all = np.ones((Q.size, te.size))
+    P_all[inside] = P_in
+    fp = np.zeros(Q.size)
+    fp[inside] = fp_in
+    shape, dims, coords = _coords(is_grid, qa, pa, Q, P)
+    coords["t_eval"] = ("t_eval", te, cf.attrs("t_eval"))
+    ds = xr.Dataset({"P_escape": (dims + ("t_eval",), P_all.reshape(shape + (te.size,)), cf.attrs("P_escape")),
+                     "first_passage_mean": (dims, fp.reshape(shape), cf.attrs("first_passage_mean"))},
+                    coords=coords)
+    ds.attrs.update(_attrs(par, w, dgrid, advection), cycles=cycles, steps_per_cycle=spc, grid=int(is_grid))
+    return ds
+
+
+@api_provenance
+def mean_first_passage(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_max: float, *,
+                       noise: float, damping: float = 0.0, well: WellArg = None, grid: bool | None = None,
+                       cells: tuple[int, int] = GRID_DEFAULT, advection: str = "central") -> xr.Dataset:
+    """Mean first-passage time to ``xi_max`` (forcing cycles) of the averaged theory, from the
+    stationary backward equation ``L T = -1``; arguments as :func:`escape_probability`.  Returns a
+    Dataset with ``mean_first_passage`` (ic dims; 0 for ICs at or beyond xi_max)."""
+    w, par, (is_grid, qa, pa, Q, P), dgrid, diff = _setup(q0, p0, F, Omega, Psi, xi_max, noise, damping, well,
+                                                          grid, cells, advection)
+    inside, gamma, J = _slow_points(w, Q, P, par["Psi"], par["xi_max"])
+    M, _ = generator(dgrid, diff, par["F"], par["Omega"], par["damping"], par["noise"], advection)
+    W, _ = interpolation(dgrid, gamma, J)
+    T = np.zeros(Q.size)
+    T[inside] = solve_first_passage(M, W) * par["Omega"] / (2.0 * np.pi)
+    shape, dims, coords = _coords(is_grid, qa, pa, Q, P)
+    ds = xr.Dataset({"mean_first_passage": (dims, T.reshape(shape), cf.attrs("mean_first_passage"))}, coords=coords)
+    ds.attrs.update(_attrs(par, w, dgrid, advection), grid=int(is_grid))
+    return ds
