@@ -61,7 +61,7 @@ def orbit_averages(well: Well, xi: ArrayLike, n_theta: int = N_THETA) -> dict[st
     J = np.asarray(well.J(xs), float)
     p2 = (p * p).mean(axis=0)
     out = {"J": J, "omega": om, "m_JJ": p2 / om ** 2, "m_gg": (q_J * q_J).mean(axis=0),
-           "m_gJ": -(q_J * q_th).mean(axis=0), "drift_J": 0.5 * (1.0 / om - p2 * om_E / om ** 3)}
+           "m_gJ": -(q_J * q_th).mean(axis=0), "drift_J": 0.5 * (1.0 / om - p2 * om_E / om ** 2)}
     return {k: v.reshape(x.shape) for k, v in out.items()}
 
 
