@@ -1,7 +1,7 @@
 """Analyses of analytic and numeric safe basins.
 
 safe             the one definition ``safe = escape_cycle > t_eval``; safe masks and areas of charts
-agreement        IoU, pixel agreement, energy vs displacement criterion counts (Fig 19)
+agreement        IoU, pixel agreement, energy vs displacement criterion counts (Fig 19), escape-probability maps
 integrity        GIM, LIM, IF of safe masks
 erosion          integrity profiles versus the forcing amplitude
 phase_invariant  the safe basin for every forcing phase

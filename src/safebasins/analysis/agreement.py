@@ -1,4 +1,4 @@
-"""Agreement of safe sets: intersection over union, pixel agreement, criteria counts.
+"""Agreement of safe sets: intersection over union, pixel agreement, criteria counts; of escape-probability maps.
 
 One definition each, used by the pipeline (the IoU stored in the Figs 13-17 charts, the
 Fig 19 counts), the first-harmonic comparison and the tests.
@@ -12,9 +12,11 @@ import numpy as np
 import numpy.typing as npt
 import xarray as xr
 
+from safebasins.core import cf
 from safebasins.analysis.safe import CRITERIA, check_chart, check_t_eval, is_safe
 
-__all__ = ["iou", "pixel_agreement", "mask_agreement", "criteria_counts", "criteria_table", "chart_agreement"]
+__all__ = ["iou", "pixel_agreement", "mask_agreement", "criteria_counts", "criteria_table", "chart_agreement",
+           "probability_agreement"]
 
 
 def _boolean(name, a):
@@ -202,4 +204,49 @@ def chart_agreement(chart: xr.Dataset, basin: xr.Dataset, t_eval: float, scan: L
     )
     for v, a_, px in zip(np.atleast_1d(i[scan].values), np.atleast_1d(i.values), np.atleast_1d(pixel.values)):
         print(f"{scan} = {v}: IoU = {a_:.4f}, pixel agreement = {px:.4f}")
+    return out
+
+
+def probability_agreement(theory: xr.Dataset, numeric: xr.Dataset) -> xr.Dataset:
+    """Agreement of two escape-probability maps on the same initial conditions and ``t_eval``:
+    ``theory`` (theory.escape_probability) and ``numeric`` (numerics.escape_probability, with its
+    Wilson interval).
+
+    Returns ``numeric`` with ``P_escape_theory`` and, over ``t_eval``, ``P_escape_mean_abs_difference``
+    and ``P_escape_max_abs_difference`` (mean and maximum of ``|P_theory - P_numeric|`` over the ICs),
+    and the attributes ``P_escape_mean_abs_difference`` / ``P_escape_max_abs_difference`` (over ICs
+    and t_eval), the same mean over the ICs not certain to escape (``P_escape = 1`` in both at every
+    t_eval; the ICs at or beyond the threshold, which agree trivially) as
+    ``P_escape_mean_abs_difference_uncertain``, the fraction of (IC, t_eval) where the theory lies in
+    the numerics' 95% Wilson interval (``P_escape_theory_within_wilson``) and ``agreement_definition``."""
+    for name, ds in (("theory", theory), ("numeric", numeric)):
+        if not isinstance(ds, xr.Dataset) or "P_escape" not in ds or "t_eval" not in ds["P_escape"].dims:
+            raise ValueError(f"{name} must be an escape-probability Dataset with P_escape over t_eval")
+    pt, pn = theory["P_escape"], numeric["P_escape"]
+    if set(pt.dims) != set(pn.dims):
+        raise ValueError(f"theory and numeric P_escape have different dims: {pt.dims} vs {pn.dims}")
+    for c in pn.dims:
+        for coord in [c] + [k for k in ("q0", "p0") if k in numeric.coords and c in numeric[k].dims and k != c]:
+            a, b = np.asarray(theory[coord].values, float), np.asarray(numeric[coord].values, float)
+            if a.shape != b.shape or not np.allclose(a, b, rtol=1e-12, atol=1e-12):
+                raise ValueError(f"theory and numeric differ along {coord}")
+    pt = pt.reset_coords(drop=True).assign_coords({c: numeric[c] for c in pn.dims}).transpose(*pn.dims)
+    ic = [d for d in pn.dims if d != "t_eval"]
+    diff = abs(pt - pn.reset_coords(drop=True))
+    certain = ((pt == 1) & (pn == 1)).all("t_eval")
+    out = numeric.copy()
+    for name, da in (("P_escape_theory", pt), ("P_escape_mean_abs_difference", diff.mean(ic)),
+                     ("P_escape_max_abs_difference", diff.max(ic))):
+        out[name] = da.drop_attrs(deep=False).assign_attrs(cf.attrs(name))
+    uncertain = diff.where(~certain)
+    attrs = {"P_escape_mean_abs_difference": float(diff.mean()), "P_escape_max_abs_difference": float(diff.max()),
+             "P_escape_mean_abs_difference_uncertain": float(uncertain.mean()) if bool((~certain).any()) else 0.0,
+             "agreement_definition": ("|P_escape_theory - P_escape| over the initial conditions (mean, max) per "
+                                      "t_eval; the attributes over ICs and t_eval, _uncertain without the ICs whose "
+                                      "P_escape is 1 in both at every t_eval")}
+    if "P_escape_low" in numeric and "P_escape_high" in numeric:
+        inside = (pt >= numeric["P_escape_low"].reset_coords(drop=True)) & (
+            pt <= numeric["P_escape_high"].reset_coords(drop=True))
+        attrs["P_escape_theory_within_wilson"] = float(inside.mean())
+    out.attrs.update(attrs)
     return out
