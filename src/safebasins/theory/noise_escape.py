@@ -108,7 +108,7 @@ def _attrs(par: dict[str, float], w: Well, grid: DiscGrid, advection: str) -> di
     return {**par, "noise_model": MODEL_TEXT, "theory": "averaged (stochastic slow flow)",
             "solver": (f"finite volumes on {grid.n_gamma} x {grid.n_J} cells uniform in (gamma, J) (equal-area polar "
                        f"grid of X + iY = sqrt(2J) e^(i gamma)), {advection} advection, absorbing at J(xi_max)"),
-            "escape_criteria": f"averaged energy xi reaches xi_max = {par['xi_max']!r}", "well": w.name}
+            "escape_criteria": f"averaged energy xi reaches xi_max = {par['xi_max']!r}", **w.numerics_attrs()}
 
 
 @api_provenance
