@@ -6,8 +6,8 @@ within the stated tolerances (safebasins.io.reproduction): no dataset "differs" 
 one this CPU selects (Haswell, or Sandybridge where Haswell is the native one) and numpy's own
 SIMD loops without their AVX-512 paths (``exp``, ``arccos``, ... differ from the AVX2 ones; a
 no-op on a CPU without AVX-512).  Both are read back in a child process, so a setting the
-libraries ignored fails here.  One extra run of the `datasets` target: 4.5 min on a loaded
-2-core Xeon (the whole test 13 min there, the shared quick run of `all` included)."""
+libraries ignored fails here.  The datasets are built by the rules' own code in two worker
+processes (tests/pipeline/rebuild.py), not one process per dataset job."""
 from __future__ import annotations
 
 import json
@@ -18,9 +18,13 @@ import time
 import pytest
 
 from safebasins.io.reproduction import DIFFERS, IDENTICAL, MISSING, WITHIN, verify_reproduction
-from tests.pipeline.sandbox import make_sandbox, run_snakemake, snakemake_env
+from safebasins.pipeline.plan import plan
+from tests.pipeline.sandbox import ROOT, make_sandbox, run_snakemake, snakemake_env
 
 pytestmark = pytest.mark.pipeline
+
+#: the quick run's configuration (the Snakefile's config, then --configfile)
+CONFIGS = ["config/config.yaml", "config/quick.yaml"]
 
 #: numpy's dispatched AVX-512 targets (numpy 2.x names); the baseline stays
 NO_AVX512 = "X86_V4 AVX512_ICL AVX512_SPR"
@@ -63,10 +67,16 @@ def test_another_machine_reproduces_the_quick_run(quick, tmp_path):
         pytest.skip("quick run failed")
     wd = make_sandbox(tmp_path / other)
     t0 = time.perf_counter()
-    run = run_snakemake(wd, "-j2", "datasets", env=env)
+    # the parameter files by their rule; the datasets by the rules' own builds in two long-lived
+    # workers (tests/pipeline/rebuild.py: one library import per worker, not one per dataset job)
+    params = run_snakemake(wd, "-j2", *plan([ROOT / c for c in CONFIGS]).param_files(), env=env)
+    assert params.returncode == 0, params.stderr[-4000:]
+    run = subprocess.run([sys.executable, "-m", "tests.pipeline.rebuild", str(wd), "2", *CONFIGS], env=env,
+                         cwd=ROOT, capture_output=True, text=True, timeout=3600)
     print(f"\nquick datasets under OPENBLAS_CORETYPE={other}, numpy SIMD {emulated['simd']} (native {native}): "
           f"{time.perf_counter() - t0:.1f} s")
     assert run.returncode == 0, run.stderr[-4000:]
+    assert set(json.loads(run.stdout.splitlines()[-1])) == set(plan([ROOT / c for c in CONFIGS]).datasets())
     report = verify_reproduction(ref / "results", wd / "results")
     lines = list(report.lines())
     print("\n".join(line for line in lines if not line.startswith("identical")))

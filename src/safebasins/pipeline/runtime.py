@@ -4,7 +4,7 @@
 * :func:`make_dataset` -- rules ``analytic``, ``numeric``, ``extras``: the product of the
   registry that the output path names is built from its inputs (with ``numerics.tiles`` = 0 a
   product reading charts integrates its experiment's chart tasks itself), given CF/provenance
-  attributes and written atomically;
+  attributes and written atomically (:func:`build_dataset`, also callable without Snakemake);
 * :func:`make_tile` -- rule ``chart_tile``: one tile (a contiguous block of q0 rows or of
   samples) of one escape-chart task.
 
@@ -20,6 +20,7 @@ from collections.abc import Mapping
 from typing import IO, Any
 
 import numba
+import xarray as xr
 import yaml
 
 from safebasins.pipeline.config import load_kinds
@@ -86,25 +87,34 @@ def load_inputs(inputs: Mapping[str, Any], ntasks: int) -> Inputs:
 
 
 def make_dataset(smk: Snakemake) -> None:
-    """Rules ``analytic`` / ``numeric`` / ``extras``: build, finalize and write one product.
-    A product reading the chart tiles gets them from the ``chart_tile`` jobs, or with
-    ``numerics.tiles`` = 0 integrates every task here (the rule's ``integrate_tasks``,
-    ``Plan.integrates_tasks``; one tile per task, the same values)."""
+    """Rules ``analytic`` / ``numeric`` / ``extras``: build, finalize and write one product
+    (:func:`build_dataset`)."""
+    params, _ = _job(smk)
+    ds = build_dataset(params, str(smk.output[0]), smk.input, Job(threads=smk.threads, backend=smk.params.backend),
+                       integrate_tasks=bool(smk.params.integrate_tasks), rule=smk.rule)
+    print(ds)
+
+
+def build_dataset(params: Params, out: str, inputs: Mapping[str, Any], job: Job, *, integrate_tasks: bool,
+                  rule: str) -> xr.Dataset:
+    """The product of experiment ``params`` written to ``out`` (its path under results/), built
+    from ``inputs`` (the rule's input files: :meth:`Plan.product_inputs`), given CF/provenance
+    attributes and written atomically; returned.  A product reading the chart tiles gets them
+    from the ``chart_tile`` jobs, or with ``integrate_tasks`` (``numerics.tiles`` = 0,
+    ``Plan.integrates_tasks``) integrates every task here (one tile per task, the same values)."""
     from safebasins.io.datasets import finalize, params_hash, write_netcdf
     from safebasins.pipeline.tiles import task_tiles
 
-    params, kind = _job(smk)
-    out = str(smk.output[0])
+    kind = KINDS[params["kind"]]
     product = next(p for p in kind.products(params["experiment"], params) if p.path == out)
-    job = Job(threads=smk.threads, backend=smk.params.backend)
-    inputs = load_inputs(smk.input, len(kind.tasks(params)))
-    if smk.params.integrate_tasks:
-        inputs["tiles"] = task_tiles(kind, params, job)
-    ds = product.build(params, inputs, job)
+    loaded = load_inputs(inputs, len(kind.tasks(params)))
+    if integrate_tasks:
+        loaded["tiles"] = task_tiles(kind, params, job)
+    ds = product.build(params, loaded, job)
     finalize(ds, title=product.title, params=params, config_hash=params_hash(params),
-             history=f"{product.history} (rule {smk.rule})")
+             history=f"{product.history} (rule {rule})")
     write_netcdf(ds, out)
-    print(ds)
+    return ds
 
 
 def make_tile(smk: Snakemake) -> None:
