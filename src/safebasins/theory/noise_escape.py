@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike
 
 from safebasins.core import cf, checks
 from safebasins.theory.noise_averaging import AveragedDiffusion, averaged_diffusion
+from safebasins.theory.noise_semilagrangian import march_escape_sl
 from safebasins.theory.noise_solver import ADVECTION, DiscGrid, generator, interpolation, march_escape, \
     solve_first_passage
 from safebasins.theory.types import FloatArray, WellArg
@@ -26,12 +27,16 @@ from safebasins.wells import resolve_well
 from safebasins.wells.base import Well
 from safebasins.wells.provenance import api_provenance
 
-__all__ = ["escape_probability", "mean_first_passage", "GRID_DEFAULT", "STEPS_PER_CYCLE"]
+__all__ = ["escape_probability", "mean_first_passage", "GRID_DEFAULT", "STEPS_PER_CYCLE", "SCHEMES"]
 
 #: cells ``(n_gamma, n_J)`` of the polar grid
 GRID_DEFAULT = (128, 160)
-#: BDF2 steps per forcing cycle of the time march
+#: time steps per forcing cycle of the march
 STEPS_PER_CYCLE = 8
+#: the advection of the time march: semi-Lagrangian (noise_semilagrangian) or the finite volumes'
+SCHEMES = ("semi-lagrangian",) + ADVECTION
+#: how far outside [0, 1] an Eulerian march may go before its oscillations are an error
+RANGE_TOL = 0.02
 
 MODEL_TEXT = ("averaged diffusion of the slow flow (gamma, J) under dp = ... + sigma dW: drift dC/dJ, -dC/dgamma - "
               "beta J plus the noise-induced (sigma^2/2) d(J/omega)/dJ; diffusion sigma^2 J/omega (action), sigma^2 "
@@ -39,9 +44,10 @@ MODEL_TEXT = ("averaged diffusion of the slow flow (gamma, J) under dp = ... + s
 
 
 def _setup(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_max: float, noise: float,
-           damping: float, well: WellArg, grid: bool | None, cells: tuple[int, int], advection: str
-           ) -> tuple[Well, dict[str, float], tuple[bool, FloatArray, FloatArray, FloatArray, FloatArray],
-                      DiscGrid, AveragedDiffusion]:
+           damping: float, well: WellArg, grid: bool | None, cells: tuple[int, int], advection: str,
+           schemes: tuple[str, ...]
+           ) -> tuple[Well, dict[str, float], tuple[bool, FloatArray, FloatArray, FloatArray, FloatArray], DiscGrid,
+                      AveragedDiffusion]:
     """Checked arguments (ValueError naming the argument before anything runs)."""
     w = resolve_well(well)
     par = {"F": checks.check_scalar("F", F, checks.check_nonnegative),
@@ -53,8 +59,8 @@ def _setup(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_
     if par["noise"] == 0:
         raise ValueError("noise must be > 0 for the averaged diffusion; at noise 0 the theory is the deterministic "
                          "slow flow (theory.slow_flow_escapes)")
-    if advection not in ADVECTION:
-        raise ValueError(f"advection must be one of {ADVECTION}, got {advection!r}")
+    if advection not in schemes:
+        raise ValueError(f"advection must be one of {schemes}, got {advection!r}")
     if (not isinstance(cells, tuple) or len(cells) != 2
             or any(isinstance(c, bool) or not isinstance(c, (int, np.integer)) or c < 8 for c in cells)):
         raise ValueError(f"cells must be a pair of integers >= 8 (n_gamma, n_J), got {cells!r}")
@@ -115,30 +121,42 @@ def _attrs(par: dict[str, float], w: Well, grid: DiscGrid, advection: str) -> di
 def escape_probability(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_max: float, *,
                        noise: float, t_eval: ArrayLike, damping: float = 0.0, well: WellArg = None,
                        grid: bool | None = None, cells: tuple[int, int] = GRID_DEFAULT,
-                       steps_per_cycle: int = STEPS_PER_CYCLE, advection: str = "central") -> xr.Dataset:
+                       steps_per_cycle: int = STEPS_PER_CYCLE, advection: str = "semi-lagrangian") -> xr.Dataset:
     """Probability of escape within each ``t_eval`` (forcing cycles) from the averaged theory.
 
     ``q0, p0, grid``: initial conditions at tau = 0 as :func:`safebasins.numerics.escape_probability`
     reads them (1-D axes -> dims (q0, p0), paired -> sample); ``F, Omega, Psi, xi_max``: as
     :func:`~safebasins.theory.slow_flow_escapes`; ``noise``: sigma > 0 of ``dp = ... + sigma dW``;
     ``damping``: beta >= 0; ``well``: a symmetric well (default the quartic).  ``cells``: the
-    polar grid ``(n_gamma, n_J)``; ``steps_per_cycle``: BDF2 steps per forcing cycle;
-    ``advection``: "central" (default) or "upwind" (monotone, numerically diffusive).
+    polar grid ``(n_gamma, n_J)``; ``steps_per_cycle``: time steps per forcing cycle;
+    ``advection``: "semi-lagrangian" (default: exact characteristics of the slow flow, quasi-monotone
+    bicubic interpolation, Strang-split implicit diffusion; values in [0, 1] at any noise), or the
+    finite volumes' BDF2 march with "central" (second order; oscillates where the cell Peclet
+    number is large, and then raises an error naming ``cells``) or "upwind" (monotone, numerically
+    diffusive) fluxes.
 
     Returns a Dataset with ``P_escape`` (ic dims, t_eval) and ``first_passage_mean`` (ic dims), the
     restricted mean ``E[min(tau, cycles)]`` in forcing cycles, ``cycles = ceil(max t_eval)`` (the
     numerics' names and horizon); attributes: the parameters, the model and the solver.
     """
     w, par, (is_grid, qa, pa, Q, P), dgrid, diff = _setup(q0, p0, F, Omega, Psi, xi_max, noise, damping, well,
-                                                          grid, cells, advection)
+                                                          grid, cells, advection, SCHEMES)
     te = checks.check_1d("t_eval", t_eval, checks.check_nonnegative)
     spc = checks.check_positive_int("steps_per_cycle", steps_per_cycle)
     cycles = max(1, math.ceil(float(te.max())))
     inside, gamma, J = _slow_points(w, Q, P, par["Psi"], par["xi_max"])
-    M, s = generator(dgrid, diff, par["F"], par["Omega"], par["damping"], par["noise"], advection)
     W, w_b = interpolation(dgrid, gamma, J)
     period = 2.0 * np.pi / par["Omega"]
-    t, Pt = march_escape(M, s, W, w_b, cycles * period, cycles * spc)
+    if advection == "semi-lagrangian":
+        t, Pt = march_escape_sl(dgrid, diff, par["F"], par["Omega"], par["damping"], par["noise"], W, w_b,
+                                cycles * period, cycles * spc)
+    else:
+        M, s = generator(dgrid, diff, par["F"], par["Omega"], par["damping"], par["noise"], advection)
+        t, Pt, (lo, hi) = march_escape(M, s, W, w_b, cycles * period, cycles * spc)
+        if lo < -RANGE_TOL or hi > 1 + RANGE_TOL:
+            raise ValueError(f"cells: the {advection} finite volumes oscillate on {dgrid.n_gamma} x {dgrid.n_J} cells "
+                             f"at noise = {par['noise']!r} (values from {lo:.3g} to {hi:.3g}): the cell Peclet number "
+                             "is too large; use advection='semi-lagrangian' (the default) or finer cells")
     t = t / period
     P_in = np.stack([np.interp(te, t, col) for col in Pt.T]) if Pt.shape[1] else np.zeros((0, te.size))
     surv = 1.0 - Pt
@@ -161,15 +179,22 @@ def mean_first_passage(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi
                        noise: float, damping: float = 0.0, well: WellArg = None, grid: bool | None = None,
                        cells: tuple[int, int] = GRID_DEFAULT, advection: str = "central") -> xr.Dataset:
     """Mean first-passage time to ``xi_max`` (forcing cycles) of the averaged theory, from the
-    stationary backward equation ``L T = -1``; arguments as :func:`escape_probability`.  Returns a
-    Dataset with ``mean_first_passage`` (ic dims; 0 for ICs at or beyond xi_max)."""
+    stationary backward equation ``L T = -1`` on the finite volumes (``advection`` "central" or
+    "upwind"; a central solution with negative times, unresolved cell Peclet numbers, raises an
+    error naming ``cells``); other arguments as :func:`escape_probability`.  Returns a Dataset with
+    ``mean_first_passage`` (ic dims; 0 for ICs at or beyond xi_max)."""
     w, par, (is_grid, qa, pa, Q, P), dgrid, diff = _setup(q0, p0, F, Omega, Psi, xi_max, noise, damping, well,
-                                                          grid, cells, advection)
+                                                          grid, cells, advection, ADVECTION)
     inside, gamma, J = _slow_points(w, Q, P, par["Psi"], par["xi_max"])
     M, _ = generator(dgrid, diff, par["F"], par["Omega"], par["damping"], par["noise"], advection)
     W, _ = interpolation(dgrid, gamma, J)
+    T_in, T_min = solve_first_passage(M, W)
+    if T_min < 0:
+        raise ValueError(f"cells: the {advection} finite volumes oscillate on {dgrid.n_gamma} x {dgrid.n_J} cells at "
+                         f"noise = {par['noise']!r} (negative first-passage times): the cell Peclet number is too "
+                         "large; use finer cells or advection='upwind' (monotone, numerically diffusive)")
     T = np.zeros(Q.size)
-    T[inside] = solve_first_passage(M, W) * par["Omega"] / (2.0 * np.pi)
+    T[inside] = T_in * par["Omega"] / (2.0 * np.pi)
     shape, dims, coords = _coords(is_grid, qa, pa, Q, P)
     ds = xr.Dataset({"mean_first_passage": (dims, T.reshape(shape), cf.attrs("mean_first_passage"))}, coords=coords)
     ds.attrs.update(_attrs(par, w, dgrid, advection), grid=int(is_grid))

@@ -35,7 +35,7 @@ from numpy.typing import NDArray
 from safebasins.theory.noise_averaging import AveragedDiffusion
 from safebasins.theory.types import FloatArray
 
-__all__ = ["ADVECTION", "DiscGrid", "generator", "interpolation", "march_escape", "solve_first_passage"]
+__all__ = ["ADVECTION", "DiscGrid", "generator", "interpolation", "row_range", "march_escape", "solve_first_passage"]
 
 #: the face values of the advective fluxes
 ADVECTION = ("central", "upwind")
@@ -72,7 +72,7 @@ class DiscGrid:
 def generator(grid: DiscGrid, diff: AveragedDiffusion, F: float, Omega: float, beta: float, sigma: float,
               advection: str = "central") -> tuple[sp.csc_matrix, FloatArray]:
     """``(M, s)``: the discrete generator acting on the cell values and the weights of the boundary
-    value, ``L u = M u + s u_boundary``."""
+    value, ``L u = M u + s u_boundary``; ``advection="none"``: the diffusion alone."""
     ng, nJ = grid.n_gamma, grid.n_J
     dg, dJ = grid.d_gamma, grid.d_J
     V = dg * dJ
@@ -84,6 +84,8 @@ def generator(grid: DiscGrid, diff: AveragedDiffusion, F: float, Omega: float, b
     # outward fluxes (area per time) through the upper J-face of ring i and the upper gamma-face of sector j
     phi_J = -(C[:, 1:] - C[:, :-1]) - beta * J_f[:, None] * dg                            # (nJ+1, ng)
     phi_g = C[1:, 1:] - C[:-1, 1:]                                                          # (nJ, ng)
+    if advection == "none":
+        phi_J, phi_g = np.zeros_like(phi_J), np.zeros_like(phi_g)
     _, _, _, _, at_c = diff.at(J_c)
     D_J = 0.5 * sigma ** 2 * (2.0 * J_f * ar_f) * dg / dJ                                   # (nJ+1,)
     D_g = 0.5 * sigma ** 2 * (at_c / (2.0 * J_c)) * dJ / dg                                 # (nJ,)
@@ -173,10 +175,29 @@ def interpolation(grid: DiscGrid, gamma: FloatArray, J: FloatArray) -> tuple[sp.
     return W, w_b
 
 
+def row_range(W: sp.csr_matrix, w_b: FloatArray, u: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Row-wise min and max of the values a row of W touches (the boundary value 1 where w_b > 0)."""
+    n = W.shape[0]
+    lo = np.ones(n)
+    hi = np.zeros(n)
+    nz = np.diff(W.indptr) > 0
+    if nz.any():
+        v = u[W.indices]
+        starts = W.indptr[:-1][nz]
+        lo[nz] = np.minimum.reduceat(v, starts)
+        hi[nz] = np.maximum.reduceat(v, starts)
+    bnd = w_b > 0
+    lo[bnd] = np.minimum(lo[bnd], 1.0)
+    hi[bnd] = np.maximum(hi[bnd], 1.0)
+    return lo, hi
+
+
 def march_escape(M: sp.csc_matrix, s: FloatArray, W: sp.csr_matrix, w_b: FloatArray, t_end: float,
-                 steps: int) -> tuple[FloatArray, FloatArray]:
-    """``(t, P)``: the escape probability ``P(t)`` at the points of ``(W, w_b)`` (shape (steps + 1,
-    points)) on ``steps`` uniform steps to ``t_end``, from ``u(0) = 0`` with boundary value 1."""
+                 steps: int) -> tuple[FloatArray, FloatArray, tuple[float, float]]:
+    """``(t, P, (u_min, u_max))``: the escape probability ``P(t)`` at the points of ``(W, w_b)``
+    (shape (steps + 1, points)) on ``steps`` uniform steps to ``t_end``, from ``u(0) = 0`` with
+    boundary value 1, and the range of the cell values over the march (outside [0, 1]: the
+    central scheme's oscillations, unresolved cell Peclet numbers)."""
     n = M.shape[0]
     dt = t_end / steps
     eye = sp.identity(n, format="csc")
@@ -190,14 +211,17 @@ def march_escape(M: sp.csc_matrix, s: FloatArray, W: sp.csr_matrix, w_b: FloatAr
     out = np.empty((steps + 1, W.shape[0]))
     out[0] = w_b
     out[1] = W @ u + w_b
+    lo, hi = float(u.min()), float(u.max())
     for k in range(2, steps + 1):
         u, u_prev = lu_bdf.solve(4.0 * u - u_prev + 2.0 * dt * s), u
         out[k] = W @ u + w_b
-    return np.linspace(0.0, t_end, steps + 1), out
+        lo, hi = min(lo, float(u.min())), max(hi, float(u.max()))
+    return np.linspace(0.0, t_end, steps + 1), out, (lo, hi)
 
 
-def solve_first_passage(M: sp.csc_matrix, W: sp.csr_matrix) -> FloatArray:
-    """Mean first-passage time at the points of ``W``: ``M T = -1`` (T = 0 on the boundary)."""
+def solve_first_passage(M: sp.csc_matrix, W: sp.csr_matrix) -> tuple[FloatArray, float]:
+    """Mean first-passage time at the points of ``W`` (``M T = -1``, T = 0 on the boundary) and the
+    smallest cell value (negative: oscillations of the central fluxes)."""
     T = spla.splu(M.tocsc()).solve(-np.ones(M.shape[0]))
     out: FloatArray = W @ T
-    return out
+    return out, float(T.min())
