@@ -440,6 +440,22 @@ _FATAL_SHOCK_LOOK = (
     "one colour per attractor, with the grid's LIM as open markers just above it. Where a resonant and a "
     "non-resonant attractor coexist, expect the resonant one (the larger response) far easier to kick out; "
     "expect the MFS to vary with the phase the kick comes at.")
+_CONTINUATION_CAPTION = (
+    "{system}, β and ξ_max in the title: the period-1 attractors inside the well followed across F by "
+    "pseudo-arclength continuation of the DOP853 period map (docs/continuation.md); the Floquet multipliers give "
+    "their stability, and the folds, period doublings and the branch's exit from the well (the largest H0 on its "
+    "orbit reaching ξ_max) are located on the way. At every swept value the basins are labelled on a grid of "
+    "initial conditions over the well (the compiled stroboscopic map) and each attractor's basin is measured: "
+    "GIM = its area over the unforced safe area on the same grid. A basin's Dover cliff is the step of the "
+    "sweep over which the most of it escapes (grid nodes in the basin at one value that escape at the next).")
+_CONTINUATION_LOOK = (
+    "(a) The response curves: the largest |q| over the period against F, one colour per attractor where stable "
+    "(solid), grey dashed where unstable (the saddle branch between folds); open circles: folds, diamonds: period "
+    "doublings, crosses: the orbit reaching the escape energy. (b) Each attractor's GIM against F in its colour, "
+    "the safe basin's (every IC that does not escape) black dashed; each attractor's cliff shaded in its colour "
+    "with the GIM it loses there, the safe basin's hatched. Expect a resonant and a "
+    "non-resonant attractor to coexist between the folds, and the safe basin to fall steeply just above the "
+    "Melnikov tangency of the hilltop saddle, the cliff, mostly at the expense of one attractor's basin.")
 DECLARATIONS += (
     Declaration(
         name="damped_tangency", kind="tangency", key=("damped", "escape_equation"), stem="damped_tangency",
@@ -533,6 +549,22 @@ DECLARATIONS += (
         caption=_FATAL_SHOCK_CAPTION.format(system="the paper's quartic with damping, q'' + β q' + q - q³ = "
                                                    "F sin(Ωt + Ψ), at Fig. 14's forcing"),
         look=_FATAL_SHOCK_LOOK),
+    Declaration(
+        name="damped_escape_continuation", kind="continue_attractors", key=("damped", "escape_equation_continuation"),
+        stem="damped_escape_continuation", label="Damped escape equation: the attractors followed across F",
+        category=_DAMPED, options={},
+        title="Damped escape equation: the resonant and non-resonant attractors across F, their basins and the cliff",
+        caption=_CONTINUATION_CAPTION.format(system="Thompson's escape equation q'' + β q' + q - q² = F sin(Ωt + Ψ) "
+                                                    "at Ω = 0.85"),
+        look=_CONTINUATION_LOOK),
+    Declaration(
+        name="damped_quartic_continuation", kind="continue_attractors", key=("damped", "quartic_continuation"),
+        stem="damped_quartic_continuation", label="Damped quartic: the attractors followed across F at Fig. 14's Ω",
+        category=_DAMPED, options={},
+        title="Paper's quartic with damping at Fig 14's Ω and Ψ: its attractors across F, their basins and the cliff",
+        caption=_CONTINUATION_CAPTION.format(system="the paper's quartic with damping, q'' + β q' + q - q³ = "
+                                                    "F sin(Ωt + Ψ), at Fig. 14's Ω = 0.9 and Ψ = π"),
+        look=_CONTINUATION_LOOK),
 )
 
 BY_NAME = {d.name: d for d in DECLARATIONS}
