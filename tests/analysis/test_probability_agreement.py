@@ -2,8 +2,8 @@
 
 The main measure (docs/noise-theory.md): the paper's quartic at Fig 14's forcing (F = 0.01,
 Omega = 0.9, Psi = pi, xi_max = 0.18), white noise sigma = 0.01, a 21 x 16 grid over
-|q0| <= 0.95, |p0| <= 0.75, 400 paths: mean |P_theory - P_SDE| 0.0063 / 0.0078 over the plane at
-10 / 25 cycles (0.018 over the ICs not escaping at once), maximum 0.097 / 0.092; the theory lies in
+|q0| <= 0.95, |p0| <= 0.75, 400 paths: mean |P_theory - P_SDE| 0.0062 / 0.0075 over the plane at
+10 / 25 cycles (0.017 over the ICs not escaping at once), maximum 0.098 / 0.091; the theory lies in
 the ensembles' 95% Wilson interval at 94% of the (IC, t_eval).  The bound is the target 0.05 of the
 mean.
 """
