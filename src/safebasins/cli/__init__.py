@@ -17,6 +17,7 @@ basin_measures  the ``basin-measures`` command: fractal boundary measures of a d
 saddle    the ``hilltop-saddle`` command: the hilltop saddle's manifolds over escape charts, their tangency
 noise     the ``escape-probability`` command: escape probabilities under noise over a grid of ICs
 fatal_shock  the ``fatal-shock`` command: the minimal fatal shock of a damped well's attractors
+continuation  the ``continue-attractors`` command: a damped well's attractors followed across F or Omega
 """
 from safebasins.cli.commands import main
 from safebasins.cli.explore import explore
@@ -26,6 +27,7 @@ from safebasins.cli.basin_measures import basin_measures
 from safebasins.cli.saddle import hilltop_saddle
 from safebasins.cli.noise import escape_probability
 from safebasins.cli.fatal_shock import fatal_shock
+from safebasins.cli.continuation import continue_attractors
 
 main.add_command(explore)
 main.add_command(check_config)
@@ -34,5 +36,6 @@ main.add_command(basin_measures)
 main.add_command(hilltop_saddle)
 main.add_command(escape_probability)
 main.add_command(fatal_shock)
+main.add_command(continue_attractors)
 
 __all__ = ["main"]
