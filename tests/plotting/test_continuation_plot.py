@@ -85,21 +85,24 @@ def test_notes_read_the_data(branches: xr.Dataset) -> None:
     plt.close(fig)
 
 
-def test_unfollowed_and_unlocated_are_reported(branches: xr.Dataset) -> None:
+def test_unfollowed_unsettled_and_unlocated_are_reported(branches: xr.Dataset) -> None:
     import matplotlib.pyplot as plt
 
     ds = branches.copy(deep=True)
     ds["n_unfollowed"][:] = [0, 0, 1, 0]
+    ds["n_unsettled"][:] = [0, 7, 0, 3]
     ds["event_located"][1] = False
     fig = figure_continuation(ds)
     text = "\n".join(notes(fig))
     assert "At 1 of 4 values the grid settles on attractors no branch follows" in text
     assert "1 event(s) not located" in text
+    assert "at 2 of 4 values, the most 7 of 441 at F = 0.06." in text
     plt.close(fig)
     ds["n_unfollowed"][:] = 0
     ds["event_located"][:] = True
+    ds["n_unsettled"][:] = 0
     text = "\n".join(notes(figure_continuation(ds)))
-    assert "no branch follows" not in text and "not located" not in text
+    assert "no branch follows" not in text and "not located" not in text and "not settled" not in text
     plt.close("all")
 
 

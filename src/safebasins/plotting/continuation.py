@@ -110,7 +110,7 @@ def _branches(ax: Axes, ds: xr.Dataset) -> None:
             handles.append(Line2D([], [], ls="", ms=7, mew=1.0, label=style["label"], **mk))
     ax.set_ylabel(r"response amplitude: largest $|q|$ over the period")
     ax.set_title("(a) period-1 orbits inside the well", fontsize=9)
-    ax.legend(handles=handles, fontsize=7, frameon=False, loc="upper left")
+    ax.legend(handles=handles, fontsize=7, frameon=False, loc="lower right")
 
 
 def _integrity(ax: Axes, ds: xr.Dataset) -> None:
@@ -195,4 +195,10 @@ def _notes(fig: Figure, ds: xr.Dataset) -> None:
         safe += (f" At {int((unf > 0).sum())} of {sweep.size} values the grid settles on attractors no branch "
                  "follows (period > 1, or a fixed point Newton did not converge on): their basins count as safe, "
                  "not as a followed attractor's.")
+    uns = var(ds, "n_unsettled").values
+    if uns.any():
+        k = int(np.argmax(uns))
+        safe += (f" ICs not settled within the map iterations (each given the nearest attractor) at "
+                 f"{int((uns > 0).sum())} of {sweep.size} values, the most {int(uns[k])} of {n_grid ** 2} at "
+                 f"{sym} = {sweep[k]:.4g}.")
     add_note(fig, safe)
