@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from safebasins.analysis.continuation import continue_attractors, label_iterations
+from safebasins.analysis.continuation import continue_attractors
+from safebasins.core.settling import settle_iterations
 from safebasins.pipeline.config import ConfigError
 from safebasins.pipeline.kinds.continuation import build_continuation
 from safebasins.pipeline.plan import plan
@@ -60,8 +61,8 @@ def test_cost_counts_the_labels_and_the_branches(base: dict[str, Any]) -> None:
     run = plan(base)
     p = run.experiments[NAMES[0]].params
     kind = KINDS["continue_attractors"]
-    labels = len(p["F"]) * label_iterations(0.1, 0.85) * 101 ** 2 * 32
-    assert label_iterations(0.1, 0.85) == 50
+    labels = len(p["F"]) * settle_iterations(0.1, 0.85) * 101 ** 2 * 32
+    assert settle_iterations(0.1, 0.85) == 50
     branches = kind.cost(p) - labels
     assert branches > 0
     finer = kind.cost({**p, "step_max": 0.01}) - labels        # the cubic window's width 2.0: 200 steps a pass
@@ -70,7 +71,7 @@ def test_cost_counts_the_labels_and_the_branches(base: dict[str, Any]) -> None:
     assert capped == kind.cost({**p, "step_max": 1e-5, "max_points": 50}) - labels < finer
     om = plan(merged(base, {"damped": {KEY: {"F": 0.055, "Omega": {"start": 0.7, "stop": 1.0, "num": 4}}}}))
     po = om.experiments[NAMES[0]].params
-    assert kind.cost(po) - branches == sum(label_iterations(0.1, w) for w in po["Omega"]) * 101 ** 2 * 32
+    assert kind.cost(po) - branches == sum(settle_iterations(0.1, w) for w in po["Omega"]) * 101 ** 2 * 32
 
 
 @pytest.mark.parametrize("override,key", [

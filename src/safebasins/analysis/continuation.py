@@ -32,16 +32,16 @@ import xarray as xr
 
 from safebasins.analysis import arclength as al
 from safebasins.analysis.basin_labels import map_labels
-from safebasins.analysis.fatal_shock import SETTLE
 from safebasins.analysis.integrity import integrity_measures
 from safebasins.core import cf, checks
+from safebasins.core.settling import settle_iterations
 from safebasins.numerics import criteria, engine, stroboscopic_map
 from safebasins.numerics.problem import check_cycles
 from safebasins.wells import resolve_well, well_attrs
 from safebasins.wells.base import Well, WellLike
 from safebasins.wells.provenance import api_provenance
 
-__all__ = ["continue_attractors", "label_iterations", "PERIOD_MAX", "ATTRACTOR_CLASSES"]
+__all__ = ["continue_attractors", "PERIOD_MAX", "ATTRACTOR_CLASSES"]
 
 Array = npt.NDArray[np.float64]
 
@@ -76,18 +76,10 @@ def _check_sweep(Omega: Any, F: Any) -> tuple[al.Parameter, Array, float, float]
     return name, vals, Fv, Omv
 
 
-def label_iterations(beta: float, Omega: float, n_iter: int | None = None) -> int:
-    """Map iterations of the basin labels at ``Omega``: ``n_iter``, or by default
-    ``max(50, 2 SETTLE / (beta T))`` (transients decayed to ``exp(-SETTLE)``)."""
-    if n_iter is not None:
-        return int(n_iter)
-    return max(50, math.ceil(2.0 * SETTLE / (beta * (2.0 * np.pi / Omega))))
-
-
 def _labels(w: Well, F: float, Om: float, beta: float, Psi: float, xi: float, q0: Array, p0: Array,
             n_iter: int | None, spc: int, threads: int | None) -> xr.DataArray:
     """The basin labels of the grid (0 escape, k the k-th attractor of map_labels); none settled: all 0."""
-    n = label_iterations(beta, Om, n_iter)
+    n = settle_iterations(beta, Om, n_iter)
     Q, P = np.meshgrid(q0, p0, indexing="ij")
     strobe = stroboscopic_map(Q, P, F, Om, Psi, n_iter=n, xi_max=xi, well=w, steps_per_cycle=spc, threads=threads,
                               damping=beta)

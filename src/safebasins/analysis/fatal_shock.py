@@ -37,6 +37,7 @@ from safebasins.analysis.basin_labels import map_labels
 from safebasins.analysis.floquet import forced_flow, forced_flow_dense, periodic_orbit
 from safebasins.analysis.integrity import integrity_measures
 from safebasins.core import checks
+from safebasins.core.settling import settle_iterations
 from safebasins.core.cf import annotate
 from safebasins.numerics import criteria, engine, escape_chart, stroboscopic_map
 from safebasins.numerics.problem import check_cycles
@@ -52,9 +53,6 @@ Array = npt.NDArray[np.float64]
 NORMS = ("energy", "weighted")
 #: points per k-section round (the bracket shrinks by K_SECTION + 1 per compiled call)
 K_SECTION = 31
-#: the damped transient is settled to exp(-SETTLE) when the seeds have been iterated
-#: SETTLE / (beta T / 2) periods (the slowest decay rate of a focus is beta / 2)
-SETTLE = 15.0
 #: default steps per cycle: the engine checks the energy after each step, so a trajectory that grazes
 #: xi_max between steps is missed and the MFS lies above the continuous-time one (measured on the
 #: escape equation against DOP853: 0.5% at 32 steps per cycle, 1e-5 at 128)
@@ -170,7 +168,7 @@ def _attractors(w: Well, F: float, Omega: float, beta: float, phi0: float, xi: f
     q0 = np.linspace(lo, hi, n_seeds + 2)[1:-1]
     p0 = np.linspace(pl, ph, n_seeds + 2)[1:-1]
     Q, P = np.meshgrid(q0, p0, indexing="ij")
-    n_iter = max(50, int(np.ceil(2.0 * SETTLE / (beta * T))))
+    n_iter = settle_iterations(beta, Omega)
     strobe = stroboscopic_map(Q, P, F, Omega, phi0, n_iter=n_iter, xi_max=xi, well=w, steps_per_cycle=spc,
                               threads=threads, damping=beta)
     try:

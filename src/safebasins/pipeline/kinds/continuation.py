@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+from safebasins.core.settling import settle_iterations
 from safebasins.pipeline import values
 from safebasins.pipeline.registry import Block, FigureInputs, Inputs, Job, Kind, Params, Product, dataset_path, register
 
@@ -105,12 +106,10 @@ class ContinueAttractors(Kind):
         """An estimate: the compiled map of the labels at every swept value (no early escape), and the
         branches' DOP853 period maps in trajectory-steps of the same cost (the number of branches and
         their lengths are known only when they are followed)."""
-        from safebasins.analysis.continuation import label_iterations
-
         Om = values.as_list(params["Omega"])
         n_values = len(values.as_list(params[params["sweep"]]))
         beta = values.damping(params)
-        iters = sum(label_iterations(beta, om, params["n_iter"]) for om in Om) * (n_values if len(Om) == 1 else 1)
+        iters = sum(settle_iterations(beta, om, params["n_iter"]) for om in Om) * (n_values if len(Om) == 1 else 1)
         labels = iters * params["n_grid"] ** 2 * params["steps_per_cycle"]
         (q_lo, q_hi), _ = values.base_well(params).ic_window()
         per_pass = _STEPS_ACROSS if params["step_max"] is None else (q_hi - q_lo) / params["step_max"]
