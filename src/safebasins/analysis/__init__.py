@@ -24,3 +24,4 @@ from safebasins.analysis.saddle import hilltop_orbit, manifold_tangency, saddle_
 from safebasins.analysis.fatal_shock import minimal_fatal_shock  # noqa: F401
 from safebasins.analysis.continuation import continue_attractors  # noqa: F401
 from safebasins.analysis.stochastic_integrity import stochastic_erosion, stochastic_safe_basin  # noqa: F401
+from safebasins.analysis.stochastic_integrity import stochastic_erosion_theory  # noqa: F401

@@ -30,12 +30,18 @@ for the true probabilities, nor for the same random numbers scaled by sigma).
 :func:`stochastic_erosion` is the profile of these measures against sigma and/or F, one ensemble
 per (F, sigma), all with the same seed (common random numbers: path m of an IC draws the same
 Gaussians at every sigma and F, so neighbouring profile points differ by the dynamics, not by
-independent sampling).  docs/stochastic-integrity.md.
+independent sampling).
+
+From the averaged theory (:func:`safebasins.theory.escape_probability`, a deterministic solve of
+the backward Kolmogorov equation with no path counts) the basin is the plain set S_epsilon: there is
+no confidence interval, so no conservative basin, and the Dataset's ``conservative`` attribute says
+so.  :func:`stochastic_erosion_theory` is the profile from the theory, one solve per (F, sigma),
+read by the same code.  docs/stochastic-integrity.md.
 """
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -47,11 +53,14 @@ from safebasins.core import cf, checks
 from safebasins.core.cf import annotate
 from safebasins.numerics import escape_probability
 from safebasins.numerics.noise import WILSON_Z, wilson_interval
+from safebasins.theory import escape_probability as theory_escape_probability
+from safebasins.theory.noise_escape import RANGE_TOL
 from safebasins.wells import from_attrs, resolve_well, well_attrs
 from safebasins.wells.base import Well, WellLike
 from safebasins.wells.provenance import api_provenance
 
-__all__ = ["stochastic_safe_basin", "stochastic_erosion", "certifiable_epsilon", "paths_to_certify"]
+__all__ = ["stochastic_safe_basin", "stochastic_erosion", "stochastic_erosion_theory", "certifiable_epsilon",
+           "paths_to_certify"]
 
 #: the measures computed for each basin (the normalisers area/r_*_unforced are shared)
 MEASURES = ("GIM", "LIM", "IF", "area", "r_local", "r_global", "if_q0", "if_p0")
@@ -67,12 +76,19 @@ SAFE_ATTRS = {
 DEFINITION = ("safe = P_escape <= epsilon (fraction of paths escaped at or before t_eval); conservative: "
               "P_escape_high <= epsilon (upper end of the 95% Wilson interval: safe at level epsilon with 95% "
               "confidence, pointwise); GIM/LIM/IF of the masks by safebasins.analysis.integrity.integrity_measures")
+THEORY_DEFINITION = ("safe = P_escape <= epsilon (P_escape of the averaged theory, "
+                     "safebasins.theory.escape_probability); GIM/LIM/IF of the mask by "
+                     "safebasins.analysis.integrity.integrity_measures")
+NO_CONSERVATIVE = ("none: the averaged theory's P_escape is a deterministic solve with no path counts, so no "
+                   "confidence interval and no conservative basin")
+#: the keywords of theory.escape_probability that stochastic_erosion_theory passes on
+THEORY_KWARGS = ("cells", "steps_per_cycle", "advection")
 ZERO_NOISE = ("at noise = 0 every path is the deterministic trajectory: P_escape is exact (0 or 1), the "
               "conservative basin is the basin, and one path per initial condition is integrated")
 #: ensemble attributes carried into the basins' and profiles' Datasets
 _CARRIED = ("F", "Omega", "Psi", "xi_max", "noise", "noise_time", "paths", "seed", "cycles", "steps_per_cycle",
             "damping", "noise_model", "noise_scheme", "integrator", "random_numbers", "boundary_correction",
-            "escape_criteria")
+            "escape_criteria", "theory", "solver")
 
 
 # --------------------------------------------------------------------------- checks
@@ -131,22 +147,32 @@ def _check_certifiable(eps: npt.NDArray[np.float64], paths: int) -> None:
                          "or conservative=False")
 
 
+def _is_theory(ds: xr.Dataset) -> bool:
+    """A map of the averaged theory (theory.escape_probability): no path counts."""
+    return "theory" in ds.attrs and "paths" not in ds.attrs
+
+
 def _check_ensemble(ds: Any) -> xr.Dataset:
-    """``ds`` is an escape-probability map of numerics.escape_probability on a (q0, p0) grid."""
+    """``ds`` is an escape-probability map of numerics.escape_probability or theory.escape_probability
+    on a (q0, p0) grid."""
     if not isinstance(ds, xr.Dataset):
-        raise ValueError(f"ds must be the Dataset of numerics.escape_probability, got {type(ds).__name__}")
-    missing = [v for v in ("P_escape", "P_escape_high") if v not in ds]
-    missing += [a for a in ("noise", "paths", "xi_max", "well") if a not in ds.attrs]
+        raise ValueError("ds must be the Dataset of numerics.escape_probability or theory.escape_probability, got "
+                         f"{type(ds).__name__}")
+    theory = _is_theory(ds)
+    missing = [v for v in (("P_escape",) if theory else ("P_escape", "P_escape_high")) if v not in ds]
+    missing += [a for a in (("noise", "xi_max", "well") if theory else ("noise", "paths", "xi_max", "well"))
+                if a not in ds.attrs]
     if missing:
         raise ValueError(f"ds is not an escape-probability map: it lacks {', '.join(map(repr, missing))} "
-                         "(make it with numerics.escape_probability)")
+                         "(make it with numerics.escape_probability or theory.escape_probability)")
     if not {"q0", "p0", "t_eval"} <= set(ds["P_escape"].dims):
         raise ValueError(f"ds must be an escape-probability map on a (q0, p0) grid (integrity measures need a grid; "
                          f"paired initial conditions have none), got P_escape dims {ds['P_escape'].dims}")
     grid_spacing(ds["q0"].values, ds["p0"].values)
-    for v in ("P_escape", "P_escape_high"):
+    tol = RANGE_TOL if theory else 0.0     # the theory's Eulerian marches may overshoot by up to its own bound
+    for v in ("P_escape",) if theory else ("P_escape", "P_escape_high"):
         x = ds[v].values
-        if not ((x >= 0) & (x <= 1)).all():       # (NaN fails too)
+        if not ((x >= -tol) & (x <= 1 + tol)).all():       # (NaN fails too)
             raise ValueError(f"ds: {v} must be probabilities in [0, 1], got values outside (or NaN)")
     return ds
 
@@ -178,11 +204,17 @@ def _measures(mask: xr.DataArray, xi_max: float, well: Well, bottom: tuple[float
     return out.assign_attrs(m.attrs)
 
 
-def _basin(ds: xr.Dataset, epsilon: Any, t_eval: npt.ArrayLike | None, conservative: bool,
+def _basin(ds: xr.Dataset, epsilon: Any, t_eval: npt.ArrayLike | None, conservative: bool | None,
            bottom: tuple[float, float]) -> xr.Dataset:
     ds = _check_ensemble(ds)
+    theory = _is_theory(ds)
     eps, eps_scalar = _check_epsilon(epsilon)
+    if conservative is None:
+        conservative = not theory
     _check_bool("conservative", conservative)
+    if theory and conservative:
+        raise ValueError("conservative=True needs path counts (the Wilson interval of numerics.escape_probability); "
+                         "the averaged theory's map has none: use conservative=False or None")
     b = checks.check_finite("bottom", bottom)
     if b.shape != (2,):
         raise ValueError(f"bottom must be a pair (q0, p0), got {checks.value_repr(b)}")
@@ -208,6 +240,9 @@ def _basin(ds: xr.Dataset, epsilon: Any, t_eval: npt.ArrayLike | None, conservat
     out = out.transpose(*lead, ...)
     out.attrs.update({k: ds.attrs[k] for k in _CARRIED if k in ds.attrs})
     out.attrs.update(well_attrs(well))
+    if theory:
+        out.attrs.update(kind="stochastic", method=THEORY_DEFINITION, conservative=NO_CONSERVATIVE)
+        return out
     out.attrs.update(kind="stochastic", method=DEFINITION, confidence=f"95% Wilson score interval (z = {WILSON_Z})")
     if deterministic:
         out.attrs["zero_noise"] = ZERO_NOISE
@@ -218,19 +253,22 @@ def _basin(ds: xr.Dataset, epsilon: Any, t_eval: npt.ArrayLike | None, conservat
 
 @api_provenance
 def stochastic_safe_basin(ds: xr.Dataset, epsilon: npt.ArrayLike, *, t_eval: npt.ArrayLike | None = None,
-                          conservative: bool = True, bottom: tuple[float, float] = (0.0, 0.0)) -> xr.Dataset:
+                          conservative: bool | None = None, bottom: tuple[float, float] = (0.0, 0.0)) -> xr.Dataset:
     """The stochastic safe basin {P_escape <= epsilon} of an escape-probability map, with GIM, LIM, IF.
 
     Parameters
     ----------
-    ds : a Dataset of :func:`safebasins.numerics.escape_probability` on a (q0, p0) grid (1-D uniform
-        axes).
+    ds : a Dataset of :func:`safebasins.numerics.escape_probability` (an SDE ensemble) or of
+        :func:`safebasins.theory.escape_probability` (the averaged theory) on a (q0, p0) grid (1-D
+        uniform axes).
     epsilon : level(s) in (0, 1); a 1-D sequence (strictly increasing) adds the dimension ``epsilon``.
     t_eval : evaluation time(s) among the map's ``t_eval`` (None: all of them; a scalar: a scalar
         coordinate).
     conservative : also the conservative basin {P_escape_high <= epsilon} (the upper end of the 95%
         Wilson interval; at noise = 0 the basin itself).  An epsilon below
         :func:`certifiable_epsilon` of the map's ``paths`` is refused (the set would be empty).
+        None (default): where the map has path counts (the numerics' maps), not for the theory's,
+        which have no confidence interval (True is refused for them).
     bottom : centre of the LIM disk (default the well bottom (0, 0), as the deterministic profiles;
         an attractor's position for the damped well's basins).
 
@@ -242,7 +280,9 @@ def stochastic_safe_basin(ds: xr.Dataset, epsilon: npt.ArrayLike, *, t_eval: npt
     S0(xi_max) on the same grid); with ``conservative`` the same with the suffix ``_conservative``
     (``safe_conservative``, ``GIM_conservative``, ...).  Attributes: the ensemble's (F, Omega, Psi,
     xi_max, noise, paths, seed, scheme, well, ...), the definition and, under noise,
-    ``conservative_epsilon_floor`` (:func:`certifiable_epsilon` of the paths).
+    ``conservative_epsilon_floor`` (:func:`certifiable_epsilon` of the paths).  From a theory map:
+    the plain basin only, the theory's attributes (``theory``, ``solver``, ...) and ``conservative``
+    saying that there is no conservative basin.
     """
     return annotate(_basin(ds, epsilon, t_eval, conservative, bottom))
 
@@ -255,6 +295,38 @@ def _stack(parts: list[xr.Dataset], name: str, values: npt.NDArray[np.float64], 
     out = xr.concat(parts, dim=name, coords="minimal", compat="override", join="override",
                     combine_attrs="drop_conflicts")
     return out.assign_coords({name: coord})
+
+
+def _profile(make_map: Callable[[float, float], xr.Dataset], Fs: npt.NDArray[np.float64], F_scalar: bool,
+             sig: npt.NDArray[np.float64], sig_scalar: bool, epsilon: npt.ArrayLike, t_eval: npt.ArrayLike,
+             conservative: bool | None, bottom: tuple[float, float], keep_masks: bool
+             ) -> tuple[xr.Dataset, dict[str, Any]]:
+    """The basins of ``make_map(F, sigma)`` over the sweep, stacked over (F?, noise?, epsilon?, t_eval),
+    and the attributes of one map (a noisy one where there is one), less F and noise."""
+    t_one = t_eval if np.ndim(t_eval) == 0 else None     # a scalar t_eval: a scalar coordinate
+    rows = []
+    attrs: dict[str, Any] = {}      # a noisy ensemble's, where there is one (its paths, scheme, correction)
+    for Fi in Fs:
+        cols = []
+        for s in sig:
+            ens = make_map(float(Fi), float(s))
+            part = _basin(ens, epsilon, t_one, conservative, bottom)
+            if keep_masks:
+                names = [v for v in ("P_escape", "P_escape_high") if v in ens]
+                maps = _select_t_eval(ens[names], t_one).transpose(..., "q0", "p0")
+                part = part.merge(maps, compat="override", join="exact", combine_attrs="override")
+            else:
+                part = part.drop_vars([v for v in ("safe", "safe_conservative") if v in part])
+            if not attrs or (s > 0 and float(attrs["noise"]) == 0):
+                attrs = dict(part.attrs)
+            cols.append(part if keep_masks else part.drop_vars(["q0", "p0"]))
+        rows.append(_stack(cols, "noise", sig, sig_scalar))
+    out = _stack(rows, "F", Fs, F_scalar)
+    lead = [d for d in ("F", "noise", "epsilon", "t_eval") if d in out.dims]
+    out = out.transpose(*lead, ...)
+    for k in ("F", "noise"):
+        attrs.pop(k)
+    return out, attrs
 
 
 @api_provenance
@@ -305,32 +377,60 @@ def stochastic_erosion(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float | Sequence
     if conservative and (sig > 0).any():
         _check_certifiable(eps, paths)
     w = resolve_well(well)
-    t_one = t_eval if np.ndim(t_eval) == 0 else None     # a scalar t_eval: a scalar coordinate
-    rows = []
-    attrs: dict[str, Any] = {}      # a noisy ensemble's, where there is one (its paths, scheme, correction)
-    for Fi in Fs:
-        cols = []
-        for s in sig:
-            ens = escape_probability(q0, p0, float(Fi), Omega, Psi, noise=float(s), paths=paths if s > 0 else 1,
-                                     xi_max=xi_max, t_eval=t_eval, damping=damping, well=w, seed=seed,
-                                     cycles=cycles, **ensemble_kwargs)
-            part = _basin(ens, epsilon, t_one, conservative, bottom)
-            if keep_masks:
-                maps = _select_t_eval(ens[["P_escape", "P_escape_high"]], t_one).transpose(..., "q0", "p0")
-                part = part.merge(maps, compat="override", join="exact", combine_attrs="override")
-            else:
-                part = part.drop_vars([v for v in ("safe", "safe_conservative") if v in part])
-            if not attrs or (s > 0 and float(attrs["noise"]) == 0):
-                attrs = dict(part.attrs)
-            cols.append(part if keep_masks else part.drop_vars(["q0", "p0"]))
-        rows.append(_stack(cols, "noise", sig, sig_scalar))
-    out = _stack(rows, "F", Fs, F_scalar)
-    lead = [d for d in ("F", "noise", "epsilon", "t_eval") if d in out.dims]
-    out = out.transpose(*lead, ...)
-    for k in ("F", "noise"):
-        attrs.pop(k)
+
+    def ensemble(Fi: float, s: float) -> xr.Dataset:
+        return escape_probability(q0, p0, Fi, Omega, Psi, noise=s, paths=paths if s > 0 else 1, xi_max=xi_max,
+                                  t_eval=t_eval, damping=damping, well=w, seed=seed, cycles=cycles,
+                                  **ensemble_kwargs)
+
+    out, attrs = _profile(ensemble, Fs, F_scalar, sig, sig_scalar, epsilon, t_eval, conservative, bottom,
+                          keep_masks)
     out.attrs = {**attrs, "paths": paths}
     if (sig == 0).any():
         out.attrs["zero_noise"] = ZERO_NOISE
     out.attrs["kind"] = "stochastic"
+    return annotate(out)
+
+
+@api_provenance
+def stochastic_erosion_theory(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float | Sequence[float] | npt.ArrayLike,
+                              Omega: float, Psi: float, *, noise: float | Sequence[float] | npt.ArrayLike,
+                              epsilon: npt.ArrayLike, xi_max: float, t_eval: npt.ArrayLike, damping: float = 0.0,
+                              well: WellLike = None, bottom: tuple[float, float] = (0.0, 0.0),
+                              keep_masks: bool = False, **theory_kwargs: Any) -> xr.Dataset:
+    """Stochastic erosion profile from the averaged theory: GIM, LIM, IF of {P_escape <= epsilon}
+    against sigma and/or F, one :func:`safebasins.theory.escape_probability` solve per (F, noise),
+    read by :func:`stochastic_safe_basin` (the plain basin: the theory has no path counts, hence no
+    conservative basin).
+
+    Arguments as :func:`stochastic_erosion`, less the ensemble's (``paths``, ``seed``, ``cycles``,
+    ``conservative``); ``noise`` > 0 (at noise 0 the theory is the deterministic slow flow,
+    :func:`safebasins.theory.slow_flow_escapes`); ``well`` a symmetric well; ``theory_kwargs``:
+    ``cells``, ``steps_per_cycle``, ``advection`` of theory.escape_probability.  ``keep_masks`` adds
+    ``safe`` and ``P_escape`` over (..., q0, p0).
+
+    Returns
+    -------
+    xr.Dataset over (F?, noise?, epsilon?, t_eval) with ``GIM``, ``LIM``, ``IF`` and the raw measures;
+    attributes: the theory's (model, solver, well, ...) and ``conservative`` saying there is none.
+    """
+    grid_spacing(q0, p0)
+    Fs, F_scalar = _check_sweep("F", F)
+    sig, sig_scalar = _check_sweep("noise", noise)
+    if (sig == 0).any():
+        raise ValueError("noise must be > 0 for the averaged theory (at noise 0 it is the deterministic slow flow, "
+                         "theory.slow_flow_escapes); got " + checks.value_repr(noise))
+    _check_epsilon(epsilon)
+    _check_bool("keep_masks", keep_masks)
+    unknown = sorted(set(theory_kwargs) - set(THEORY_KWARGS))
+    if unknown:
+        raise ValueError(f"unknown keyword(s) {unknown} for the theory's solve: expected some of {THEORY_KWARGS}")
+    w = resolve_well(well)
+
+    def solve(Fi: float, s: float) -> xr.Dataset:
+        return theory_escape_probability(q0, p0, Fi, Omega, Psi, xi_max, noise=s, t_eval=t_eval, damping=damping,
+                                         well=w, grid=True, **theory_kwargs)
+
+    out, attrs = _profile(solve, Fs, F_scalar, sig, sig_scalar, epsilon, t_eval, False, bottom, keep_masks)
+    out.attrs = attrs
     return annotate(out)
