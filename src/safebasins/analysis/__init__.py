@@ -12,6 +12,7 @@ melnikov         Melnikov threshold F_M(Omega) of the hilltop saddle: first homo
 basin_measures   basin entropy S_b / S_bb (log 2 criterion), the fractal test, the grid uncertainty exponent
 wada             the Wada test of three or more basins (merging method)
 basin_labels     labelled basins from escape charts and damped maps; reference_basins: known answers
+basin_sides      escape left / safe / escape right of a two-barrier well (the side of the first crossing)
 saddle           the forced hilltop saddle's periodic orbit, its manifolds and their first tangency (floquet: shooting)
 fatal_shock      the minimal fatal shock of the damped attractors, beside their LIM
 continuation     the damped attractors followed across Omega or F (arclength), their basins' GIM/LIM, the Dover cliff

@@ -10,8 +10,8 @@ reads them from an escape chart, :func:`map_labels` from the stroboscopic map of
 An escape chart (:func:`safebasins.numerics.escape_chart`) records *when* an initial condition
 escapes, not over which barrier: its labels are escaped (0) and safe (1), two basins.  A Wada
 test needs three or more: escape and two attractors of a damped well (:func:`map_labels`), or
-escape over each barrier of the quartic, which the engine does not record (an escape chart keeps
-the step of escape, not the side).
+escape over each barrier of the quartic (an escape chart keeps the step of escape, not the side:
+:func:`safebasins.analysis.basin_sides.side_labels` replays the escaped ICs for it).
 """
 from __future__ import annotations
 
