@@ -8,16 +8,18 @@ correctly rounded: llvm.sqrt on the CPU, sqrt.rn.f64 on CUDA) and two bit casts,
 differently; these functions round identically wherever they are compiled.  They are written
 with selects rather than branches, so that a loop calling them vectorises on the CPU.
 
-* sin, cos, sincos: x = n pi/2 + r, Cody-Waite in three parts (r as a double-double, exact for
-  ``|x| <= 2^30``), exact Payne-Hanek reduction beyond (elementary_reduction: a branch that on the
-  CPU is a vector-masked call, taken only by the lanes that need it); minimax kernels on
-  [-pi/4, pi/4] with their r^3/6 and r^2/2 terms in double-double.
-* exp, expm1: x = n ln2 + r (r a double-double), e^r - 1 by a minimax polynomial with r^2/2
-  exact, 2^n applied in two factors (no spurious overflow), one rounding in the subnormal range.
+* sin, cos, sincos, tan (elementary_trig): x = n pi/2 + r, Cody-Waite in three parts (r = r_h + r_l,
+  exact to 2^-77 for ``|x| <= 2^30``), exact Payne-Hanek reduction beyond (elementary_reduction:
+  a branch that on the CPU is a vector-masked call, taken only by the lanes that need it);
+  faithful minimax kernels on [-pi/4, pi/4] (double-double kernels on the huge-argument path).
+* exp, expm1: x = n ln2 + r_h + r_l (r_h exact, r_l = -n LN2_LO not normalised), e^r - 1 - r_h
+  by a minimax polynomial with r_h^2/2 exact, r_l added as r_l e^r_h; 2^n applied in two factors
+  (no spurious overflow), one rounding in the subnormal range; faithful.
 * log, log1p: x = 2^E z, z in [sqrt(1/2), sqrt(2)), log z = 2 atanh(s), s = (z-1)/(z+1) as a
   double-double, minimax polynomial in s^2.
 * cosh, sinh, tanh: from the double-double e^|x| and its reciprocal (sinh below 1/4 by its own
-  polynomial); tanh = E/(E + 2) with E = expm1(2|x|) as a double-double.
+  polynomial; cosh from exp's faithful polynomial, sinh's from a double-double one: it cancels);
+  tanh = E/(E + 2) with E = expm1(2|x|) as a double-double.
 * pow(x, y) = exp(y log x) with log x as a double-double to 2^-70 and y log x a double-double;
   the special cases of C99 Annex F.  powi(x, n): binary powering in double-double.
 * sqrt: the IEEE square root (NaN below zero, without the exception Python would raise).
@@ -45,9 +47,9 @@ from typing import Any
 
 from numba import njit
 
-from safebasins.wells import elementary_dd, elementary_reduction, elementary_targets
+from safebasins.wells import elementary_dd, elementary_reduction, elementary_targets, elementary_trig
 from safebasins.wells.elementary_dd import _ABS, _copysign, _dd_mul, _fast_two_sum, _pow2, _two_prod, _two_sum
-from safebasins.wells.elementary_reduction import reduce_pio2 as _payne_hanek
+from safebasins.wells.elementary_trig import SIN_COS_FAST_LIMIT, cos, sin, sincos, tan
 from safebasins.wells.elementary_targets import (as_bits, as_bits_cpu, cold_call_cpu, compile_code, from_bits,
                                                     from_bits_cpu, register_cpu_overload)
 from safebasins.wells.compiled import cpu_jit, fma, fma_cpu, mul, mul_cpu
@@ -59,17 +61,17 @@ __all__ = ["sin", "cos", "tan", "sincos", "exp", "expm1", "log", "log1p", "tanh"
 FUNCTIONS = ("sin", "cos", "tan", "sincos", "exp", "expm1", "log", "log1p", "tanh", "cosh", "sinh", "sqrt", "pow",
              "powi")
 #: the largest error in ulps (against mpmath) that each function may make on its whole domain,
-#: tested (tests/wells/test_elementary.py); the measured maxima: docs/elementary.md.  tan = sin/cos:
-#: two kernel errors of <= 0.53 ulp (relative 1.06 2^-52 each at a binade's bottom) and the
-#: division's rounding bound it by 2.62 ulp
-ULP_BOUNDS = {"sin": 0.55, "cos": 0.55, "sincos": 0.55, "tan": 2.7, "exp": 0.55, "expm1": 0.55, "log": 0.55,
-              "log1p": 0.6, "tanh": 0.55, "cosh": 0.55, "sinh": 0.55, "sqrt": 0.5, "pow": 0.55, "powi": 0.55}
-#: hash of the source of the functions (this module and the three it compiles with): part of the key
+#: tested (tests/wells/test_elementary.py); the measured maxima: docs/elementary.md.  sin, cos,
+#: exp, expm1, tanh and cosh are faithful (< 1 ulp; no double-double kernel terms: the wells' forces
+#: call them); the others almost correctly rounded.  tan = sin/cos: two kernel errors of <= 0.8
+#: ulp (relative 1.6 2^-52 each at a binade's bottom) and the division's rounding bound it by 3.7
+ULP_BOUNDS = {"sin": 0.8, "cos": 0.8, "sincos": 0.8, "tan": 3.7, "exp": 0.65, "expm1": 0.85, "log": 0.55,
+              "log1p": 0.6, "tanh": 0.65, "cosh": 0.65, "sinh": 0.55, "sqrt": 0.5, "pow": 0.55, "powi": 0.55}
+#: hash of the source of the functions (this module and the four it compiles with): part of the key
 #: of every compiled well that calls them (an edit never reuses a kernel cached before it)
 MODULE_HASH = hashlib.blake2b(b"".join(Path(str(m.__file__)).read_bytes() for m in (
-    sys.modules[__name__], elementary_dd, elementary_reduction, elementary_targets)), digest_size=16).hexdigest()
-#: ``|x|`` up to which sin and cos reduce by Cody-Waite (beyond: Payne-Hanek)
-SIN_COS_FAST_LIMIT = 2.0 ** 30
+    sys.modules[__name__], elementary_dd, elementary_reduction, elementary_targets, elementary_trig)),
+    digest_size=16).hexdigest()
 
 
 # ------------------------------------------------------------------------------- constants
@@ -89,14 +91,9 @@ _LN2_42 = _h("0x1.62e42fefa3800p-1")     # 42 bits: E LN2_42 is exact for |E| < 
 _LN2_42M = _h("0x1.ef35793c76730p-45")
 _LN2_42L = _h("0x1.f97b57a079a19p-103")
 
-_TWO_OVER_PI = _h("0x1.45f306dc9c883p-1")
-_PIO2_1 = _h("0x1.921fb54442d18p+0")      # pi/2 = PIO2_1 + PIO2_2 + PIO2_3 + O(2^-163)
-_PIO2_2 = _h("0x1.1a62633145c07p-54")
-_PIO2_3 = _h("-0x1.f1976b7ed8fbcp-110")
 
 _TWO3_HI, _TWO3_LO = _h("0x1.5555555555555p-1"), _h("0x1.5555555555555p-55")
 _TWO5_HI, _TWO5_LO = _h("0x1.999999999999ap-2"), _h("-0x1.999999999999ap-56")
-_SIXTH_HI, _SIXTH_LO = _h("0x1.5555555555555p-3"), _h("0x1.5555555555555p-57")
 _THIRD_HI, _THIRD_LO = _h("0x1.5555555555555p-2"), _h("0x1.5555555555555p-56")
 
 # minimax polynomials (benchmarks/elementary_coefficients.py), relative error with these doubles:
@@ -118,14 +115,6 @@ _L0, _L1, _L2, _L3, _L4, _L5, _L6, _L7 = map(_h, (
 _M0, _M1, _M2, _M3, _M4, _M5, _M6 = map(_h, (
     "0x1.249249249265cp-2", "0x1.c71c71c6a5341p-3", "0x1.745d17a975632p-3", "0x1.3b1385e47f1b6p-3",
     "0x1.111baba317c66p-3", "0x1.def45c9c15738p-4", "0x1.e5333184de147p-4"))
-# sin r = r - r^3/6 + r^5 (S0 + S1 z + ... + S5 z^5), z = r^2, |r| <= pi/4 + 2^-20: 2^-67.4
-_S0, _S1, _S2, _S3, _S4, _S5 = map(_h, (
-    "0x1.111111111110fp-7", "-0x1.a01a01a0194b2p-13", "0x1.71de3a53f2fd2p-19", "-0x1.ae64537b27b3dp-26",
-    "0x1.61211c7af2333p-33", "-0x1.aae6ec007d962p-41"))
-# cos r = 1 - r^2/2 + z^2 (C0 + C1 z + ... + C5 z^5): 2^-63.4
-_C0, _C1, _C2, _C3, _C4, _C5 = map(_h, (
-    "0x1.555555555554bp-5", "-0x1.6c16c16c150c8p-10", "0x1.a01a019caf829p-16", "-0x1.27e4f81097945p-22",
-    "0x1.1ee9f46249f29p-29", "-0x1.8fb46a41c8459p-37"))
 # sinh x = x + x z (H0 + H1 z + ... + H4 z^4), z = x^2, |x| <= 1/4: 2^-65.0
 _H0, _H1, _H2, _H3, _H4 = map(_h, (
     "0x1.5555555555555p-3", "0x1.111111111132ap-7", "0x1.a01a019f98f55p-13", "0x1.71de34379e275p-19",
@@ -203,19 +192,34 @@ def _exp_finish(n: int, bh: float, bl: float) -> float:
     return sub if tiny else normal
 
 
+def _exp_fast(x: float) -> tuple[int, float, float]:
+    """(n, r_h, t): e^x = 2^n (1 + r_h + t), t = e^r - 1 - r_h to ~2^-58 absolute, for
+    ``|x| <= 746``: r_h exact, r_l = -n LN2_LO (not normalised) added as r_l e^r_h."""
+    k = fma(x, _INV_LN2, _SHIFT)
+    nf = k - _SHIFT
+    rh = fma(-nf, _LN2_HI, x)                        # exact
+    rl = mul(-nf, _LN2_LO)
+    r2 = mul(rh, rh)
+    q = _poly10(rh, r2, mul(r2, r2), _E0, _E1, _E2, _E3, _E4, _E5, _E6, _E7, _E8, _E9)
+    # e^r_h - 1 - r_h = r_h^2/2 + r_h^3 q, r_h^2 = r2 + fma(r_h, r_h, -r2) exactly
+    t = fma(0.5, r2, fma(mul(r2, rh), q, mul(0.5, fma(rh, rh, -r2))))
+    return as_bits(k) - _SHIFT_BITS, rh, t + fma(rl, rh + t, rl)
+
+
 def exp(x: float) -> float:
     """e^x."""
     xc = x if x > -746.0 else -746.0                 # NaN -> -746 here, restored at the end
     xc = xc if xc < 710.0 else 710.0
-    n, rh, rl = _exp_reduce(xc, 0.0)
-    bh, bl = _exp_poly(rh, rl)
-    res = _exp_finish(n, bh, bl)
+    n, rh, t = _exp_fast(xc)
+    bh, be = _fast_two_sum(1.0, rh)
+    res = _exp_finish(n, bh, be + t)
     return x + x if x != x else res
 
 
-def _expm1_dd(n: int, rh: float, rl: float) -> tuple[float, float]:
-    """2^n (1 + u) - 1, u = e^r - 1, for -55 <= n <= 60, as a double-double (exact sums)."""
-    uh, ul = _expm1_poly(rh, rl)
+def _expm1_dd(n: int, rh: float, t: float) -> tuple[float, float]:
+    """2^n (1 + r_h + t) - 1 for e^r - 1 = r_h + t (:func:`_exp_fast`), -55 <= n <= 60, as a
+    double-double (exact sums)."""
+    uh, ul = _fast_two_sum(rh, t)
     s = _pow2(n)
     th, tl = _two_sum(s, -1.0)                       # 2^n - 1 exactly
     sh, se = _two_sum(mul(s, uh), th)
@@ -226,10 +230,10 @@ def expm1(x: float) -> float:
     """e^x - 1."""
     xc = x if x > -38.0 else -38.0                   # e^-38 < 2^-54: expm1 = -1 rounded
     xc = xc if xc < 710.0 else 710.0
-    n, rh, rl = _exp_reduce(xc, 0.0)
-    dh, dl = _expm1_dd(n if n < 60 else 60, rh, rl)
-    bh, bl = _exp_poly(rh, rl)
-    res = _exp_finish(n, bh, bl) if n > 60 else dh + dl    # n > 60: the -1 is below 2^-8 ulp
+    n, rh, t = _exp_fast(xc)
+    dh, dl = _expm1_dd(n if n < 60 else 60, rh, t)
+    bh, be = _fast_two_sum(1.0, rh)
+    res = _exp_finish(n, bh, be + t) if n > 60 else dh + dl    # n > 60: the -1 is below 2^-8 ulp
     res = x if abs(x) < _M54 else res
     return x + x if x != x else res
 
@@ -248,7 +252,11 @@ def cosh(x: float) -> float:
     """cosh x = 2^(n-1) (b + 2^-2n / b)."""
     ax = abs(x)
     ax = ax if ax < 711.0 else 711.0                 # NaN -> 711 here, restored at the end
-    n, bh, bl, ih, il = _exp_dd(ax)
+    n, rh, t = _exp_fast(ax)                         # no cancellation: e^r to ~2^-58 suffices
+    bh, be = _fast_two_sum(1.0, rh)
+    bh, bl = _fast_two_sum(bh, be + t)
+    ih = 1.0 / bh
+    il = mul(fma(-bh, ih, 1.0) - mul(bl, ih), ih)
     g = _pow2(-2 * (n if n < 511 else 511))
     ch, ce = _two_sum(bh, mul(g, ih))
     res = _scale(n - 1, ch + (ce + (bl + mul(g, il))))
@@ -274,8 +282,8 @@ def tanh(x: float) -> float:
     """tanh x = sign(x) E/(E + 2), E = expm1(2|x|) as a double-double."""
     ax = abs(x)
     ax2 = ax + ax if ax < 20.0 else 40.0             # tanh(20) = 1 - 2^-56.7: 1 rounded
-    n, rh, rl = _exp_reduce(ax2, 0.0)
-    dh, dl = _expm1_dd(n, rh, rl)
+    n, rh, t = _exp_fast(ax2)
+    dh, dl = _expm1_dd(n, rh, t)
     sh, se = _two_sum(dh, 2.0)
     inv = 1.0 / sh
     qh = mul(dh, inv)
@@ -419,123 +427,10 @@ def sqrt(x: float) -> float:
     return math.sqrt(x) if x >= 0.0 else _NAN
 
 
-# ------------------------------------------------------------------------------- sin, cos
-def _reduce_pio2(x: float) -> tuple[int, float, float]:
-    """(n mod 4, r_h, r_l): x = n pi/2 + r_h + r_l, |r| <= pi/4 + 2^-23, for |x| <= 2^30."""
-    k = fma(x, _TWO_OVER_PI, _SHIFT)
-    nf = k - _SHIFT
-    t = fma(-nf, _PIO2_1, x)                         # exact
-    p, pe = _two_prod(nf, _PIO2_2)
-    th, te = _two_sum(t, -p)
-    rh, rl = _fast_two_sum(th, (te - pe) - mul(nf, _PIO2_3))
-    return as_bits(k) & 3, rh, rl
-
-
-def _sin_kernel(rh: float, rl: float) -> float:
-    """sin(r_h + r_l), |r| <= pi/4 + 2^-20: r - r^3/6 in double-double, the rest a polynomial."""
-    zh = mul(rh, rh)
-    zl = fma(rh, rh, -zh)
-    ch = mul(zh, rh)                                 # r^3 = ch + cl
-    cl = fma(zh, rh, -ch) + mul(zl, rh)
-    th = mul(ch, -_SIXTH_HI)                         # -r^3/6 = th + tl
-    tl = fma(ch, -_SIXTH_HI, -th) - (mul(ch, _SIXTH_LO) + mul(cl, _SIXTH_HI))
-    p = fma(fma(fma(fma(fma(_S5, zh, _S4), zh, _S3), zh, _S2), zh, _S1), zh, _S0)
-    sh, se = _fast_two_sum(rh, th)
-    return sh + (se + (tl + (fma(mul(ch, zh), p, rl) - mul(mul(0.5, zh), rl))))
-
-
-def _cos_kernel(rh: float, rl: float) -> float:
-    """cos(r_h + r_l), |r| <= pi/4 + 2^-20: 1 - r^2/2 and C0 r^4 in double-double, the rest a
-    polynomial."""
-    zh = mul(rh, rh)
-    zl = fma(rh, rh, -zh)
-    hz = mul(0.5, zh)
-    w = 1.0 - hz
-    e = (1.0 - w) - hz                               # exact
-    z2 = mul(zh, zh)
-    z2l = fma(zh, zh, -z2)
-    p = fma(fma(fma(fma(_C5, zh, _C4), zh, _C3), zh, _C2), zh, _C1)
-    sr = fma(mul(zh, -_SIXTH_HI), rh, rh)             # sin r to ~r^5/120: the factor of r_l
-    tail = fma(z2l, _C0, (e - mul(0.5, zl)) - mul(sr, rl))
-    return w + fma(z2, _C0, fma(mul(z2, zh), p, tail))
-
-
-def _quadrant(q: int, s: float, c: float) -> float:
-    """sin(n pi/2 + r) from n mod 4 = q, s = sin r, c = cos r (cos: q + 1)."""
-    v = c if (q & 1) == 1 else s
-    return -v if (q & 2) == 2 else v
-
-
-def _sincos_huge(x: float) -> tuple[float, float]:
-    """(sin x, cos x) for 2^30 < |x| < inf, reduced exactly (Payne-Hanek)."""
-    b = as_bits(x) & _ABS
-    q, a0, a1, a2 = _payne_hanek((b & 0xFFFFFFFFFFFFF) | 0x10000000000000, (b >> 52) - 1023)
-    fh, fl = _fast_two_sum(a0, a1)
-    rh, rl = _dd_mul(fh, fl + a2, _PIO2_1, _PIO2_2)
-    s = _sin_kernel(rh, rl)
-    c = _cos_kernel(rh, rl)
-    sn = _quadrant(q, s, c)
-    return (-sn if x < 0.0 else sn), _quadrant(q + 1, s, c)
-
-
-def _sin_huge(x: float) -> float:
-    return _sincos_huge(x)[0]
-
-
-def _cos_huge(x: float) -> float:
-    return _sincos_huge(x)[1]
-
-
-def sincos(x: float) -> tuple[float, float]:
-    """(sin x, cos x)."""
-    ax = abs(x)
-    fast = ax <= SIN_COS_FAST_LIMIT                  # False for NaN
-    q, rh, rl = _reduce_pio2(x if fast else 0.0)
-    s = _sin_kernel(rh, rl)
-    c = _cos_kernel(rh, rl)
-    sn = _quadrant(q, s, c)
-    cs = _quadrant(q + 1, s, c)
-    if (not fast) & (ax < _INF):
-        sn = _sin_huge(x)
-        cs = _cos_huge(x)
-    sn = x if ax < _M27 else sn                      # sin(-0) = -0
-    bad = not (ax < _INF)
-    return (x - x if bad else sn), (x - x if bad else cs)
-
-
-def sin(x: float) -> float:
-    """sin x."""
-    ax = abs(x)
-    fast = ax <= SIN_COS_FAST_LIMIT
-    q, rh, rl = _reduce_pio2(x if fast else 0.0)
-    res = _quadrant(q, _sin_kernel(rh, rl), _cos_kernel(rh, rl))
-    if (not fast) & (ax < _INF):
-        res = _sin_huge(x)
-    res = x if ax < _M27 else res
-    return x - x if not (ax < _INF) else res         # sin(+-inf) = NaN
-
-
-def tan(x: float) -> float:
-    """tan x = sin x / cos x (both from one reduction)."""
-    s, c = sincos(x)
-    return s / c
-
-
-def cos(x: float) -> float:
-    """cos x."""
-    ax = abs(x)
-    fast = ax <= SIN_COS_FAST_LIMIT
-    q, rh, rl = _reduce_pio2(x if fast else 0.0)
-    res = _quadrant(q + 1, _sin_kernel(rh, rl), _cos_kernel(rh, rl))
-    if (not fast) & (ax < _INF):
-        res = _cos_huge(x)
-    return x - x if not (ax < _INF) else res
-
-
 # ------------------------------------------------------------------------------- targets
 #: functions here that are not code (compile_code compiles the others)
 NOT_CODE = ("cpu", "cuda_device", "for_target", "_cold", "_cpu_function")
-_MODULES = (sys.modules[__name__], elementary_dd, elementary_reduction)
+_MODULES = (sys.modules[__name__], elementary_dd, elementary_reduction, elementary_trig)
 
 
 def _cold(ns: SimpleNamespace, name: str) -> Any:
