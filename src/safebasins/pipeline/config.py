@@ -45,7 +45,7 @@ KIND_MODULES = ("safebasins.pipeline.kinds.fcr", "safebasins.pipeline.kinds.basi
                 "safebasins.pipeline.kinds.maps", "safebasins.pipeline.kinds.damped",
                 "safebasins.pipeline.kinds.basin_measures",
                 "safebasins.pipeline.kinds.saddle", "safebasins.pipeline.kinds.fatal_shock",
-                "safebasins.pipeline.kinds.continuation")
+                "safebasins.pipeline.kinds.continuation", "safebasins.pipeline.kinds.noise")
 
 __all__ = ["ConfigError", "load_yaml", "merge_config", "build_schema", "validate_config", "experiment_blocks",
            "SCHEMA_PATH"]

@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 
     from safebasins.plotting.data import DataSource
 
-__all__ = ["figure_escape_probability"]
+__all__ = ["figure_escape_probability", "figure_escape_probability_levels"]
 
 
 def figure_escape_probability(probability: DataSource, *, title: str | None = None) -> Figure:
@@ -64,3 +64,41 @@ def _notes(fig: Figure, ds: xr.Dataset) -> None:
         add_note(fig, f"within {t:g} cycles: mean P_escape {float(np.mean(p)):.3f}; "
                       f"{100 * float(np.mean(p == 0)):.1f}% of the initial conditions with no escaped path, "
                       f"{100 * float(np.mean(p == 1)):.1f}% with every path escaped.")
+
+
+def figure_escape_probability_levels(probability: DataSource, *, title: str | None = None) -> Figure:
+    """One row per noise level sigma, one column per evaluation time: P_escape over the (q0, p0) grid
+    (the Dataset of the ``escape_probability`` kind: ensembles stacked over ``noise``)."""
+    ds = open_dataset(probability)
+    P = var(ds, "P_escape")
+    if P.dims != ("noise", "q0", "p0", "t_eval"):
+        raise ValueError(f"probability: P_escape must be on (noise, q0, p0, t_eval), got dims {P.dims}")
+    sig, t_eval = var(ds, "noise").values, var(ds, "t_eval").values
+    q0, p0 = var(ds, "q0").values, var(ds, "p0").values
+    fig, axes = plt.subplots(sig.size, t_eval.size, figsize=(3.6 * t_eval.size + 1.2, 3.0 * sig.size + 0.6),
+                             squeeze=False, layout="compressed", sharex=True, sharey=True)
+    meshes = []
+    for i, s in enumerate(sig):
+        for k, t in enumerate(t_eval):
+            ax = axes[i, k]
+            meshes.append(ax.pcolormesh(q0, p0, P.values[i, :, :, k].T, cmap="Greys", vmin=0.0, vmax=1.0,
+                                        shading="nearest", rasterized=True))
+            ax.set_title(f"({chr(ord('a') + i * t_eval.size + k)}) σ = {s:g}, within {t:g} cycles", fontsize=9)
+            if i == sig.size - 1:
+                ax.set_xlabel(LABELS["q0"])
+            if k == 0:
+                ax.set_ylabel(LABELS["p0"])
+    fig.colorbar(meshes[0], ax=axes.ravel().tolist(), label="escape probability $P_{escape}$", shrink=0.8)
+    names = ("F", "Omega", "Psi", "xi_max", "damping", "noise_time")
+    par = {k: param(ds, k) for k in names if k in ds.attrs}
+    fig.suptitle(title or "Escape probability under noise: " + param_text(par), fontsize=10)
+    paths = int(param(ds, "paths"))
+    add_note(fig, f"{paths} paths from each of {ds.sizes['q0']} x {ds.sizes['p0']} initial conditions per noise level "
+                  f"(seed {int(param(ds, 'seed'))}).")
+    t = t_eval[-1]
+    for i, s in enumerate(sig):
+        p = P.values[i, :, :, -1]
+        add_note(fig, f"σ = {s:g}, within {t:g} cycles: mean P_escape {float(np.mean(p)):.3f}; "
+                      f"{100 * float(np.mean(p <= 0.05)):.1f}% of the ICs at P_escape <= 0.05, "
+                      f"{100 * float(np.mean(p == 1)):.1f}% with every path escaped.")
+    return fig
