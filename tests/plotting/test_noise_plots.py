@@ -4,6 +4,7 @@ dataset of the wrong shape or lacking a variable named."""
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import matplotlib
 import numpy as np
@@ -20,7 +21,7 @@ from safebasins.plotting.stochastic_erosion import figure_stochastic_erosion
 matplotlib.use("Agg")
 
 Q0, P0 = np.linspace(-0.9, 0.9, 5), np.linspace(-0.7, 0.7, 4)
-KW = dict(xi_max=0.18, t_eval=[1, 3], cycles=3, steps_per_cycle=16, threads=1)
+KW: dict[str, Any] = dict(xi_max=0.18, t_eval=[1, 3], cycles=3, steps_per_cycle=16, threads=1)
 
 
 @pytest.fixture(scope="module")
