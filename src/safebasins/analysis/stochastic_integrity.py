@@ -40,7 +40,6 @@ read by the same code.  docs/stochastic-integrity.md.
 """
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -51,8 +50,8 @@ import xarray as xr
 from safebasins.analysis.integrity import MEASURE_ATTRS, grid_spacing, integrity_measures
 from safebasins.core import cf, checks
 from safebasins.core.cf import annotate
+from safebasins.core.statistics import WILSON_Z, certifiable_epsilon, paths_needed
 from safebasins.numerics import escape_probability
-from safebasins.numerics.noise import WILSON_Z, wilson_interval
 from safebasins.theory import escape_probability as theory_escape_probability
 from safebasins.theory.noise_escape import RANGE_TOL
 from safebasins.wells import from_attrs, resolve_well, well_attrs
@@ -92,21 +91,10 @@ _CARRIED = ("F", "Omega", "Psi", "xi_max", "noise", "noise_time", "paths", "seed
 
 
 # --------------------------------------------------------------------------- checks
-def certifiable_epsilon(paths: int) -> float:
-    """The smallest upper end of the 95% Wilson interval ``paths`` paths can give (none escaped):
-    ``z^2 / (paths + z^2)``; a conservative basin of a smaller epsilon is empty."""
-    n = checks.check_positive_int("paths", paths)
-    return float(wilson_interval(0, n)[1])
-
-
-def paths_to_certify(epsilon: float) -> int:
-    """The fewest paths whose Wilson upper bound at no escape is <= ``epsilon``:
-    ``ceil(z^2 (1 - epsilon) / epsilon)`` (checked against :func:`certifiable_epsilon`)."""
-    eps = _check_epsilon(epsilon)[0]
-    n = max(1, math.ceil(WILSON_Z ** 2 * (1.0 - float(eps.min())) / float(eps.min())))
-    while certifiable_epsilon(n) > float(eps.min()):    # the closed form's last-bit rounding
-        n += 1
-    return n
+def paths_to_certify(epsilon: npt.ArrayLike) -> int:
+    """The fewest paths whose Wilson upper bound at no escape is <= ``epsilon`` (the smallest, for
+    several): ``ceil(z^2 (1 - epsilon) / epsilon)`` (checked against :func:`certifiable_epsilon`)."""
+    return paths_needed(float(_check_epsilon(epsilon)[0].min()))
 
 
 def _check_epsilon(epsilon: Any) -> tuple[npt.NDArray[np.float64], bool]:

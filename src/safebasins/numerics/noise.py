@@ -24,6 +24,7 @@ import numpy.typing as npt
 import xarray as xr
 
 from safebasins.core import cf, checks
+from safebasins.core.statistics import WILSON_Z, wilson_interval
 from safebasins.numerics import criteria, engine, noise_kernels, schemes
 from safebasins.numerics.charts import _ic_arrays, ic_coords
 from safebasins.numerics.problem import check_cycles, ensemble_problem
@@ -40,8 +41,6 @@ GOBET_SHIFT = 0.5825971579390106
 #: the discrete-monitoring corrections: "shift" (the energy threshold moved inwards by
 #: GOBET_SHIFT sigma ``|p|`` sqrt(h), the local volatility of H0 being sigma ``|p|``) or "none"
 CORRECTIONS = ("shift", "none")
-#: the normal quantile of the 95% Wilson interval
-WILSON_Z = 1.959963984540054
 #: the backends of the noisy ensemble, as the engine's: the CPU lanes (noise_kernels, the
 #: reference), the CUDA kernel (cuda_noise: bitwise the same escape steps) or "auto" (the GPU when
 #: one is visible)
@@ -66,19 +65,6 @@ def energy_shift(sigma: float, h: float, correction: str, noise_time: float = 0.
     white noise; 0 for "none" and for coloured noise (p is then differentiable in time: no
     O(sqrt(h)) monitoring bias to correct)."""
     return 2.0 * GOBET_SHIFT * sigma * math.sqrt(h) if correction == "shift" and noise_time == 0.0 else 0.0
-
-
-def wilson_interval(k: npt.ArrayLike, n: int, z: float = WILSON_Z) -> tuple[np.ndarray, np.ndarray]:
-    """The Wilson score interval (low, high) of a binomial proportion k / n (95% for the default z)."""
-    kk = np.asarray(k, dtype=float)
-    p = kk / n
-    z2 = z * z
-    centre = (p + z2 / (2 * n)) / (1 + z2 / n)
-    half = z / (1 + z2 / n) * np.sqrt(p * (1 - p) / n + z2 / (4 * n * n))
-    # the ends are exactly 0 at k = 0 and 1 at k = n (the rounding of centre -+ half is not)
-    low = np.where(kk == 0, 0.0, np.clip(centre - half, 0.0, 1.0))
-    high = np.where(kk == n, 1.0, np.clip(centre + half, 0.0, 1.0))
-    return low, high
 
 
 def _check_seed(seed: object) -> int:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
+from safebasins.core.statistics import certifiable_epsilon, paths_needed
 from safebasins.pipeline import values
 from safebasins.pipeline.cost import NOISE_STEP_COST
 from safebasins.pipeline.registry import Block, FigureInputs, Inputs, Job, Kind, Params, Product, dataset_path, register
@@ -206,13 +207,11 @@ class StochasticErosion(Kind):
         _check_common(block, key, ctx, ("F", "noise", "epsilon"))
         sig = values.as_list(block["noise"])
         if block["conservative"] and any(s > 0 for s in sig):
-            from safebasins.analysis.stochastic_integrity import certifiable_epsilon, paths_to_certify
-
             eps, floor = min(values.as_list(block["epsilon"])), certifiable_epsilon(int(block["paths"]))
             if eps < floor:
                 ctx.fail(f"{key}.paths", f"{block['paths']} paths certify no epsilon below {floor:.4g} (the upper end "
                                          f"of the 95% Wilson interval with no escaped path), epsilon {eps} asks for "
-                                         f"paths >= {paths_to_certify(eps)}; or set conservative: false")
+                                         f"paths >= {paths_needed(eps)}; or set conservative: false")
 
     def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         F = values.as_list(block["F"])
