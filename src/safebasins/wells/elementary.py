@@ -19,7 +19,7 @@ with selects rather than branches, so that a loop calling them vectorises on the
   double-double, minimax polynomial in s^2.
 * cosh, sinh, tanh: from the double-double e^|x| and its reciprocal (sinh below 1/4 by its own
   polynomial; cosh from exp's faithful polynomial, sinh's from a double-double one: it cancels);
-  tanh = E/(E + 2) with E = expm1(2|x|) as a double-double.
+  tanh = (e - 1)/(e + 1) with e = e^(2|x|) as a double-double and exact sums.
 * pow(x, y) = exp(y log x) with log x as a double-double to 2^-70 and y log x a double-double;
   the special cases of C99 Annex F.  powi(x, n): binary powering in double-double.
 * sqrt: the IEEE square root (NaN below zero, without the exception Python would raise).
