@@ -112,3 +112,30 @@ def value_repr(a: Any) -> str:
     a = np.asarray(a)
     return repr(a.item()) if a.ndim == 0 else repr(a.tolist() if a.size <= 6 else f"array with range [{a.min()}, "
                                                                                   f"{a.max()}]")
+
+
+def _monotone(a: np.ndarray) -> bool:
+    d = np.diff(a)
+    return bool(np.all(d > 0) or np.all(d < 0))
+
+
+def initial_conditions(q0: npt.ArrayLike, p0: npt.ArrayLike, grid: bool | None
+                       ) -> tuple[bool, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(is_grid, q axis, p axis, Q, P)`` of the initial conditions of an ensemble: 1-D axes make
+    a grid (dims q0, p0; ``grid=None``: when both are monotone) unless ``grid=False``; otherwise
+    paired points of the same shape."""
+    qa = check_finite("q0", q0)
+    pa = check_finite("p0", p0)
+    if grid is None:
+        grid = qa.ndim == 1 and pa.ndim == 1 and _monotone(qa) and _monotone(pa)
+    if grid:
+        if qa.ndim != 1 or pa.ndim != 1:
+            raise ValueError(f"q0 and p0 must be 1-D axes for grid=True, got shapes {qa.shape}, {pa.shape}")
+        if qa.size == 0 or pa.size == 0:
+            raise ValueError("q0 and p0 axes must not be empty")
+        Q, P = np.meshgrid(qa, pa, indexing="ij")
+        return True, qa, pa, Q.ravel(), P.ravel()
+    if qa.shape != pa.shape:
+        raise ValueError(f"q0 and p0 must have the same shape for paired initial conditions (grid=False), "
+                         f"got {qa.shape} and {pa.shape}")
+    return False, qa, pa, qa.ravel(), pa.ravel()

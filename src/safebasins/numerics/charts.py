@@ -16,34 +16,11 @@ from safebasins.wells import Well, resolve_well
 from safebasins.wells.base import WellLike
 
 
-def _monotone(a: np.ndarray) -> bool:
-    d = np.diff(a)
-    return bool(np.all(d > 0) or np.all(d < 0))
-
-
-def _ic_arrays(q0: npt.ArrayLike, p0: npt.ArrayLike, grid: bool | None
-               ) -> tuple[bool, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    qa = checks.check_finite("q0", q0)
-    pa = checks.check_finite("p0", p0)
-    if grid is None:
-        grid = qa.ndim == 1 and pa.ndim == 1 and _monotone(qa) and _monotone(pa)
-    if grid:
-        if qa.ndim != 1 or pa.ndim != 1:
-            raise ValueError(f"q0 and p0 must be 1-D axes for grid=True, got shapes {qa.shape}, {pa.shape}")
-        if qa.size == 0 or pa.size == 0:
-            raise ValueError("q0 and p0 axes must not be empty")
-        Q, P = np.meshgrid(qa, pa, indexing="ij")
-        return True, qa, pa, Q.ravel(), P.ravel()
-    if qa.shape != pa.shape:
-        raise ValueError(f"q0 and p0 must have the same shape for paired initial conditions (grid=False), "
-                         f"got {qa.shape} and {pa.shape}")
-    return False, qa, pa, qa.ravel(), pa.ravel()
-
-
 def ic_coords(is_grid: bool, qa: np.ndarray, pa: np.ndarray, Q: np.ndarray, P: np.ndarray
               ) -> tuple[tuple[int, ...], tuple[str, ...], dict[str, Any]]:
-    """(shape, dims, coords) of a result over the initial conditions of :func:`_ic_arrays`: a
-    grid (q0, p0) of the axes qa, pa, or paired samples (sample) at Q, P."""
+    """(shape, dims, coords) of a result over the initial conditions of
+    :func:`safebasins.core.checks.initial_conditions`: a grid (q0, p0) of the axes qa, pa, or paired
+    samples (sample) at Q, P."""
     if is_grid:
         return (qa.size, pa.size), ("q0", "p0"), {"q0": ("q0", qa, cf.attrs("q0")), "p0": ("p0", pa, cf.attrs("p0"))}
     return (Q.size,), ("sample",), {"sample": ("sample", np.arange(Q.size), cf.attrs("sample")),
@@ -116,7 +93,7 @@ def escape_chart(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: float, P
     One integration serves every threshold and every t_eval <= cycles; a trajectory stops once
     it has crossed every requested threshold.
     """
-    is_grid, qa, pa, Q, P = _ic_arrays(q0, p0, grid)
+    is_grid, qa, pa, Q, P = checks.initial_conditions(q0, p0, grid)
     F = checks.check_scalar("F", F, checks.check_nonnegative)
     Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)
@@ -179,7 +156,7 @@ def escape_chart_batch(q0: npt.ArrayLike, p0: npt.ArrayLike, F: npt.ArrayLike, O
     ``escape_cycle_displacement (control, q_max, q0, p0)`` (and ``escape_cycle_bounds (control,
     q_bounds, q0, p0)`` when q_bounds are given) and coordinates ``F(control)``, ``Omega(control)``.
     """
-    is_grid, qa, pa, Q, P = _ic_arrays(q0, p0, True)
+    is_grid, qa, pa, Q, P = checks.initial_conditions(q0, p0, True)
     F = checks.check_1d("F", F, checks.check_nonnegative)
     Omega = checks.check_1d("Omega", Omega, checks.check_positive)
     if F.size != Omega.size or F.size == 0:

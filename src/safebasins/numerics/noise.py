@@ -26,7 +26,7 @@ import xarray as xr
 from safebasins.core import cf, checks
 from safebasins.core.statistics import WILSON_Z, wilson_interval
 from safebasins.numerics import criteria, engine, noise_kernels, schemes
-from safebasins.numerics.charts import _ic_arrays, ic_coords
+from safebasins.numerics.charts import ic_coords
 from safebasins.numerics.problem import check_cycles, ensemble_problem
 from safebasins.wells import resolve_well
 from safebasins.wells.base import WellLike
@@ -144,7 +144,7 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
     Attributes: the equation, noise (and noise_time), paths, seed, the scheme, the random
     numbers, the correction, the escape criteria and the well.
     """
-    is_grid, qa, pa, Q, P = _ic_arrays(q0, p0, grid)
+    is_grid, qa, pa, Q, P = checks.initial_conditions(q0, p0, grid)
     F = checks.check_scalar("F", F, checks.check_nonnegative)
     Omega = checks.check_scalar("Omega", Omega, checks.check_positive)
     Psi = checks.check_scalar("Psi", Psi, checks.check_finite)

@@ -64,33 +64,9 @@ def _setup(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_
     if (not isinstance(cells, tuple) or len(cells) != 2
             or any(isinstance(c, bool) or not isinstance(c, (int, np.integer)) or c < 8 for c in cells)):
         raise ValueError(f"cells must be a pair of integers >= 8 (n_gamma, n_J), got {cells!r}")
-    ics = _ic_arrays(q0, p0, grid)
+    ics = checks.initial_conditions(q0, p0, grid)
     diff = averaged_diffusion(w, par["xi_max"])
     return w, par, ics, DiscGrid(int(cells[0]), int(cells[1]), diff.J_max), diff
-
-
-def _ic_arrays(q0: ArrayLike, p0: ArrayLike, grid: bool | None
-               ) -> tuple[bool, FloatArray, FloatArray, FloatArray, FloatArray]:
-    """``(is_grid, q axis, p axis, Q, P)``: 1-D axes make a grid (dims q0, p0) unless ``grid=False``;
-    otherwise paired points (dim sample), as the numerics' escape_probability reads them."""
-    qa = checks.check_finite("q0", q0)
-    pa = checks.check_finite("p0", p0)
-    if grid is None:
-        grid = qa.ndim == 1 and pa.ndim == 1 and _monotone(qa) and _monotone(pa)
-    if grid:
-        if qa.ndim != 1 or pa.ndim != 1 or qa.size == 0 or pa.size == 0:
-            raise ValueError(f"q0 and p0 must be non-empty 1-D axes for grid=True, got shapes {qa.shape}, {pa.shape}")
-        Q, P = np.meshgrid(qa, pa, indexing="ij")
-        return True, qa, pa, Q.ravel(), P.ravel()
-    if qa.shape != pa.shape:
-        raise ValueError(f"q0 and p0 must have the same shape for paired initial conditions (grid=False), got "
-                         f"{qa.shape} and {pa.shape}")
-    return False, qa, pa, qa.ravel(), pa.ravel()
-
-
-def _monotone(a: FloatArray) -> bool:
-    d = np.diff(a)
-    return bool(np.all(d > 0) or np.all(d < 0))
 
 
 def _slow_points(w: Well, Q: FloatArray, P: FloatArray, Psi: float, xi_max: float
