@@ -1,7 +1,8 @@
 """The escape_probability and stochastic_erosion kinds (config ``noise.quartic_escape_probability`` and
 ``noise.escape_equation_erosion``): resolved with the run's seed, schema defaults = the library's, the
-cost guard counting paths x ICs x steps, refused where they cannot run (naming the key), and each build
-function is the library call bit for bit."""
+cost guard counting paths x ICs x steps (and the averaged theory's cells x steps), refused where they cannot
+run (naming the key), and each build function is the library call bit for bit: the ensembles, the averaged
+theory's map and its agreement with them, or an attribute saying why the theory does not apply."""
 from __future__ import annotations
 
 import inspect
@@ -11,10 +12,12 @@ from typing import Any
 import numpy as np
 import pytest
 
+from safebasins import theory
 from safebasins.analysis import stochastic_erosion
+from safebasins.analysis.agreement import probability_agreement
 from safebasins.numerics import escape_probability
 from safebasins.pipeline.config import ConfigError
-from safebasins.pipeline.cost import NOISE_STEP_COST
+from safebasins.pipeline.cost import NOISE_STEP_COST, analytic_cost
 from safebasins.pipeline.kinds.noise import build_escape_probability, build_stochastic_erosion
 from safebasins.pipeline.plan import plan
 from safebasins.pipeline.registry import KINDS, Job
@@ -43,6 +46,10 @@ def test_schema_defaults_are_the_library_defaults() -> None:
         props = KINDS[kind].schema["properties"]
         for key in ("cycles", "noise_time", "correction"):
             assert props[key]["default"] == lib[key].default, (kind, key)
+    th = inspect.signature(theory.escape_probability).parameters
+    props = KINDS["escape_probability"].schema["properties"]
+    assert tuple(props["theory_cells"]["default"]) == th["cells"].default
+    assert props["theory_steps_per_cycle"]["default"] == th["steps_per_cycle"].default
     props = KINDS["stochastic_erosion"].schema["properties"]
     assert props["conservative"]["default"] == ero["conservative"].default
     assert tuple(props["bottom"]["default"]) == ero["bottom"].default
@@ -75,6 +82,11 @@ def test_cost_counts_paths_ics_and_steps(base: dict[str, Any]) -> None:
     ("quartic_escape_probability", {"noise_time": 0.01}, "quartic_escape_probability.noise_time"),
     ("quartic_escape_probability", {"xi_max": 0.3}, "quartic_escape_probability.xi_max"),
     ("quartic_escape_probability", {"grid": {"q0": [1.0, -1.0]}}, "quartic_escape_probability.grid.q0"),
+    ("quartic_escape_probability", {"theory": "yes"}, "quartic_escape_probability.theory"),
+    ("quartic_escape_probability", {"theory_cells": [4, 160]}, "quartic_escape_probability.theory_cells"),
+    ("quartic_escape_probability", {"theory_cells": [128]}, "quartic_escape_probability.theory_cells"),
+    ("quartic_escape_probability", {"theory_steps_per_cycle": 0}, "quartic_escape_probability.theory_steps_per_cycle"),
+    ("escape_equation_erosion", {"theory": True}, "escape_equation_erosion"),
     ("escape_equation_erosion", {"paths": 20}, "escape_equation_erosion.paths"),
     ("escape_equation_erosion", {"epsilon": [0.5, 0.05]}, "escape_equation_erosion.epsilon[1]"),
     ("escape_equation_erosion", {"epsilon": 1.0}, "escape_equation_erosion.epsilon"),
@@ -104,6 +116,69 @@ def test_map_build_is_the_library_call(base: dict[str, Any]) -> None:
         for k in ("P_escape", "P_escape_low", "P_escape_high"):
             np.testing.assert_array_equal(ds[k].values[i], ref[k].values, err_msg=f"{k} at sigma {s}")
     assert 0 < float(ds["P_escape"].sel(noise=0.02).mean()) < 1
+    # a noise level 0: no theory, and the dataset says why
+    assert "P_escape_theory" not in ds and ds.attrs["theory"] == "none"
+    assert "noise 0" in ds.attrs["theory_reason"]
+
+
+THEORY = {**TINY, "noise": [0.01, 0.02], "theory_cells": [16, 20], "theory_steps_per_cycle": 6}
+
+
+def test_map_build_with_the_theory_is_the_library_calls(base: dict[str, Any]) -> None:
+    p = plan(merged(base, {"noise": {"quartic_escape_probability": THEORY}})).experiments[MAP].params
+    ds = build_escape_probability(p, {}, Job(threads=1))
+    q0, p0 = np.linspace(-0.95, 0.95, 5), np.linspace(-0.75, 0.75, 4)
+    assert ds["P_escape_theory"].dims == ("noise", "q0", "p0", "t_eval")
+    assert ds["P_escape_mean_abs_difference"].dims == ("noise", "t_eval")
+    means, maxima = [], []
+    for i, s in enumerate((0.01, 0.02)):
+        ens = escape_probability(q0, p0, 0.01, 0.9, math.pi, noise=s, paths=6, xi_max=0.18, t_eval=[1, 3],
+                                 seed=p["seed"], cycles=3, steps_per_cycle=16, threads=1)
+        th = theory.escape_probability(q0, p0, 0.01, 0.9, math.pi, 0.18, noise=s, t_eval=[1, 3], cells=(16, 20),
+                                       steps_per_cycle=6)
+        ref = probability_agreement(th, ens)
+        np.testing.assert_array_equal(ds["P_escape"].values[i], ens["P_escape"].values)
+        np.testing.assert_array_equal(ds["P_escape_theory"].values[i], th["P_escape"].values)
+        for k in ("P_escape_mean_abs_difference", "P_escape_max_abs_difference"):
+            np.testing.assert_array_equal(ds[k].values[i], ref[k].values, err_msg=f"{k} at sigma {s}")
+            assert ds[k].attrs["units"] == "1" and ds[k].attrs["long_name"]
+        for k in ("P_escape_mean_abs_difference_uncertain", "P_escape_theory_within_wilson"):
+            assert float(ds[k].values[i]) == ref.attrs[k], (k, s)
+            assert ds[k].dims == ("noise",) and ds[k].attrs["units"] == "1"
+        means.append(ref.attrs["P_escape_mean_abs_difference"])
+        maxima.append(ref.attrs["P_escape_max_abs_difference"])
+    # the summary over noise levels (equal IC counts: the mean of the means), the solver's settings
+    assert ds.attrs["P_escape_mean_abs_difference"] == pytest.approx(np.mean(means), rel=1e-14)
+    assert ds.attrs["P_escape_max_abs_difference"] == max(maxima)
+    assert 0 < ds.attrs["P_escape_mean_abs_difference"] < 0.2
+    assert ds.attrs["theory"] == th.attrs["theory"] and ds.attrs["theory_solver"] == th.attrs["solver"]
+    assert list(ds.attrs["theory_cells"]) == [16, 20] and ds.attrs["theory_steps_per_cycle"] == 6
+    assert "theory_reason" not in ds.attrs
+
+
+@pytest.mark.parametrize("override,reason", [
+    ({"well": "cubic", "xi_max": 0.12}, "symmetric wells"),    # the theory refuses the well (naming it)
+    ({"noise_time": 1.0}, "coloured noise"),
+    ({"theory": False}, "theory: false"),
+])
+def test_map_without_the_theory_says_why(base: dict[str, Any], override: dict[str, Any], reason: str) -> None:
+    p = plan(merged(base, {"noise": {"quartic_escape_probability": {**THEORY, **override}}})).experiments[MAP].params
+    ds = build_escape_probability(p, {}, Job(threads=1))
+    assert ds.attrs["theory"] == "none" and reason in ds.attrs["theory_reason"]
+    assert not [v for v in ds.data_vars if "theory" in str(v) or "abs_difference" in str(v)]
+    assert ds["P_escape"].notnull().all()
+
+
+def test_analytic_cost_counts_the_theory(base: dict[str, Any]) -> None:
+    def cost(over: dict[str, Any]) -> int:
+        return analytic_cost(plan(merged(base, {"noise": {"quartic_escape_probability": {**THEORY, **over}}}
+                                         )).experiments[MAP])
+
+    # two noise levels x 16 x 20 cells x 3 cycles of 6 steps
+    assert cost({}) == 2 * 16 * 20 * 3 * 6
+    assert cost({"t_eval": [1, 2.5]}) == 2 * 16 * 20 * 3 * 6      # the theory's horizon: the largest t_eval, up
+    assert cost({"theory": False}) == cost({"noise_time": 1.0}) == cost({"noise": [0.0, 0.01]}) == 0
+    assert analytic_cost(plan(base).experiments[MAP]) == 3 * 128 * 160 * 50 * 8
 
 
 def test_erosion_build_is_the_library_call(base: dict[str, Any]) -> None:

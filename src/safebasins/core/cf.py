@@ -70,6 +70,11 @@ VARIABLES = {
     "P_escape_mean_abs_difference": ("1", "mean over the initial conditions of |P_escape theory - P_escape numerics|"),
     "P_escape_max_abs_difference": ("1", "maximum over the initial conditions of |P_escape theory - P_escape "
                                          "numerics|"),
+    "P_escape_mean_abs_difference_uncertain": ("1", "mean over the initial conditions and t_eval of |P_escape "
+                                                    "theory - P_escape numerics|, without the ICs whose P_escape "
+                                                    "is 1 in both at every t_eval"),
+    "P_escape_theory_within_wilson": ("1", "fraction of (initial condition, t_eval) where the theory's P_escape "
+                                           "lies in the numerics' 95% Wilson interval"),
     "F_cr": ("1", "critical forcing amplitude"),
     "F_MM_0": ("1", "critical forcing, maximum mechanism through gamma* = 0"),
     "F_MM_pi": ("1", "critical forcing, maximum mechanism through gamma* = pi"),

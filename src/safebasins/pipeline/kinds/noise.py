@@ -6,6 +6,9 @@ several noise amplitudes sigma (one ensemble each, stacked over ``noise``).  ``s
 GIM, LIM and IF of the stochastic safe basin {P_escape <= epsilon} and of the conservative one
 against sigma and/or F (:func:`safebasins.analysis.stochastic_erosion`, the same seed at every
 point).  Both draw their random numbers from the run's seed plus the experiment's offset.
+``escape_probability`` also solves the averaged theory (:func:`safebasins.theory.escape_probability`)
+at each noise level where it applies and stores its map with the agreement
+(:func:`safebasins.analysis.agreement.probability_agreement`).
 Datasets: ``results/data/extras/<experiment>.nc``.
 """
 from __future__ import annotations
@@ -104,8 +107,76 @@ def _ensemble_kwargs(params: Params, job: Job) -> dict[str, Any]:
 
 
 # --------------------------------------------------------------------------- escape_probability
+#: the averaged theory's keys (the defaults of safebasins.theory.escape_probability)
+_THEORY = {
+    "theory": {"description": "also solve the averaged theory (safebasins.theory.escape_probability, "
+                              "docs/noise-theory.md) at every noise level and store its map P_escape_theory with "
+                              "its agreement with the ensembles: P_escape_mean_abs_difference and "
+                              "P_escape_max_abs_difference (over the ICs, per noise and t_eval), "
+                              "P_escape_mean_abs_difference_uncertain and P_escape_theory_within_wilson (per "
+                              "noise). It applies to white noise (noise_time 0), every noise level > 0, a "
+                              "symmetric well and xi_max below the barrier; elsewhere, or with false, the "
+                              "dataset's attribute theory is 'none' and theory_reason says why",
+               "type": "boolean", "default": True},
+    "theory_cells": {"description": "the theory's polar grid (n_gamma, n_J)", "type": "array", "minItems": 2,
+                     "maxItems": 2, "items": {"type": "integer", "minimum": 8}, "default": [128, 160]},
+    "theory_steps_per_cycle": {"description": "the theory's time steps per forcing cycle", "type": "integer",
+                               "minimum": 1, "default": 8},
+}
+#: the theory's refusals of a block (a ValueError naming one of these arguments): an asymmetric
+#: well, xi_max at the barrier
+_THEORY_REFUSALS = ("well:", "xi_max ")
+#: slow-flow evaluations per cell and time step of the theory's march (Fig 14's quartic, 128 x 160
+#: cells, 50 cycles of 8 steps: 8.4-10.1 s per noise level on one core of a 2.5 GHz Xeon, about
+#: 1e6 cell-steps per second = pipeline.cost.ANALYTIC_RATE)
+THEORY_CELL_STEP_EVALUATIONS = 1
+
+
+def _theory_cycles(params: Params) -> int:
+    # the theory's horizon (theory.escape_probability): the largest t_eval rounded up
+    return max(1, math.ceil(max(params["t_eval"])))
+
+
+def _theory_reason(params: Params) -> str | None:
+    """Why the block gets no theory (None: it may, unless its well or xi_max is refused)."""
+    if not params["theory"]:
+        return "not computed (theory: false)"
+    if params["noise_time"] > 0:
+        return ("not applicable to coloured noise (noise_time > 0): the averaged theory is derived for white noise "
+                "(docs/noise-theory.md)")
+    if any(s == 0 for s in params["noise"]):
+        return ("not applicable at noise 0 (a level of this block): the averaged diffusion needs sigma > 0; "
+                "at sigma = 0 the theory is the deterministic slow flow (theory.slow_flow_escapes)")
+    return None
+
+
+def _theory_map(params: Params, q0: Any, p0: Any, noise: float) -> xr.Dataset:
+    from safebasins.theory import escape_probability
+
+    return escape_probability(q0, p0, params["F"], params["Omega"], params["Psi"], params["xi_max"], noise=noise,
+                              t_eval=params["t_eval"], damping=values.damping(params), well=values.base_well(params),
+                              cells=tuple(params["theory_cells"]), steps_per_cycle=params["theory_steps_per_cycle"])
+
+
+def _with_agreement(theory: xr.Dataset, ensemble: xr.Dataset) -> xr.Dataset:
+    """The ensemble with the theory's map and their agreement; the per-level summaries that
+    probability_agreement gives as attributes become variables (stacked over noise)."""
+    import xarray as xr
+
+    from safebasins.analysis.agreement import probability_agreement
+    from safebasins.core import cf
+
+    out = probability_agreement(theory, ensemble)
+    for name in ("P_escape_mean_abs_difference_uncertain", "P_escape_theory_within_wilson"):
+        out[name] = xr.DataArray(out.attrs.pop(name), attrs=cf.attrs(name))
+    for name in ("P_escape_mean_abs_difference", "P_escape_max_abs_difference"):
+        del out.attrs[name]
+    return out
+
+
 def build_escape_probability(params: Params, data: Inputs, job: Job) -> xr.Dataset:
-    """One ensemble per noise level, stacked over ``noise`` (each the library call's Dataset)."""
+    """One ensemble per noise level, stacked over ``noise`` (each the library call's Dataset), with
+    the averaged theory's map and the agreement where the theory applies."""
     import xarray as xr
 
     from safebasins.numerics import escape_probability
@@ -114,14 +185,37 @@ def build_escape_probability(params: Params, data: Inputs, job: Job) -> xr.Datas
     kw = _ensemble_kwargs(params, job)
     print(f"{params['experiment']}: P_escape of {q0.size} x {p0.size} ICs, {params['paths']} paths, "
           f"noise {params['noise']}", flush=True)
+    reason = _theory_reason(params)
+    theory: xr.Dataset | None = None
     maps = []
     for s in params["noise"]:
         ds = escape_probability(q0, p0, params["F"], params["Omega"], params["Psi"], noise=s,
                                 **{**kw, "paths": kw["paths"] if s > 0 else 1})
+        if reason is None:
+            try:
+                theory = _theory_map(params, q0, p0, s)
+            except ValueError as exc:
+                if theory is not None or not str(exc).startswith(_THEORY_REFUSALS):
+                    raise
+                reason = f"not applicable: {exc}"
+            else:
+                ds = _with_agreement(theory, ds)
+                print(f"  sigma = {s:g}: |P_escape_theory - P_escape| mean "
+                      f"{float(ds['P_escape_mean_abs_difference'].mean()):.4f}, max "
+                      f"{float(ds['P_escape_max_abs_difference'].max()):.4f} over the ICs and t_eval", flush=True)
         maps.append(ds.expand_dims(noise=[s]).assign_attrs(paths=params["paths"]))
     out = xr.concat(maps, dim="noise", combine_attrs="override", data_vars="all")
     out["noise"].attrs.update(maps[0]["noise"].attrs)
     out.attrs.pop("noise", None)
+    if reason is None and theory is not None:
+        out.attrs.update(theory=theory.attrs["theory"], theory_model=theory.attrs["noise_model"],
+                         theory_solver=theory.attrs["solver"], theory_cells=list(params["theory_cells"]),
+                         theory_steps_per_cycle=params["theory_steps_per_cycle"],
+                         theory_cycles=theory.attrs["cycles"],
+                         P_escape_mean_abs_difference=float(out["P_escape_mean_abs_difference"].mean()),
+                         P_escape_max_abs_difference=float(out["P_escape_max_abs_difference"].max()))
+    else:
+        out.attrs.update(theory="none", theory_reason=str(reason))
     return out
 
 
@@ -131,13 +225,14 @@ class EscapeProbability(Kind):
     damped = True
     any_well = True
     description = ("the probability of escape under noise within each t_eval over a grid of initial conditions, "
-                   "from paths paths per IC, at one or several noise amplitudes sigma of dp = ... + sigma dW")
+                   "from paths paths per IC, at one or several noise amplitudes sigma of dp = ... + sigma dW, "
+                   "with the averaged theory's map and its agreement where the theory applies")
     builder = "safebasins.plotting.noise:figure_escape_probability_levels"
     schema = {
         "description": description,
         "type": "object", "additionalProperties": False,
         "required": ["F", "Omega", "xi_max", "grid", "noise", "paths", "t_eval"],
-        "properties": {**_COMMON,
+        "properties": {**_COMMON, **_THEORY,
                        "noise": _value_or_list(SIGMA, "noise amplitude(s) sigma >= 0 (a list: one ensemble each, "
                                                       "strictly increasing)")},
     }
@@ -147,17 +242,31 @@ class EscapeProbability(Kind):
 
     def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         return dict(F=float(block["F"]), noise=[float(x) for x in values.as_list(block["noise"])],
-                    **_resolve_common(block, ctx))
+                    theory=bool(block["theory"]), theory_cells=[int(n) for n in block["theory_cells"]],
+                    theory_steps_per_cycle=int(block["theory_steps_per_cycle"]), **_resolve_common(block, ctx))
 
     def cost(self, params: Params) -> int:
         n = len(params["noise"])
         return _cost(params, n, sum(1 for s in params["noise"] if s > 0))
 
+    def analytic_cost(self, params: Params) -> int:
+        """The theory's march: cells x time steps per noise level (0 where it does not apply; an upper
+        bound for a well the theory refuses at build time)."""
+        if _theory_reason(params) is not None:
+            return 0
+        n_gamma, n_J = params["theory_cells"]
+        steps = _theory_cycles(params) * params["theory_steps_per_cycle"]
+        return len(params["noise"]) * n_gamma * n_J * steps * THEORY_CELL_STEP_EVALUATIONS
+
     def products(self, experiment: str, params: Params) -> list[Product]:
         G = ("noise", "q0", "p0", "t_eval")
+        history = "safebasins.numerics.escape_probability"
+        if params["theory"]:
+            history += (", where it applies safebasins.theory.escape_probability and "
+                        "safebasins.analysis.agreement.probability_agreement")
         return [Product(dataset_path("extras", experiment), "extras", build_escape_probability, heavy=True,
                         title=params["title"] + " (escape probability under noise)",
-                        history=f"safebasins.numerics.escape_probability ({experiment})",
+                        history=f"{history} ({experiment})",
                         contract={"P_escape": G, "P_escape_low": G, "P_escape_high": G})]
 
     def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
