@@ -56,6 +56,54 @@ def test_levels_figure_and_notes(levels: xr.Dataset) -> None:
         figure_escape_probability_levels(ds.isel(noise=0))
 
 
+@pytest.fixture(scope="module")
+def with_theory(levels: xr.Dataset) -> xr.Dataset:
+    from safebasins import theory
+    from safebasins.pipeline.kinds.noise import _with_agreement
+
+    maps = []
+    for s in (0.005, 0.02):
+        th = theory.escape_probability(Q0, P0, 0.01, 0.9, math.pi, 0.18, noise=s, t_eval=[1, 3], cells=(16, 20))
+        maps.append(_with_agreement(th, levels.sel(noise=s)).expand_dims(noise=[s]))
+    out = xr.concat(maps, dim="noise", combine_attrs="override", data_vars="all")
+    return out.assign_attrs(theory_cells=[16, 20])
+
+
+def test_levels_figure_with_the_theory(with_theory: xr.Dataset) -> None:
+    import matplotlib.pyplot as plt
+
+    ds = with_theory.copy(deep=True)
+    ds["P_escape_mean_abs_difference"].loc[{"noise": 0.02}] = [0.0123, 0.0456]   # numbers the notes must read
+    ds["P_escape_theory_within_wilson"].loc[{"noise": 0.005}] = 0.87
+    fig = figure_escape_probability_levels(ds)
+    text = "\n".join(notes(fig))
+    assert "on 16 x 20 cells" in text
+    assert "σ = 0.02, theory vs ensembles within 1 / 3 cycles: mean |ΔP| 0.012 / 0.046" in text
+    assert "Wilson interval at 87% of (IC, t)" in text
+    high = ds["P_escape_max_abs_difference"].sel(noise=0.005).values
+    assert f"max {high[0]:.2f} / {high[1]:.2f}" in text
+    # the contours: one set per panel where a level lies inside the theory's map, and the legend's two lines
+    drawn = sum(len(ax.collections) - 1 for ax in fig.axes[:4])
+    inside = sum(int(any(P.min() < v < P.max() for v in (0.05, 0.5)))
+                 for P in ds["P_escape_theory"].transpose("noise", "t_eval", "q0", "p0").values.reshape(4, -1))
+    assert drawn == inside > 0
+    assert len(fig.legends[0].get_lines()) == 2
+    plt.close(fig)
+    ds.attrs.pop("theory_cells")
+    with pytest.raises(MissingData, match="theory_cells"):
+        figure_escape_probability_levels(ds)
+
+
+def test_levels_figure_says_why_there_is_no_theory(levels: xr.Dataset) -> None:
+    import matplotlib.pyplot as plt
+
+    fig = figure_escape_probability_levels(levels.assign_attrs(theory="none", theory_reason="not computed (theory: "
+                                                                                           "false)"))
+    assert "No averaged theory: not computed (theory: false)." in notes(fig)
+    assert not fig.legends and all(len(ax.collections) == 1 for ax in fig.axes[:4])
+    plt.close(fig)
+
+
 def test_erosion_figure_and_notes(erosion: xr.Dataset) -> None:
     import matplotlib.pyplot as plt
 

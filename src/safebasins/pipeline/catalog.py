@@ -577,10 +577,15 @@ DECLARATIONS += (
         caption=("The paper's quartic q'' + q - q³ = F sin(Ωt + Ψ) + σ ξ(t) at Fig. 14's forcing with white noise "
                  "of amplitude σ (dp = ... dt + σ dW): the probability P_escape that a path from (q0, p0) escapes "
                  "(H0 above ξ_max, docs/noise.md) within t cycles, from an ensemble of paths per initial condition "
-                 "(Philox random numbers keyed by the seed, the IC, the path and the step)."),
+                 "(Philox random numbers keyed by the seed, the IC, the path and the step); in red, the "
+                 "P_escape = 0.05 (dashed) and 0.5 (solid) contours of the averaged theory (the backward "
+                 "Kolmogorov equation of the stochastic slow flow, docs/noise-theory.md), with no paths."),
         look=("One row per noise level, one column per evaluation time; white: no path escaped, black: every path "
               "escaped. Expect the deterministic safe basin's grey-free core to shrink and its edge to blur as σ "
-              "grows, and the maps to darken with time (escape accumulates).")),
+              "grows, and the maps to darken with time (escape accumulates). The red contours should run along "
+              "the grey edge of each map: where they leave it, the averaging (an O(F) error on the edge of the "
+              "deterministic basin) or the ensemble's sampling (the Wilson interval) is at fault; the notes give "
+              "the mean and largest |ΔP|.")),
     Declaration(
         name="noise_escape_erosion", kind="stochastic_erosion", key=("noise", "escape_equation_erosion"),
         stem="noise_escape_erosion", label="Noise: stochastic erosion of the escape equation",
