@@ -6,7 +6,7 @@ the ``escape_probability`` kind.  The caption sentences are computed from it (:f
 """
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -70,7 +70,7 @@ def _notes(fig: Figure, ds: xr.Dataset) -> None:
 
 
 #: the averaged theory's P_escape levels drawn over the ensembles' maps, with their line styles
-THEORY_LEVELS = {0.05: "--", 0.5: "-"}
+THEORY_LEVELS: dict[float, Literal["--", "-"]] = {0.05: "--", 0.5: "-"}
 THEORY_COLOUR = "tab:red"
 
 
