@@ -227,13 +227,16 @@ def _expm1_dd(n: int, rh: float, t: float) -> tuple[float, float]:
 
 
 def expm1(x: float) -> float:
-    """e^x - 1."""
-    xc = x if x > -38.0 else -38.0                   # e^-38 < 2^-54: expm1 = -1 rounded
+    """e^x - 1.  Reduced with exp's clamps: code calling exp(x) and expm1(x) of one x computes the
+    reduction and the polynomial once (the compiler merges the identical pure operations)."""
+    xc = x if x > -746.0 else -746.0                 # as exp: NaN -> -746 here, restored at the end
     xc = xc if xc < 710.0 else 710.0
     n, rh, t = _exp_fast(xc)
-    dh, dl = _expm1_dd(n if n < 60 else 60, rh, t)
+    m = n if n > -55 else -55                        # x < -38: any finite value, replaced below
+    dh, dl = _expm1_dd(m if m < 60 else 60, rh, t)
     bh, be = _fast_two_sum(1.0, rh)
     res = _exp_finish(n, bh, be + t) if n > 60 else dh + dl    # n > 60: the -1 is below 2^-8 ulp
+    res = -1.0 if x < -38.0 else res                 # e^-38 < 2^-54: expm1 = -1 rounded
     res = x if abs(x) < _M54 else res
     return x + x if x != x else res
 

@@ -33,6 +33,7 @@ from safebasins.wells.base import STEP_COST_ARITHMETIC, STEP_COST_ELEMENTARY, ST
 from safebasins.wells.numeric import NumericWell
 from safebasins.wells import elementary
 from safebasins.wells.compiled import Jit, WellCode, mul, target_code
+from safebasins.wells.expression_forms import Form, exponential_forms
 
 __all__ = ["ExpressionWell", "expression", "FUNCTIONS"]
 
@@ -44,7 +45,7 @@ FUNCTIONS = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "log": 
 #: the functions of the generated source that are not wells.elementary's
 _LIBM = {"atan": math.atan, "asinh": math.asinh}
 #: the namespace of the generated source when it runs on numpy arrays (the theory)
-_NAMESPACE_NUMPY = {"mul": np.multiply, "pow": np.power, **FUNCTIONS}
+_NAMESPACE_NUMPY = {"mul": np.multiply, "pow": np.power, "expm1": np.expm1, "copysign": np.copysign, **FUNCTIONS}
 
 
 def _sympy() -> Any:
@@ -93,8 +94,8 @@ class _Printer:
 
     def __call__(self, e: Any) -> str:
         sp = self.sp
-        if e == self.q:
-            return "q"
+        if e.is_Symbol:
+            return str(e.name)                  # q, or a local variable of the generated code
         if e is sp.pi:
             return repr(math.pi)
         if e is sp.E:
@@ -111,6 +112,12 @@ class _Printer:
             return self._pow(e.base, e.exp)
         if isinstance(e, sp.sech):
             return f"1.0 / cosh({self(e.args[0])})"
+        if isinstance(e, sp.Abs):
+            return f"abs({self(e.args[0])})"
+        if isinstance(e, sp.sign):
+            return f"copysign(1.0, {self(e.args[0])})"
+        if type(e).__name__ == "expm1":            # the rewritten forms' (wells.expression_forms)
+            return f"expm1({self(e.args[0])})"
         name = type(e).__name__
         if isinstance(e, sp.Function) and name in FUNCTIONS and len(e.args) == 1:
             return f"{name}({self(e.args[0])})"
@@ -179,45 +186,165 @@ class _Printer:
         return f"pow({self(b)}, {self(x)})"
 
 
-#: where the candidate forms of V' are compared with a 40-digit evaluation: ``|q|`` from 1e-4 to 30
-_PROBE = np.concatenate([-np.geomspace(1e-4, 30.0, 40)[::-1], np.geomspace(1e-4, 30.0, 40)])
+#: where the candidate forms of V and V' are compared with a 40-digit evaluation: ``|q|`` from
+#: 1e-4 to 30 (the bottom and the decaying tail) and far out, to 1e3 (no form may overflow into a
+#: NaN or an infinity where the value is a double)
+_PROBE = np.concatenate([-np.geomspace(1e-4, 30.0, 40)[::-1], [-1e3, -300.0, -100.0, 100.0, 300.0, 1e3],
+                         np.geomspace(1e-4, 30.0, 40)])
+#: forms whose largest relative error is within this of the most accurate form's are as accurate
+#: (four ulps of 1): the cheapest of them is printed
+ACCURACY_SLACK = 4 * 2.0 ** -52
+_TINY, _HUGE = np.finfo(float).tiny, np.finfo(float).max
 
 
-def _relative_error(form: Any, exact: Any, pr: _Printer, q: Any) -> float:
-    """Largest relative error of the double-precision evaluation of ``form`` (the generated
-    source, on numpy) against ``exact`` (40 digits) on the probe points where both are finite."""
+def _exact(f: Any, q: Any) -> list[Any]:
+    """``f`` at the probe points to 30 digits (mpmath at ``40 + 3 |q|`` digits, the cancellation
+    of an exponential tail included, confirmed at twice that); None where it is not a finite real
+    number, exactly zero or not confirmed."""
+    import mpmath  # type: ignore[import-untyped]  # noqa: PLC0415  (lazy: sympy's dependency, as sympy)
+
     sp = _sympy()
-    f = _functions(f"def V(q):\n    return {pr(form)}\n\n\ndef dV(q):\n    return 0.0\n", _NAMESPACE_NUMPY)[0]
-    worst = 0.0
+    fn = sp.lambdify(q, f, modules="mpmath")
+
+    def at(x: float, dps: int) -> Any:
+        with mpmath.workdps(dps):
+            try:
+                e = fn(mpmath.mpf(x))
+            except (ZeroDivisionError, ValueError, OverflowError):
+                return None
+            return e if isinstance(e, mpmath.mpf) and mpmath.isfinite(e) and e != 0 else None
+
+    out: list[Any] = []
+    for x in _PROBE:
+        dps = 40 + 3 * int(abs(x))
+        e, e2 = at(float(x), dps), at(float(x), 2 * dps)
+        with mpmath.workdps(2 * dps):
+            out.append(e2 if e is not None and e2 is not None and abs(e - e2) <= abs(e2) * 1e-30 else None)
+    return out
+
+
+def _relative_error(form: Form, exact: list[Any], pr: _Printer) -> float:
+    """Largest relative error of the double-precision evaluation of ``form`` (its generated source,
+    on numpy) against ``exact`` on the probe points: a value that underflows counts its error
+    relative to the smallest normal double, one that overflows only a NaN; a NaN or an infinity
+    where the value is a double is an infinite error."""
+    import mpmath  # noqa: PLC0415  (as _exact)
+
+    f = _functions(_code("V", form, pr) + "\n\ndef dV(q):\n    return 0.0\n", _NAMESPACE_NUMPY)[0]
     with np.errstate(all="ignore"):
         got = np.asarray(f(_PROBE.copy()), dtype=float) * np.ones_like(_PROBE)
-    for x, g in zip(_PROBE, got):
-        e = exact.subs(q, sp.Float(float(x), 40)).evalf(40)
-        if not (e.is_real and e.is_finite) or e == 0 or not np.isfinite(g):
-            continue
-        worst = max(worst, abs(float((sp.Float(float(g), 40) - e) / e)))
+    worst = 0.0
+    with mpmath.workdps(40):
+        for g, e in zip(got, exact):
+            if e is None:
+                continue
+            if abs(e) > _HUGE:
+                err = math.inf if np.isnan(g) else 0.0
+            elif not np.isfinite(g):
+                err = math.inf
+            else:
+                err = float(abs(mpmath.mpf(float(g)) - e) / max(abs(e), _TINY))
+            worst = max(worst, err)
     return worst
+
+
+def _cost(form: Form) -> tuple[int, int, int]:
+    """(function calls, counting exp and expm1 of one argument once; calls; operations) of a form."""
+    sp = _sympy()
+    exprs = [v for _, v in form.lets] + [form.body]
+    calls = {(type(c).__name__, c.args) for e in exprs for c in e.atoms(sp.Function)
+             if not isinstance(c, (sp.Abs, sp.sign))}
+    groups = {("exp", a) if n in ("exp", "expm1") else (n, a) for n, a in calls}
+    return len(groups), len(calls), int(sum(sp.count_ops(e) for e in exprs))
+
+
+def _choose(forms: list[Form], n_given: int, f: Any, q: Any, pr: _Printer) -> Form:
+    """The form printed: of the first ``n_given`` (sympy's own spellings) the most accurate
+    (ties: the first), unless a form as accurate (:data:`ACCURACY_SLACK`) is cheaper
+    (:func:`_cost`) or that one is not as accurate as the best of all."""
+    if len(forms) == 1:
+        return forms[0]
+    exact = _exact(f, q)
+    errors = [_relative_error(g, exact, pr) for g in forms]
+    default = int(np.argmin(errors[:n_given]))
+    best = min(errors)
+    if not math.isfinite(best):
+        return forms[default]
+    ok = [i for i, e in enumerate(errors) if e <= best + ACCURACY_SLACK]
+    cheapest = min(ok, key=lambda i: (_cost(forms[i]), i))
+    if default in ok and _cost(forms[default]) <= _cost(forms[cheapest]):
+        return forms[default]
+    return forms[cheapest]
+
+
+def _forms(f: Any, q: Any, spellings: bool) -> tuple[list[Form], int]:
+    """(candidate forms of ``f``, how many are sympy's spellings of it): ``f`` itself and, when
+    ``spellings``, its simplified and cancelled forms; then the rewrites of
+    wells.expression_forms."""
+    sp = _sympy()
+    given: list[Any] = []
+    for g in (f, sp.simplify(f), sp.cancel(f)) if spellings else (f,):
+        if all(g != h for h in given):
+            given.append(g)
+    forms = [Form((), g) for g in given]
+    seen = {(g.lets, g.body) for g in forms}
+    for g in exponential_forms(f, q):
+        if (g.lets, g.body) not in seen:
+            seen.add((g.lets, g.body))
+            forms.append(g)
+    return forms, len(given)
+
+
+def _code(name: str, form: Form, pr: _Printer) -> str:
+    """Source of ``def name(q)`` computing ``form``: its local variables, the common
+    subexpressions of its body once each (sympy's cse), the base of an integer power once."""
+    sp = _sympy()
+    reps, (body,) = sp.cse([form.body], symbols=sp.numbered_symbols("t"))
+    lines: list[str] = []
+    bases: dict[Any, Any] = {}
+    for k, v in (*form.lets, *reps):
+        lines.append(f"    {k} = {pr(_name_power_bases(v, bases, lines, pr))}")
+    lines.append(f"    return {pr(_name_power_bases(body, bases, lines, pr))}")
+    return f"def {name}(q):\n" + "\n".join(lines) + "\n"
+
+
+def _name_power_bases(e: Any, bases: dict[Any, Any], lines: list[str], pr: _Printer) -> Any:
+    """``e`` with the base of every integer power ``b^n`` (``|n| >= 2``, ``b`` not a name or a
+    number; printed as repeated products) replaced by a local variable, defined in ``lines``
+    before its first use."""
+    sp = _sympy()
+    if e.is_Atom:
+        return e
+    args = [_name_power_bases(a, bases, lines, pr) for a in e.args]
+    e = e.func(*args) if any(a is not b for a, b in zip(args, e.args)) else e
+    if e.is_Pow and e.exp.is_Integer and abs(e.exp) >= 2 and not (e.base.is_Symbol or e.base.is_Number):
+        if e.base not in bases:
+            bases[e.base] = sp.Symbol(f"b{len(bases)}")
+            lines.append(f"    {bases[e.base]} = {pr(e.base)}")
+        return sp.Pow(bases[e.base], e.exp, evaluate=False)
+    return e
 
 
 def generate_source(V: Any, q: Any) -> tuple[str, Any]:
     """(source text of ``V(q)`` and ``dV(q)``, the sympy derivative as printed).
 
-    V' is printed in whichever of sympy's equivalent forms (as differentiated, simplified,
-    cancelled) keeps the best relative accuracy in double precision over ``|q|`` in
-    [1e-4, 30] (against a 40-digit evaluation): the derivative of tanh(q)^2 as differentiated,
-    2 tanh(q) (1 - tanh(q)^2), has no relative accuracy where the well's tail decays; its
-    simplified form 2 tanh(q) / cosh(q)^2 has."""
+    Each of V and V' is printed in whichever equivalent form keeps the best relative accuracy in
+    double precision at the probe points (``|q|`` in [1e-4, 30] and far out, against a 40-digit
+    evaluation), the cheapest among those as accurate (:func:`_choose`): sympy's spellings of V'
+    (as differentiated, simplified, cancelled: the derivative of tanh(q)^2 as differentiated,
+    2 tanh(q) (1 - tanh(q)^2), has no relative accuracy where the well's tail decays) and the
+    rewrites through one exponential (wells.expression_forms: sech^2's V' = 2 tanh(q)/cosh(q)^2 as
+    -8 sign(q) D M/(D + 1)^3 with D = exp(-2|q|), M = expm1(-2|q|)).  Common subexpressions are
+    computed once."""
     sp = _sympy()
     dV = sp.diff(V, q)
     pr = _Printer(q)
-    forms: list[Any] = []
-    for f in (dV, sp.simplify(dV), sp.cancel(dV)):
-        if all(f != g for g in forms):
-            forms.append(f)
-    if len(forms) > 1:
-        errors = [_relative_error(f, dV, pr, q) for f in forms]
-        dV = forms[int(np.argmin(errors))]          # ties: the first (as differentiated)
-    return f"def V(q):\n    return {pr(V)}\n\n\ndef dV(q):\n    return {pr(dV)}\n", dV
+    fV = _choose(*_forms(V, q, spellings=False), V, q, pr)
+    fdV = _choose(*_forms(dV, q, spellings=True), dV, q, pr)
+    printed = fdV.body
+    for k, v in reversed(fdV.lets):
+        printed = printed.xreplace({k: v})
+    return f"{_code('V', fV, pr)}\n\n{_code('dV', fdV, pr)}", printed
 
 
 def _step_cost(V: Any, dV: Any) -> float:
@@ -296,8 +423,8 @@ class ExpressionWell(NumericWell):
 def _compiled_namespace(functions: SimpleNamespace) -> dict[str, Any]:
     """The generated source's names in a compiled engine: ``functions`` (wells.elementary compiled
     for the target), the libm functions elementary has not, the wells' ``mul``."""
-    own = {k: getattr(functions, k) for k in (*FUNCTIONS, "pow") if k not in _LIBM}
-    return {"mul": mul, **_LIBM, **own}
+    own = {k: getattr(functions, k) for k in (*FUNCTIONS, "pow", "expm1") if k not in _LIBM}
+    return {"mul": mul, "copysign": functions._copysign, **_LIBM, **own}
 
 
 def expression(text: str, **kwargs: Any) -> ExpressionWell:
