@@ -158,6 +158,7 @@ def test_map_build_with_the_theory_is_the_library_calls(base: dict[str, Any]) ->
 
 @pytest.mark.parametrize("override,reason", [
     ({"well": "cubic", "xi_max": 0.12}, "symmetric wells"),    # the theory refuses the well (naming it)
+    ({"xi_max": 0.25}, "below the barrier energy"),            # the numerics' threshold at the barrier
     ({"noise_time": 1.0}, "coloured noise"),
     ({"theory": False}, "theory: false"),
 ])
