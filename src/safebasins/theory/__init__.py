@@ -7,7 +7,8 @@ it); with damping (docs/damping.md): damped (the damped slow flow and its frames
 damped_escape (safe ICs, F_cr), trajectories (one slow trajectory); then the entry points of both
 slow flows: slow_flow (eqs 11, 18, 21), critical (eqs 22-26), basins (eqs 27-28).  Under noise
 (docs/noise-theory.md): noise_averaging (the averaged diffusion), noise_solver (its backward
-equation), noise_escape (escape probabilities, mean first-passage times).
+equation), noise_escape (escape probabilities, mean first-passage times), noise_quasipotential (the weak-noise
+limit: quasi-potential barriers and the Arrhenius law).
 """
 from .action_angle import (H0, q_max_from_xi, J, omega, G, dJ_dxi, dG_dxi, nome,
                            angle_energy, phase_point, initial_condition)
@@ -19,10 +20,11 @@ from .responses import steady_responses
 from .trajectories import slow_trajectory
 from .damped_escape import slow_flow_outcomes, UndecidedWarning
 from .noise_escape import escape_probability, mean_first_passage
+from .noise_quasipotential import quasi_potential, QuasiPotential
 
 __all__ = ["H0", "q_max_from_xi", "J", "omega", "G", "dJ_dxi", "dG_dxi", "nome",
            "angle_energy", "phase_point", "initial_condition",
            "first_integral", "escapes_on_manifold", "slow_flow_escapes", "slow_flow_profile",
            "slow_flow_rhs", "xi_from_J", "saddles", "critical_forcing", "MECHANISMS",
            "safe_basin_boundaries", "steady_responses", "slow_trajectory", "slow_flow_outcomes",
-           "UndecidedWarning", "escape_probability", "mean_first_passage"]
+           "UndecidedWarning", "escape_probability", "mean_first_passage", "quasi_potential", "QuasiPotential"]

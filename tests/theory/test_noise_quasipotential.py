@@ -1,0 +1,116 @@
+"""The weak-noise limit of the averaged diffusion (docs/noise-theory.md, "The weak-noise limit").
+
+Independent routes (the bounds leave a margin over the measured values):
+
+* closed forms at F = 0: Phi = 2 beta E(J) for any well (the averaged diffusion's stationary
+  density exp(-2 beta E / sigma^2), Boltzmann with sigma^2 = 2 beta T), so the barrier is
+  2 beta xi_max and the Hessian at the bottom 2 beta omega(0) I;
+* the forced linear oscillator (constant omega and a, isotropic diffusion 1/(2 omega), linear drift):
+  Phi = beta omega |x - x*|^2 exactly, barrier beta omega (R - |x*|)^2;
+* the drift against the well's exact damped slow flow (damped.rhs_exact) and its Jacobian against
+  central differences;
+* the chain of two attractors against its mean first-passage time solved at small noise;
+* F > 0: the slope of ln T against 1/sigma^2 from the backward-Kolmogorov solver
+  (theory.mean_first_passage) at decreasing sigma approaches the barrier.
+"""
+
+import numpy as np
+import pytest
+
+from safebasins import theory
+from safebasins.theory.damped import rhs_exact
+from safebasins.theory.noise_averaging import AveragedDiffusion, averaged_diffusion
+from safebasins.theory.noise_quasipotential import _Problem, _solve, attractor_barriers, coefficient_table
+from safebasins.wells import QUARTIC
+
+
+def _linear(J_max, omega):
+    Jn = np.linspace(0.0, J_max, 50)
+    c = np.full(50, 0.5 / omega)
+    return AveragedDiffusion(Jn, H=omega * Jn, omega=np.full(50, omega), a=np.full(50, 0.5 / np.sqrt(omega)),
+                             a_r=c, a_t=c)
+
+
+@pytest.mark.parametrize("F", [0.0, 0.02])
+def test_linear_oscillator_closed_form(F):
+    omega, Omega, beta, J_max = 1.2, 1.0, 0.05, 0.1
+    d = _linear(J_max, omega)
+    pb = _Problem(coefficient_table(d), J_max, F, Omega, beta)
+    # the attractor of X' = -(beta/2) X - g Y, Y' = g X - (beta/2) Y - F a, g = omega - Omega
+    g, a = omega - Omega, 0.5 / np.sqrt(omega)
+    x_star = np.linalg.solve([[-0.5 * beta, -g], [g, -0.5 * beta]], [0.0, F * a])
+    qp = _solve(pb, x_star[None, :], np.zeros((0, 2)), 0.1, 64, 0.05)
+    R = np.sqrt(2 * J_max)
+    assert np.allclose(qp.hessian[0], 2 * beta * omega * np.eye(2), rtol=1e-9)
+    assert qp.barrier[0] == pytest.approx(beta * omega * (R - np.hypot(*x_star)) ** 2, rel=1e-6)
+    if F > 0:       # the nearest point of the circle
+        assert np.allclose(qp.exit_point[0], R * x_star / np.hypot(*x_star), atol=1e-3 * R)
+
+
+def test_thermal_quartic_at_zero_forcing():
+    beta, xi_max = 0.05, 0.18
+    qp = theory.quasi_potential(0.0, 0.9, xi_max, damping=beta)
+    assert qp.barrier[0] == pytest.approx(2 * beta * xi_max, rel=1e-6)
+    assert np.allclose(qp.hessian[0], 2 * beta * QUARTIC.omega(0.0) * np.eye(2), rtol=1e-4)
+    assert qp.exit_set == ("circle",) and qp.saddles.shape == (0, 2)
+
+
+def test_drift_and_jacobian():
+    F, Omega, beta, xi_max = 0.01, 0.9, 0.02, 0.18
+    d = averaged_diffusion(QUARTIC, xi_max)
+    pb = _Problem(coefficient_table(d), d.J_max, F, Omega, beta)
+    rng = np.random.default_rng(1)
+    r = np.sqrt(2 * d.J_max) * np.sqrt(rng.uniform(0.01, 0.95, 40))
+    g = rng.uniform(0, 2 * np.pi, 40)
+    x = np.stack([r * np.cos(g), r * np.sin(g)], axis=1)
+    out = pb.flow(x)
+    bX, bY = rhs_exact(QUARTIC, x[:, 0], x[:, 1], F, Omega, beta)
+    scale = np.hypot(bX, bY).max()
+    assert np.max(np.abs(out[:, 0] - bX)) < 1e-6 * scale and np.max(np.abs(out[:, 1] - bY)) < 1e-6 * scale
+    h = 1e-6
+    for c, e in ((0, np.array([h, 0.0])), (1, np.array([0.0, h]))):
+        fd = (pb.flow(x + e)[:, :2] - pb.flow(x - e)[:, :2]) / (2 * h)
+        assert np.allclose(out[:, [2 + c, 4 + c]], fd, atol=1e-4 * np.abs(out[:, 2:6]).max())
+
+
+def test_chain_of_two_attractors():
+    # W(A->R), W(A->circle), W(R->A), W(R->circle) through one saddle whose branches go to A and R
+    w_ar, w_ac, w_ra, w_rc = 1.0, 1.3, 2.7, 0.36
+    to_saddle = np.array([[w_ar], [w_ra]])
+    barrier, sets = attractor_barriers(np.array([w_ac, w_rc]), to_saddle, np.array([[1, 0]]))
+    # the chain's mean first-passage time from A solved at small eps: eps ln T -> barrier
+    eps = 0.004
+    a, c, r, d = np.exp(-np.array([w_ar, w_ac, w_ra, w_rc]) / eps)
+    M = np.array([[-(a + c), a], [r, -(r + d)]])
+    T = np.linalg.solve(M, -np.ones(2))
+    assert eps * np.log(T) == pytest.approx(barrier, abs=10 * eps)
+    assert barrier[0] == pytest.approx(w_ar) and sets == ("chain", "chain")
+    # a saddle whose other branch escapes joins the circle
+    b1, s1 = attractor_barriers(np.array([w_ac]), np.array([[w_ar]]), np.array([[-1, 0]]))
+    assert b1[0] == w_ar and s1 == ("saddle 0",)
+
+
+def test_arrhenius_slope_of_the_backward_equation():
+    """F > 0: d ln T / d(1/sigma^2) from the solver approaches the barrier (measured 0.935, 0.965,
+    0.985, 1.008 of it between sigma = 0.02, 0.016, 0.013, 0.011, 0.009)."""
+    F, Omega, beta, xi_max = 0.01, 0.9, 0.02, 0.09
+    qp = theory.quasi_potential(F, Omega, xi_max, damping=beta)
+    assert qp.attractors.shape == (1, 2) and qp.exit_set == ("circle",)
+    X, Y = qp.attractors[0]
+    xi = float(theory.xi_from_J(0.5 * (X * X + Y * Y)))
+    q0, p0 = QUARTIC.phase_point(np.arctan2(Y, X), xi)       # Psi = 0: gamma = theta
+    sig = np.array([0.02, 0.016, 0.011, 0.009])
+    T = [float(theory.mean_first_passage([float(q0)], [float(p0)], F, Omega, 0.0, xi_max, noise=s, damping=beta,
+                                         grid=False)["mean_first_passage"][0]) for s in sig]
+    slope = np.diff(np.log(T)) / np.diff(1 / sig ** 2) / qp.barrier[0]
+    assert abs(slope[-1] - 1) < 0.03
+    assert abs(slope[-1] - 1) < abs(slope[0] - 1)
+
+
+@pytest.mark.parametrize("kw, name", [(dict(damping=0.0), "damping"), (dict(F=-1.0), "F"),
+                                      (dict(F=0.2), "F"), (dict(n_rays=4), "n_rays"), (dict(step=2.0), "step"),
+                                      (dict(xi_max=0.3), "xi_max")])
+def test_bad_input_named(kw, name):
+    args = dict(F=0.01, Omega=0.9, xi_max=0.09, damping=0.02) | kw
+    with pytest.raises(ValueError, match=name):
+        theory.quasi_potential(args.pop("F"), args.pop("Omega"), args.pop("xi_max"), **args)
