@@ -15,6 +15,7 @@ import pytest
 from safebasins import theory
 from safebasins.analysis import stochastic_erosion
 from safebasins.analysis.agreement import probability_agreement
+from safebasins.analysis.stochastic_integrity import stochastic_erosion_theory
 from safebasins.numerics import escape_probability
 from safebasins.pipeline.config import ConfigError
 from safebasins.pipeline.cost import NOISE_STEP_COST, analytic_cost
@@ -47,9 +48,10 @@ def test_schema_defaults_are_the_library_defaults() -> None:
         for key in ("cycles", "noise_time", "correction"):
             assert props[key]["default"] == lib[key].default, (kind, key)
     th = inspect.signature(theory.escape_probability).parameters
-    props = KINDS["escape_probability"].schema["properties"]
-    assert tuple(props["theory_cells"]["default"]) == th["cells"].default
-    assert props["theory_steps_per_cycle"]["default"] == th["steps_per_cycle"].default
+    for kind in ("escape_probability", "stochastic_erosion"):
+        props = KINDS[kind].schema["properties"]
+        assert tuple(props["theory_cells"]["default"]) == th["cells"].default, kind
+        assert props["theory_steps_per_cycle"]["default"] == th["steps_per_cycle"].default, kind
     props = KINDS["stochastic_erosion"].schema["properties"]
     assert props["conservative"]["default"] == ero["conservative"].default
     assert tuple(props["bottom"]["default"]) == ero["bottom"].default
@@ -86,7 +88,8 @@ def test_cost_counts_paths_ics_and_steps(base: dict[str, Any]) -> None:
     ("quartic_escape_probability", {"theory_cells": [4, 160]}, "quartic_escape_probability.theory_cells"),
     ("quartic_escape_probability", {"theory_cells": [128]}, "quartic_escape_probability.theory_cells"),
     ("quartic_escape_probability", {"theory_steps_per_cycle": 0}, "quartic_escape_probability.theory_steps_per_cycle"),
-    ("escape_equation_erosion", {"theory": True}, "escape_equation_erosion"),
+    ("escape_equation_erosion", {"theory": "yes"}, "escape_equation_erosion.theory"),
+    ("escape_equation_erosion", {"theory_cells": [128, 7]}, "escape_equation_erosion.theory_cells"),
     ("escape_equation_erosion", {"paths": 20}, "escape_equation_erosion.paths"),
     ("escape_equation_erosion", {"epsilon": [0.5, 0.05]}, "escape_equation_erosion.epsilon[1]"),
     ("escape_equation_erosion", {"epsilon": 1.0}, "escape_equation_erosion.epsilon"),
@@ -193,3 +196,28 @@ def test_erosion_build_is_the_library_call(base: dict[str, Any]) -> None:
     assert ds["GIM"].dims == ("F", "noise", "epsilon", "t_eval")
     for k in ("GIM", "LIM", "IF", "GIM_conservative", "LIM_conservative", "IF_conservative"):
         np.testing.assert_array_equal(ds[k].values, ref[k].values, err_msg=k)
+    # the cubic (asymmetric) at a noise level 0: no theory, and the dataset says why
+    assert ds.attrs["theory"] == "none" and "noise 0" in ds.attrs["theory_reason"]
+    assert not [v for v in ds.data_vars if str(v).endswith("_theory")]
+
+
+QUARTIC_EROSION = {**TINY, "well": "quartic", "xi_max": 0.18, "F": [0.0, 0.01], "noise": [0.01, 0.02],
+                   "epsilon": [0.3, 0.5], "paths": 12, "theory_cells": [16, 20], "theory_steps_per_cycle": 6,
+                   "grid": {"q0": [-0.95, 0.95], "p0": [-0.75, 0.75], "n": [5, 4]}}
+
+
+def test_erosion_build_with_the_theory_is_the_library_calls(base: dict[str, Any]) -> None:
+    p = plan(merged(base, {"noise": {"escape_equation_erosion": QUARTIC_EROSION}})).experiments[EROSION].params
+    ds = build_stochastic_erosion(p, {}, Job(threads=1))
+    q0, p0 = np.linspace(-0.95, 0.95, 5), np.linspace(-0.75, 0.75, 4)
+    ref = stochastic_erosion_theory(q0, p0, [0.0, 0.01], 0.9, math.pi, noise=[0.01, 0.02], epsilon=[0.3, 0.5],
+                                    xi_max=0.18, t_eval=[1, 3], cells=(16, 20), steps_per_cycle=6)
+    for k in ("GIM", "LIM", "IF"):
+        assert ds[k + "_theory"].dims == ("F", "noise", "epsilon", "t_eval")
+        np.testing.assert_array_equal(ds[k + "_theory"].values, ref[k].transpose(*ds[k].dims).values, err_msg=k)
+        assert ds[k + "_theory"].attrs["units"] == "1" and "averaged theory" in ds[k + "_theory"].attrs["long_name"]
+    assert 0 < float(ds["GIM_theory"].min()) < 1          # eroded somewhere, not empty: a profile to compare
+    assert ds.attrs["theory_solver"] == ref.attrs["solver"] and list(ds.attrs["theory_cells"]) == [16, 20]
+    assert analytic_cost(plan(merged(base, {"noise": {"escape_equation_erosion": QUARTIC_EROSION}}))
+                         .experiments[EROSION]) == 2 * 2 * 16 * 20 * 3 * 6
+    assert analytic_cost(plan(base).experiments[EROSION]) == 0           # the default: a noise level 0

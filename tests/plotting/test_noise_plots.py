@@ -119,3 +119,23 @@ def test_erosion_figure_and_notes(erosion: xr.Dataset) -> None:
     plt.close(fig)
     with pytest.raises(MissingData, match="LIM"):
         figure_stochastic_erosion(ds.drop_vars("LIM"))
+
+
+def test_erosion_figure_with_the_theory(erosion: xr.Dataset) -> None:
+    import matplotlib.pyplot as plt
+
+    ds = erosion.copy(deep=True)
+    for m in ("GIM", "LIM", "IF"):
+        ds[m + "_theory"] = ds[m].copy()
+    ds["GIM_theory"].loc[{"F": 0.01, "noise": 0.02, "epsilon": 0.3, "t_eval": 3.0}] += 0.2   # read from the data
+    fig = figure_stochastic_erosion(ds.assign_attrs(theory_cells=[16, 20]))
+    text = "\n".join(notes(fig))
+    assert "crosses: the averaged theory's P_escape <= 0.3 (docs/noise-theory.md, 16 x 20 cells)" in text
+    assert "differs from the ensembles' by 0.050 on average, at most 0.200" in text
+    # a line of crosses per curve value in every panel, after the solid, dashed and dotted ones
+    assert all(len(ax.get_lines()) == 2 * 4 for ax in fig.axes)
+    assert all(line.get_marker() == "x" for ax in fig.axes for line in ax.get_lines()[3::4])
+    plt.close(fig)
+    fig = figure_stochastic_erosion(erosion.assign_attrs(theory="none", theory_reason="not computed (theory: false)"))
+    assert "No averaged theory: not computed (theory: false)." in notes(fig)
+    plt.close(fig)

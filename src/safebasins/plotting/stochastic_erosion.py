@@ -38,7 +38,8 @@ def _profile(ds: xr.Dataset) -> xr.Dataset:
 def figure_stochastic_erosion(erosion: DataSource, *, title: str | None = None) -> Figure:
     """Top row: GIM, LIM, IF against sigma, one colour per F; bottom row: the same against F, one
     colour per sigma; solid the basin {P_escape <= epsilon} at the smallest epsilon, dashed the
-    conservative one, dotted the basin at the largest epsilon; all at the last evaluation time."""
+    conservative one, dotted the basin at the largest epsilon, crosses the averaged theory's basin at the
+    smallest epsilon (where the Dataset holds ``GIM_theory``, ...); all at the last evaluation time."""
     ds = open_dataset(erosion)
     for v in MEASURES:
         var(ds, v)
@@ -60,6 +61,9 @@ def figure_stochastic_erosion(erosion: DataSource, *, title: str | None = None) 
                             color=c, lw=1)
                 if eps.size > 1:
                     ax.plot(x, cut[m].sel(epsilon=eps[-1]).transpose(xname).values, ":", color=c, lw=1)
+                if m + "_theory" in pr:
+                    ax.plot(x, cut[m + "_theory"].sel(epsilon=eps[0]).transpose(xname).values, "x", color=c,
+                            ms=6, mew=1.2)
             ax.set_xlabel("noise amplitude σ" if xname == "noise" else "forcing amplitude F")
             ax.set_ylabel(m)
             ax.set_ylim(-0.03, 1.08)
@@ -79,6 +83,10 @@ def _notes(fig: Figure, ds: xr.Dataset, pr: xr.Dataset, t: float, cons: bool) ->
     styles = f"solid: P_escape <= {eps[0]:g}" + (", dashed: its conservative basin" if cons else "")
     if eps.size > 1:
         styles += f", dotted: P_escape <= {eps[-1]:g}"
+    theory = all(v + "_theory" in pr for v in MEASURES)
+    if theory:
+        styles += (f", crosses: the averaged theory's P_escape <= {eps[0]:g} (docs/noise-theory.md, "
+                   f"{' x '.join(str(int(n)) for n in param(ds, 'theory_cells'))} cells)")
     add_note(fig, f"{int(param(ds, 'paths'))} paths per initial condition (seed {int(param(ds, 'seed'))}), "
                   f"within {t:g} cycles; {styles}.")
     g = pr["GIM"].sel(epsilon=eps[0])
@@ -89,3 +97,9 @@ def _notes(fig: Figure, ds: xr.Dataset, pr: xr.Dataset, t: float, cons: bool) ->
     if cons:
         gap = float((g - pr["GIM_conservative"].sel(epsilon=eps[0])).max())
         add_note(fig, f"The conservative basin's GIM lies at most {gap:.3f} below the plain one's.")
+    if theory:
+        d = abs(pr["GIM_theory"].sel(epsilon=eps[0]) - g)
+        add_note(fig, f"The averaged theory's GIM (ε = {eps[0]:g}) differs from the ensembles' by "
+                      f"{float(d.mean()):.3f} on average, at most {float(d.max()):.3f}.")
+    elif "theory_reason" in ds.attrs:
+        add_note(fig, f"No averaged theory: {param(ds, 'theory_reason')}.")

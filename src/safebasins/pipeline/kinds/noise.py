@@ -6,9 +6,10 @@ several noise amplitudes sigma (one ensemble each, stacked over ``noise``).  ``s
 GIM, LIM and IF of the stochastic safe basin {P_escape <= epsilon} and of the conservative one
 against sigma and/or F (:func:`safebasins.analysis.stochastic_erosion`, the same seed at every
 point).  Both draw their random numbers from the run's seed plus the experiment's offset.
-``escape_probability`` also solves the averaged theory (:func:`safebasins.theory.escape_probability`)
-at each noise level where it applies and stores its map with the agreement
-(:func:`safebasins.analysis.agreement.probability_agreement`).
+Where the averaged theory applies, ``escape_probability`` also stores its map
+(:func:`safebasins.theory.escape_probability`) with the agreement
+(:func:`safebasins.analysis.agreement.probability_agreement`) and ``stochastic_erosion`` its profile
+(:func:`safebasins.analysis.stochastic_integrity.stochastic_erosion_theory`).
 Datasets: ``results/data/extras/<experiment>.nc``.
 """
 from __future__ import annotations
@@ -107,22 +108,42 @@ def _ensemble_kwargs(params: Params, job: Job) -> dict[str, Any]:
 
 
 # --------------------------------------------------------------------------- escape_probability
-#: the averaged theory's keys (the defaults of safebasins.theory.escape_probability)
-_THEORY = {
-    "theory": {"description": "also solve the averaged theory (safebasins.theory.escape_probability, "
-                              "docs/noise-theory.md) at every noise level and store its map P_escape_theory with "
-                              "its agreement with the ensembles: P_escape_mean_abs_difference and "
-                              "P_escape_max_abs_difference (over the ICs, per noise and t_eval), "
-                              "P_escape_mean_abs_difference_uncertain and P_escape_theory_within_wilson (per "
-                              "noise). It applies to white noise (noise_time 0), every noise level > 0, a "
-                              "symmetric well and xi_max below the barrier; elsewhere, or with false, the "
-                              "dataset's attribute theory is 'none' and theory_reason says why",
-               "type": "boolean", "default": True},
-    "theory_cells": {"description": "the theory's polar grid (n_gamma, n_J)", "type": "array", "minItems": 2,
-                     "maxItems": 2, "items": {"type": "integer", "minimum": 8}, "default": [128, 160]},
-    "theory_steps_per_cycle": {"description": "the theory's time steps per forcing cycle", "type": "integer",
-                               "minimum": 1, "default": 8},
-}
+#: where the averaged theory applies (the schema's and the docs' words)
+THEORY_APPLIES = ("white noise (noise_time 0), every noise level > 0, a symmetric well and xi_max below the "
+                  "barrier; elsewhere, or with false, the dataset's attribute theory is 'none' and theory_reason "
+                  "says why")
+
+
+def _theory_keys(stores: str) -> dict[str, Any]:
+    """The averaged theory's keys (the defaults of safebasins.theory.escape_probability); ``stores``:
+    what the kind's dataset gains with it."""
+    return {
+        "theory": {"description": f"also solve the averaged theory (docs/noise-theory.md) and store {stores}. "
+                                  f"It applies to {THEORY_APPLIES}", "type": "boolean", "default": True},
+        "theory_cells": {"description": "the theory's polar grid (n_gamma, n_J)", "type": "array", "minItems": 2,
+                         "maxItems": 2, "items": {"type": "integer", "minimum": 8}, "default": [128, 160]},
+        "theory_steps_per_cycle": {"description": "the theory's time steps per forcing cycle", "type": "integer",
+                                   "minimum": 1, "default": 8},
+    }
+
+
+def _resolve_theory(block: Block) -> Params:
+    return dict(theory=bool(block["theory"]), theory_cells=[int(n) for n in block["theory_cells"]],
+                theory_steps_per_cycle=int(block["theory_steps_per_cycle"]))
+
+
+def _theory_settings(params: Params) -> dict[str, Any]:
+    # the keywords of theory.escape_probability's solver
+    return dict(cells=tuple(params["theory_cells"]), steps_per_cycle=params["theory_steps_per_cycle"])
+
+
+def _theory_attrs(params: Params, theory: xr.Dataset) -> dict[str, Any]:
+    """The attributes naming the theory's model and settings (``theory``: a solve's Dataset)."""
+    return dict(theory=theory.attrs["theory"], theory_model=theory.attrs["noise_model"],
+                theory_solver=theory.attrs["solver"], theory_cells=list(params["theory_cells"]),
+                theory_steps_per_cycle=params["theory_steps_per_cycle"], theory_cycles=_theory_cycles(params))
+
+
 #: the theory's refusals of a block (a ValueError naming one of these arguments): an asymmetric
 #: well, xi_max at the barrier
 _THEORY_REFUSALS = ("well:", "xi_max ")
@@ -144,10 +165,27 @@ def _theory_reason(params: Params) -> str | None:
     if params["noise_time"] > 0:
         return ("not applicable to coloured noise (noise_time > 0): the averaged theory is derived for white noise "
                 "(docs/noise-theory.md)")
-    if any(s == 0 for s in params["noise"]):
+    if any(s == 0 for s in values.as_list(params["noise"])):
         return ("not applicable at noise 0 (a level of this block): the averaged diffusion needs sigma > 0; "
                 "at sigma = 0 the theory is the deterministic slow flow (theory.slow_flow_escapes)")
     return None
+
+
+def _theory_cost(params: Params, solves: int) -> int:
+    """The theory's march: cells x time steps per solve (0 where it does not apply; an upper bound
+    for a well the theory refuses at build time)."""
+    if _theory_reason(params) is not None:
+        return 0
+    n_gamma, n_J = params["theory_cells"]
+    steps = _theory_cycles(params) * params["theory_steps_per_cycle"]
+    return solves * n_gamma * n_J * steps * THEORY_CELL_STEP_EVALUATIONS
+
+
+def _refused(exc: ValueError) -> str:
+    """The reason of the theory's refusal of the block (its well or xi_max); any other error is raised."""
+    if not str(exc).startswith(_THEORY_REFUSALS):
+        raise exc
+    return f"not applicable: {exc}"
 
 
 def _theory_map(params: Params, q0: Any, p0: Any, noise: float) -> xr.Dataset:
@@ -155,7 +193,7 @@ def _theory_map(params: Params, q0: Any, p0: Any, noise: float) -> xr.Dataset:
 
     return escape_probability(q0, p0, params["F"], params["Omega"], params["Psi"], params["xi_max"], noise=noise,
                               t_eval=params["t_eval"], damping=values.damping(params), well=values.base_well(params),
-                              cells=tuple(params["theory_cells"]), steps_per_cycle=params["theory_steps_per_cycle"])
+                              **_theory_settings(params))
 
 
 def _with_agreement(theory: xr.Dataset, ensemble: xr.Dataset) -> xr.Dataset:
@@ -195,9 +233,9 @@ def build_escape_probability(params: Params, data: Inputs, job: Job) -> xr.Datas
             try:
                 theory = _theory_map(params, q0, p0, s)
             except ValueError as exc:
-                if theory is not None or not str(exc).startswith(_THEORY_REFUSALS):
+                if theory is not None:
                     raise
-                reason = f"not applicable: {exc}"
+                reason = _refused(exc)
             else:
                 ds = _with_agreement(theory, ds)
                 print(f"  sigma = {s:g}: |P_escape_theory - P_escape| mean "
@@ -208,10 +246,7 @@ def build_escape_probability(params: Params, data: Inputs, job: Job) -> xr.Datas
     out["noise"].attrs.update(maps[0]["noise"].attrs)
     out.attrs.pop("noise", None)
     if reason is None and theory is not None:
-        out.attrs.update(theory=theory.attrs["theory"], theory_model=theory.attrs["noise_model"],
-                         theory_solver=theory.attrs["solver"], theory_cells=list(params["theory_cells"]),
-                         theory_steps_per_cycle=params["theory_steps_per_cycle"],
-                         theory_cycles=theory.attrs["cycles"],
+        out.attrs.update(**_theory_attrs(params, theory),
                          P_escape_mean_abs_difference=float(out["P_escape_mean_abs_difference"].mean()),
                          P_escape_max_abs_difference=float(out["P_escape_max_abs_difference"].max()))
     else:
@@ -232,7 +267,11 @@ class EscapeProbability(Kind):
         "description": description,
         "type": "object", "additionalProperties": False,
         "required": ["F", "Omega", "xi_max", "grid", "noise", "paths", "t_eval"],
-        "properties": {**_COMMON, **_THEORY,
+        "properties": {**_COMMON,
+                       **_theory_keys("its map P_escape_theory with its agreement with the ensembles: "
+                                      "P_escape_mean_abs_difference and P_escape_max_abs_difference (over the ICs, "
+                                      "per noise and t_eval), P_escape_mean_abs_difference_uncertain and "
+                                      "P_escape_theory_within_wilson (per noise)"),
                        "noise": _value_or_list(SIGMA, "noise amplitude(s) sigma >= 0 (a list: one ensemble each, "
                                                       "strictly increasing)")},
     }
@@ -242,21 +281,14 @@ class EscapeProbability(Kind):
 
     def resolve(self, block: Block, ctx: ResolveContext) -> Params:
         return dict(F=float(block["F"]), noise=[float(x) for x in values.as_list(block["noise"])],
-                    theory=bool(block["theory"]), theory_cells=[int(n) for n in block["theory_cells"]],
-                    theory_steps_per_cycle=int(block["theory_steps_per_cycle"]), **_resolve_common(block, ctx))
+                    **_resolve_theory(block), **_resolve_common(block, ctx))
 
     def cost(self, params: Params) -> int:
         n = len(params["noise"])
         return _cost(params, n, sum(1 for s in params["noise"] if s > 0))
 
     def analytic_cost(self, params: Params) -> int:
-        """The theory's march: cells x time steps per noise level (0 where it does not apply; an upper
-        bound for a well the theory refuses at build time)."""
-        if _theory_reason(params) is not None:
-            return 0
-        n_gamma, n_J = params["theory_cells"]
-        steps = _theory_cycles(params) * params["theory_steps_per_cycle"]
-        return len(params["noise"]) * n_gamma * n_J * steps * THEORY_CELL_STEP_EVALUATIONS
+        return _theory_cost(params, len(params["noise"]))
 
     def products(self, experiment: str, params: Params) -> list[Product]:
         G = ("noise", "q0", "p0", "t_eval")
@@ -274,16 +306,43 @@ class EscapeProbability(Kind):
 
 
 # --------------------------------------------------------------------------- stochastic_erosion
+#: the integrity measures the theory's profile adds (as <measure>_theory)
+MEASURES = ("GIM", "LIM", "IF")
+
+
 def build_stochastic_erosion(params: Params, data: Inputs, job: Job) -> xr.Dataset:
-    """The library's profile over (F, noise, epsilon, t_eval)."""
+    """The library's profile over (F, noise, epsilon, t_eval), with the averaged theory's GIM, LIM and
+    IF (``GIM_theory``, ...) where the theory applies."""
+    import xarray as xr
+
     from safebasins.analysis import stochastic_erosion
+    from safebasins.analysis.stochastic_integrity import stochastic_erosion_theory
 
     q0, p0 = values.grid_axes(params["grid"])
     print(f"{params['experiment']}: stochastic erosion at F {params['F']}, noise {params['noise']} on "
           f"{q0.size} x {p0.size} ICs, {params['paths']} paths", flush=True)
-    return stochastic_erosion(q0, p0, params["F"], params["Omega"], params["Psi"], noise=params["noise"],
-                              epsilon=params["epsilon"], conservative=params["conservative"],
-                              bottom=tuple(params["bottom"]), **_ensemble_kwargs(params, job))
+    out = stochastic_erosion(q0, p0, params["F"], params["Omega"], params["Psi"], noise=params["noise"],
+                             epsilon=params["epsilon"], conservative=params["conservative"],
+                             bottom=tuple(params["bottom"]), **_ensemble_kwargs(params, job))
+    reason, theory = _theory_reason(params), None
+    if reason is None:
+        try:
+            theory = stochastic_erosion_theory(q0, p0, params["F"], params["Omega"], params["Psi"],
+                                               noise=params["noise"], epsilon=params["epsilon"],
+                                               xi_max=params["xi_max"], t_eval=params["t_eval"],
+                                               damping=values.damping(params), well=values.base_well(params),
+                                               bottom=tuple(params["bottom"]), **_theory_settings(params))
+        except ValueError as exc:
+            reason = _refused(exc)
+    if theory is None:
+        out.attrs.update(theory="none", theory_reason=str(reason))
+        return out
+    for m in MEASURES:
+        da = theory[m].reset_coords(drop=True).transpose(*out[m].dims)
+        xr.align(out[m], da, join="exact")      # the same sweep: a mismatch is an error, never NaN
+        out[m + "_theory"] = da.assign_attrs(long_name=f"{da.attrs['long_name']}, from the averaged theory")
+    out.attrs.update(_theory_attrs(params, theory))
+    return out
 
 
 @register
@@ -309,7 +368,10 @@ class StochasticErosion(Kind):
                        "conservative": {"description": "also the conservative basin P_escape_high <= epsilon",
                                         "type": "boolean", "default": True},
                        "bottom": {"description": "centre (q0, p0) of the LIM", "type": "array", "minItems": 2,
-                                  "maxItems": 2, "items": {"type": "number"}, "default": [0.0, 0.0]}},
+                                  "maxItems": 2, "items": {"type": "number"}, "default": [0.0, 0.0]},
+                       **_theory_keys("its profile GIM_theory, LIM_theory, IF_theory of the basin {P_escape <= "
+                                      "epsilon} (no conservative one: the theory has no path counts), one "
+                                      "solve per (F, noise)")},
     }
 
     def check(self, block: Block, key: str, ctx: CheckContext) -> None:
@@ -330,21 +392,27 @@ class StochasticErosion(Kind):
                     epsilon=([float(x) for x in block["epsilon"]] if isinstance(block["epsilon"], list)
                              else float(block["epsilon"])),
                     conservative=bool(block["conservative"]), bottom=[float(x) for x in block["bottom"]],
-                    **_resolve_common(block, ctx))
+                    **_resolve_theory(block), **_resolve_common(block, ctx))
 
     def cost(self, params: Params) -> int:
         sig = values.as_list(params["noise"])
         nF = len(values.as_list(params["F"]))
         return _cost(params, nF * len(sig), nF * sum(1 for s in sig if s > 0))
 
+    def analytic_cost(self, params: Params) -> int:
+        return _theory_cost(params, len(values.as_list(params["F"])) * len(values.as_list(params["noise"])))
+
     def products(self, experiment: str, params: Params) -> list[Product]:
         lead = tuple(d for d in ("F", "noise", "epsilon") if isinstance(params[d], list)) + ("t_eval",)
         contract = {k: lead for k in ("GIM", "LIM", "IF")}
         if params["conservative"]:
             contract.update({k + "_conservative": lead for k in ("GIM", "LIM", "IF")})
+        history = "safebasins.analysis.stochastic_erosion"
+        if params["theory"]:
+            history += ", where it applies safebasins.analysis.stochastic_integrity.stochastic_erosion_theory"
         return [Product(dataset_path("extras", experiment), "extras", build_stochastic_erosion, heavy=True,
                         title=params["title"] + " (stochastic erosion profile)",
-                        history=f"safebasins.analysis.stochastic_erosion ({experiment})", contract=contract)]
+                        history=f"{history} ({experiment})", contract=contract)]
 
     def figure_inputs(self, experiment: str, params: Params) -> FigureInputs:
         return {"erosion": dataset_path("extras", experiment)}
