@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -67,7 +68,7 @@ TABLE_NODES = 4097
 #: branch targets of a saddle: an attractor's index, or these
 ESCAPE, UNDECIDED = -1, -2
 
-_flow_tilde = njit(flow_tilde)          # the drift's one formula, compiled for the rays
+_flow_tilde: Any = njit(flow_tilde)     # the drift's one formula, compiled for the rays (scalars)
 
 
 def coefficient_table(diff: AveragedDiffusion, n: int = TABLE_NODES) -> FloatArray:
