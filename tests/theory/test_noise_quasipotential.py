@@ -11,13 +11,14 @@ Independent routes (the bounds leave a margin over the measured values):
   largest value) and its Jacobian against central differences (1.0e-5 of its largest entry);
 * the chain of two attractors against its mean first-passage time solved at small noise;
 * F > 0: the slope of ln T against 1/sigma^2 from the backward-Kolmogorov solver
-  (theory.mean_first_passage) at decreasing sigma approaches the barrier.
+  (theory.mean_first_passage) at decreasing sigma approaches the barrier, and the full equation's
+  SDE ensemble (numerics.escape_probability) follows the Poisson law 1 - exp(-t/T).
 """
 
 import numpy as np
 import pytest
 
-from safebasins import theory
+from safebasins import numerics, theory
 from safebasins.theory.damped import rhs_exact
 from safebasins.theory.noise_averaging import AveragedDiffusion, averaged_diffusion
 from safebasins.theory.noise_quasipotential import _Problem, _solve, attractor_barriers, coefficient_table
@@ -90,21 +91,52 @@ def test_chain_of_two_attractors():
     assert b1[0] == w_ar and s1 == ("saddle 0",)
 
 
-def test_arrhenius_slope_of_the_backward_equation():
-    """F > 0: d ln T / d(1/sigma^2) from the solver approaches the barrier (measured 0.935, 0.965,
-    0.985, 1.008 of it between sigma = 0.02, 0.016, 0.013, 0.011, 0.009)."""
-    F, Omega, beta, xi_max = 0.01, 0.9, 0.02, 0.09
-    qp = theory.quasi_potential(F, Omega, xi_max, damping=beta)
-    assert qp.attractors.shape == (1, 2) and qp.exit_set == ("circle",)
+FORCED = dict(F=0.01, Omega=0.9, xi_max=0.09, damping=0.02)       # one attractor, no saddle inside
+
+
+@pytest.fixture(scope="module")
+def forced():
+    """The quasi-potential at FORCED and the IC (q0, p0) at tau = 0 on its attractor (Psi = 0)."""
+    k = FORCED
+    qp = theory.quasi_potential(k["F"], k["Omega"], k["xi_max"], damping=k["damping"])
     X, Y = qp.attractors[0]
     xi = float(theory.xi_from_J(0.5 * (X * X + Y * Y)))
-    q0, p0 = QUARTIC.phase_point(np.arctan2(Y, X), xi)       # Psi = 0: gamma = theta
+    q0, p0 = QUARTIC.phase_point(np.arctan2(Y, X), xi)       # gamma = theta - Psi
+    return qp, float(q0), float(p0)
+
+
+def _mfpt(q0, p0, sigma):
+    k = FORCED
+    ds = theory.mean_first_passage([q0], [p0], k["F"], k["Omega"], 0.0, k["xi_max"], noise=sigma,
+                                   damping=k["damping"], grid=False)
+    return float(ds["mean_first_passage"][0])
+
+
+def test_arrhenius_slope_of_the_backward_equation(forced):
+    """F > 0: d ln T / d(1/sigma^2) from the solver approaches the barrier (measured 0.935, 0.965,
+    0.985, 1.008 of it between sigma = 0.02, 0.016, 0.013, 0.011, 0.009)."""
+    qp, q0, p0 = forced
+    assert qp.attractors.shape == (1, 2) and qp.exit_set == ("circle",)
     sig = np.array([0.02, 0.016, 0.011, 0.009])
-    T = [float(theory.mean_first_passage([float(q0)], [float(p0)], F, Omega, 0.0, xi_max, noise=s, damping=beta,
-                                         grid=False)["mean_first_passage"][0]) for s in sig]
+    T = [_mfpt(q0, p0, s) for s in sig]
     slope = np.diff(np.log(T)) / np.diff(1 / sig ** 2) / qp.barrier[0]
     assert abs(slope[-1] - 1) < 0.03
     assert abs(slope[-1] - 1) < abs(slope[0] - 1)
+
+
+def test_poisson_law_against_the_sde_ensemble(forced):
+    """Once relaxed, escape is a Poisson event: the full equation's ensemble (2000 paths) at
+    sigma = 0.025 (barrier / sigma^2 = 3.5) against 1 - exp(-t/T), T from the backward equation
+    (194 cycles): measured 0.6245 [0.603, 0.645] and 0.7645 [0.745, 0.783] (Wilson) at t = T, 1.5 T
+    against 0.632 and 0.777 (at T/2: 0.3725 [0.352, 0.394] against 0.393, the relaxation's lag)."""
+    _, q0, p0 = forced
+    k, sigma = FORCED, 0.025
+    T = _mfpt(q0, p0, sigma)
+    te = np.array([1.0, 1.5]) * T
+    ds = numerics.escape_probability([q0], [p0], k["F"], k["Omega"], 0.0, noise=sigma, paths=2000,
+                                     xi_max=k["xi_max"], t_eval=te, damping=k["damping"], grid=False)
+    law = 1 - np.exp(-te / T)
+    assert np.all(ds["P_escape_low"].values.ravel() <= law) and np.all(law <= ds["P_escape_high"].values.ravel())
 
 
 @pytest.mark.parametrize("kw, name", [(dict(damping=0.0), "damping"), (dict(F=-1.0), "F"),
