@@ -107,7 +107,7 @@ def _ensemble_kwargs(params: Params, job: Job) -> dict[str, Any]:
                 steps_per_cycle=params["steps_per_cycle"], threads=job.threads)
 
 
-# --------------------------------------------------------------------------- escape_probability
+# --------------------------------------------------------------------------- the averaged theory (both kinds)
 #: where the averaged theory applies (the schema's and the docs' words)
 THEORY_APPLIES = ("white noise (noise_time 0), every noise level > 0, a symmetric well and xi_max below the "
                   "barrier; elsewhere, or with false, the dataset's attribute theory is 'none' and theory_reason "
@@ -189,6 +189,7 @@ def _refused(exc: ValueError) -> str:
 
 
 def _theory_map(params: Params, q0: Any, p0: Any, noise: float) -> xr.Dataset:
+    """The theory's escape-probability map of the block's grid at one noise level."""
     from safebasins.theory import escape_probability
 
     return escape_probability(q0, p0, params["F"], params["Omega"], params["Psi"], params["xi_max"], noise=noise,
@@ -196,6 +197,7 @@ def _theory_map(params: Params, q0: Any, p0: Any, noise: float) -> xr.Dataset:
                               **_theory_settings(params))
 
 
+# --------------------------------------------------------------------------- escape_probability
 def _with_agreement(theory: xr.Dataset, ensemble: xr.Dataset) -> xr.Dataset:
     """The ensemble with the theory's map and their agreement; the per-level summaries that
     probability_agreement gives as attributes become variables (stacked over noise)."""
