@@ -396,6 +396,9 @@ def _solve(pb: _Problem, atts: FloatArray, sads: FloatArray, xm: float, n_rays: 
         s_all = np.concatenate(params)
         exits, near_d, near_phi = pb.shoot(np.concatenate([starts(k, p) for k, p in enumerate(params)]), owner,
                                            sads, dt, steps)
+        exits[~np.isfinite(exits[:, 0]), 0] = np.inf          # a ray that went wrong is no exit
+        near_phi[~np.isfinite(near_phi)] = np.inf
+        near_d[~np.isfinite(near_phi)] = np.inf
         params = []
         for k in range(K):
             mine = owner == k
@@ -427,6 +430,9 @@ def _solve(pb: _Problem, atts: FloatArray, sads: FloatArray, xm: float, n_rays: 
                                    f"{sad_d[k, j] / R:.2g} of the escape radius; raise n_rays")
     to_saddle = np.where(reached, sad_phi, np.inf)
     barrier, sets = attractor_barriers(best_c, to_saddle, targets)
+    if not np.isfinite(barrier).all():
+        lost = np.nonzero(~np.isfinite(barrier))[0].tolist()
+        raise RuntimeError(f"no ray of the attractors {lost} reached the escape circle within the time limit")
     return QuasiPotential(F=pb.F, Omega=pb.Omega, damping=pb.beta, xi_max=xm, J_max=pb.J_max, attractors=atts,
                           hessian=np.array(Qs), saddles=sads, saddle_targets=targets, to_circle=best_c,
                           exit_point=best_x, to_saddle=to_saddle, barrier=barrier, exit_set=sets)
