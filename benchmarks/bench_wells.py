@@ -27,6 +27,12 @@ forces call wells.elementary in the vectorised lanes, and the electrostatic q^2/
 + a q, a = 0.05).  Ratios to the quartic: from the best times, and the median of the ratios paired
 within each interleaved round (robust to a loaded machine).
 
+Generated code before / after (``--wells-only --sources-before REV``): only the dense jobs of the
+quartic and the non-polynomial wells, each expression well also compiled from the V, dV source
+that wells/expression.py of git revision REV generates for it (imported from a temporary file
+beside today's package), both in this process, interleaved; ratios to the quartic paired per
+round.
+
 Measured (docs/numerics.md, "Wells"), AMD EPYC (AVX-512), 1 thread, SRKN6b, with one compiled form per well:
 quartic after / before 1.020 dense, 0.957 chart (escape steps equal); time per step vs the quartic:
 signed 1.12, cubic (degree 4) 1.29, quartic coefficients 1.29, degree-8 class 3.07, cubic as an
@@ -36,6 +42,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import importlib.util
 import os
 import subprocess
 import sys
@@ -49,7 +56,7 @@ import numpy as np
 from safebasins import wells
 from safebasins.numerics import engine, kernels, schemes
 from safebasins.numerics.scheme_code import scheme_code
-from safebasins.wells import compiled
+from safebasins.wells import compiled, elementary
 
 ROOT = Path(__file__).resolve().parents[1]
 QUARTIC_COEFS = [0.0, 0.0, 0.5, 0.0, -0.25]
@@ -190,6 +197,72 @@ def well_ics(well, n, seed):
     return disc_ics(n, H, 0.5 * Eb, seed=seed)
 
 
+def load_expression_before(rev):
+    """wells/expression.py of git revision ``rev`` as a module (its generate_source prints the
+    V, dV source that revision compiled)."""
+    src = subprocess.run(["git", "show", f"{rev}:src/safebasins/wells/expression.py"], cwd=ROOT, check=True,
+                         capture_output=True, text=True).stdout
+    d = Path(tempfile.mkdtemp(prefix="safebasins_expression_before"))
+    path = d / "expression_before.py"
+    path.write_text(src)
+    spec = importlib.util.spec_from_file_location("expression_before", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def code_before(well, before):
+    """The compiled form of expression well ``well`` from the source ``before`` generates."""
+    X = sys.modules["safebasins.wells.expression"]
+    V, q = X.parse(well.expression)
+    source = before.generate_source(V, q)[0]
+
+    def functions(jit):
+        return X._functions(source, X._compiled_namespace(elementary.for_target(jit)))
+    return compiled.target_code(functions, well.barriers, f"{well.name} (before)",
+                                f"{elementary.MODULE_HASH}\0{source}"), source
+
+
+def wells_only(args):
+    """Dense jobs of the quartic and the non-polynomial wells, today's generated code and (with
+    --sources-before) the code of that revision's wells/expression.py, interleaved."""
+    S = args.steps_per_cycle
+    qd, pd = disc_ics(args.dense_n, H_quartic, 0.2)
+    before = load_expression_before(args.sources_before) if args.sources_before else None
+    for integ in args.integrators:
+        dense = dict(F=0.0, Omega=1.0, Psi=0.0, xi_max=0.25, cycles=args.dense_cycles, S=S, integrator=integ,
+                     threads=args.threads)
+        jobs = [Job("quartic dense, after", kernels, qd, pd, **dense, code=wells.QUARTIC.compiled)]
+        for i, (k, spec) in enumerate(TRANSCENDENTAL.items()):
+            w = wells.resolve_well(spec)
+            ics = well_ics(w, args.dense_n, seed=2 + i)
+            kw = dict(dense, xi_max=w.barrier_energy)
+            jobs.append(Job(f"{k} dense, after", kernels, *ics, **kw, code=w.compiled))
+            if before is not None:
+                code, source = code_before(w, before)
+                print(f"{k}: today's source\n{w.source}\n{k}: source of {args.sources_before}\n{source}")
+                jobs.append(Job(f"{k} dense, before", kernels, *ics, **kw, code=code))
+        t = time.perf_counter()
+        rounds = {}
+        best, _ = bench(jobs, args.repeat, rounds)
+        print(f"\n=== {integ} (compile or cache load + runs: {time.perf_counter() - t:.0f} s) ===")
+        ref = jobs[0]
+        for j in jobs[1:]:
+            paired = np.array(rounds[j.name]) / j.steps() / (np.array(rounds[ref.name]) / ref.steps())
+            ratio = best[j.name] / j.steps() / (best[ref.name] / ref.steps())
+            print(f"{j.name}: time per step / quartic's = {ratio:.2f} (best times), "
+                  f"{np.median(paired):.2f} (median of {paired.size} paired rounds, "
+                  f"{paired.min():.2f}-{paired.max():.2f})")
+        by = {j.name: j for j in jobs}
+        for k in TRANSCENDENTAL:
+            if f"{k} dense, before" in by:
+                a, b = np.array(rounds[f"{k} dense, after"]), np.array(rounds[f"{k} dense, before"])
+                same = np.array_equal(by[f"{k} dense, after"].out, by[f"{k} dense, before"].out)
+                print(f"{k}: after / before = {np.median(a / b):.2f} (median of paired rounds), "
+                      f"{a.min() / b.min():.2f} (best times); escape steps equal: {same}")
+    print("\nmachine after:", machine())
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--before", default="f85d441", help="git revision of the kernels before the well flag")
@@ -201,7 +274,15 @@ def main(argv=None):
     ap.add_argument("--dense-cycles", type=int, default=600)
     ap.add_argument("--chart-cycles", type=int, default=300)
     ap.add_argument("--steps-per-cycle", type=int, default=32)
+    ap.add_argument("--wells-only", action="store_true",
+                    help="only the dense jobs of the quartic and the non-polynomial wells")
+    ap.add_argument("--sources-before", default=None,
+                    help="with --wells-only: also each expression well's code as this git revision generated it")
     args = ap.parse_args(argv)
+    if args.wells_only:
+        numba.set_num_threads(args.threads)
+        print("machine:", machine())
+        return wells_only(args)
 
     numba.set_num_threads(args.threads)
     print("machine:", machine())

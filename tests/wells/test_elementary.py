@@ -118,6 +118,25 @@ def test_sincos_is_sin_and_cos() -> None:
     assert np.array_equal(c.view(np.int64), ref.cpu_values("cos", x).view(np.int64))
 
 
+def test_exp_expm1_is_exp_and_expm1() -> None:
+    """The pair from one reduction has exp's and expm1's bits (compiled and as Python source)."""
+    x, _ = ref.samples("expm1", N_SAMPLES)
+    hx, _ = ref.hard_points("exp")
+    x = np.concatenate([x, hx, ref.samples("exp", N_SAMPLES)[0], [0.0, -0.0, INF, -INF, NAN, -38.0, -37.9, 41.0,
+                                                                   42.0, 1e-17, -1e-17, 5e-324]])
+    e, m = np.empty_like(x), np.empty_like(x)
+    f = elementary.cpu().exp_expm1
+    for i in range(x.size):
+        e[i], m[i] = f(x[i])
+    want_e, want_m = ref.cpu_values("exp", x), ref.cpu_values("expm1", x)
+    assert np.array_equal(e, want_e, equal_nan=True) and np.array_equal(m, want_m, equal_nan=True)
+    finite = ~np.isnan(x)
+    assert np.array_equal(e[finite].view(np.int64), want_e[finite].view(np.int64))
+    assert np.array_equal(m[finite].view(np.int64), want_m[finite].view(np.int64))
+    py = [elementary.exp_expm1(float(v)) for v in x[finite][::7]]
+    assert np.array_equal(np.array(py).view(np.int64), np.stack([e[finite][::7], m[finite][::7]], 1).view(np.int64))
+
+
 def _simulator_cases() -> dict[str, dict[str, list[float]]]:
     cases = {}
     for name in ref.CHECKED:

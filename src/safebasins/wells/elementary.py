@@ -14,7 +14,8 @@ with selects rather than branches, so that a loop calling them vectorises on the
   faithful minimax kernels on [-pi/4, pi/4] (double-double kernels on the huge-argument path).
 * exp, expm1: x = n ln2 + r_h + r_l (r_h exact, r_l = -n LN2_LO not normalised), e^r - 1 - r_h
   by a minimax polynomial with r_h^2/2 exact, r_l added as r_l e^r_h; 2^n applied in two factors
-  (no spurious overflow), one rounding in the subnormal range; faithful.
+  (no spurious overflow), one rounding in the subnormal range; faithful.  exp_expm1: both, with
+  their bits, from one reduction.
 * log, log1p: x = 2^E z, z in [sqrt(1/2), sqrt(2)), log z = 2 atanh(s), s = (z-1)/(z+1) as a
   double-double, minimax polynomial in s^2.
 * cosh, sinh, tanh: from the double-double e^|x| and its reciprocal (sinh below 1/4 by its own
@@ -54,8 +55,9 @@ from safebasins.wells.elementary_targets import (as_bits, as_bits_cpu, cold_call
                                                     from_bits_cpu, register_cpu_overload)
 from safebasins.wells.compiled import cpu_jit, fma, fma_cpu, mul, mul_cpu
 
-__all__ = ["sin", "cos", "tan", "sincos", "exp", "expm1", "log", "log1p", "tanh", "cosh", "sinh", "sqrt", "pow",
-           "powi", "cpu", "cuda_device", "for_target", "FUNCTIONS", "SIN_COS_FAST_LIMIT", "ULP_BOUNDS", "MODULE_HASH"]
+__all__ = ["sin", "cos", "tan", "sincos", "exp", "expm1", "exp_expm1", "log", "log1p", "tanh", "cosh", "sinh", "sqrt",
+           "pow", "powi", "cpu", "cuda_device", "for_target", "FUNCTIONS", "SIN_COS_FAST_LIMIT", "ULP_BOUNDS",
+           "MODULE_HASH"]
 
 #: the public functions
 FUNCTIONS = ("sin", "cos", "tan", "sincos", "exp", "expm1", "log", "log1p", "tanh", "cosh", "sinh", "sqrt", "pow",
@@ -226,19 +228,34 @@ def _expm1_dd(n: int, rh: float, t: float) -> tuple[float, float]:
     return _fast_two_sum(sh, se + (tl + mul(s, ul)))
 
 
-def expm1(x: float) -> float:
-    """e^x - 1.  Reduced with exp's clamps: code calling exp(x) and expm1(x) of one x computes the
-    reduction and the polynomial once (the compiler merges the identical pure operations)."""
-    xc = x if x > -746.0 else -746.0                 # as exp: NaN -> -746 here, restored at the end
-    xc = xc if xc < 710.0 else 710.0
-    n, rh, t = _exp_fast(xc)
+def _expm1_finish(x: float, n: int, rh: float, t: float, e: float) -> float:
+    """e^x - 1 from exp's reduction of x (clamped to [-746, 710]) and e = exp's rounded 2^n (1 + r_h + t)."""
     m = n if n > -55 else -55                        # x < -38: any finite value, replaced below
     dh, dl = _expm1_dd(m if m < 60 else 60, rh, t)
-    bh, be = _fast_two_sum(1.0, rh)
-    res = _exp_finish(n, bh, be + t) if n > 60 else dh + dl    # n > 60: the -1 is below 2^-8 ulp
+    res = e if n > 60 else dh + dl                   # n > 60: the -1 is below 2^-8 ulp
     res = -1.0 if x < -38.0 else res                 # e^-38 < 2^-54: expm1 = -1 rounded
     res = x if abs(x) < _M54 else res
     return x + x if x != x else res
+
+
+def expm1(x: float) -> float:
+    """e^x - 1."""
+    xc = x if x > -746.0 else -746.0                 # as exp: NaN -> -746 here, restored at the end
+    xc = xc if xc < 710.0 else 710.0
+    n, rh, t = _exp_fast(xc)
+    bh, be = _fast_two_sum(1.0, rh)
+    return _expm1_finish(x, n, rh, t, _exp_finish(n, bh, be + t))
+
+
+def exp_expm1(x: float) -> tuple[float, float]:
+    """(e^x, e^x - 1), the bits of exp and expm1, from one reduction and polynomial (about the
+    cost of expm1 alone): the rewritten forms of the expression wells call it."""
+    xc = x if x > -746.0 else -746.0
+    xc = xc if xc < 710.0 else 710.0
+    n, rh, t = _exp_fast(xc)
+    bh, be = _fast_two_sum(1.0, rh)
+    e = _exp_finish(n, bh, be + t)
+    return (x + x if x != x else e), _expm1_finish(x, n, rh, t, e)
 
 
 def _exp_dd(ax: float) -> tuple[int, float, float, float, float]:

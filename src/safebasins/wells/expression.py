@@ -45,7 +45,9 @@ FUNCTIONS = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "log": 
 #: the functions of the generated source that are not wells.elementary's
 _LIBM = {"atan": math.atan, "asinh": math.asinh}
 #: the namespace of the generated source when it runs on numpy arrays (the theory)
-_NAMESPACE_NUMPY = {"mul": np.multiply, "pow": np.power, "expm1": np.expm1, "copysign": np.copysign, **FUNCTIONS}
+#: the functions only the rewritten forms call (wells.expression_forms), with their numpy version
+_REWRITE_FUNCTIONS = {"expm1": np.expm1, "exp_expm1": lambda a: (np.exp(a), np.expm1(a))}
+_NAMESPACE_NUMPY = {"mul": np.multiply, "pow": np.power, "copysign": np.copysign, **_REWRITE_FUNCTIONS, **FUNCTIONS}
 
 
 def _sympy() -> Any:
@@ -116,8 +118,8 @@ class _Printer:
             return f"abs({self(e.args[0])})"
         if isinstance(e, sp.sign):
             return f"copysign(1.0, {self(e.args[0])})"
-        if type(e).__name__ == "expm1":            # the rewritten forms' (wells.expression_forms)
-            return f"expm1({self(e.args[0])})"
+        if type(e).__name__ in _REWRITE_FUNCTIONS:  # the rewritten forms' (wells.expression_forms)
+            return f"{type(e).__name__}({self(e.args[0])})"
         name = type(e).__name__
         if isinstance(e, sp.Function) and name in FUNCTIONS and len(e.args) == 1:
             return f"{name}({self(e.args[0])})"
@@ -254,7 +256,7 @@ def _cost(form: Form) -> tuple[int, int, int]:
     exprs = [v for _, v in form.lets] + [form.body]
     calls = {(type(c).__name__, c.args) for e in exprs for c in e.atoms(sp.Function)
              if not isinstance(c, (sp.Abs, sp.sign))}
-    groups = {("exp", a) if n in ("exp", "expm1") else (n, a) for n, a in calls}
+    groups = {("exp", a) if n in ("exp", *_REWRITE_FUNCTIONS) else (n, a) for n, a in calls}
     return len(groups), len(calls), int(sum(sp.count_ops(e) for e in exprs))
 
 
@@ -303,7 +305,8 @@ def _code(name: str, form: Form, pr: _Printer) -> str:
     lines: list[str] = []
     bases: dict[Any, Any] = {}
     for k, v in (*form.lets, *reps):
-        lines.append(f"    {k} = {pr(_name_power_bases(v, bases, lines, pr))}")
+        names = ", ".join(map(str, k)) if isinstance(k, tuple) else str(k)
+        lines.append(f"    {names} = {pr(_name_power_bases(v, bases, lines, pr))}")
     lines.append(f"    return {pr(_name_power_bases(body, bases, lines, pr))}")
     return f"def {name}(q):\n" + "\n".join(lines) + "\n"
 
@@ -343,7 +346,9 @@ def generate_source(V: Any, q: Any) -> tuple[str, Any]:
     fdV = _choose(*_forms(dV, q, spellings=True), dV, q, pr)
     printed = fdV.body
     for k, v in reversed(fdV.lets):
-        printed = printed.xreplace({k: v})
+        if isinstance(k, tuple):                     # (D, M) = exp_expm1(a)
+            k, v = dict(zip(k, (sp.exp(v.args[0]), sp.Function("expm1")(v.args[0])))), None
+        printed = printed.xreplace(k if v is None else {k: v})
     return f"{_code('V', fV, pr)}\n\n{_code('dV', fdV, pr)}", printed
 
 
@@ -423,7 +428,7 @@ class ExpressionWell(NumericWell):
 def _compiled_namespace(functions: SimpleNamespace) -> dict[str, Any]:
     """The generated source's names in a compiled engine: ``functions`` (wells.elementary compiled
     for the target), the libm functions elementary has not, the wells' ``mul``."""
-    own = {k: getattr(functions, k) for k in (*FUNCTIONS, "pow", "expm1") if k not in _LIBM}
+    own = {k: getattr(functions, k) for k in (*FUNCTIONS, "pow", *_REWRITE_FUNCTIONS) if k not in _LIBM}
     return {"mul": mul, "copysign": functions._copysign, **_LIBM, **own}
 
 

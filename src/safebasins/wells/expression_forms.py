@@ -5,8 +5,8 @@ original expression for real q.  The rewrite here: the functions of the exponent
 (exp, sinh, cosh, tanh, sech) whose arguments are rational multiples ``c a`` of one argument ``a``
 are rational functions of one exponential ``D = exp(+-g a)`` (``g`` the largest common step of the
 ``c``); the factors ``D - 1``, which cancel where ``a`` is small, become ``M = expm1(+-g a)``.  D
-and M of one argument cost about one call: wells.elementary's exp and expm1 share their
-reduction and polynomial, which the compiler computes once.
+and M of one argument cost about one call: wells.elementary's ``exp_expm1`` returns both from one
+reduction and polynomial.
 
 For a function even or odd in q (``a = q``) the variable is the decaying ``D = exp(-g |q|)`` in
 (0, 1] and the sign is restored by ``sign(q)``: no overflow however large ``|q|`` (``exp(+g q)``
@@ -30,7 +30,8 @@ FAMILY = ("exp", "sinh", "cosh", "tanh", "sech")
 
 @dataclass(frozen=True)
 class Form:
-    """``lets``: ((symbol, sympy expression), ...) evaluated in order; ``body``: the value."""
+    """``lets``: ((symbol or tuple of symbols, sympy expression), ...) evaluated in order (a
+    tuple: ``exp_expm1``'s pair); ``body``: the value."""
 
     lets: tuple[tuple[Any, Any], ...]
     body: Any
@@ -85,13 +86,15 @@ def exponential_forms(f: Any, q: Any) -> list[Form]:
     for sgn in (-1, 1):
         variants.append(((), sgn * g * base, 1, R.xreplace({T: D ** sgn})))
     out: list[Form] = []
-    expm1 = sp.Function("expm1")
+    expm1, exp_expm1 = sp.Function("expm1"), sp.Function("exp_expm1")
     for lets, arg, sign, RD in variants:
         RD = sp.factor(sp.cancel(RD), D)
         repaired = RD.xreplace({D - 1: M, 1 - D: -M})
         only_m = sp.factor(sp.cancel(RD.xreplace({D: M + 1})), M)
         for body in (RD, repaired, only_m):
-            used = tuple((k, v) for k, v in ((D, sp.exp(a)), (M, expm1(a))) if body.has(k))
+            both = body.has(D) and body.has(M)
+            used = (((D, M), exp_expm1(a)),) if both else tuple(
+                (k, v) for k, v in ((D, sp.exp(a)), (M, expm1(a))) if body.has(k))
             out.append(Form(lets + ((a, arg),) + used, sign * body))
     return out
 
