@@ -24,17 +24,20 @@ attractors with rates ``exp(-W / sigma^2)`` (one attractor: ``W(k -> circle)``).
 """
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numba import njit
+from numba import literally, njit
 from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 from scipy.linalg import solve_continuous_lyapunov
 
 from safebasins.core import checks
+from safebasins.theory import damped
 from safebasins.theory.damped import flow_tilde
 from safebasins.theory.noise_averaging import AveragedDiffusion, averaged_diffusion
 from safebasins.theory.responses import SADDLE, fixed_points
@@ -69,6 +72,9 @@ TABLE_NODES = 4097
 ESCAPE, UNDECIDED = -1, -2
 
 _flow_tilde: Any = njit(flow_tilde)     # the drift's one formula, compiled for the rays (scalars)
+#: the numba literal of the cached ray kernels: a hash of the drift's module, so that a kernel
+#: cached on disk (which holds the compiled drift) is never reused after an edit of it
+_DRIFT_KEY = int(hashlib.blake2b(Path(damped.__file__).read_bytes(), digest_size=8).hexdigest()[:15], 16)
 
 
 def coefficient_table(diff: AveragedDiffusion, n: int = TABLE_NODES) -> FloatArray:
@@ -86,7 +92,7 @@ def coefficient_table(diff: AveragedDiffusion, n: int = TABLE_NODES) -> FloatArr
                                           v[:, 3], d1[:, 3]], axis=1))
 
 
-@njit(cache=True)
+@njit
 def _flow(tab, J_max, X, Y, F, Om, beta):  # type: ignore[no-untyped-def]
     """Drift (bX, bY), its Jacobian (dbX/dX, dbX/dY, dbY/dX, dbY/dY) and the diffusion's
     (a_t, c, a_t', c') at one point.  With ``g = omega - Omega``, ``e = a'``:
@@ -106,7 +112,7 @@ def _flow(tab, J_max, X, Y, F, Om, beta):  # type: ignore[no-untyped-def]
     return bX, bY, jxx, jxy, jyx, jyy, r[5], r[7], r[6], r[8]
 
 
-@njit(cache=True)
+@njit
 def _ray_rhs(tab, J_max, X, Y, pX, pY, F, Om, beta):  # type: ignore[no-untyped-def]
     """Characteristics of ``H = b.p + (1/2) p^T A p``, ``A = a_t I + c x x^T``."""
     bX, bY, jxx, jxy, jyx, jyy, at, c, at1, c1 = _flow(tab, J_max, X, Y, F, Om, beta)
@@ -118,7 +124,7 @@ def _ray_rhs(tab, J_max, X, Y, pX, pY, F, Om, beta):  # type: ignore[no-untyped-
             -(jxy * pX + jyy * pY) - 0.5 * gk * Y - c * xp * pY, 0.5 * (pX * ApX + pY * ApY))
 
 
-@njit(cache=True)
+@njit
 def _rk4_step(tab, J_max, F, Om, beta, X, Y, pX, pY, P, dt):  # type: ignore[no-untyped-def]
     """One RK4 step of the rays' equations."""
     h = 0.5 * dt
@@ -133,14 +139,15 @@ def _rk4_step(tab, J_max, F, Om, beta, X, Y, pX, pY, P, dt):  # type: ignore[no-
 
 
 @njit(cache=True)
-def _shoot(tab, J_max, F, Om, beta, s0, owner, points, dt, steps, stop_radius, exits, near_d,  # type: ignore[no-untyped-def]
+def _shoot(key, tab, J_max, F, Om, beta, s0, owner, points, dt, steps, stop_radius, exits, near_d,  # type: ignore[no-untyped-def]
            near_phi):
     """RK4 rays from the rows ``(X, Y, pX, pY, Phi)`` of s0 until ``J >= J_max`` (``exits[n]``: Phi,
     X, Y there, a partial step found by Newton's method on J; inf, nan, nan if not within
     ``steps``) and the closest step to each point (``near_d``, and ``near_phi``: Phi there plus
     ``p.(point - x)``).  A ray stops early (rays winding without end) where its Phi exceeds PHI_CAP
     times the least exit Phi of an earlier ray of the same owner or its time TIME_CAP times their
-    earliest exit, or within ``stop_radius`` of a point."""
+    earliest exit, or within ``stop_radius`` of a point (``key``: :data:`_DRIFT_KEY`)."""
+    literally(key)
     best = np.full(owner.max() + 1, np.inf)
     first = np.full(owner.max() + 1, steps)
     for n in range(s0.shape[0]):
@@ -180,8 +187,9 @@ def _shoot(tab, J_max, F, Om, beta, s0, owner, points, dt, steps, stop_radius, e
 
 
 @njit(cache=True)
-def _flow_points(tab, J_max, xs, F, Om, beta):  # type: ignore[no-untyped-def]
-    """:func:`_flow` at the rows of xs: (n, 10)."""
+def _flow_points(key, tab, J_max, xs, F, Om, beta):  # type: ignore[no-untyped-def]
+    """:func:`_flow` at the rows of xs: (n, 10) (``key``: :data:`_DRIFT_KEY`)."""
+    literally(key)
     out = np.empty((xs.shape[0], 10))
     for n in range(xs.shape[0]):
         out[n] = _flow(tab, J_max, xs[n, 0], xs[n, 1], F, Om, beta)
@@ -197,8 +205,8 @@ class _Problem:
     beta: float
 
     def flow(self, xs: FloatArray) -> FloatArray:
-        out: FloatArray = _flow_points(self.tab, self.J_max, np.ascontiguousarray(xs, dtype=np.float64), self.F,
-                                       self.Omega, self.beta)
+        xs = np.ascontiguousarray(xs, dtype=np.float64)
+        out: FloatArray = _flow_points(_DRIFT_KEY, self.tab, self.J_max, xs, self.F, self.Omega, self.beta)
         return out
 
     def jacobian(self, x: FloatArray) -> FloatArray:
@@ -215,7 +223,7 @@ class _Problem:
               stop_radius: float = 0.0) -> tuple[FloatArray, FloatArray, FloatArray]:
         n, m = s0.shape[0], points.shape[0]
         exits, near_d, near_phi = np.empty((n, 3)), np.empty((m, n)), np.empty((m, n))
-        _shoot(self.tab, self.J_max, self.F, self.Omega, self.beta, np.ascontiguousarray(s0),
+        _shoot(_DRIFT_KEY, self.tab, self.J_max, self.F, self.Omega, self.beta, np.ascontiguousarray(s0),
                np.ascontiguousarray(owner, dtype=np.intp), np.ascontiguousarray(points, dtype=np.float64).reshape(m, 2),
                dt, steps, stop_radius, exits, near_d, near_phi)
         return exits, near_d, near_phi
