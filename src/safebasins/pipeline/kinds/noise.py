@@ -7,9 +7,9 @@ GIM, LIM and IF of the stochastic safe basin {P_escape <= epsilon} and of the co
 against sigma and/or F (:func:`safebasins.analysis.stochastic_erosion`, the same seed at every
 point).  Both draw their random numbers from the run's seed plus the experiment's offset.
 Where the averaged theory applies, ``escape_probability`` also stores its map
-(:func:`safebasins.theory.escape_probability`) with the agreement
-(:func:`safebasins.analysis.agreement.probability_agreement`) and ``stochastic_erosion`` its profile
-(:func:`safebasins.analysis.stochastic_integrity.stochastic_erosion_theory`).
+(:func:`safebasins.theory.escape_probability`) with the agreement and ``stochastic_erosion`` its
+profile (:func:`safebasins.analysis.stochastic_integrity.stochastic_erosion_theory`), both added by
+:mod:`safebasins.analysis.noise_theory` (the CLI's commands call the same functions).
 Datasets: ``results/data/extras/<experiment>.nc``.
 """
 from __future__ import annotations
@@ -133,126 +133,60 @@ def _resolve_theory(block: Block) -> Params:
 
 
 def _theory_settings(params: Params) -> dict[str, Any]:
-    # the keywords of theory.escape_probability's solver
-    return dict(cells=tuple(params["theory_cells"]), steps_per_cycle=params["theory_steps_per_cycle"])
+    # the theory's switch and solver settings (analysis.noise_theory)
+    return dict(noise_time=params["noise_time"], theory=params["theory"], cells=tuple(params["theory_cells"]),
+                steps_per_cycle=params["theory_steps_per_cycle"])
 
 
-def _theory_attrs(params: Params, theory: xr.Dataset) -> dict[str, Any]:
-    """The attributes naming the theory's model and settings (``theory``: a solve's Dataset)."""
-    return dict(theory=theory.attrs["theory"], theory_model=theory.attrs["noise_model"],
-                theory_solver=theory.attrs["solver"], theory_cells=list(params["theory_cells"]),
-                theory_steps_per_cycle=params["theory_steps_per_cycle"], theory_cycles=_theory_cycles(params))
-
-
-#: the theory's refusals of a block (a ValueError naming one of these arguments): an asymmetric
-#: well, xi_max at the barrier
-_THEORY_REFUSALS = ("well:", "xi_max ")
 #: slow-flow evaluations per cell and time step of the theory's march (Fig 14's quartic, 128 x 160
 #: cells, 50 cycles of 8 steps: 8.4-10.1 s per noise level on one core of a 2.5 GHz Xeon, about
 #: 1e6 cell-steps per second = pipeline.cost.ANALYTIC_RATE)
 THEORY_CELL_STEP_EVALUATIONS = 1
 
 
-def _theory_cycles(params: Params) -> int:
-    # the theory's horizon (theory.escape_probability): the largest t_eval rounded up
-    return max(1, math.ceil(max(params["t_eval"])))
-
-
-def _theory_reason(params: Params) -> str | None:
-    """Why the block gets no theory (None: it may, unless its well or xi_max is refused)."""
-    if not params["theory"]:
-        return "not computed (theory: false)"
-    if params["noise_time"] > 0:
-        return ("not applicable to coloured noise (noise_time > 0): the averaged theory is derived for white noise "
-                "(docs/noise-theory.md)")
-    if any(s == 0 for s in values.as_list(params["noise"])):
-        return ("not applicable at noise 0 (a level of this block): the averaged diffusion needs sigma > 0; "
-                "at sigma = 0 the theory is the deterministic slow flow (theory.slow_flow_escapes)")
-    return None
-
-
 def _theory_cost(params: Params, solves: int) -> int:
     """The theory's march: cells x time steps per solve (0 where it does not apply; an upper bound
     for a well the theory refuses at build time)."""
-    if _theory_reason(params) is not None:
+    from safebasins.analysis.noise_theory import theory_cycles, theory_reason
+
+    if theory_reason(theory=params["theory"], noise=params["noise"], noise_time=params["noise_time"]) is not None:
         return 0
     n_gamma, n_J = params["theory_cells"]
-    steps = _theory_cycles(params) * params["theory_steps_per_cycle"]
+    steps = theory_cycles(params["t_eval"]) * params["theory_steps_per_cycle"]
     return solves * n_gamma * n_J * steps * THEORY_CELL_STEP_EVALUATIONS
 
 
-def _refused(exc: ValueError) -> str:
-    """The reason of the theory's refusal of the block (its well or xi_max); any other error is raised."""
-    if not str(exc).startswith(_THEORY_REFUSALS):
-        raise exc
-    return f"not applicable: {exc}"
-
-
-def _theory_map(params: Params, q0: Any, p0: Any, noise: float) -> xr.Dataset:
-    """The theory's escape-probability map of the block's grid at one noise level."""
-    from safebasins.theory import escape_probability
-
-    return escape_probability(q0, p0, params["F"], params["Omega"], params["Psi"], params["xi_max"], noise=noise,
-                              t_eval=params["t_eval"], damping=values.damping(params), well=values.base_well(params),
-                              **_theory_settings(params))
-
-
 # --------------------------------------------------------------------------- escape_probability
-def _with_agreement(theory: xr.Dataset, ensemble: xr.Dataset) -> xr.Dataset:
-    """The ensemble with the theory's map and their agreement; the per-level summaries that
-    probability_agreement gives as attributes become variables (stacked over noise)."""
-    import xarray as xr
-
-    from safebasins.analysis.agreement import probability_agreement
-    from safebasins.core import cf
-
-    out = probability_agreement(theory, ensemble)
-    for name in ("P_escape_mean_abs_difference_uncertain", "P_escape_theory_within_wilson"):
-        out[name] = xr.DataArray(out.attrs.pop(name), attrs=cf.attrs(name))
-    for name in ("P_escape_mean_abs_difference", "P_escape_max_abs_difference"):
-        del out.attrs[name]
-    return out
-
-
 def build_escape_probability(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """One ensemble per noise level, stacked over ``noise`` (each the library call's Dataset), with
-    the averaged theory's map and the agreement where the theory applies."""
+    the averaged theory's map and the agreement where the theory applies
+    (:func:`safebasins.analysis.noise_theory.escape_probability_with_theory`)."""
     import xarray as xr
 
+    from safebasins.analysis.noise_theory import escape_probability_with_theory
     from safebasins.numerics import escape_probability
 
     q0, p0 = values.grid_axes(params["grid"])
     kw = _ensemble_kwargs(params, job)
     print(f"{params['experiment']}: P_escape of {q0.size} x {p0.size} ICs, {params['paths']} paths, "
           f"noise {params['noise']}", flush=True)
-    reason = _theory_reason(params)
-    theory: xr.Dataset | None = None
     maps = []
     for s in params["noise"]:
         ds = escape_probability(q0, p0, params["F"], params["Omega"], params["Psi"], noise=s,
                                 **{**kw, "paths": kw["paths"] if s > 0 else 1})
-        if reason is None:
-            try:
-                theory = _theory_map(params, q0, p0, s)
-            except ValueError as exc:
-                if theory is not None:
-                    raise
-                reason = _refused(exc)
-            else:
-                ds = _with_agreement(theory, ds)
-                print(f"  sigma = {s:g}: |P_escape_theory - P_escape| mean "
-                      f"{float(ds['P_escape_mean_abs_difference'].mean()):.4f}, max "
-                      f"{float(ds['P_escape_max_abs_difference'].max()):.4f} over the ICs and t_eval", flush=True)
         maps.append(ds.expand_dims(noise=[s]).assign_attrs(paths=params["paths"]))
     out = xr.concat(maps, dim="noise", combine_attrs="override", data_vars="all")
     out["noise"].attrs.update(maps[0]["noise"].attrs)
     out.attrs.pop("noise", None)
-    if reason is None and theory is not None:
-        out.attrs.update(**_theory_attrs(params, theory),
-                         P_escape_mean_abs_difference=float(out["P_escape_mean_abs_difference"].mean()),
-                         P_escape_max_abs_difference=float(out["P_escape_max_abs_difference"].max()))
-    else:
-        out.attrs.update(theory="none", theory_reason=str(reason))
+    out = escape_probability_with_theory(out, params["F"], params["Omega"], params["Psi"], params["xi_max"],
+                                         damping=values.damping(params), well=values.base_well(params),
+                                         **_theory_settings(params))
+    if "P_escape_theory" in out:
+        for s in params["noise"]:
+            print(f"  sigma = {s:g}: |P_escape_theory - P_escape| mean "
+                  f"{float(out['P_escape_mean_abs_difference'].sel(noise=s).mean()):.4f}, max "
+                  f"{float(out['P_escape_max_abs_difference'].sel(noise=s).max()):.4f} over the ICs and t_eval",
+                  flush=True)
     return out
 
 
@@ -308,17 +242,12 @@ class EscapeProbability(Kind):
 
 
 # --------------------------------------------------------------------------- stochastic_erosion
-#: the integrity measures the theory's profile adds (as <measure>_theory)
-MEASURES = ("GIM", "LIM", "IF")
-
-
 def build_stochastic_erosion(params: Params, data: Inputs, job: Job) -> xr.Dataset:
     """The library's profile over (F, noise, epsilon, t_eval), with the averaged theory's GIM, LIM and
-    IF (``GIM_theory``, ...) where the theory applies."""
-    import xarray as xr
-
+    IF (``GIM_theory``, ...) where the theory applies
+    (:func:`safebasins.analysis.noise_theory.stochastic_erosion_with_theory`)."""
     from safebasins.analysis import stochastic_erosion
-    from safebasins.analysis.stochastic_integrity import stochastic_erosion_theory
+    from safebasins.analysis.noise_theory import stochastic_erosion_with_theory
 
     q0, p0 = values.grid_axes(params["grid"])
     print(f"{params['experiment']}: stochastic erosion at F {params['F']}, noise {params['noise']} on "
@@ -326,25 +255,11 @@ def build_stochastic_erosion(params: Params, data: Inputs, job: Job) -> xr.Datas
     out = stochastic_erosion(q0, p0, params["F"], params["Omega"], params["Psi"], noise=params["noise"],
                              epsilon=params["epsilon"], conservative=params["conservative"],
                              bottom=tuple(params["bottom"]), **_ensemble_kwargs(params, job))
-    reason, theory = _theory_reason(params), None
-    if reason is None:
-        try:
-            theory = stochastic_erosion_theory(q0, p0, params["F"], params["Omega"], params["Psi"],
-                                               noise=params["noise"], epsilon=params["epsilon"],
-                                               xi_max=params["xi_max"], t_eval=params["t_eval"],
-                                               damping=values.damping(params), well=values.base_well(params),
-                                               bottom=tuple(params["bottom"]), **_theory_settings(params))
-        except ValueError as exc:
-            reason = _refused(exc)
-    if theory is None:
-        out.attrs.update(theory="none", theory_reason=str(reason))
-        return out
-    for m in MEASURES:
-        da = theory[m].reset_coords(drop=True).transpose(*out[m].dims)
-        xr.align(out[m], da, join="exact")      # the same sweep: a mismatch is an error, never NaN
-        out[m + "_theory"] = da.assign_attrs(long_name=f"{da.attrs['long_name']}, from the averaged theory")
-    out.attrs.update(_theory_attrs(params, theory))
-    return out
+    return stochastic_erosion_with_theory(out, q0, p0, params["F"], params["Omega"], params["Psi"],
+                                          noise=params["noise"], epsilon=params["epsilon"], xi_max=params["xi_max"],
+                                          t_eval=params["t_eval"], damping=values.damping(params),
+                                          well=values.base_well(params), bottom=tuple(params["bottom"]),
+                                          **_theory_settings(params))
 
 
 @register
