@@ -16,6 +16,7 @@ reproduction  the ``verify-reproduction`` command: a new run checked against a r
 basin_measures  the ``basin-measures`` command: fractal boundary measures of a damped well's basins
 saddle    the ``hilltop-saddle`` command: the hilltop saddle's manifolds over escape charts, their tangency
 noise     the ``escape-probability`` command: escape probabilities under noise over a grid of ICs
+erosion   the ``stochastic-erosion`` command: integrity of the stochastic safe basin against noise and F
 fatal_shock  the ``fatal-shock`` command: the minimal fatal shock of a damped well's attractors
 continuation  the ``continue-attractors`` command: a damped well's attractors followed across F or Omega
 """
@@ -26,6 +27,7 @@ from safebasins.cli.reproduction import verify_reproduction
 from safebasins.cli.basin_measures import basin_measures
 from safebasins.cli.saddle import hilltop_saddle
 from safebasins.cli.noise import escape_probability
+from safebasins.cli.erosion import stochastic_erosion
 from safebasins.cli.fatal_shock import fatal_shock
 from safebasins.cli.continuation import continue_attractors
 
@@ -35,6 +37,7 @@ main.add_command(verify_reproduction)
 main.add_command(basin_measures)
 main.add_command(hilltop_saddle)
 main.add_command(escape_probability)
+main.add_command(stochastic_erosion)
 main.add_command(fatal_shock)
 main.add_command(continue_attractors)
 

@@ -9,20 +9,68 @@ from typing import Any
 import click
 
 from safebasins.cli.commands import check_step, damping_text, grid_axes, well_label
-from safebasins.cli.options import (NONNEG, THRESHOLD, Deferred, Number, NumberList, checked, common_options,
-                                    cost_guard, current_well, damping_option, forcing_options, from_library,
-                                    grid_options, grid_params, joined, lib_check, library_errors, no_fourier,
-                                    out_option, steps_option, threads_option)
+from safebasins.cli.options import (NONNEG, THRESHOLD, Deferred, Fields, Number, NumberList, checked,
+                                    common_options, cost_guard, current_well, damping_option, forcing_options,
+                                    from_library, grid_options, grid_params, joined, lib_check, library_errors,
+                                    no_fourier, out_option, steps_option, threads_option)
 from safebasins.cli.output import chatter, draw, finish, write_outputs
 from safebasins.pipeline.cost import NOISE_STEP_COST
 from safebasins.pipeline.values import fmt
 
-__all__ = ["escape_probability"]
+__all__ = ["escape_probability", "theory_options", "noise_options", "theory_settings"]
 
 #: the library function whose defaults the options take
 LIBRARY = "safebasins.numerics:escape_probability"
+#: the library function adding the averaged theory (its defaults: the theory's solver settings)
+THEORY = "safebasins.analysis.noise_theory:escape_probability_with_theory"
 #: at most this many --t-eval values (one panel each)
 MAX_T_EVAL = 4
+#: the theory's smallest polar grid per axis (theory.escape_probability refuses fewer cells)
+MIN_THEORY_CELLS = 8
+
+
+def _theory_cells(ctx: click.Context, param: click.Parameter, value: Any) -> tuple[int, int]:
+    cells = tuple(int(n) for n in value)
+    if len(cells) != 2 or min(cells) < MIN_THEORY_CELLS:
+        raise click.BadParameter(f"the theory's polar grid needs at least {MIN_THEORY_CELLS} cells per axis "
+                                 f"(n_gamma x n_J), got {value!r}", ctx, param)
+    return cells[0], cells[1]
+
+
+def theory_options(f: Any) -> Any:
+    """--theory/--no-theory, --theory-cells, --theory-steps-per-cycle (the library's defaults)."""
+    f = click.option("--theory-steps-per-cycle", "theory_steps_per_cycle", cls=Deferred, type=int,
+                     default=from_library(THEORY, "steps_per_cycle"),
+                     callback=checked("steps_per_cycle", lib_check("safebasins.core.checks:check_positive_int")),
+                     help="The averaged theory's time steps per forcing cycle.")(f)
+    f = click.option("--theory-cells", "theory_cells", cls=Deferred, type=Fields("size"),
+                     default=lambda: "x".join(str(n) for n in from_library(THEORY, "cells")()),
+                     callback=_theory_cells,
+                     help=f"The averaged theory's polar grid: N or N_GAMMAxN_J cells (>= {MIN_THEORY_CELLS}).")(f)
+    return click.option("--theory/--no-theory", "theory", default=True, show_default=True,
+                        help="Also solve the averaged theory (docs/noise-theory.md) and store it with its agreement "
+                             "where it applies (white noise, every --noise > 0, a symmetric well, --xi-max below "
+                             "the barrier); elsewhere the dataset's attribute theory_reason says why not.")(f)
+
+
+def noise_options(f: Any) -> Any:
+    """--noise-time, --paths, --seed (the library's defaults)."""
+    f = click.option("--seed", "seed", cls=Deferred, type=click.IntRange(0, 2 ** 63 - 1),
+                     default=from_library(LIBRARY, "seed"),
+                     help="Key of the counter-based random streams (the same numbers for any --threads).")(f)
+    f = click.option("--paths", "paths", type=int, default=100, show_default=True,
+                     callback=checked("paths", lib_check("safebasins.core.checks:check_positive_int")),
+                     help="Paths per initial condition (the 95% Wilson interval of P_escape is about "
+                          "+-1/sqrt(paths)).")(f)
+    return click.option("--noise-time", "noise_time", cls=Deferred, type=Number("noise_time", NONNEG),
+                        default=from_library(LIBRARY, "noise_time"),
+                        help="Correlation time tau >= 0 of coloured noise (an Ornstein-Uhlenbeck force of the same "
+                             "low-frequency intensity sigma^2; 0: white noise). The step must resolve it.")(f)
+
+
+def theory_settings(theory: bool, theory_cells: tuple[int, int], theory_steps_per_cycle: int) -> dict[str, Any]:
+    """The keywords of safebasins.analysis.noise_theory's functions from the theory options."""
+    return dict(theory=theory, cells=tuple(theory_cells), steps_per_cycle=theory_steps_per_cycle)
 
 
 @click.command("escape-probability")
@@ -32,16 +80,7 @@ MAX_T_EVAL = 4
 @click.option("--noise", "noise", type=Number("noise", NONNEG), required=True,
               help="Noise amplitude sigma >= 0 of dp = ... + sigma dW (thermal noise at temperature T: "
                    "sigma^2 = 2 beta T; 0: every path is the deterministic trajectory).")
-@click.option("--noise-time", "noise_time", cls=Deferred, type=Number("noise_time", NONNEG),
-              default=from_library(LIBRARY, "noise_time"),
-              help="Correlation time tau >= 0 of coloured noise (an Ornstein-Uhlenbeck force of the same "
-                   "low-frequency intensity sigma^2; 0: white noise). The step must resolve it.")
-@click.option("--paths", "paths", type=int, default=100, show_default=True,
-              callback=checked("paths", lib_check("safebasins.core.checks:check_positive_int")),
-              help="Paths per initial condition (the 95% Wilson interval of P_escape is about +-1/sqrt(paths)).")
-@click.option("--seed", "seed", cls=Deferred, type=click.IntRange(0, 2 ** 63 - 1),
-              default=from_library(LIBRARY, "seed"),
-              help="Key of the counter-based random streams (the same numbers for any --threads).")
+@noise_options
 @click.option("--t-eval", "t_eval", type=NumberList("t_eval", NONNEG), multiple=True, required=True,
               callback=joined(unique=True),
               help=f"Evaluation times in forcing cycles (>= 0): comma list or repeated, at most {MAX_T_EVAL} "
@@ -50,6 +89,7 @@ MAX_T_EVAL = 4
               help="Horizon in forcing cycles (>= every --t-eval; the first-passage mean is restricted to it) "
                    "[default: the largest --t-eval rounded up].")
 @grid_options
+@theory_options
 @steps_option(LIBRARY, " (>= 4)")
 @threads_option
 @damping_option()
@@ -57,7 +97,8 @@ MAX_T_EVAL = 4
 @out_option("escape_probability")
 def escape_probability(F: float, Omega: float, Psi: float, xi_max: float, noise: float, noise_time: float, paths: int,
                        seed: int, t_eval: list[float], cycles: int | None, grid: dict[str, list[float]] | None,
-                       n: list[int], steps_per_cycle: int, threads: int | None, damping: float, fourier: str | None,
+                       n: list[int], theory: bool, theory_cells: tuple[int, int], theory_steps_per_cycle: int,
+                       steps_per_cycle: int, threads: int | None, damping: float, fourier: str | None,
                        well: dict[str, Any], no_plot: bool,
                        quiet: bool, verbose: bool, allow_expensive: bool, out: str) -> None:
     """Escape probabilities under noise over a grid of initial conditions.
@@ -66,8 +107,11 @@ def escape_probability(F: float, Omega: float, Psi: float, xi_max: float, noise:
     + Psi)) dt + sigma dW (or an Ornstein-Uhlenbeck force with --noise-time) are integrated (weak
     order 2, counter-based random numbers) and escape by the criteria of the escape charts.
     PREFIX.nc is the library's dataset: P_escape(q0, p0, t_eval) with its 95% Wilson interval,
-    the survival curve and the restricted mean first-passage time (docs/noise.md); PREFIX.png
-    maps P_escape at each --t-eval.
+    the survival curve and the restricted mean first-passage time (docs/noise.md), and where the
+    averaged theory applies (white noise, --noise > 0, a symmetric well, --xi-max below the
+    barrier) its map P_escape_theory with the agreement |P_escape_theory - P_escape|
+    (docs/noise-theory.md; --no-theory: none, and the attribute theory_reason says why);
+    PREFIX.png maps P_escape at each --t-eval with the theory's contours.
 
     Example: safebasins escape-probability --F 0.05 --Omega 0.9 --xi-max 0.2 --damping 0.05 --noise 0.06
     --t-eval 3,5 --n 41 --paths 200
@@ -83,7 +127,8 @@ def escape_probability(F: float, Omega: float, Psi: float, xi_max: float, noise:
     params: dict[str, Any] = dict(command="escape-probability", experiment=name, well=well, F=F, Omega=Omega, Psi=Psi,
                                   xi_max=xi_max, damping=damping, noise=noise, noise_time=noise_time, paths=paths,
                                   seed=seed, t_eval=t_eval, cycles=cycles, grid=grid_params(grid, n),
-                                  steps_per_cycle=steps_per_cycle)
+                                  steps_per_cycle=steps_per_cycle, theory=theory, theory_cells=list(theory_cells),
+                                  theory_steps_per_cycle=theory_steps_per_cycle)
     damped, beta = damping_text(damping)
     params["title"] = (f"Escape probability under noise sigma = {fmt(noise)}"
                        + (f", tau = {fmt(noise_time)}" if noise_time > 0 else "")
@@ -98,8 +143,9 @@ def escape_probability(F: float, Omega: float, Psi: float, xi_max: float, noise:
                reduce="--n, --paths or --cycles")
     # the ensemble and its figure load numba and matplotlib: imported when the command runs, so
     # that `safebasins --help` and the other commands start without them
+    from safebasins.analysis.noise_theory import escape_probability_with_theory
     from safebasins.numerics import escape_probability as ensemble
-    from safebasins.plotting.noise import figure_escape_probability
+    from safebasins.plotting.noise import figure_escape_probability_levels
 
     q0, p0 = grid_axes(params["grid"])
     with library_errors(), chatter(verbose):
@@ -107,11 +153,22 @@ def escape_probability(F: float, Omega: float, Psi: float, xi_max: float, noise:
                       damping=damping, well=current_well(ctx), seed=seed, cycles=cycles, noise_time=noise_time,
                       steps_per_cycle=steps_per_cycle, grid=True, threads=threads)
         params["cycles"] = int(ds.attrs["cycles"])
+        ds = escape_probability_with_theory(ds, F, Omega, Psi, xi_max, damping=damping, well=current_well(ctx),
+                                            noise_time=noise_time,
+                                            **theory_settings(theory, theory_cells, theory_steps_per_cycle))
         ds = finish(ds, title=params["title"], params=params)
-        fig = None if no_plot else draw(figure_escape_probability, ds)
+        # the pipeline's figure of stacked noise levels, one row: the theory's contours and notes
+        fig = None if no_plot else draw(figure_escape_probability_levels, ds.expand_dims(noise=[noise]))
     write_outputs([(f"{out}.nc", ds)], fig, f"{out}.png")
     for t in t_eval:
         p = ds["P_escape"].sel(t_eval=t)
         half = float((ds["P_escape_high"] - ds["P_escape_low"]).sel(t_eval=t).max()) / 2
         click.echo(f"within {fmt(t)} cycles: mean P_escape {float(p.mean()):.4f} over {p.size} ICs, "
                    f"{float((p == 0).mean()):.1%} with no path escaped (95% intervals at most +-{half:.2g})")
+    if "P_escape_theory" in ds:
+        click.echo(f"averaged theory vs ensemble: mean |P_escape_theory - P_escape| "
+                   f"{ds.attrs['P_escape_mean_abs_difference']:.4f}, max {ds.attrs['P_escape_max_abs_difference']:.4f} "
+                   f"over the ICs and t_eval; inside the 95% Wilson interval at "
+                   f"{float(ds['P_escape_theory_within_wilson']):.0%} of them")
+    else:
+        click.echo(f"no averaged theory: {ds.attrs['theory_reason']}")
