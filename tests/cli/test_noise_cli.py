@@ -1,6 +1,8 @@
 """``safebasins escape-probability``: the dataset is the library's escape_probability value for value
-(white and coloured noise, the well's own IC window), zero noise gives escape_chart's escapes, bad
-options are named before anything runs, and the command is listed."""
+(white and coloured noise, the well's own IC window), with the averaged theory's map and agreement
+as theory.escape_probability and probability_agreement give them (or the reason there is none),
+zero noise gives escape_chart's escapes, bad options are named before anything runs, and the
+command is listed."""
 from __future__ import annotations
 
 import json
@@ -10,6 +12,8 @@ import pytest
 import xarray as xr
 from click.testing import CliRunner
 
+from safebasins import theory
+from safebasins.analysis.agreement import probability_agreement
 from safebasins.cli import main
 from safebasins.numerics import escape_chart, escape_probability
 from safebasins.wells import resolve_well
@@ -118,3 +122,58 @@ def test_numeric_commands_refuse_fourier(args, tmp_path):
     res = CliRunner().invoke(main, [*args, "--fourier", "exact", "-o", str(tmp_path / "x")])
     assert res.exit_code == 2 and "--fourier" in res.output, res.output
     assert not list(tmp_path.iterdir())
+
+
+THEORY = ["--theory-cells", "16x20", "--theory-steps-per-cycle", "6"]
+
+
+def test_theory_map_and_agreement_are_the_library_calls(tmp_path):
+    res = invoke([*BASE, *THEORY, "--damping", "0.05"], tmp_path)
+    assert res.exit_code == 0, res.output
+    q0, p0 = window("quartic", 5, 4)
+    ens = escape_probability(q0, p0, 0.05, 0.9, 0.0, noise=0.06, paths=12, xi_max=0.2, t_eval=[2, 4], damping=0.05,
+                             grid=True)
+    th = theory.escape_probability(q0, p0, 0.05, 0.9, 0.0, 0.2, noise=0.06, t_eval=[2, 4], damping=0.05,
+                                   cells=(16, 20), steps_per_cycle=6)
+    ref = probability_agreement(th, ens)
+    with xr.open_dataset(tmp_path / "ep.nc") as ds:
+        np.testing.assert_array_equal(ds["P_escape_theory"].values, th["P_escape"].values)
+        for k in ("P_escape_mean_abs_difference", "P_escape_max_abs_difference"):
+            assert ds[k].dims == ("t_eval",)
+            np.testing.assert_array_equal(ds[k].values, ref[k].values, err_msg=k)
+            assert ds.attrs[k] == ref.attrs[k]
+        for k in ("P_escape_mean_abs_difference_uncertain", "P_escape_theory_within_wilson"):
+            assert ds[k].dims == () and float(ds[k]) == ref.attrs[k], k
+        assert ds.attrs["theory_solver"] == th.attrs["solver"] and list(ds.attrs["theory_cells"]) == [16, 20]
+        assert ds.attrs["theory_steps_per_cycle"] == 6 and "theory_reason" not in ds.attrs
+        assert 0 < ds.attrs["P_escape_mean_abs_difference"] < 0.2          # compared, and not a constant
+    assert (tmp_path / "ep.png").exists()
+    assert f"mean |P_escape_theory - P_escape| {ref.attrs['P_escape_mean_abs_difference']:.4f}" in res.output
+
+
+@pytest.mark.parametrize("extra, reason", [
+    (["--no-theory"], "theory: false"),
+    (["--noise-time", "0.5", "--steps-per-cycle", "24"], "coloured noise"),
+    (["--noise", "0"], "noise 0"),
+    (["--well", "cubic", "--xi-max", "0.16"], "symmetric wells"),        # the theory refuses the well
+], ids=["no-theory", "coloured", "zero-noise", "cubic"])
+def test_no_theory_says_why(tmp_path, extra, reason):
+    res = invoke([*BASE, *THEORY, "--no-plot", *extra], tmp_path)
+    assert res.exit_code == 0, res.output
+    with xr.open_dataset(tmp_path / "ep.nc") as ds:
+        assert ds.attrs["theory"] == "none" and reason in ds.attrs["theory_reason"]
+        assert not [v for v in ds.data_vars if "theory" in str(v) or "abs_difference" in str(v)]
+    assert "no averaged theory: " in res.output
+
+
+@pytest.mark.parametrize("args, reason", [
+    (["--theory-cells", "4x20"], "at least 8 cells"),
+    (["--theory-cells", "16,20"], "N or NQxNP"),
+    (["--theory-steps-per-cycle", "0"], "steps_per_cycle"),
+])
+def test_bad_theory_options_named(tmp_path, args, reason):
+    res = CliRunner().invoke(main, [*BASE, *args, "-o", str(tmp_path / "bad")])
+    assert res.exit_code == 2, res.output
+    last = res.output.strip().splitlines()[-1]
+    assert f"'{args[0]}'" in last and reason in last, last
+    assert list(tmp_path.iterdir()) == []

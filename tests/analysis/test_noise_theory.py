@@ -1,0 +1,106 @@
+"""analysis.noise_theory: the averaged theory added to ensemble Datasets is theory.escape_probability
+with probability_agreement (one level and stacked over noise) and stochastic_erosion_theory, value for
+value; where it does not apply the Dataset says why; bad arguments are named."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from safebasins import theory
+from safebasins.analysis import stochastic_erosion
+from safebasins.analysis.agreement import probability_agreement
+from safebasins.analysis.noise_theory import (escape_probability_with_theory, stochastic_erosion_with_theory,
+                                              theory_cycles, theory_reason)
+from safebasins.analysis.stochastic_integrity import stochastic_erosion_theory
+from safebasins.numerics import escape_probability
+
+Q0, P0 = np.linspace(-0.95, 0.95, 5), np.linspace(-0.75, 0.75, 4)
+ARGS = (0.01, 0.9, math.pi)
+SOLVER = dict(cells=(16, 20), steps_per_cycle=6)
+
+
+def ensemble(noise: float, xi_max: float = 0.18, **kw) -> xr.Dataset:
+    return escape_probability(Q0, P0, *ARGS, noise=noise, paths=6, xi_max=xi_max, t_eval=[1, 3], cycles=3,
+                              steps_per_cycle=16, threads=1, **kw)
+
+
+def test_one_level_is_the_theory_and_the_agreement() -> None:
+    ens = ensemble(0.02)
+    out = escape_probability_with_theory(ens, *ARGS, 0.18, **SOLVER)
+    th = theory.escape_probability(Q0, P0, *ARGS, 0.18, noise=0.02, t_eval=[1, 3], **SOLVER)
+    ref = probability_agreement(th, ens)
+    np.testing.assert_array_equal(out["P_escape_theory"].values, th["P_escape"].values)
+    for k in ("P_escape_mean_abs_difference", "P_escape_max_abs_difference"):
+        np.testing.assert_array_equal(out[k].values, ref[k].values, err_msg=k)
+        assert out.attrs[k] == ref.attrs[k]
+    for k in ("P_escape_mean_abs_difference_uncertain", "P_escape_theory_within_wilson"):
+        assert out[k].dims == () and float(out[k]) == ref.attrs[k] and out[k].attrs["units"] == "1"
+    assert out.attrs["theory_cycles"] == 3 and list(out.attrs["theory_cells"]) == [16, 20]
+    assert "P_escape_theory" not in ens                 # a copy: the ensemble is unchanged
+    for v in ens.data_vars:
+        xr.testing.assert_identical(out[v], ens[v])
+
+
+def test_stacked_levels_are_the_single_levels() -> None:
+    levels = [ensemble(s).expand_dims(noise=[s]) for s in (0.01, 0.02)]
+    out = escape_probability_with_theory(xr.concat(levels, "noise", combine_attrs="drop_conflicts"), *ARGS, 0.18,
+                                         **SOLVER)
+    assert out["P_escape_theory"].dims == ("noise", "q0", "p0", "t_eval")
+    means = []
+    for i, s in enumerate((0.01, 0.02)):
+        one = escape_probability_with_theory(ensemble(s), *ARGS, 0.18, **SOLVER)
+        for k in ("P_escape_theory", "P_escape_mean_abs_difference", "P_escape_max_abs_difference",
+                  "P_escape_mean_abs_difference_uncertain", "P_escape_theory_within_wilson"):
+            np.testing.assert_array_equal(out[k].values[i], one[k].values, err_msg=f"{k} at {s}")
+        means.append(one.attrs["P_escape_mean_abs_difference"])
+    assert out.attrs["P_escape_mean_abs_difference"] == pytest.approx(np.mean(means), rel=1e-14)
+    assert 0 < out.attrs["P_escape_mean_abs_difference"] < 0.2
+
+
+@pytest.mark.parametrize("kw, ens_kw, reason", [
+    (dict(theory=False), {}, "theory: false"),
+    (dict(noise_time=1.0), dict(noise_time=1.0), "coloured noise"),
+    (dict(well="cubic", xi_max=0.12), dict(well="cubic", xi_max=0.12), "symmetric wells"),
+])
+def test_no_theory_says_why(kw, ens_kw, reason) -> None:
+    out = escape_probability_with_theory(ensemble(0.02, **ens_kw), *ARGS, **{"xi_max": 0.18, **kw}, **SOLVER)
+    assert out.attrs["theory"] == "none" and reason in out.attrs["theory_reason"]
+    assert "P_escape_theory" not in out
+
+
+def test_reason_and_horizon() -> None:
+    assert theory_reason(theory=True, noise=[0.01, 0.02], noise_time=0.0) is None
+    assert "noise 0" in theory_reason(theory=True, noise=[0.0, 0.02], noise_time=0.0)
+    assert theory_cycles([1, 2.5]) == 3 and theory_cycles([0]) == 1
+
+
+@pytest.mark.parametrize("kw, word", [
+    (dict(cells=(4, 20)), "cells"),
+    (dict(cells=(16,)), "cells"),
+    (dict(steps_per_cycle=0), "steps_per_cycle"),
+    (dict(theory="yes"), "theory"),
+    (dict(noise_time=-1.0), "noise_time"),
+])
+def test_bad_arguments_named(kw, word) -> None:
+    with pytest.raises(ValueError, match=word):
+        escape_probability_with_theory(ensemble(0.02), *ARGS, 0.18, **{**SOLVER, **kw})
+    with pytest.raises(ValueError, match="ensemble"):
+        escape_probability_with_theory(xr.Dataset(), *ARGS, 0.18)
+
+
+def test_erosion_is_the_theory_profile() -> None:
+    kw = dict(noise=[0.01, 0.02], epsilon=[0.3, 0.5], xi_max=0.18, t_eval=[1, 3])
+    prof = stochastic_erosion(Q0, P0, [0.0, 0.01], 0.9, math.pi, paths=12, steps_per_cycle=16, **kw)
+    out = stochastic_erosion_with_theory(prof, Q0, P0, [0.0, 0.01], 0.9, math.pi, **kw, **SOLVER)
+    ref = stochastic_erosion_theory(Q0, P0, [0.0, 0.01], 0.9, math.pi, **kw, **SOLVER)
+    for m in ("GIM", "LIM", "IF"):
+        np.testing.assert_array_equal(out[m + "_theory"].values, ref[m].transpose(*out[m].dims).values, err_msg=m)
+    assert out.attrs["theory_solver"] == ref.attrs["solver"]
+    # another sweep than the profile's is an error, never a NaN-filled alignment
+    with pytest.raises(ValueError):
+        stochastic_erosion_with_theory(prof, Q0, P0, [0.0, 0.02], 0.9, math.pi, **kw, **SOLVER)
+    none = stochastic_erosion_with_theory(prof, Q0, P0, [0.0, 0.01], 0.9, math.pi, **kw, theory=False)
+    assert none.attrs["theory"] == "none" and not [v for v in none.data_vars if str(v).endswith("_theory")]
