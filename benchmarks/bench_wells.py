@@ -234,6 +234,8 @@ def wells_only(args):
                      threads=args.threads)
         jobs = [Job("quartic dense, after", kernels, qd, pd, **dense, code=wells.QUARTIC.compiled)]
         for i, (k, spec) in enumerate(TRANSCENDENTAL.items()):
+            if k not in args.wells:
+                continue
             w = wells.resolve_well(spec)
             ics = well_ics(w, args.dense_n, seed=2 + i)
             kw = dict(dense, xi_max=w.barrier_energy)
@@ -254,7 +256,7 @@ def wells_only(args):
                   f"{np.median(paired):.2f} (median of {paired.size} paired rounds, "
                   f"{paired.min():.2f}-{paired.max():.2f})")
         by = {j.name: j for j in jobs}
-        for k in TRANSCENDENTAL:
+        for k in args.wells:
             if f"{k} dense, before" in by:
                 a, b = np.array(rounds[f"{k} dense, after"]), np.array(rounds[f"{k} dense, before"])
                 same = np.array_equal(by[f"{k} dense, after"].out, by[f"{k} dense, before"].out)
@@ -278,6 +280,8 @@ def main(argv=None):
                     help="only the dense jobs of the quartic and the non-polynomial wells")
     ap.add_argument("--sources-before", default=None,
                     help="with --wells-only: also each expression well's code as this git revision generated it")
+    ap.add_argument("--wells", nargs="+", default=list(TRANSCENDENTAL), choices=list(TRANSCENDENTAL),
+                    help="with --wells-only: which wells")
     args = ap.parse_args(argv)
     if args.wells_only:
         numba.set_num_threads(args.threads)

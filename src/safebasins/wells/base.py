@@ -61,7 +61,7 @@ STEP_COST_POLY8 = 3.5
 STEP_COST_ARITHMETIC = 1.5
 STEP_COST_TRANSCENDENTAL = 150.0
 #: a code calling wells.elementary (vectorised sin, exp, tanh, ...; docs/elementary.md): measured
-#: (Intel Cascade Lake, AVX-512 and AVX2) pendulum 17-24, Morse 17-24, sech^2 23-37
+#: (Intel Cascade Lake, AVX-512 and AVX2) pendulum 14-24, Morse 17-24, sech^2 22-37
 STEP_COST_ELEMENTARY = 40.0
 #: top of a resonance-manifold panel as a fraction of the escape energy (:attr:`Well.manifold_top`)
 MANIFOLD_TOP = 0.9996

@@ -244,7 +244,7 @@ def expm1(x: float) -> float:
     xc = xc if xc < 710.0 else 710.0
     n, rh, t = _exp_fast(xc)
     bh, be = _fast_two_sum(1.0, rh)
-    return _expm1_finish(x, n, rh, t, _exp_finish(n, bh, be + t))
+    return _expm1_finish(x, n, rh, t, _scale(n, bh + (be + t)))   # used for n > 60: exp's bits, never subnormal
 
 
 def exp_expm1(x: float) -> tuple[float, float]:
