@@ -14,6 +14,7 @@ from click.testing import CliRunner
 from safebasins.analysis import stochastic_erosion
 from safebasins.analysis.stochastic_integrity import stochastic_erosion_theory
 from safebasins.cli import main
+from tests.cli.test_quiet_cli import STRICT, run
 
 BASE = ["stochastic-erosion", "--F", "0,0.01", "--Omega", "0.9", "--Psi", "pi", "--xi-max", "0.18",
         "--noise", "0.01,0.02", "--epsilon", "0.3,0.5", "--t-eval", "1,3", "--n", "5x4",
@@ -121,3 +122,11 @@ def test_help_lists_the_command():
     res = CliRunner().invoke(main, ["stochastic-erosion", "--help"])
     assert res.exit_code == 0 and all(o in res.output for o in ("--noise", "--epsilon", "--paths", "--theory",
                                                                 "--no-conservative", "--theory-cells"))
+
+
+def test_warns_nothing(tmp_path):
+    """Run as a user runs it (a child process, runtime and user warnings as errors): no warning."""
+    res = run([*BASE, "-o", "x"], tmp_path, env=STRICT)
+    assert res.returncode == 0, res.stderr
+    assert "Warning" not in res.stderr and "Warning" not in res.stdout, res.stderr
+    assert (tmp_path / "x.png").stat().st_size > 0
