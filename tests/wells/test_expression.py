@@ -23,6 +23,7 @@ from numba import njit
 
 from safebasins import wells
 from safebasins.wells import elementary
+from safebasins.wells.expression_forms import exponential_forms
 import safebasins.wells.expression  # noqa: F401  (the module; the package binds the name to the function)
 
 X = sys.modules["safebasins.wells.expression"]
@@ -141,3 +142,18 @@ def test_compiled_equals_python_source_bitwise(text):
         b = np.array([p(float(v)) for v in x])
         assert not np.isnan(a).any(), text
         assert np.array_equal(a.view(np.int64), b.view(np.int64)), text
+
+
+@pytest.mark.parametrize("text,V,dV", [
+    ("log(1 + exp(q))", lambda q: np.logaddexp(0.0, q), lambda q: 0.5 * (1 + np.tanh(q / 2))),
+    ("sqrt(1 + exp(-q))", lambda q: np.sqrt(1 + np.exp(-q)), lambda q: -np.exp(-q) / (2 * np.sqrt(1 + np.exp(-q)))),
+    ("sin(exp(q))", lambda q: np.sin(np.exp(q)), lambda q: np.exp(q) * np.cos(np.exp(q))),
+])
+def test_not_rational_in_the_exponential_left_to_sympy(text, V, dV):
+    """The family inside a function other than a rational one: no rewrite, the spellings of sympy."""
+    V_, q = X.parse(text)
+    assert exponential_forms(V_, q) == []
+    f, df = _generated(text, X._NAMESPACE_NUMPY)
+    x = np.linspace(-3, 3, 41)
+    np.testing.assert_allclose(f(x), V(x), rtol=1e-14)
+    np.testing.assert_allclose(df(x), dV(x), rtol=1e-13)

@@ -1,7 +1,9 @@
 """Wells written as an expression in ``q``: ``{expression: "1 - cos(q)"}``.
 
-The text is parsed by sympy; ``V'`` is its symbolic derivative.  One generated Python source of
-``V(q)`` and ``dV(q)`` serves every consumer:
+The text is parsed by sympy; ``V'`` is its symbolic derivative.  Each is printed in its most
+accurate equivalent form, the cheapest of the equally accurate ones (sympy's spellings, the
+rewrites of wells.expression_forms), common subexpressions once (:func:`generate_source`).  One
+generated Python source of ``V(q)`` and ``dV(q)`` serves every consumer:
 
 * the theory (action-angle variables by quadrature, :class:`~safebasins.wells.numeric.NumericWell`)
   runs it vectorised on numpy arrays;

@@ -51,7 +51,8 @@ def _family_atoms(f: Any) -> list[Any]:
 
 def exponential_forms(f: Any, q: Any) -> list[Form]:
     """The forms of ``f`` through one exponential (module docstring); [] when ``f`` calls no
-    function of the family or their arguments are not rational multiples of one argument."""
+    function of the family, their arguments are not rational multiples of one argument, or ``f``
+    is not a rational function of them."""
     sp = _sympy()
     atoms = _family_atoms(f)
     if not atoms:
@@ -69,6 +70,8 @@ def exponential_forms(f: Any, q: Any) -> list[Form]:
 
     R = f.xreplace({a: a.rewrite(sp.exp) for a in atoms}).replace(lambda e: isinstance(e, sp.exp), to_T)
     if any(isinstance(a, sp.exp) and a.has(q) and a.args[0].as_coeff_Mul()[1] == base for a in R.atoms(sp.Function)):
+        return []
+    if not R.is_rational_function(T):             # e.g. log(1 + exp(q)): not a rational function of D
         return []
     R = sp.cancel(sp.together(R))
     k = _power_step(R, T)                        # R a function of T^k: D = exp(+-k g a)
