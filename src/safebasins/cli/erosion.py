@@ -148,7 +148,7 @@ def stochastic_erosion(F: list[float], Omega: float, Psi: float, xi_max: float, 
     from safebasins.plotting.stochastic_erosion import figure_stochastic_erosion
 
     q0, p0 = grid_axes(params["grid"])
-    sweep = dict(noise=_one_or_list(noise), epsilon=_one_or_list(epsilon), xi_max=xi_max, t_eval=t_eval,
+    sweep: dict[str, Any] = dict(noise=_one_or_list(noise), epsilon=_one_or_list(epsilon), xi_max=xi_max, t_eval=t_eval,
                  damping=damping, well=current_well(ctx))
     with library_errors(), chatter(verbose):
         ds = profile(q0, p0, _one_or_list(F), Omega, Psi, paths=paths, seed=seed, cycles=cycles,
@@ -160,9 +160,8 @@ def stochastic_erosion(F: list[float], Omega: float, Psi: float, xi_max: float, 
         fig = None if no_plot else draw(figure_stochastic_erosion, ds)
     write_outputs([(f"{out}.nc", ds)], fig, f"{out}.png")
     gim = ds["GIM"].isel(t_eval=-1)
-    for d in ("epsilon",):
-        if d in gim.dims:
-            gim = gim.isel({d: 0})
+    if "epsilon" in gim.dims:
+        gim = gim.isel(epsilon=0)
     click.echo(f"GIM of {{P_escape <= {fmt(min(epsilon))}}} within {fmt(t_eval[-1])} cycles: "
                f"{float(gim.min()):.3f} to {float(gim.max()):.3f} over {gim.size} (F, sigma)")
     if "GIM_theory" in ds:
