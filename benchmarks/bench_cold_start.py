@@ -15,7 +15,9 @@ cold cases, unset for the installed cache, which then lives in the package's ``_
   leapfrog of the quartic) -- the unit the chart's compile time is quoted in, so that the ratio
   carries over between machines.
 
-Prints the times, the ratio chart / plain kernel and a ``BENCH`` line.
+Prints the times (wall clock, and the CPU time of the first call: on a loaded machine the wall
+clock counts other processes' turns), the ratio chart / plain kernel and a ``BENCH`` line.
+benchmarks/profile_compile.py breaks a first compile down by numba's compile events.
 """
 from __future__ import annotations
 
@@ -38,12 +40,14 @@ t0 = time.perf_counter()
 import numpy as np
 import safebasins.numerics as nu
 t1 = time.perf_counter()
+c1 = time.process_time()
 q = np.linspace(-0.5, 0.5, 4)
 nu.escape_chart(q, q, F=0.01, Omega=0.9, Psi=np.pi, xi_max=(0.18,), cycles=5)
 t2 = time.perf_counter()
+c2 = time.process_time()
 nu.escape_chart(q, q, F=0.01, Omega=0.9, Psi=np.pi, xi_max=(0.18,), cycles=5)
 t3 = time.perf_counter()
-print(json.dumps({"import": t1 - t0, "first": t2 - t1, "second": t3 - t2}))
+print(json.dumps({"import": t1 - t0, "first": t2 - t1, "second": t3 - t2, "cpu": c2 - c1}))
 """
 
 # a new expression well (a Coulomb term whose constant no cache has seen) on a cache that holds
@@ -73,10 +77,12 @@ class Total(ev.Listener):
 llvm = Total()
 q = np.linspace(-0.2, 0.2, 4)
 t2 = time.perf_counter()
+c2 = time.process_time()
 with ev.install_listener("numba:llvm_lock", llvm):
     nu.escape_chart(q, q, F=0.01, Omega=0.9, Psi=np.pi, xi_max=(0.05,), cycles=5, well=w)
 t3 = time.perf_counter()
-print(json.dumps({"import": t1 - t0, "well": t2 - t1, "first": t3 - t2, "second": 0.0, "llvm": llvm.total}))
+print(json.dumps({"import": t1 - t0, "well": t2 - t1, "first": t3 - t2, "second": 0.0, "llvm": llvm.total,
+                  "cpu": time.process_time() - c2}))
 """
 
 PLAIN = r"""
@@ -85,6 +91,7 @@ t0 = time.perf_counter()
 import numpy as np
 from numba import njit
 t1 = time.perf_counter()
+c1 = time.process_time()
 
 @njit(cache=True)
 def leapfrog(q, p, h, n):
@@ -99,7 +106,7 @@ def leapfrog(q, p, h, n):
 
 leapfrog(np.zeros(4), np.ones(4) * 0.1, 0.01, 10)
 t2 = time.perf_counter()
-print(json.dumps({"import": t1 - t0, "first": t2 - t1, "second": 0.0}))
+print(json.dumps({"import": t1 - t0, "first": t2 - t1, "second": 0.0, "cpu": time.process_time() - c1}))
 """
 
 
@@ -138,15 +145,20 @@ def main():
         rows["chart, installed cache"].append(run(CHART, None))
         with tempfile.TemporaryDirectory() as d:
             rows["plain numba kernel, empty cache"].append(run(PLAIN, d))
-    med = {k: {f: float(np.median([r[f] for r in v])) for f in ("import", "first", "second")} for k, v in rows.items()}
-    print(f"{'case':34s} {'import [s]':>10s} {'first call [s]':>15s} {'second [s]':>10s}")
+    med = {k: {f: float(np.median([r[f] for r in v])) for f in ("import", "first", "second", "cpu")}
+           for k, v in rows.items()}
+    print(f"{'case':34s} {'import [s]':>10s} {'first call [s]':>15s} {'(CPU [s])':>10s} {'second [s]':>10s}")
     for k, v in med.items():
-        print(f"{k:34s} {v['import']:10.2f} {v['first']:15.2f} {v['second']:10.3f}")
+        print(f"{k:34s} {v['import']:10.2f} {v['first']:15.2f} {v['cpu']:10.2f} {v['second']:10.3f}")
     plain = med["plain numba kernel, empty cache"]["first"]
     cold = med["chart, empty cache"]["first"]
     inst = med["chart, installed cache"]["first"]
     print(f"first chart call / plain kernel compile: empty cache {cold / plain:.1f}, "
           f"installed cache {inst / plain:.2f}")
+    c_plain, c_cold = med["plain numba kernel, empty cache"]["cpu"], med["chart, empty cache"]["cpu"]
+    c_new = med["new expression well, warm cache"]["cpu"]
+    print(f"in CPU time (less sensitive to the machine's load): plain kernel {c_plain:.2f} s, "
+          f"empty cache chart {c_cold / c_plain:.1f}x, new expression well {c_new:.2f} s ({c_new / c_plain:.1f}x)")
     ex = rows["new expression well, warm cache"]
     llvm = float(np.median([r["llvm"] for r in ex]))
     well = float(np.median([r["well"] for r in ex]))

@@ -21,7 +21,7 @@ from tests.import_graph import SRC, closure, graph
 
 ENGINE_MODULES = (kernels, periods, scheme_code, schemes, steps, compiled)
 #: cached dispatchers that inline nothing from another file (keyed by their own file alone)
-SELF_CONTAINED = {"safebasins.wells.compiled._fma_python"}
+SELF_CONTAINED = {"safebasins.wells.compiled._fma_python", "safebasins.numerics.steps.wtuple"}
 
 
 def _module_name(path) -> str:

@@ -8,7 +8,7 @@ machinery: escape detection, replay, refill, compaction, and the entry points.
 Schemes and wells are compile-time constants of the inline period bodies: `scheme`, the key of a
 scheme's compiled form (scheme_code.SchemeCode.key; the forcing table's width and the coefficient
 table match it) and `well`, the kernel key of a compiled well (wells.compiled.WellCode.key), which
-_run_task forces to numba literals (`literally`): every pair of keys is its own compiled kernel,
+_run_task takes as numba literals (kernels.specialised): every pair of keys is its own compiled kernel,
 cached on disk and compiled on first use, and holds only its own scheme's and well's code (numba
 @overload on the literal, resolved at typing time).  Keys hash the arithmetic and the engine's
 source, so a cached kernel is never reused after an edit.
@@ -50,7 +50,7 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-from numba import literally, njit, typeof, types
+from numba import njit, typeof, types
 from numba.core import errors
 from numba.extending import overload
 
@@ -148,55 +148,36 @@ def _replay(scheme: int, well: int, wpar: Floats, i: Int, q: float, p: float, pe
 def _run_task(well: int, scheme: int, shared: bool, wpar: Floats, task: int, n_tasks: int, lanes: int, q0: Floats,
               p0: Floats, pidx: Ints, coef: Floats, hpar: Floats, Fpar: Floats, sintab: Floats, thrE2: Floats,
               thrLo: Floats, thrHi: Floats, cycles: int, stop_any: bool, outE: Ints, outQ: Ints, store: Floats,
-              do_store: bool) -> None:
+              do_store: bool, FS: Floats, segs: Ints, lane_f: Floats, snap: Floats, SMN: Floats, lane_i: Ints,
+              lane_b: npt.NDArray[np.bool_], lane_t: Floats, CL: Floats) -> None:
     """Trajectories task, task + n_tasks, ... (one thread): the lane machinery of the module
     docstring.  `well` is the kernel key of a compiled well, `scheme` the key of a scheme code and
     `shared` whether all trajectories share one parameter set (``coef.shape[0] == 1``: the
-    shared loop, else the per-lane loop); numba literals: one specialised, cached kernel per
-    triple, compiled on first use, with only the period loop it runs."""
-    literally(well)
-    literally(scheme)
-    literally(shared)
+    shared loop, else the per-lane loop); numba literals (:func:`specialised`): one specialised,
+    cached kernel per triple, compiled on first use, with only the period loop it runs.
+    FS .. CL: the task's work arrays (:func:`_workspace`), allocated by the caller: numpy's
+    allocation overloads would be compiled anew with every kernel."""
     damped = is_damped(scheme)
     N = q0.shape[0]
-    S = sintab.shape[0]
     nE = thrE2.shape[0]
     nQ = thrHi.shape[0]
     L: Int = np.int64(lanes)
-    # every array np.zeros: np.empty would be one more numba overload to compile (the cost is nil)
-    Lmem = max(L, 4 * MIN_SEGMENT) + 32       # room for the padded segments
-    Q = np.zeros(Lmem)
-    P = np.zeros(Lmem)
+    # lane state: (q, p), the per-lane path's step and amplitude
+    Q, P, HL, FL = lane_f[0], lane_f[1], lane_f[2], lane_f[3]
     # the period is run in G segments; snapshots of (q, p) before each segment and the
     # segment maxima let a crossing be replayed over one segment only.  Segments cost a
     # snapshot per lane each; they pay off only while lanes cross thresholds, so a period
     # after one without any crossing runs as ONE segment (a crossing there is replayed over
     # the whole period; the recorded steps are the same either way)
-    Gmax = SEGMENTS if S >= 4 * SEGMENTS else 1
-    segs = np.zeros((2, Gmax + 1), np.int64)
-    for g in range(Gmax + 1):
-        segs[0, g] = g * S // Gmax
-        segs[1, g] = S if g > 0 else 0
-    SQ = np.zeros((Gmax, Lmem))
-    SP = np.zeros((Gmax, Lmem))
-    SME = np.zeros((Gmax, Lmem))
-    SMQ = np.zeros((Gmax, Lmem))
-    SMN = np.zeros((Gmax, 1 if abs_tracking(well) else Lmem))    # max -q (signed tracking only)
+    Gmax = segs.shape[1] - 1
+    SQ, SP, SME, SMQ = snap[0], snap[1], snap[2], snap[3]
     nhit = np.int64(1)         # crossings at the last period boundary (first period: segmented)
-    traj = np.zeros(L, np.int64)
-    per = np.zeros(L, np.int64)
-    lE = np.zeros(L, np.int64)
-    lQ = np.zeros(L, np.int64)
-    done = np.zeros(L, np.bool_)
-    hit = np.zeros(L, np.bool_)
-    tE = np.zeros(L)      # next uncrossed 2*xi threshold of the lane (inf: none)
-    tQ = np.zeros(L)      # next uncrossed |q| (|q| tracking) or upper bound, or the barrier
-    tN = np.zeros(L)      # signed tracking: next uncrossed -lower bound, or -q_left
-    FS = Fpar[0] * sintab        # (S, width), shared path
-    HL = np.zeros(Lmem)          # per-lane path
-    FL = np.zeros(Lmem)
+    traj, per, lE, lQ = lane_i[0], lane_i[1], lane_i[2], lane_i[3]
+    done, hit = lane_b[0], lane_b[1]
+    # next uncrossed 2*xi threshold of the lane (inf: none); next uncrossed |q| (|q| tracking) or
+    # upper bound, or the barrier; signed tracking: next uncrossed -lower bound, or -q_left
+    tE, tQ, tN = lane_t[0], lane_t[1], lane_t[2]
     NC = coef.shape[1]
-    CL = np.zeros((NC, Lmem if damped else 1))     # per-lane coefficient columns (damped schemes)
 
     zero = np.int64(0)
     nxt = np.int64(task)
@@ -365,6 +346,32 @@ def specialised(dispatcher: Any, args: Sequence[Any], n_literal: int = 2) -> Cal
 _ENTRIES: dict[tuple[Any, tuple[Any, ...]], Callable[..., Any]] = {}
 
 
+def _zeros(shape: tuple[int, ...], dtype: type = np.float64) -> np.ndarray:
+    """Zeros with rows aligned to 64 bytes (the vector loop's arrays; a row length the callers
+    round to 8 elements)."""
+    size = int(np.prod(shape)) * np.dtype(dtype).itemsize
+    buf = np.zeros(size + 64, np.uint8)
+    start = -buf.ctypes.data % 64
+    return buf[start:start + size].view(dtype).reshape(shape)
+
+
+def _workspace(lanes: int, shared: bool, damped: bool, abs_q: bool, coef: np.ndarray, Fpar: np.ndarray,
+               sintab: np.ndarray) -> list[np.ndarray]:
+    """The work arrays of one task of :func:`_run_task` (its arguments FS .. CL)."""
+    S = sintab.shape[0]
+    Lmem = (max(lanes, 4 * MIN_SEGMENT) + 32 + 7) // 8 * 8     # room for the padded segments
+    Lr = (lanes + 7) // 8 * 8
+    Gmax = SEGMENTS if S >= 4 * SEGMENTS else 1
+    segs = np.zeros((2, Gmax + 1), np.int64)
+    for g in range(Gmax + 1):
+        segs[0, g] = g * S // Gmax
+        segs[1, g] = S if g > 0 else 0
+    FS = Fpar[0] * sintab if shared else np.zeros((1, sintab.shape[1]))      # the shared path's forcing
+    return [FS, segs, _zeros((4, Lmem)), _zeros((4, Gmax, Lmem)), _zeros((Gmax, 1 if abs_q else Lmem)),
+            _zeros((4, Lr), np.int64), _zeros((2, Lr), np.bool_), _zeros((3, Lr)),
+            _zeros((coef.shape[1], Lmem if damped else 1))]
+
+
 def run_tasks(fn: Callable[[int], object], n_tasks: int) -> None:
     """fn(task) for task in range(n_tasks), on n_tasks threads (the compiled task functions release
     the GIL); exceptions propagate."""
@@ -411,10 +418,12 @@ def ensemble(q0: np.ndarray, p0: np.ndarray, pidx: np.ndarray, coef: np.ndarray,
     hi = np.ascontiguousarray(thrQ, dtype=float)
     lo = -hi if thrQlo is None else np.ascontiguousarray(thrQlo, dtype=float)
     sc = _scheme(scheme, sintab, coef)
-    args = [code.key, sc.key, bool(coef.shape[0] == 1), code.wpar, 0, int(n_tasks), int(lanes), q0, p0, pidx, coef,
+    shared = bool(coef.shape[0] == 1)
+    args = [code.key, sc.key, shared, code.wpar, 0, int(n_tasks), int(lanes), q0, p0, pidx, coef,
             hpar, Fpar, sintab, thrE2, lo, hi, int(cycles), bool(stop_any), outE, outQ, store, bool(do_store)]
-    entry = specialised(_run_task, args, n_literal=3)
-    run_tasks(lambda task: entry(*args[:4], task, *args[5:]), n_tasks)
+    work = [_workspace(int(lanes), shared, sc.damped, code.abs_tracking, coef, Fpar, sintab) for _ in range(n_tasks)]
+    entry = specialised(_run_task, args + work[0], n_literal=3)
+    run_tasks(lambda task: entry(*args[:4], task, *args[5:], *work[task]), n_tasks)
 
 
 def _scheme(scheme: SchemeCode | None, sintab: np.ndarray, coef: np.ndarray) -> SchemeCode:
@@ -434,8 +443,6 @@ def _scheme(scheme: SchemeCode | None, sintab: np.ndarray, coef: np.ndarray) -> 
 def _final_states(well: int, scheme: int, wpar: Floats, q0: Floats, p0: Floats, pidx: Ints, coef: Floats,
                   Fpar: Floats, sintab: Floats, n_periods: int, task: int, n_tasks: int, qo: Floats,
                   po: Floats) -> None:
-    literally(well)
-    literally(scheme)
     N = q0.shape[0]
     S = sintab.shape[0]
     w = wtuple(wpar)

@@ -52,7 +52,7 @@ from safebasins.numerics.kernels import run_tasks, specialised
 from safebasins.numerics.scheme_code import SchemeCode, fingerprint
 from safebasins.numerics.steps import coefs, row, step, wtuple
 from safebasins.wells import elementary
-from safebasins.wells.compiled import WellCode, abs_tracking, cpu_jit, fma, mul, well_energy2
+from safebasins.wells.compiled import LLVM_INLINE, WellCode, abs_tracking, cpu_jit, fma, mul, well_energy2
 
 __all__ = ["RNG_KEY", "MAX_STEPS", "StepNoise", "step_noise", "prepare", "escape_steps", "final_states",
            "gaussian_pairs"]
@@ -86,7 +86,8 @@ _S0, _S1, _S2, _S3, _S4, _S5, _S6, _S7 = (_taylor(k) for k in range(8))
 _C0, _C1, _C2, _C3, _C4, _C5, _C6, _C7, _C8 = (_taylor_cos(k) for k in range(9))
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+# not cached on disk: compiled into the kernels, whose rng key hashes this file (as _gauss2)
+@njit(**LLVM_INLINE)
 def _sincos_2pi(u: Any) -> tuple[float, float]:
     """(sin 2 pi u, cos 2 pi u) for u in [0, 1]: 4u = n + r with n an integer and |r| <= 1/2 (r
     exact), the Taylor polynomials of sin and cos(pi r / 2), rotated by the quadrant n mod 4
@@ -109,7 +110,8 @@ def _sincos_2pi(u: Any) -> tuple[float, float]:
     return s_out, c_out
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+# not cached on disk: it calls numerics.philox and wells.elementary, which the kernels' rng key hashes
+@njit(**LLVM_INLINE)
 def _gauss2(k0: Any, k1: Any, k: Any, m: Any, i: Any, tag: Any = _ZERO) -> tuple[float, float]:
     """The Box-Muller pair of step k of path m from initial condition i (module docstring; tag 1:
     the initial value of the coloured noise)."""
@@ -124,7 +126,7 @@ def _plus(f: Any, x: Any) -> Any:
     raise NotImplementedError("compiled code (numba)")
 
 
-@overload(_plus, inline="always")
+@overload(_plus, jit_options=LLVM_INLINE)
 def _ol_plus(f: Any, x: Any) -> Any:
     n = f.count
     ns: dict[str, Any] = {"Any": Any}
@@ -178,9 +180,6 @@ def _escape_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks
     -1: not within cycles periods).  Lanes run one forcing period at a time; at the period
     boundary finished lanes are written out and compacted and empty lanes take the next
     trajectories (every lane is at the same sub-step of the period)."""
-    literally(well)
-    literally(scheme)
-    literally(rng)
     S = FS.shape[0]
     w = wtuple(wpar)
     c = coefs(scheme, coef[0])
@@ -269,9 +268,6 @@ def _final_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks:
                 po: Any, eo: Any) -> None:
     """Plain integration (no escape) of trajectories j = task, task + n_tasks, ... for n_steps
     steps; the same step as _escape_task."""
-    literally(well)
-    literally(scheme)
-    literally(rng)
     S = FS.shape[0]
     w = wtuple(wpar)
     c = coefs(scheme, coef[0])

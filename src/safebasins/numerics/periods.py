@@ -65,13 +65,12 @@ def _reset(n: Int, ME: Floats, MQ: Floats, MN: Floats, signed: bool) -> None:
 def _arithmetic(scheme: types.Type,
                 well: types.Type) -> tuple[dict[str, Callable[..., Any]], bool, Step, Energy2, Lane]:
     """(helpers, abs_tracking, STEP, ENERGY2, LANE) of the literal scheme and kernel key: the
-    scheme's tuple helpers, the code's step and energy compiled for the CPU lanes (njit
-    inline="always") and the lane's coefficients (``LANE(l, HL, CL)``: formed from its step h =
-    HL[l] for an undamped scheme, the IEEE products lane_coefficients precomputes; read from its
-    column of CL, copied at load, for a damped one).  The loop bodies below call them directly
-    (inlined into the untyped IR, typed once with the body), not through the generic inline
-    overloads of steps.py / wells/compiled.py, which numba types anew at every call site and
-    type-inference round (~30 ms each, ~0.8 s of a kernel's first compile)."""
+    scheme's tuple helpers, the code's step and energy compiled for the CPU lanes
+    (wells.compiled.cpu_jit: compiled once, inlined by LLVM) and the lane's coefficients
+    (``LANE(l, HL, CL)``: formed from its step h = HL[l] for an undamped scheme, the IEEE
+    products lane_coefficients precomputes; read from its column of CL, copied at load, for a
+    damped one).  The loop bodies below call them directly, not through the generic overloads
+    of steps.py / wells/compiled.py (one wrapper fewer to type and compile)."""
     sc, code = literal_scheme(scheme), literal_code(well)
     return (cpu_helpers(sc.key), code.abs_tracking, cpu_step(sc.key, code.key), cpu_functions(code.key)[1],
             cpu_lane(sc.key))

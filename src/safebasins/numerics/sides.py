@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 import numpy.typing as npt
-from numba import literally, njit
+from numba import njit
 
 from safebasins.core import checks
 from safebasins.numerics import engine, schemes
@@ -33,8 +33,6 @@ RIGHT, LEFT, NONE = 1, -1, 0
 @njit(cache=True, nogil=True)
 def _sides(well: int, scheme: int, wpar: Floats, q0: Floats, p0: Floats, coef: Floats, F: float,
            sintab: Floats, n_steps: int, task: int, n_tasks: int, out: Ints, at: Ints) -> None:
-    literally(well)
-    literally(scheme)
     S = sintab.shape[0]
     w = wtuple(wpar)
     cc = coefs(scheme, coef[0])

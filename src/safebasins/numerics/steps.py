@@ -32,7 +32,7 @@ from numba.core import errors
 from numba.extending import overload
 
 from safebasins.numerics.scheme_code import SchemeCode, code_of_scheme, scheme_code
-from safebasins.wells.compiled import (Coefs, WellCode, literal_code, cpu_functions, cpu_jit, quartic_code,
+from safebasins.wells.compiled import (LLVM_INLINE, Coefs, WellCode, literal_code, cpu_functions, cpu_jit, quartic_code,
                                       well_energy2, well_force)
 
 #: the engine's float64 and int64 arrays
@@ -51,7 +51,7 @@ Lane = Callable[[int, Floats, Floats], Row]
 QUARTIC_KEY = quartic_code().key
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **LLVM_INLINE)
 def wtuple(wpar: Floats) -> Coefs:
     """The 14 coefficients of wpar as scalars (loaded once, before the step loops)."""
     return (wpar[2], wpar[3], wpar[4], wpar[5], wpar[6], wpar[7], wpar[8],
@@ -138,7 +138,7 @@ def step(scheme: int, well: int, w: Coefs, q: float, p: float, c: Row, f: Row) -
 
 # an overload's typing function sees numba types, its implementation values, and numba compares
 # their signatures, annotations included: Any is the annotation true of both
-@overload(step, inline="always")
+@overload(step, jit_options=LLVM_INLINE)
 def _ol_step(scheme: Any, well: Any, w: Any, q: Any, p: Any, c: Any, f: Any) -> Callable[..., tuple[float, float]]:
     STEP = cpu_step(literal_scheme(scheme).key, literal_code(well).key)
 
@@ -176,7 +176,7 @@ def _H(scheme: types.Type, name: str) -> Callable[..., Row]:
     return cpu_helpers(literal_scheme(scheme).key)[name]
 
 
-@overload(row, inline="always")
+@overload(row, jit_options=LLVM_INLINE)
 def _ol_row(scheme: Any, tab: Any, s: Any) -> Callable[..., Row]:
     H = _H(scheme, "row")
 
@@ -185,7 +185,7 @@ def _ol_row(scheme: Any, tab: Any, s: Any) -> Callable[..., Row]:
     return impl
 
 
-@overload(scaled, inline="always")
+@overload(scaled, jit_options=LLVM_INLINE)
 def _ol_scaled(scheme: Any, F: Any, t: Any) -> Callable[..., Row]:
     H = _H(scheme, "scaled")
 
@@ -194,7 +194,7 @@ def _ol_scaled(scheme: Any, F: Any, t: Any) -> Callable[..., Row]:
     return impl
 
 
-@overload(coefs, inline="always")
+@overload(coefs, jit_options=LLVM_INLINE)
 def _ol_coefs(scheme: Any, c: Any) -> Callable[..., Row]:
     H = _H(scheme, "coefs")
 
@@ -203,7 +203,7 @@ def _ol_coefs(scheme: Any, c: Any) -> Callable[..., Row]:
     return impl
 
 
-@overload(column, inline="always")
+@overload(column, jit_options=LLVM_INLINE)
 def _ol_column(scheme: Any, CL: Any, l: Any) -> Callable[..., Row]:
     H = _H(scheme, "column")
 
@@ -212,7 +212,7 @@ def _ol_column(scheme: Any, CL: Any, l: Any) -> Callable[..., Row]:
     return impl
 
 
-@overload(from_h, inline="always")
+@overload(from_h, jit_options=LLVM_INLINE)
 def _ol_from_h(scheme: Any, h: Any) -> Callable[..., Row]:
     H = _H(scheme, "from_h")
 
@@ -226,7 +226,7 @@ def is_damped(scheme: int) -> bool:
     raise NotImplementedError("compiled code (numba)")
 
 
-@overload(is_damped, inline="always")
+@overload(is_damped, jit_options=LLVM_INLINE)
 def _ol_is_damped(scheme: Any) -> Callable[..., bool]:
     def yes(scheme: Any) -> bool:
         return True
@@ -236,7 +236,7 @@ def _ol_is_damped(scheme: Any) -> Callable[..., bool]:
     return yes if literal_scheme(scheme).damped else no
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, **LLVM_INLINE)
 def scaled_row(scheme: int, tab: Floats, s: int, F: float) -> Row:
     """F times row s of a forcing table (the products the shared loop precomputes)."""
     return scaled(scheme, F, row(scheme, tab, s))

@@ -8,7 +8,7 @@ A well reaches the engines as a :class:`WellCode` (``Well.compiled``, built once
   coefficients), ``wpar = [q_left, q_right, w_0 .. w_13]`` with the barriers (+-inf on a side
   without one).
 * ``make(jit) -> (force, energy2)`` compiles them with a target's decorator: the CPU lanes use
-  :func:`cpu_jit`, ``numba.njit(inline="always")`` with the primitives bound to their CPU
+  :func:`cpu_jit`, ``numba.njit`` inlined by LLVM with the primitives bound to their CPU
   intrinsics (numerics/kernels.py, through :func:`well_force` / :func:`well_energy2`),
   the CUDA kernels ``numba.cuda.jit(device=True)`` (numerics/cuda_kernels.py).  The SAME Python
   source serves both; only the two primitives below differ by target.
@@ -50,7 +50,7 @@ import types as types_module
 from dataclasses import dataclass, field
 from pathlib import Path
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from numpy.typing import ArrayLike
 
@@ -59,9 +59,13 @@ from numba import njit, types
 from numba.core import errors
 from numba.extending import intrinsic, overload
 
+if TYPE_CHECKING:
+    from numba.core.decorators import _JITOptions   # numba's stubs: the options of njit
+
 __all__ = ["WellCode", "fma", "mul", "fma_cpu", "mul_cpu", "N_WPAR", "quartic_code", "polynomial_code", "callable_code",
            "target_code",
            "well_force", "well_energy2", "abs_tracking", "code_of", "literal_code", "cpu_jit", "cpu_leaf_jit",
+           "LLVM_INLINE",
            "cpu_functions",
            "POLY_DEGREES"]
 
@@ -102,7 +106,12 @@ def mul(a: float, b: float) -> float:
     return a * b
 
 
-@overload(fma, inline="always")
+#: the options of the engine's compiled helpers (:func:`cpu_jit`, the overloads' implementations):
+#: each compiled on its own and inlined by LLVM (alwaysinline) into its callers
+LLVM_INLINE: _JITOptions = {"forceinline": True, "error_model": "numpy"}
+
+
+@overload(fma, jit_options=LLVM_INLINE)
 def _ol_fma(a: Any, b: Any, c: Any) -> Callable[..., float]:
     # an overload's implementation takes its parameters with the same annotations (numba compares them)
     def impl(a: Any, b: Any, c: Any) -> float:
@@ -110,7 +119,7 @@ def _ol_fma(a: Any, b: Any, c: Any) -> Callable[..., float]:
     return impl
 
 
-@overload(mul, inline="always")
+@overload(mul, jit_options=LLVM_INLINE)
 def _ol_mul(a: Any, b: Any) -> Callable[..., float]:
     def impl(a: Any, b: Any) -> float:
         return a * b  # type: ignore[no-any-return]  # floats (numba types the call)
@@ -331,19 +340,20 @@ _CPU_PRIMITIVES = {"fma": (fma, fma_cpu), "mul": (mul, mul_cpu)}
 
 
 def cpu_jit(fn: Callable[..., Any]) -> Any:
-    """``njit(inline="always")`` of a function of the wells' one source (a force, an energy, a
-    scheme's step) for the CPU lanes, with its globals ``fma`` and ``mul`` (when they are this
-    module's) bound to the CPU primitives: the same operations, typed once per signature; through
-    the generic functions' inline overloads numba reruns its front end at every call site and
-    type-inference round (~2.5 ms each, ~2 s of a kernel's first compile)."""
-    return njit(inline="always")(_cpu_globals(fn))
+    """A function of the wells' one source (a force, an energy, a scheme's step, a well's ``V`` or
+    ``dV``) for the CPU lanes: ``njit`` with its globals ``fma`` and ``mul`` (when they are this
+    module's) bound to the CPU primitives, compiled on its own once per signature and inlined by
+    LLVM into its callers (:data:`LLVM_INLINE`).  Inlined by numba instead (``inline="always"``),
+    every call site would be typed and lowered anew (the step once per chain of the lane loop, the
+    force once per stage of the step): most of a kernel's first compile.  numpy's error model: a
+    division never raises (x/0 is inf, as on the GPU); a raising one would give the lane loop an
+    exit and keep it scalar."""
+    return njit(**LLVM_INLINE)(_cpu_globals(fn))
 
 
 def cpu_leaf_jit(fn: Callable[..., Any]) -> Any:
-    """A well's ``V`` or ``dV`` for the CPU lanes: compiled on its own with numpy's error model (a
-    division never raises, x/0 is inf as on the GPU: a raising division would give the lane loop
-    an exit and keep it scalar) and inlined by LLVM; globals bound as by :func:`cpu_jit`."""
-    return njit(error_model="numpy", forceinline=True)(_cpu_globals(fn))
+    """A well's ``V`` or ``dV`` for the CPU lanes: :func:`cpu_jit`."""
+    return cpu_jit(fn)
 
 
 def _cpu_globals(fn: Callable[..., Any]) -> Callable[..., Any]:
@@ -378,7 +388,7 @@ def abs_tracking(well: int) -> bool:
 
 
 # the code of a key is chosen at typing time: a kernel holds only its own well's arithmetic
-@overload(well_force, inline="always")
+@overload(well_force, jit_options=LLVM_INLINE)
 def _ol_well_force(well: Any, w: Any, q: Any, f: Any) -> Callable[..., float]:
     FORCE = cpu_functions(literal_code(well).key)[0]
 
@@ -387,7 +397,7 @@ def _ol_well_force(well: Any, w: Any, q: Any, f: Any) -> Callable[..., float]:
     return impl
 
 
-@overload(well_energy2, inline="always")
+@overload(well_energy2, jit_options=LLVM_INLINE)
 def _ol_well_energy2(well: Any, w: Any, q: Any, p: Any) -> Callable[..., float]:
     ENERGY2 = cpu_functions(literal_code(well).key)[1]
 
@@ -396,7 +406,7 @@ def _ol_well_energy2(well: Any, w: Any, q: Any, p: Any) -> Callable[..., float]:
     return impl
 
 
-@overload(abs_tracking, inline="always")
+@overload(abs_tracking, jit_options=LLVM_INLINE)
 def _ol_abs_tracking(well: Any) -> Callable[..., bool]:
     def yes(well: Any) -> bool:
         return True
