@@ -58,15 +58,9 @@ def test_levels_figure_and_notes(levels: xr.Dataset) -> None:
 
 @pytest.fixture(scope="module")
 def with_theory(levels: xr.Dataset) -> xr.Dataset:
-    from safebasins import theory
-    from safebasins.pipeline.kinds.noise import _with_agreement
+    from safebasins.analysis.noise_theory import escape_probability_with_theory
 
-    maps = []
-    for s in (0.005, 0.02):
-        th = theory.escape_probability(Q0, P0, 0.01, 0.9, math.pi, 0.18, noise=s, t_eval=[1, 3], cells=(16, 20))
-        maps.append(_with_agreement(th, levels.sel(noise=s)).expand_dims(noise=[s]))
-    out = xr.concat(maps, dim="noise", combine_attrs="override", data_vars="all")
-    return out.assign_attrs(theory_cells=[16, 20])
+    return escape_probability_with_theory(levels, 0.01, 0.9, math.pi, KW["xi_max"], cells=(16, 20))
 
 
 def test_levels_figure_with_the_theory(with_theory: xr.Dataset) -> None:
