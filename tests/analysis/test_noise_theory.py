@@ -35,7 +35,11 @@ def test_one_level_is_the_theory_and_the_agreement() -> None:
     np.testing.assert_array_equal(out["P_escape_theory"].values, th["P_escape"].values)
     for k in ("P_escape_mean_abs_difference", "P_escape_max_abs_difference"):
         np.testing.assert_array_equal(out[k].values, ref[k].values, err_msg=k)
-        assert out.attrs[k] == ref.attrs[k]
+    # the overall mean is the mean of the per-t_eval means (levels may be stacked), summed in
+    # another order than probability_agreement's: its last bit follows numpy's SIMD loops
+    assert out.attrs["P_escape_mean_abs_difference"] == pytest.approx(ref.attrs["P_escape_mean_abs_difference"],
+                                                                      rel=1e-14)
+    assert out.attrs["P_escape_max_abs_difference"] == ref.attrs["P_escape_max_abs_difference"]
     for k in ("P_escape_mean_abs_difference_uncertain", "P_escape_theory_within_wilson"):
         assert out[k].dims == () and float(out[k]) == ref.attrs[k] and out[k].attrs["units"] == "1"
     assert out.attrs["theory_cycles"] == 3 and list(out.attrs["theory_cells"]) == [16, 20]
