@@ -14,6 +14,7 @@ from click.testing import CliRunner
 from safebasins.analysis import stochastic_erosion
 from safebasins.analysis.stochastic_integrity import stochastic_erosion_theory
 from safebasins.cli import main
+from safebasins.core.averaged_theory import MIN_CELLS
 from tests.cli.test_quiet_cli import STRICT, run
 
 BASE = ["stochastic-erosion", "--F", "0,0.01", "--Omega", "0.9", "--Psi", "pi", "--xi-max", "0.18",
@@ -88,7 +89,7 @@ def test_zero_noise_level_has_no_theory(tmp_path):
     (["--epsilon", "0.1"], "'--paths'", "--no-conservative"),        # 12 paths certify no epsilon < 0.24
     (["--t-eval", "3,1"], "'--t-eval'", "strictly increasing"),
     (["--cycles", "2"], "'--t-eval'", "beyond the horizon"),
-    (["--theory-cells", "4"], "'--theory-cells'", "at least 8"),
+    (["--theory-cells", "4"], "'--theory-cells'", f">= {MIN_CELLS}"),
     (["--paths", "0"], "'--paths'", "paths"),
     (["--xi-max", "0.3"], "'--xi-max'", "1/4"),
 ], ids=lambda v: v if isinstance(v, str) else " ".join(v))

@@ -15,6 +15,7 @@ from click.testing import CliRunner
 from safebasins import theory
 from safebasins.analysis.agreement import probability_agreement
 from safebasins.cli import main
+from safebasins.core.averaged_theory import MIN_CELLS
 from safebasins.numerics import escape_chart, escape_probability
 from safebasins.wells import resolve_well
 
@@ -167,7 +168,7 @@ def test_no_theory_says_why(tmp_path, extra, reason):
 
 
 @pytest.mark.parametrize("args, reason", [
-    (["--theory-cells", "4x20"], "at least 8 cells"),
+    (["--theory-cells", "4x20"], f">= {MIN_CELLS} (n_gamma, n_J)"),
     (["--theory-cells", "16,20"], "N or NQxNP"),
     (["--theory-steps-per-cycle", "0"], "steps_per_cycle"),
 ])

@@ -19,7 +19,6 @@ an absent theory is stated, never a silent gap.  Where it applies the Dataset ga
 """
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import Any
 
@@ -30,12 +29,12 @@ import xarray as xr
 from safebasins.analysis.agreement import probability_agreement
 from safebasins.analysis.stochastic_integrity import stochastic_erosion_theory
 from safebasins.core import cf, checks
+from safebasins.core.averaged_theory import CELLS, STEPS_PER_CYCLE, check_cells, theory_cycles
 from safebasins.theory import escape_probability as theory_escape_probability
-from safebasins.theory.noise_escape import GRID_DEFAULT, STEPS_PER_CYCLE
 from safebasins.wells import resolve_well
 from safebasins.wells.base import WellLike
 
-__all__ = ["escape_probability_with_theory", "stochastic_erosion_with_theory", "theory_reason", "theory_cycles",
+__all__ = ["escape_probability_with_theory", "stochastic_erosion_with_theory", "theory_reason",
            "THEORY_MEASURES"]
 
 #: the integrity measures the theory's erosion profile adds (as <measure>_theory)
@@ -45,11 +44,6 @@ _REFUSALS = ("well:", "xi_max ")
 #: the per-level summaries of probability_agreement stored as variables (stacked over noise)
 _LEVEL_SUMMARIES = ("P_escape_mean_abs_difference_uncertain", "P_escape_theory_within_wilson")
 _AGREEMENT = ("P_escape_theory", "P_escape_mean_abs_difference", "P_escape_max_abs_difference")
-
-
-def theory_cycles(t_eval: npt.ArrayLike) -> int:
-    """The theory's horizon (theory.escape_probability): the largest t_eval rounded up, at least 1."""
-    return max(1, math.ceil(float(np.max(t_eval))))
 
 
 def theory_reason(*, theory: bool, noise: float | Sequence[float] | npt.ArrayLike, noise_time: float) -> str | None:
@@ -84,9 +78,7 @@ def _settings(cells: Any, steps_per_cycle: Any, theory: Any) -> tuple[tuple[int,
     if not isinstance(theory, (bool, np.bool_)):
         raise ValueError(f"theory must be True or False, got {checks.value_repr(theory)}")
     c = tuple(checks.check_positive_int("cells", n) for n in np.atleast_1d(np.asarray(cells)).tolist())
-    if len(c) != 2:
-        raise ValueError(f"cells must be (n_gamma, n_J), got {checks.value_repr(cells)}")
-    return (c[0], c[1]), checks.check_positive_int("steps_per_cycle", steps_per_cycle)
+    return check_cells(c), checks.check_positive_int("steps_per_cycle", steps_per_cycle)
 
 
 def _levels(ensemble: Any) -> tuple[np.ndarray, bool]:
@@ -106,7 +98,7 @@ def _levels(ensemble: Any) -> tuple[np.ndarray, bool]:
 
 def escape_probability_with_theory(ensemble: xr.Dataset, F: float, Omega: float, Psi: float, xi_max: float, *,
                                    damping: float = 0.0, well: WellLike = None, noise_time: float = 0.0,
-                                   theory: bool = True, cells: tuple[int, int] = GRID_DEFAULT,
+                                   theory: bool = True, cells: tuple[int, int] = CELLS,
                                    steps_per_cycle: int = STEPS_PER_CYCLE) -> xr.Dataset:
     """The ensemble map with the averaged theory's map and their agreement, where the theory applies.
 
@@ -169,7 +161,7 @@ def stochastic_erosion_with_theory(profile: xr.Dataset, q0: npt.ArrayLike, p0: n
                                    noise: float | Sequence[float] | npt.ArrayLike, epsilon: npt.ArrayLike,
                                    xi_max: float, t_eval: npt.ArrayLike, damping: float = 0.0, well: WellLike = None,
                                    bottom: tuple[float, float] = (0.0, 0.0), noise_time: float = 0.0,
-                                   theory: bool = True, cells: tuple[int, int] = GRID_DEFAULT,
+                                   theory: bool = True, cells: tuple[int, int] = CELLS,
                                    steps_per_cycle: int = STEPS_PER_CYCLE) -> xr.Dataset:
     """The ensembles' erosion profile with the averaged theory's, where the theory applies.
 

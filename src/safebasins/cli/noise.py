@@ -14,6 +14,7 @@ from safebasins.cli.options import (NONNEG, THRESHOLD, Deferred, Fields, Number,
                                     from_library, grid_options, grid_params, joined, lib_check, library_errors,
                                     no_fourier, out_option, steps_option, threads_option)
 from safebasins.cli.output import chatter, draw, finish, write_outputs
+from safebasins.core.averaged_theory import CELLS, MIN_CELLS, STEPS_PER_CYCLE, check_cells
 from safebasins.pipeline.cost import NOISE_STEP_COST
 from safebasins.pipeline.values import fmt
 
@@ -21,32 +22,20 @@ __all__ = ["escape_probability", "theory_options", "noise_options", "theory_sett
 
 #: the library function whose defaults the options take
 LIBRARY = "safebasins.numerics:escape_probability"
-#: the library function adding the averaged theory (its defaults: the theory's solver settings)
-THEORY = "safebasins.analysis.noise_theory:escape_probability_with_theory"
 #: at most this many --t-eval values (one panel each)
 MAX_T_EVAL = 4
-#: the theory's smallest polar grid per axis (theory.escape_probability refuses fewer cells)
-MIN_THEORY_CELLS = 8
-
-
-def _theory_cells(ctx: click.Context, param: click.Parameter, value: Any) -> tuple[int, int]:
-    cells = tuple(int(n) for n in value)
-    if len(cells) != 2 or min(cells) < MIN_THEORY_CELLS:
-        raise click.BadParameter(f"the theory's polar grid needs at least {MIN_THEORY_CELLS} cells per axis "
-                                 f"(n_gamma x n_J), got {value!r}", ctx, param)
-    return cells[0], cells[1]
 
 
 def theory_options(f: Any) -> Any:
-    """--theory/--no-theory, --theory-cells, --theory-steps-per-cycle (the library's defaults)."""
-    f = click.option("--theory-steps-per-cycle", "theory_steps_per_cycle", cls=Deferred, type=int,
-                     default=from_library(THEORY, "steps_per_cycle"),
+    """--theory/--no-theory, --theory-cells, --theory-steps-per-cycle (the theory's defaults,
+    safebasins.core.averaged_theory)."""
+    f = click.option("--theory-steps-per-cycle", "theory_steps_per_cycle", type=int, default=STEPS_PER_CYCLE,
+                     show_default=True,
                      callback=checked("steps_per_cycle", lib_check("safebasins.core.checks:check_positive_int")),
                      help="The averaged theory's time steps per forcing cycle.")(f)
-    f = click.option("--theory-cells", "theory_cells", cls=Deferred, type=Fields("size"),
-                     default=lambda: "x".join(str(n) for n in from_library(THEORY, "cells")()),
-                     callback=_theory_cells,
-                     help=f"The averaged theory's polar grid: N or N_GAMMAxN_J cells (>= {MIN_THEORY_CELLS}).")(f)
+    f = click.option("--theory-cells", "theory_cells", type=Fields("size"), default="x".join(str(n) for n in CELLS),
+                     show_default=True, callback=checked(None, lambda v: check_cells(tuple(int(n) for n in v))),
+                     help=f"The averaged theory's polar grid: N or N_GAMMAxN_J cells (>= {MIN_CELLS}).")(f)
     return click.option("--theory/--no-theory", "theory", default=True, show_default=True,
                         help="Also solve the averaged theory (docs/noise-theory.md) and store it with its agreement "
                              "where it applies (white noise, every --noise > 0, a symmetric well, --xi-max below "

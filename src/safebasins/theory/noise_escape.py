@@ -11,13 +11,12 @@ ensembles of :func:`safebasins.numerics.escape_probability`.
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
 
 from safebasins.core import cf, checks
+from safebasins.core.averaged_theory import CELLS, STEPS_PER_CYCLE, check_cells, theory_cycles
 from safebasins.theory.noise_averaging import AveragedDiffusion, averaged_diffusion
 from safebasins.theory.noise_semilagrangian import march_escape_sl
 from safebasins.theory.noise_solver import ADVECTION, DiscGrid, generator, interpolation, march_escape, \
@@ -27,12 +26,8 @@ from safebasins.wells import resolve_well
 from safebasins.wells.base import Well
 from safebasins.wells.provenance import api_provenance
 
-__all__ = ["escape_probability", "mean_first_passage", "GRID_DEFAULT", "STEPS_PER_CYCLE", "SCHEMES"]
+__all__ = ["escape_probability", "mean_first_passage", "SCHEMES"]
 
-#: cells ``(n_gamma, n_J)`` of the polar grid
-GRID_DEFAULT = (128, 160)
-#: time steps per forcing cycle of the march
-STEPS_PER_CYCLE = 8
 #: the advection of the time march: semi-Lagrangian (noise_semilagrangian) or the finite volumes'
 SCHEMES = ("semi-lagrangian",) + ADVECTION
 #: how far outside [0, 1] an Eulerian march may go before its oscillations are an error
@@ -61,12 +56,10 @@ def _setup(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_
                          "slow flow (theory.slow_flow_escapes)")
     if advection not in schemes:
         raise ValueError(f"advection must be one of {schemes}, got {advection!r}")
-    if (not isinstance(cells, tuple) or len(cells) != 2
-            or any(isinstance(c, bool) or not isinstance(c, (int, np.integer)) or c < 8 for c in cells)):
-        raise ValueError(f"cells must be a pair of integers >= 8 (n_gamma, n_J), got {cells!r}")
+    n_gamma, n_J = check_cells(cells)
     ics = checks.initial_conditions(q0, p0, grid)
     diff = averaged_diffusion(w, par["xi_max"])
-    return w, par, ics, DiscGrid(int(cells[0]), int(cells[1]), diff.J_max), diff
+    return w, par, ics, DiscGrid(n_gamma, n_J, diff.J_max), diff
 
 
 def _slow_points(w: Well, Q: FloatArray, P: FloatArray, Psi: float, xi_max: float
@@ -96,7 +89,7 @@ def _attrs(par: dict[str, float], w: Well, grid: DiscGrid, advection: str) -> di
 @api_provenance
 def escape_probability(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_max: float, *,
                        noise: float, t_eval: ArrayLike, damping: float = 0.0, well: WellArg = None,
-                       grid: bool | None = None, cells: tuple[int, int] = GRID_DEFAULT,
+                       grid: bool | None = None, cells: tuple[int, int] = CELLS,
                        steps_per_cycle: int = STEPS_PER_CYCLE, advection: str = "semi-lagrangian") -> xr.Dataset:
     """Probability of escape within each ``t_eval`` (forcing cycles) from the averaged theory.
 
@@ -119,7 +112,7 @@ def escape_probability(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi
                                                           grid, cells, advection, SCHEMES)
     te = checks.check_1d("t_eval", t_eval, checks.check_nonnegative)
     spc = checks.check_positive_int("steps_per_cycle", steps_per_cycle)
-    cycles = max(1, math.ceil(float(te.max())))
+    cycles = theory_cycles(te)
     inside, gamma, J = _slow_points(w, Q, P, par["Psi"], par["xi_max"])
     W, w_b = interpolation(dgrid, gamma, J)
     period = 2.0 * np.pi / par["Omega"]
@@ -153,7 +146,7 @@ def escape_probability(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi
 @api_provenance
 def mean_first_passage(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_max: float, *,
                        noise: float, damping: float = 0.0, well: WellArg = None, grid: bool | None = None,
-                       cells: tuple[int, int] = GRID_DEFAULT, advection: str = "central") -> xr.Dataset:
+                       cells: tuple[int, int] = CELLS, advection: str = "central") -> xr.Dataset:
     """Mean first-passage time to ``xi_max`` (forcing cycles) of the averaged theory, from the
     stationary backward equation ``L T = -1`` on the finite volumes (``advection`` "central" or
     "upwind"; a central solution with negative times, unresolved cell Peclet numbers, raises an

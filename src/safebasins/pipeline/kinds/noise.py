@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
+from safebasins.core.averaged_theory import CELLS, MIN_CELLS, STEPS_PER_CYCLE
 from safebasins.core.statistics import certifiable_epsilon, paths_needed
 from safebasins.pipeline import values
 from safebasins.pipeline.cost import NOISE_STEP_COST
@@ -115,15 +116,15 @@ THEORY_APPLIES = ("white noise (noise_time 0), every noise level > 0, a symmetri
 
 
 def _theory_keys(stores: str) -> dict[str, Any]:
-    """The averaged theory's keys (the defaults of safebasins.theory.escape_probability); ``stores``:
+    """The averaged theory's keys (the theory's defaults, safebasins.core.averaged_theory); ``stores``:
     what the kind's dataset gains with it."""
     return {
         "theory": {"description": f"also solve the averaged theory (docs/noise-theory.md) and store {stores}. "
                                   f"It applies to {THEORY_APPLIES}", "type": "boolean", "default": True},
         "theory_cells": {"description": "the theory's polar grid (n_gamma, n_J)", "type": "array", "minItems": 2,
-                         "maxItems": 2, "items": {"type": "integer", "minimum": 8}, "default": [128, 160]},
+                         "maxItems": 2, "items": {"type": "integer", "minimum": MIN_CELLS}, "default": list(CELLS)},
         "theory_steps_per_cycle": {"description": "the theory's time steps per forcing cycle", "type": "integer",
-                                   "minimum": 1, "default": 8},
+                                   "minimum": 1, "default": STEPS_PER_CYCLE},
     }
 
 
