@@ -5,12 +5,12 @@ bitwise, and escape_probability(backend="cuda") returns the CPU's Dataset.
 The simulator must be switched on before numba.cuda is first imported, so the GPU side runs in a
 SUBPROCESS with NUMBA_ENABLE_CUDASIM=1 (this file run as a script, cases as JSON on stdin), as in
 tests/numerics/test_cuda_simulator.py; the CPU side runs in the test process.  Cases: white and
-coloured noise, undamped and damped, the quartic (|q| tracking) and the pendulum (signed
-tracking; its force and energy call wells.elementary's sin and cos), SRKN6b and RK4, a seed above
-2^32 (both words of the Philox key), a displacement bound pair; in every case some paths escape at
-the initial condition, some later and some not within the horizon.  Few initial conditions,
-paths and cycles of 8 steps, few simulator threads (each takes several trajectories): the
-simulator runs every operation as Python, every thread as a Python thread.
+coloured noise, Gaussian and five-point variates, undamped and damped, the quartic (|q| tracking)
+and the pendulum (signed tracking; its force and energy call wells.elementary's sin and cos),
+SRKN6b and RK4, a seed above 2^32 (both words of the Philox key), a displacement bound pair; in
+every case some paths escape at the initial condition, some later and some not within the
+horizon.  Few initial conditions, paths and cycles of 8 steps, few simulator threads (each takes
+several trajectories): the simulator runs every operation as Python, every thread as a Python thread.
 """
 from __future__ import annotations
 
@@ -61,6 +61,12 @@ def _cases() -> dict[str, dict[str, Any]]:
         "quartic/white/bounds": dict(quartic, noise=0.05, bounds=[-0.7, 0.6], seed=3, block=2, grid=2),
         "pendulum/white": dict(pendulum, noise=0.2, seed=1),
         "pendulum/coloured/damped": dict(pendulum, noise=0.3, noise_time=1.2, damping=0.1, seed=9),
+        # the five-point law: 8 steps a period (half a Philox block), 40 (three blocks, the last one partial)
+        "quartic/white/five-point": dict(quartic, noise=0.05, seed=7, variates="five-point"),
+        "quartic/white/damped/five-point/40": dict(quartic, noise=0.08, damping=0.1, seed=2 ** 40 + 3,
+                                                   variates="five-point", steps=40),
+        "pendulum/coloured/damped/five-point": dict(pendulum, noise=0.3, noise_time=1.2, damping=0.1, seed=9,
+                                                    variates="five-point"),
     }
 
 
@@ -69,16 +75,17 @@ def _arguments(case: dict[str, Any]) -> tuple[tuple[Any, ...], dict[str, Any]]:
     escape_probability forms them."""
     q0, p0 = np.array(case["q0"]), np.array(case["p0"])
     pb = ensemble_problem(q0, p0, np.zeros(q0.size, np.int64), [case["Omega"]], [case["F"]], case["Psi"],
-                          xi_max=[case["xi_max"]], cycles=CYCLES, steps_per_cycle=STEPS,
+                          xi_max=[case["xi_max"]], cycles=CYCLES, steps_per_cycle=case.get("steps", STEPS),
                           integrator=case.get("integrator", "srkn6b"), well=case["well"],
                           damping=case.get("damping", 0.0))
     h = float(pb.step_sizes()[0])
     tau = case.get("noise_time", 0.0)
     thrE2 = case.get("thrE2", float(pb.thrE2[0]))
+    variates = case.get("variates", "gaussian")
     args = (pb.code, pb.scheme, q0, p0, PATHS, pb.coefficients(), pb.sine_table(), case["F"], thrE2, CYCLES,
-            noise_kernels.step_noise(case["noise"], h, tau), case["seed"])
+            noise_kernels.step_noise(case["noise"], h, tau, noise_kernels.LAWS[variates]), case["seed"])
     bounds = tuple(case.get("bounds", (-math.inf, math.inf)))
-    kw = dict(shift=energy_shift(case["noise"], h, "shift", tau), bounds=bounds)
+    kw = dict(shift=energy_shift(case["noise"], h, "shift", tau, variates), bounds=bounds)
     return args, kw
 
 
@@ -119,7 +126,7 @@ def child() -> None:
         t = time.perf_counter()
         steps = cuda_noise.escape_steps(*args, **kw, block=case.get("block", 4), grid=case.get("grid", 1))
         out[name] = dict(steps=steps.tolist(), dtype=str(steps.dtype), seconds=round(time.perf_counter() - t, 2))
-    ds = escape_probability(**API, backend="cuda")
+    ds = [escape_probability(**API, backend="cuda", variates=v) for v in ("gaussian", "five-point")]
     Path(job["api"]).write_bytes(pickle.dumps(ds))
     print(json.dumps(out))
 
@@ -161,12 +168,13 @@ def test_cuda_simulator_noise_matches_cpu_bitwise(tmp_path: Path) -> None:
         assert (cpu == 0).any() and (cpu > 0).any() and (cpu < 0).any(), (name, cpu)
         # and the noise acts: some initial condition's paths differ
         assert (cpu.min(axis=1) != cpu.max(axis=1)).any(), (name, cpu)
-    cuda_ds = pickle.loads(api_path.read_bytes())
-    cpu_ds = escape_probability(**API, backend="cpu")
-    xr.testing.assert_identical(_without_call(cuda_ds), _without_call(cpu_ds))
-    p = cpu_ds.P_escape.values
-    assert ((p > 0) & (p < 1)).any() and (p == 0).any(), p
-    assert json.loads(cuda_ds.attrs["parameters"])["backend"] == "cuda"
+    for cuda_ds, variates in zip(pickle.loads(api_path.read_bytes()), ("gaussian", "five-point")):
+        cpu_ds = escape_probability(**API, backend="cpu", variates=variates)
+        xr.testing.assert_identical(_without_call(cuda_ds), _without_call(cpu_ds))
+        p = cpu_ds.P_escape.values
+        assert ((p > 0) & (p < 1)).any() and (p == 0).any(), p
+        assert json.loads(cuda_ds.attrs["parameters"])["backend"] == "cuda"
+        assert cpu_ds.attrs["variates"] == variates
     print(f"simulator subprocess: {wall:.1f} s; per case {[gpu[n]['seconds'] for n in cases]}")
 
 

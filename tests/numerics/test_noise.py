@@ -19,46 +19,51 @@ P = np.linspace(-0.5, 0.5, 7)
 FORCING = dict(F=0.04, Omega=0.9, Psi=0.3)
 
 
-@pytest.mark.parametrize("damping", [0.0, 0.02])
-def test_zero_noise_is_escape_chart_bitwise(damping):
+@pytest.mark.parametrize("damping,variates", [(0.0, "gaussian"), (0.02, "gaussian"), (0.02, "five-point")])
+def test_zero_noise_is_escape_chart_bitwise(damping, variates):
     """sigma = 0: every path is the engine's trajectory (the half kicks add exact zeros), so the
-    escape cycles are escape_chart's, bit for bit, for every path and seed."""
+    escape cycles are escape_chart's, bit for bit, for every path, seed and law of the variates."""
     chart = escape_chart(Q, P, **FORCING, xi_max=0.2, cycles=40, damping=damping)
     want = np.minimum(chart.escape_cycle_energy.isel(xi_max=0).values, 40.0)
     assert np.isinf(want).any() is np.False_ and (want == 40).any() and ((want > 0) & (want < 40)).any()
     ds = escape_probability(Q, P, **FORCING, noise=0.0, paths=1, xi_max=0.2, t_eval=[40], cycles=40, damping=damping,
-                            seed=5)
+                            seed=5, variates=variates)
     np.testing.assert_array_equal(ds.first_passage_mean.values, want)
     np.testing.assert_array_equal(ds.censored_fraction.values, np.isinf(chart.escape_cycle_energy[0]).values)
     assert np.isnan(ds.first_passage_sem).all()          # one path: no standard error (documented)
     three = escape_probability(Q, P, **FORCING, noise=0.0, paths=3, xi_max=0.2, t_eval=[10, 40], cycles=40,
-                               damping=damping, seed=9)
+                               damping=damping, seed=9, variates=variates)
     for t in (10, 40):
         np.testing.assert_array_equal(three.P_escape.sel(t_eval=t).values,
                                       (chart.escape_cycle_energy[0] <= t).values.astype(float))
     assert (three.first_passage_sem == 0).all()          # three equal paths
 
 
-def _kernel_run(n_tasks, lanes, n_paths=37, seed=11):
+def _kernel_run(n_tasks, lanes, n_paths=37, seed=11, law=noise_kernels.GAUSSIAN, S=16):
     code, sc = quartic_code(), scheme_code("srkn6b", True)
-    coef = schemes.lane_coefficients([0.9], 16, "srkn6b", 0.05)
-    tab = schemes.sine_table(16, 0.0)
+    coef = schemes.lane_coefficients([0.9], S, "srkn6b", 0.05)
+    tab = schemes.sine_table(S, 0.0)
     q0, p0 = np.array([0.0, 0.3, -0.5, 0.9]), np.array([0.0, 0.1, 0.2, 0.5])
     return noise_kernels.escape_steps(code, sc, q0, p0, n_paths, coef, tab, 0.03, 0.4, 30,
-                                      noise_kernels.StepNoise(0.02), seed, shift=0.01,
+                                      noise_kernels.StepNoise(0.02, law=law), seed, shift=0.01,
                                       n_tasks=n_tasks, lanes=lanes)
 
 
-def test_paths_do_not_depend_on_tasks_lanes_or_order():
+@pytest.mark.parametrize("law,S", [(noise_kernels.GAUSSIAN, 16), (noise_kernels.FIVE_POINT, 16),
+                                   (noise_kernels.FIVE_POINT, 21)])
+def test_paths_do_not_depend_on_tasks_lanes_or_order(law, S):
     """Counter-based streams: the first-passage steps are the same for 1 or 3 tasks and 256 or 7
     lanes (lanes refilled and compacted at other moments); a path's steps do not depend on how
-    many paths are run (path m of IC i is the same path in a longer run)."""
-    ref = _kernel_run(1, 256)
+    many paths are run (path m of IC i is the same path in a longer run); either law (five-point:
+    a block per period, or two with the second partial)."""
+    ref = _kernel_run(1, 256, law=law, S=S)
     assert (ref > 0).any() and (ref < 0).any()
-    np.testing.assert_array_equal(_kernel_run(3, 7), ref)
-    np.testing.assert_array_equal(_kernel_run(2, 64), ref)
-    np.testing.assert_array_equal(_kernel_run(1, 256, n_paths=50)[:, :37], ref)
-    assert not np.array_equal(_kernel_run(1, 256, seed=12), ref)
+    np.testing.assert_array_equal(_kernel_run(3, 7, law=law, S=S), ref)
+    np.testing.assert_array_equal(_kernel_run(2, 64, law=law, S=S), ref)
+    np.testing.assert_array_equal(_kernel_run(1, 256, n_paths=50, law=law, S=S)[:, :37], ref)
+    assert not np.array_equal(_kernel_run(1, 256, seed=12, law=law, S=S), ref)
+    if law != noise_kernels.GAUSSIAN:
+        assert not np.array_equal(_kernel_run(1, 256, S=S), ref)
     kw = dict(noise=0.03, paths=40, xi_max=0.2, t_eval=[5, 20], damping=0.05, seed=3)
     a = escape_probability(Q, P, **FORCING, threads=1, **kw)
     b = escape_probability(Q, P, **FORCING, threads=2, **kw)
@@ -148,7 +153,8 @@ GOOD = dict(noise=0.05, paths=10, xi_max=0.2, t_eval=[5])
     (dict(xi_max=0.3), "xi_max"), (dict(xi_max=-1), "xi_max"),
     (dict(t_eval=[-1]), "t_eval"), (dict(t_eval=[20], cycles=10), "t_eval"), (dict(t_eval=[]), "t_eval"),
     (dict(seed=-1), "seed"), (dict(seed=2 ** 63), "seed"), (dict(seed=1.5), "seed"), (dict(seed=True), "seed"),
-    (dict(correction="bridge"), "correction"), (dict(backend="gpu"), "backend"), (dict(damping=-0.1), "damping"),
+    (dict(correction="bridge"), "correction"), (dict(variates="uniform"), "variates"), (dict(backend="gpu"), "backend"),
+    (dict(damping=-0.1), "damping"),
     (dict(cycles=0), "cycles"), (dict(steps_per_cycle=2), "steps_per_cycle"), (dict(threads=0), "threads"),
     (dict(integrator="euler"), "integrator"), (dict(noise_time=-1.0), "noise_time"),
     (dict(noise_time=0.05), "noise_time"),

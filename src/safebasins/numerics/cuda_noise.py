@@ -4,7 +4,8 @@
 noise_kernels.prepare) and returns the same first steps beyond the thresholds, bitwise: each
 trajectory (initial condition i, path m) runs the CPU lanes' sequence of IEEE operations,
 
-    eta(0) = s_eta Z_1(0, m, i, tag 1);  per step n: (Z_1, Z_2) = Box-Muller of Philox (n, m, i, 0),
+    eta(0) = s_eta Z_1(0, m, i, tag 1);  per step n: (Z_1, Z_2) = Box-Muller of Philox (n, m, i, 0)
+    (five-point law: the nibbles of the step's byte of block (b, m, i, 2), noise_kernels),
     eta = c1 eta + c2 Z_1, p += a Z_1, (q, p) = step(q, p; F sin + eta), p += a Z_2, eta = c1 eta + c2 Z_2,
     escape when 2 H0 + shift ``|p|`` > 2 xi_max, q beyond a barrier or a bound (a NaN state included)
 
@@ -78,11 +79,24 @@ def _as_module(ns: SimpleNamespace, name: str) -> ModuleType:
 
 
 @functools.cache
+def _philox_device() -> Any:
+    return _device(philox.philox4x32)
+
+
+@functools.cache
+def _five_point() -> tuple[Any, Any]:
+    """noise_kernels._block and _five2 as device functions: a five-point block's words and the
+    variates of one byte."""
+    five = _retarget(noise_kernels._five)
+    return (_retarget(noise_kernels._block, _philox=_philox_device()), _retarget(noise_kernels._five2, _five=five))
+
+
+@functools.cache
 def _gauss2() -> Any:
     """noise_kernels._gauss2 as a device function: the Box-Muller pair of one Philox block."""
     el = _as_module(elementary.cuda_device(), "safebasins.wells.elementary.cuda_device")
     sincos = _retarget(noise_kernels._sincos_2pi)
-    return _retarget(noise_kernels._gauss2, _philox=_device(philox.philox4x32), _uniform53=_device(philox.uniform53),
+    return _retarget(noise_kernels._gauss2, _philox=_philox_device(), _uniform53=_device(philox.uniform53),
                      _sincos_2pi=sincos, elementary=el)
 
 
@@ -93,9 +107,10 @@ def _constant(value: bool) -> Any:
 
 
 @functools.cache
-def noise_kernel(well_key: int, scheme_key: int) -> Any:
+def noise_kernel(well_key: int, scheme_key: int, law: int = noise_kernels.GAUSSIAN) -> Any:
     """The compiled kernel of the noisy ensemble for a compiled well and scheme (their keys:
-    wells.compiled.WellCode.key, scheme_code.SchemeCode.key; cached per pair).
+    wells.compiled.WellCode.key, scheme_code.SchemeCode.key) and a law of the variates
+    (noise_kernels.GAUSSIAN, FIVE_POINT); cached per triple.
 
     Launch: kernel[grid, block](q0, p0, n_paths, coef, FS, SW, total, thrE2, lo, hi, amp, shift, c1,
     c2, s_eta, k0, k1, wpar, counter, out): q0, p0 (n_ic,) float64; coef (NC,) the scheme's
@@ -114,7 +129,10 @@ def noise_kernel(well_key: int, scheme_key: int) -> Any:
     plus = _device(noise_kernels._ol_plus(types.UniTuple(types.float64, sc.width), types.float64))
     beyond = _retarget(noise_kernels._beyond, abs_tracking=_constant(code.abs_tracking))
     gauss2 = _gauss2()
+    block, five2 = _five_point()
     UW = np.uint64(sc.width)
+    gaussian = law == noise_kernels.GAUSSIAN
+    BS = noise_kernels.BLOCK_STEPS
 
     def noisy(q0: Floats, p0: Floats, n_paths: Int, coef: Floats, FS: Floats, SW: np.uint64, total: Int,
               thrE2: float, lo: float, hi: float, amp: float, shift: float, c1: float, c2: float, s_eta: float,
@@ -123,6 +141,8 @@ def noise_kernel(well_key: int, scheme_key: int) -> Any:
              wpar[9], wpar[10], wpar[11], wpar[12], wpar[13], wpar[14], wpar[15])
         c = flat_coefs(coef, uint64(0))
         N = q0.shape[0] * n_paths
+        S = SW // UW
+        H = (S + BS - 1) // BS
         while True:
             j = cuda.atomic.add(counter, 0, 1)
             if j >= N:
@@ -137,8 +157,17 @@ def noise_kernel(well_key: int, scheme_key: int) -> Any:
             e = mul(s_eta, gauss2(k0, k1, 0, m, i, _ONE)[0])
             first = -1
             o = uint64(0)
+            s = uint64(0)                      # the sub-step of the period, and the period
+            cyc = uint64(0)
+            words = (_ZERO, _ZERO, _ZERO, _ZERO)
             for n in range(total):
-                z1, z2 = gauss2(k0, k1, n, m, i, _ZERO)
+                if gaussian:
+                    z1, z2 = gauss2(k0, k1, n, m, i, _ZERO)
+                else:
+                    r = s % BS
+                    if r == 0:
+                        words = block(k0, k1, cyc * H + s // BS, m, i)
+                    z1, z2 = five2(words[r // 4], r)
                 eta = fma(c2, z1, mul(c1, e))
                 q, p = step(w, q, fma(amp, z1, p), c, plus(flat_row(FS, o), eta))
                 p = fma(amp, z2, p)
@@ -147,8 +176,11 @@ def noise_kernel(well_key: int, scheme_key: int) -> Any:
                     first = n + 1
                     break
                 o += UW
+                s += uint64(1)
                 if o == SW:
                     o = uint64(0)
+                    s = uint64(0)
+                    cyc += uint64(1)
             out[j] = first
 
     sig = ("void(float64[::1], float64[::1], int64, float64[::1], float64[::1], uint64, int64, float64, float64, "
@@ -178,7 +210,7 @@ def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
     if N:
         blk = (checks.check_positive_int("block", block) if block is not None else
                (SIMULATOR_BLOCK if cuda_kernels.SIMULATOR else cuda_kernels.BLOCK))
-        kernel = noise_kernel(code.key, scheme.key)
+        kernel = noise_kernel(code.key, scheme.key, noise.law)
         nblk = (checks.check_positive_int("grid", grid) if grid is not None else
                 SIMULATOR_GRID if cuda_kernels.SIMULATOR else cuda_engine.launch_grid(kernel, N, blk, 0))
         wp = code.wpar if wpar is None else np.ascontiguousarray(wpar, dtype=float)

@@ -32,12 +32,24 @@ from safebasins.wells import resolve_well
 from safebasins.wells.base import WellLike
 from safebasins.wells.provenance import api_provenance
 
-__all__ = ["escape_probability", "wilson_interval", "CORRECTIONS", "GOBET_SHIFT", "WILSON_Z", "energy_shift"]
+__all__ = ["escape_probability", "wilson_interval", "CORRECTIONS", "GOBET_SHIFT", "BOUNDARY_SHIFTS", "VARIATES",
+           "WILSON_Z", "energy_shift"]
 
 #: beta_1 = -zeta(1/2) / sqrt(2 pi): the boundary shift, in units of the local volatility times
 #: sqrt(h), that removes the O(sqrt(h)) bias of a discretely monitored killed diffusion
 #: (Broadie, Glasserman & Kou 1997; Gobet & Menozzi 2010)
 GOBET_SHIFT = 0.5825971579390106
+#: the variates' laws (noise_kernels): "gaussian" (Box-Muller; the default) or "five-point"
+#: (0, +-sqrt 2, +-2 with probabilities 5/8, 1/8, 1/16: the Gaussian's moments through the fifth, weak
+#: order 2 as well, one Philox block per 16 steps)
+VARIATES = tuple(noise_kernels.LAWS)
+#: beta_1 per law: the mean overshoot, in units of sigma ``|p|`` sqrt(h), of the random walk whose
+#: steps are a step's two kicks, (Z_1 + Z_2) / sqrt 2, over a level far away (Siegmund's corrected
+#: diffusion approximation: the same shift of the boundary removes the O(sqrt h) bias).  Gaussian:
+#: -zeta(1/2)/sqrt(2 pi); five-point: -(1/pi) int_0^inf t^-2 log(2 (1 - phi(t)) / t^2) dt with phi the
+#: characteristic function of that step (Spitzer's identity; docs/noise.md;
+#: tests/numerics/test_noise_variates.py recomputes both)
+BOUNDARY_SHIFTS = {"gaussian": GOBET_SHIFT, "five-point": 0.6504667}
 #: the discrete-monitoring corrections: "shift" (the energy threshold moved inwards by
 #: GOBET_SHIFT sigma ``|p|`` sqrt(h), the local volatility of H0 being sigma ``|p|``) or "none"
 CORRECTIONS = ("shift", "none")
@@ -56,15 +68,24 @@ SCHEME_TEXT = ("Strang splitting p += a Z_1, deterministic step, p += a Z_2 with
 COLOURED_SCHEME_TEXT = ("Strang splitting eta = c1 eta + c2 Z_1, deterministic step with the force eta held "
                         "constant, eta = c1 eta + c2 Z_2 (the exact Ornstein-Uhlenbeck flow over h/2 around the "
                         "deterministic scheme's step; weak order 2)")
-RNG_TEXT = ("Philox4x32-10 with counter (step, path, initial condition, 0) and key (seed mod 2^32, seed div 2^32); "
-            "Box-Muller pair from its two 53-bit uniforms (wells.elementary log, sqrt, sincos)")
+RNG_TEXTS = {
+    "gaussian": ("Philox4x32-10 with counter (step, path, initial condition, 0) and key (seed mod 2^32, seed div "
+                 "2^32); Box-Muller pair from its two 53-bit uniforms (wells.elementary log, sqrt, sincos)"),
+    "five-point": ("Philox4x32-10 with counter (block, path, initial condition, 2) and key (seed mod 2^32, seed div "
+                   "2^32), block = period * ceil(S/16) + sub-step div 16; the sub-step's byte of the block gives "
+                   "Z_1, Z_2 from its low and high nibble t: +sqrt 2 (t < 2), -sqrt 2 (t < 4), +2 (t = 4), -2 "
+                   "(t = 5), 0 otherwise; eta(0) Box-Muller of counter (0, path, initial condition, 1)"),
+}
 
 
-def energy_shift(sigma: float, h: float, correction: str, noise_time: float = 0.0) -> float:
-    """The shift of 2 xi_max per ``|p|`` (noise_kernels): 2 GOBET_SHIFT sigma sqrt(h) for "shift" and
-    white noise; 0 for "none" and for coloured noise (p is then differentiable in time: no
-    O(sqrt(h)) monitoring bias to correct)."""
-    return 2.0 * GOBET_SHIFT * sigma * math.sqrt(h) if correction == "shift" and noise_time == 0.0 else 0.0
+def energy_shift(sigma: float, h: float, correction: str, noise_time: float = 0.0, variates: str = "gaussian"
+                 ) -> float:
+    """The shift of 2 xi_max per ``|p|`` (noise_kernels): 2 beta_1 sigma sqrt(h) for "shift" and
+    white noise, beta_1 the law's (BOUNDARY_SHIFTS); 0 for "none" and for coloured noise (p is then
+    differentiable in time: no O(sqrt(h)) monitoring bias to correct)."""
+    if correction != "shift" or noise_time != 0.0:
+        return 0.0
+    return 2.0 * BOUNDARY_SHIFTS[variates] * sigma * math.sqrt(h)
 
 
 def _check_seed(seed: object) -> int:
@@ -98,7 +119,7 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
                        seed: int = 0, cycles: int | None = None, noise_time: float = 0.0,
                        steps_per_cycle: int = engine.DEFAULT_STEPS_PER_CYCLE, grid: bool | None = None,
                        correction: str = "shift", integrator: str = engine.DEFAULT_INTEGRATOR,
-                       threads: int | None = None, backend: str = "cpu") -> xr.Dataset:
+                       threads: int | None = None, backend: str = "cpu", variates: str = "gaussian") -> xr.Dataset:
     """Probability of escape within each ``t_eval`` under noise, from ``paths`` paths per initial condition.
 
     Parameters
@@ -123,9 +144,14 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
         draws the same numbers for any threads, lanes or order (numerics.noise_kernels).
     cycles : the horizon in forcing cycles (None: the largest t_eval rounded up); the first-passage
         mean is restricted to it.
-    correction : "shift" (default: the energy threshold moved inwards by GOBET_SHIFT sigma ``|p|``
-        sqrt(h), removing the O(sqrt(h)) bias of checking the threshold only at the steps) or
-        "none".
+    correction : "shift" (default: the energy threshold moved inwards by beta_1 sigma ``|p|``
+        sqrt(h), beta_1 = BOUNDARY_SHIFTS[variates], removing the O(sqrt(h)) bias of checking the
+        threshold only at the steps) or "none".
+    variates : the law of the kicks' random numbers: "gaussian" (default: Box-Muller pairs) or
+        "five-point" (0, +-sqrt 2, +-2 with probabilities 5/8, 1/8, 1/16 each: the same moments
+        through the fifth, so the same weak order 2, at about three times the speed: one Philox
+        block serves 16 steps).  The two laws draw different paths: their P_escape agree within the
+        weak error and the sampling error, not bitwise.
     threads : numba threads of the CPU backend (None: the current setting); the result does not
         depend on it.
     backend : "cpu" (default: the compiled CPU lanes, the reference), "cuda" (numerics.cuda_noise
@@ -160,6 +186,7 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
         raise ValueError(f"t_eval must be <= cycles = {cycles}, got max {float(te.max())!r}")
     seed = _check_seed(seed)
     correction = _check_choice("correction", correction, CORRECTIONS)
+    variates = _check_choice("variates", variates, VARIATES)
     gpu = _cuda_backend(_check_choice("backend", backend, NOISE_BACKENDS))
     schemes.check_integrator(integrator)
     spc = engine.check_step(Omega, engine.check_steps_per_cycle(steps_per_cycle), w, integrator)
@@ -184,8 +211,9 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
     h = float(problem.step_sizes()[0])              # (the same h, as the engine forms it)
     # one argument list, either backend (cuda_noise.escape_steps takes noise_kernels.escape_steps's)
     args = (problem.code, problem.scheme, Q, P, paths, problem.coefficients(), problem.sine_table(), F,
-            float(problem.thrE2[0]), cycles, noise_kernels.step_noise(sigma, h, tau), seed)
-    shift = energy_shift(sigma, h, correction, tau)
+            float(problem.thrE2[0]), cycles, noise_kernels.step_noise(sigma, h, tau, noise_kernels.LAWS[variates]),
+            seed)
+    shift = energy_shift(sigma, h, correction, tau, variates)
     if gpu is not None:
         steps = gpu.escape_steps(*args, shift=shift)
     else:
@@ -222,8 +250,8 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
     ds.attrs.update(
         F=F, Omega=Omega, Psi=Psi, xi_max=xi, noise=sigma, paths=paths, seed=seed, cycles=cycles, steps_per_cycle=spc,
         noise_model=_model_text(tau), integrator=engine.integrator_text(integrator, damping),
-        noise_scheme=SCHEME_TEXT if tau == 0 else COLOURED_SCHEME_TEXT, random_numbers=RNG_TEXT,
-        boundary_correction=_correction_text(correction, tau),
+        noise_scheme=SCHEME_TEXT if tau == 0 else COLOURED_SCHEME_TEXT, variates=variates,
+        random_numbers=RNG_TEXTS[variates], boundary_correction=_correction_text(correction, tau, variates),
         first_passage=("restricted mean E[min(tau, cycles)] in forcing cycles; censored_fraction of the paths had "
                        "not escaped within cycles (the mean first-passage time where it is 0, a lower bound "
                        "otherwise)"),
@@ -249,10 +277,11 @@ def _model_text(tau: float) -> str:
             "(coloured: Ornstein-Uhlenbeck force, tau = noise_time, sigma = noise, eta(0) stationary)")
 
 
-def _correction_text(correction: str, tau: float) -> str:
+def _correction_text(correction: str, tau: float, variates: str) -> str:
     if tau > 0:
         return "none needed: p is differentiable in time under coloured noise"
     if correction == "shift":
-        return f"energy threshold shifted inwards by {GOBET_SHIFT} sigma |p| sqrt(h) (Gobet-Menozzi)"
+        source = "Gobet-Menozzi" if variates == "gaussian" else "Siegmund's mean overshoot of the five-point walk"
+        return f"energy threshold shifted inwards by {BOUNDARY_SHIFTS[variates]} sigma |p| sqrt(h) ({source})"
     return "none: checked after every step only"
 

@@ -17,22 +17,26 @@ a = sigma_w sqrt(h/2).  White noise: c_1 = c_2 = 0, eta = 0; coloured: a = 0, et
 its stationary law N(0, sigma^2 / (2 tau)).  At sigma = 0 the kicks add exact zeros and every
 state is the engine's (bitwise up to the sign of a zero).
 
-Gaussian variates: (Z_1, Z_2) of step k of path m from initial condition i are the Box-Muller pair of
-one Philox4x32-10 block (numerics.philox) with counter (k, m, i, 0) and key (seed mod 2^32,
+Variates, law "gaussian" (the default): (Z_1, Z_2) of step k of path m from initial condition i
+are the Box-Muller pair of one Philox4x32-10 block (numerics.philox) with counter (k, m, i, 0) and key (seed mod 2^32,
 seed div 2^32) (eta(0): Z_1 of the counter (0, m, i, 1)): ``Z_1 = r cos(2 pi u_2)``,
 ``Z_2 = r sin(2 pi u_2)``, ``r = sqrt(-2 log u_1)``, u_1, u_2 the two 53-bit uniforms in (0, 1] of
 the block (numerics.philox.uniform53), log and sqrt from wells.elementary, sin and cos of 2 pi u
 by :func:`_sincos_2pi` (the same bits on every target).  A path's numbers are a pure function of
 (seed, i, m, k): lanes, tasks, threads and the order of the paths cannot change them.
 
-Escape: after every step, by the engine's criteria (2 H0 > 2 xi_max or q beyond a barrier, a
-NaN state beyond every threshold; and, for the kernels' own callers, a displacement pair
-(lo, hi)); ``shift`` > 0 moves the energy threshold inwards by ``shift |p|``: the boundary
-shift of Gobet and Menozzi for a discretely monitored diffusion, here the energy H0 whose
-local volatility is sigma ``|p|`` (numerics.noise sets shift = 2 * 0.5826 sigma sqrt(h) for 2 H0).
+Law "five-point" (StepNoise.law = FIVE_POINT): Z in {0, +-sqrt 2, +-2} with probabilities 5/8, 1/8 and
+1/16 each, from four random bits: its moments equal the Gaussian's through the fifth
+(E Z^2 = 1, E Z^4 = 3, the odd ones 0), which is what weak order 2 needs (Kloeden & Platen 1992,
+section 14.2: any variates whose first five moments match), and one Philox block (counter
+(b, m, i, 2)) serves 16 steps: step k = n S + s (period n, sub-step s of S) is block
+b = n ceil(S/16) + floor(s/16), byte r = s mod 16 of its words (w_0, w_1, w_2, w_3) read as one
+128-bit string, Z_1 its low nibble, Z_2 its high nibble (nibble t: +sqrt 2 for t < 2, -sqrt 2 for
+t < 4, +2 for t = 4, -2 for t = 5, 0 otherwise).  eta(0) stays Gaussian under either law (one
+draw: its law is the stationary one, not an approximation that vanishes with h).
 
-The kernels are specialised on three numba literals: the well's and the scheme's keys (as the
-engine's, kernels.py) and :data:`RNG_KEY`, a hash of the files inlined from outside the
+The kernels are specialised on four numba literals: the well's and the scheme's keys (as the
+engine's, kernels.py), the law of the variates and :data:`RNG_KEY`, a hash of the files inlined from outside the
 engine's fingerprint (this module, numerics/philox.py, wells.elementary), so a kernel cached
 on disk is never reused after an edit of any of them.
 """
@@ -54,8 +58,8 @@ from safebasins.numerics.steps import coefs, row, step, wtuple
 from safebasins.wells import elementary
 from safebasins.wells.compiled import LLVM_INLINE, WellCode, abs_tracking, cpu_jit, fma, mul, well_energy2
 
-__all__ = ["RNG_KEY", "MAX_STEPS", "StepNoise", "step_noise", "prepare", "escape_steps", "final_states",
-           "gaussian_pairs"]
+__all__ = ["RNG_KEY", "MAX_STEPS", "GAUSSIAN", "FIVE_POINT", "LAWS", "StepNoise", "step_noise", "prepare",
+           "escape_steps", "final_states", "gaussian_pairs", "step_variates"]
 
 #: the numba literal of the random-number and noise code (module docstring)
 RNG_KEY = int(fingerprint([__file__, philox.__file__])[:15], 16) ^ int(elementary.MODULE_HASH[:15], 16)
@@ -67,6 +71,17 @@ _philox = cpu_jit(philox.philox4x32)
 _uniform53 = cpu_jit(philox.uniform53)
 #: rounds |x| < 2^51 to an integer: (x + _ROUND) - _ROUND
 _ROUND = 6755399441055744.0
+#: the laws of the variates (module docstring), by their names in the public API
+GAUSSIAN = 0
+FIVE_POINT = 1
+LAWS = {"gaussian": GAUSSIAN, "five-point": FIVE_POINT}
+_TWO = np.uint64(2)
+#: five-point law: steps per Philox block (16 bytes), the nibble's width and mask
+BLOCK_STEPS = 16
+_U4 = np.uint64(4)
+_U8 = np.uint64(8)
+_U15 = np.uint64(15)
+_SQRT2 = math.sqrt(2.0)
 
 
 def _taylor(k: int) -> float:
@@ -121,6 +136,31 @@ def _gauss2(k0: Any, k1: Any, k: Any, m: Any, i: Any, tag: Any = _ZERO) -> tuple
     return mul(r, c), mul(r, s)
 
 
+# not cached on disk: compiled into the kernels, whose rng key hashes this file
+@njit(**LLVM_INLINE)
+def _five(t: Any) -> float:
+    """The five-point variate of a nibble t in [0, 16) (module docstring; selects, no branch)."""
+    z = -2.0 if t == 5 else 0.0
+    z = 2.0 if t == 4 else z
+    z = -_SQRT2 if t < 4 else z
+    return _SQRT2 if t < 2 else z
+
+
+# not cached on disk: compiled into the kernels, whose rng key hashes this file
+@njit(**LLVM_INLINE)
+def _five2(w: Any, r: Any) -> tuple[float, float]:
+    """(Z_1, Z_2) of byte r mod 4 of the 32-bit word w: its low and high nibble."""
+    x = w >> (_U8 * (np.uint64(r) & np.uint64(3)))
+    return _five(x & _U15), _five((x >> _U4) & _U15)
+
+
+# not cached on disk: it calls numerics.philox, which the kernels' rng key hashes
+@njit(**LLVM_INLINE)
+def _block(k0: Any, k1: Any, b: Any, m: Any, i: Any) -> tuple[Any, Any, Any, Any]:
+    """The four words of five-point block b of path m from initial condition i."""
+    return _philox(np.uint64(b) & _MASK32, np.uint64(m) & _MASK32, np.uint64(i) & _MASK32, _TWO, k0, k1)  # type: ignore[no-any-return]
+
+
 def _plus(f: Any, x: Any) -> Any:
     """The tuple f with x added to each value (the forcing values plus the coloured noise)."""
     raise NotImplementedError("compiled code (numba)")
@@ -148,11 +188,35 @@ def _pairs(rng: Any, k0: Any, k1: Any, k: Any, m: Any, i: Any) -> Any:
     return z
 
 
+@njit(cache=True, error_model="numpy")
+def _five_pairs(rng: Any, k0: Any, k1: Any, k: Any, m: Any, i: Any, S: Any) -> Any:
+    literally(rng)
+    n = k.shape[0]
+    H = (S + BLOCK_STEPS - 1) // BLOCK_STEPS
+    z = np.zeros((n, 2))
+    for j in range(n):
+        s = k[j] % S
+        r = s % BLOCK_STEPS
+        words = _block(k0, k1, (k[j] // S) * H + s // BLOCK_STEPS, m[j], i[j])
+        z[j, 0], z[j, 1] = _five2(words[r // 4], r)
+    return z
+
+
 def gaussian_pairs(seed: int, step: np.ndarray, path: np.ndarray, ic: np.ndarray) -> np.ndarray:
     """The Gaussian pairs (Z_1, Z_2) the kernels use at (step, path, ic) (arrays of equal size,
     ints < 2^32) for ``seed``: shape (n, 2) (tests, documentation)."""
+    return step_variates(seed, step, path, ic)
+
+
+def step_variates(seed: int, step: np.ndarray, path: np.ndarray, ic: np.ndarray, law: int = GAUSSIAN,
+                  steps_per_cycle: int = 1) -> np.ndarray:
+    """The variates (Z_1, Z_2) the kernels use at (step, path, ic) (arrays of equal size, ints
+    < 2^32) for ``seed`` under ``law`` (GAUSSIAN, FIVE_POINT; the five-point blocks depend on the
+    steps per forcing cycle): shape (n, 2) (tests, documentation)."""
     k0, k1 = _key(seed)
     arrays = [np.ascontiguousarray(a, dtype=np.int64).ravel() for a in (step, path, ic)]
+    if law == FIVE_POINT:
+        return _five_pairs(RNG_KEY, k0, k1, *arrays, int(steps_per_cycle))  # type: ignore[no-any-return,call-arg]
     return _pairs(RNG_KEY, k0, k1, *arrays)  # type: ignore[no-any-return]  # (a numba dispatcher)
 
 
@@ -172,9 +236,9 @@ def _beyond(well: Any, wpar: Any, q: Any, e: Any, thrE2: Any, lo: Any, hi: Any) 
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _escape_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks: Any, lanes: Any, q0: Any, p0: Any,
-                 n_paths: Any, coef: Any, FS: Any, thrE2: Any, lo: Any, hi: Any, cycles: Any, amp: Any, shift: Any,
-                 c1: Any, c2: Any, s_eta: Any, k0: Any, k1: Any, out: Any) -> None:
+def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: Any, n_tasks: Any, lanes: Any,
+                 q0: Any, p0: Any, n_paths: Any, coef: Any, FS: Any, thrE2: Any, lo: Any, hi: Any, cycles: Any,
+                 amp: Any, shift: Any, c1: Any, c2: Any, s_eta: Any, k0: Any, k1: Any, out: Any) -> None:
     """Trajectories j = task, task + n_tasks, ... (path j % n_paths of initial condition
     j // n_paths): out[j] = the step after which it is first beyond (0: the initial condition,
     -1: not within cycles periods).  Lanes run one forcing period at a time; at the period
@@ -189,8 +253,14 @@ def _escape_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks
     Q = np.zeros(L)
     P = np.zeros(L)
     E = np.zeros(L)                      # the coloured noise eta of the lane
-    Z1 = np.zeros(L)                     # the step's Gaussian pair of the lane
+    Z1 = np.zeros(L)                     # the step's variates of the lane
     Z2 = np.zeros(L)
+    W0 = np.zeros(L, np.uint64)          # five-point law: the words of the lane's block
+    W1 = np.zeros(L, np.uint64)
+    W2 = np.zeros(L, np.uint64)
+    W3 = np.zeros(L, np.uint64)
+    CYC = np.zeros(L, np.int64)          # the lane's periods done (BASE / S)
+    H = (S + BLOCK_STEPS - 1) // BLOCK_STEPS      # five-point blocks per period
     IC = np.zeros(L, np.int64)
     PATH = np.zeros(L, np.int64)
     J = np.zeros(L, np.int64)
@@ -211,6 +281,7 @@ def _escape_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks
                 PATH[k] = PATH[l]
                 J[k] = J[l]
                 BASE[k] = BASE[l]
+                CYC[k] = CYC[l]
                 FIRST[k] = FIRST[l]
                 k += 1
         nact = k
@@ -233,6 +304,7 @@ def _escape_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks
             IC[nact] = i
             J[nact] = j
             BASE[nact] = 0
+            CYC[nact] = 0
             FIRST[nact] = -1
             nact += 1
         if nact == 0:
@@ -241,8 +313,18 @@ def _escape_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks
             f = row(scheme, FS, s)
             # three lane loops: the Gaussians, the step, the escape check (fused into one body
             # the same arithmetic spills registers: measured 25% slower); the same numbers either way
-            for l in range(nact):
-                Z1[l], Z2[l] = _gauss2(k0, k1, BASE[l] + s, PATH[l], IC[l])
+            if law == GAUSSIAN:
+                for l in range(nact):
+                    Z1[l], Z2[l] = _gauss2(k0, k1, BASE[l] + s, PATH[l], IC[l])
+            else:
+                r = s % BLOCK_STEPS
+                if r == 0:
+                    b = s // BLOCK_STEPS
+                    for l in range(nact):
+                        W0[l], W1[l], W2[l], W3[l] = _block(k0, k1, CYC[l] * H + b, PATH[l], IC[l])
+                W = W0 if r < 4 else (W1 if r < 8 else (W2 if r < 12 else W3))
+                for l in range(nact):
+                    Z1[l], Z2[l] = _five2(W[l], r)
             for l in range(nact):
                 z1 = Z1[l]
                 z2 = Z2[l]
@@ -260,27 +342,37 @@ def _escape_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks
                 FIRST[l] = BASE[l] + s + 1 if hit else FIRST[l]
         for l in range(nact):
             BASE[l] += S
+            CYC[l] += 1
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _final_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks: Any, q0: Any, p0: Any, n_paths: Any,
-                coef: Any, FS: Any, n_steps: Any, amp: Any, c1: Any, c2: Any, s_eta: Any, k0: Any, k1: Any, qo: Any,
-                po: Any, eo: Any) -> None:
+def _final_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: Any, n_tasks: Any, q0: Any, p0: Any,
+                n_paths: Any, coef: Any, FS: Any, n_steps: Any, amp: Any, c1: Any, c2: Any, s_eta: Any, k0: Any,
+                k1: Any, qo: Any, po: Any, eo: Any) -> None:
     """Plain integration (no escape) of trajectories j = task, task + n_tasks, ... for n_steps
     steps; the same step as _escape_task."""
     S = FS.shape[0]
     w = wtuple(wpar)
     c = coefs(scheme, coef[0])
     N = q0.shape[0] * n_paths
+    H = (S + BLOCK_STEPS - 1) // BLOCK_STEPS
     for j in range(task, N, n_tasks):
         i = j // n_paths
         m = j - i * n_paths
         q = q0[i]
         p = p0[i]
         e = mul(s_eta, _gauss2(k0, k1, 0, m, i, _ONE)[0])
+        words = (_ZERO, _ZERO, _ZERO, _ZERO)
         for n in range(n_steps):
-            z1, z2 = _gauss2(k0, k1, n, m, i)
-            f = row(scheme, FS, n % S)
+            s = n % S
+            if law == GAUSSIAN:
+                z1, z2 = _gauss2(k0, k1, n, m, i)
+            else:
+                r = s % BLOCK_STEPS
+                if r == 0:
+                    words = _block(k0, k1, (n // S) * H + s // BLOCK_STEPS, m, i)
+                z1, z2 = _five2(words[r // 4], r)
+            f = row(scheme, FS, s)
             e = fma(c2, z1, mul(c1, e))
             q, p = step(scheme, well, w, q, fma(amp, z1, p), c, _plus(f, e))
             p = fma(amp, z2, p)
@@ -294,23 +386,28 @@ def _final_task(well: Any, scheme: Any, rng: Any, wpar: Any, task: Any, n_tasks:
 class StepNoise:
     """The noise coefficients of one step (module docstring): the white half kick ``amp`` =
     sigma sqrt(h/2), the Ornstein-Uhlenbeck half step ``eta = c1 eta + c2 Z`` and ``s_eta``, the
-    standard deviation of eta's stationary law (eta(0) = s_eta Z)."""
+    standard deviation of eta's stationary law (eta(0) = s_eta Z); ``law`` the variates' law
+    (GAUSSIAN or FIVE_POINT)."""
 
     amp: float
     c1: float = 0.0
     c2: float = 0.0
     s_eta: float = 0.0
+    law: int = GAUSSIAN
 
 
-def step_noise(sigma: float, h: float, noise_time: float = 0.0) -> StepNoise:
+def step_noise(sigma: float, h: float, noise_time: float = 0.0, law: int = GAUSSIAN) -> StepNoise:
     """The coefficients of a step h for white noise of amplitude sigma (noise_time = 0) or an
     Ornstein-Uhlenbeck force d eta = -(eta / tau) dt + (sigma / tau) dW of correlation time
-    tau = noise_time > 0 (the same integrated intensity: int <eta(0) eta(t)> dt = sigma^2)."""
+    tau = noise_time > 0 (the same integrated intensity: int <eta(0) eta(t)> dt = sigma^2), with
+    variates of ``law``."""
+    if law not in LAWS.values():
+        raise ValueError(f"law must be one of {sorted(LAWS.values())} ({', '.join(LAWS)}), got {law!r}")
     if noise_time == 0.0:
-        return StepNoise(sigma * math.sqrt(0.5 * h))
+        return StepNoise(sigma * math.sqrt(0.5 * h), law=law)
     x = h / noise_time
     return StepNoise(0.0, math.exp(-0.5 * x), sigma * math.sqrt(-math.expm1(-x) / (2.0 * noise_time)),
-                     sigma / math.sqrt(2.0 * noise_time))
+                     sigma / math.sqrt(2.0 * noise_time), law)
 
 
 def prepare(code: WellCode, scheme: SchemeCode, q0: np.ndarray, coef: np.ndarray, sintab: np.ndarray, F: float,
@@ -347,11 +444,11 @@ def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
     p = np.ascontiguousarray(p0, dtype=float)
     out = np.full(q.size * int(n_paths), -1, np.int64)
     wp = code.wpar if wpar is None else np.ascontiguousarray(wpar, dtype=float)
-    args = [code.key, scheme.key, RNG_KEY, wp, 0, int(n_tasks), int(lanes), q, p, int(n_paths),
+    args = [code.key, scheme.key, RNG_KEY, int(noise.law), wp, 0, int(n_tasks), int(lanes), q, p, int(n_paths),
             np.ascontiguousarray(coef), FS, float(thrE2), float(bounds[0]), float(bounds[1]), int(cycles),
             float(noise.amp), float(shift), float(noise.c1), float(noise.c2), float(noise.s_eta), k0, k1, out]
-    entry = specialised(_escape_task, args, n_literal=3)
-    run_tasks(lambda task: entry(*args[:4], task, *args[5:]), int(n_tasks))
+    entry = specialised(_escape_task, args, n_literal=4)
+    run_tasks(lambda task: entry(*args[:5], task, *args[6:]), int(n_tasks))
     return out.reshape(q.size, int(n_paths))
 
 
@@ -365,10 +462,11 @@ def final_states(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
     qo = np.empty(q.size * int(n_paths))
     po = np.empty_like(qo)
     eo = np.empty_like(qo)
-    args = [code.key, scheme.key, RNG_KEY, code.wpar, 0, int(n_tasks), q, p, int(n_paths), np.ascontiguousarray(coef),
+    args = [code.key, scheme.key, RNG_KEY, int(noise.law), code.wpar, 0, int(n_tasks), q, p, int(n_paths),
+            np.ascontiguousarray(coef),
             FS, int(n_steps), float(noise.amp), float(noise.c1), float(noise.c2), float(noise.s_eta), k0, k1, qo, po,
             eo]
-    entry = specialised(_final_task, args, n_literal=3)
-    run_tasks(lambda task: entry(*args[:4], task, *args[5:]), int(n_tasks))
+    entry = specialised(_final_task, args, n_literal=4)
+    run_tasks(lambda task: entry(*args[:5], task, *args[6:]), int(n_tasks))
     shape = (q.size, int(n_paths))
     return qo.reshape(shape), po.reshape(shape), eo.reshape(shape)
