@@ -12,6 +12,8 @@ the whole horizon, so steps are counted exactly):
 * deterministic: numerics.escape_chart (SRKN6b, the engine's vector lanes);
 * noisy: noise_kernels.escape_steps at sigma = 0.002 (SRKN6b + two Gaussians a step from one
   Philox block, escape checked after every step);
+* noisy, five-point variates (the law's moments equal the Gaussian's through the fifth: weak
+  order 2 as well; one Philox block serves 16 steps);
 * Euler-Maruyama: a hand-written numba loop (symplectic Euler drift, one numpy normal a step,
   escape checked after every step), weak order 1.
 
@@ -289,19 +291,29 @@ def main():
                                           noise_kernels.step_noise(SIGMA, h), 7)
     assert (noisy() < 0).all(), "a noisy path escaped: steps not exact"
 
+    def five():
+        return noise_kernels.escape_steps(code, sc, q0, p0, 1, coef, tab, F, 2 * XI, cycles,
+                                          noise_kernels.step_noise(SIGMA, h, law=noise_kernels.FIVE_POINT), 7)
+    assert (five() < 0).all(), "a noisy path escaped: steps not exact"
+
     def em():
         return euler_maruyama(q0, p0, F, OMEGA, h, SIGMA, 2 * XI, cycles * S, 7)
     assert (em() < 0).all(), "an Euler-Maruyama path escaped: steps not exact"
-    t_det, t_noise, t_em = best([deterministic, noisy, em])
+    t_det, t_noise, t_five, t_em = best([deterministic, noisy, five, em])
 
-    r_det, r_noise, r_em = steps / t_det, steps / t_noise, steps / t_em
+    r_det, r_noise, r_five, r_em = steps / t_det, steps / t_noise, steps / t_five, steps / t_em
     print(f"machine: {machine()}; one thread; {n} trajectories x {cycles} cycles x {S} steps")
     print(f"deterministic engine (SRKN6b)      : {r_det:.3e} trajectory-steps/s")
     print(f"noisy ensemble (SRKN6b + Philox)   : {r_noise:.3e} trajectory-steps/s")
+    print(f"  five-point variates              : {r_five:.3e} trajectory-steps/s")
     print(f"numba Euler-Maruyama (weak order 1): {r_em:.3e} trajectory-steps/s")
     print(f"noisy / deterministic = {r_noise / r_det:.3f} (target >= 0.5); noisy / Euler-Maruyama = "
           f"{r_noise / r_em:.3f} per step")
+    print(f"five-point / deterministic = {r_five / r_det:.3f} (target >= 0.5)")
     report("noise_vs_deterministic", round(r_noise / r_det, 3), "noisy / deterministic trajectory-steps per second",
+           f"{n} x {cycles} cycles x {S} steps, one thread")
+    report("noise_five_point_vs_deterministic", round(r_five / r_det, 3),
+           "noisy (five-point variates) / deterministic trajectory-steps per second",
            f"{n} x {cycles} cycles x {S} steps, one thread")
     report("noise_vs_euler_maruyama_per_step", round(r_noise / r_em, 3),
            "noisy ensemble / numba Euler-Maruyama trajectory-steps per second (per step, not at equal accuracy)",
@@ -313,6 +325,12 @@ def main():
     report("noise_vs_euler_maruyama_equal_accuracy", round(speedup, 1),
            "time of a numba Euler-Maruyama / time of the noisy ensemble at equal weak error (harmonic oscillator, "
            "Var p)", f"splitting 32 steps/cycle, Euler-Maruyama {S_em}")
+    # the five-point scheme's mean and covariance are the Gaussian one's (a linear scheme: second moments only)
+    speedup5 = S_em / 32 * r_five / r_em
+    print(f"  with five-point variates (the same Var p error): {speedup5:.0f}x faster")
+    report("noise_five_point_vs_euler_maruyama_equal_accuracy", round(speedup5, 1),
+           "time of a numba Euler-Maruyama / time of the noisy ensemble with five-point variates at equal weak "
+           "error (harmonic oscillator, Var p)", f"splitting 32 steps/cycle, Euler-Maruyama {S_em}")
 
 
 if __name__ == "__main__":
