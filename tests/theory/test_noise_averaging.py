@@ -119,3 +119,75 @@ def test_coefficients_against_the_noisy_dynamics():
     assert abs(cov) < 3 * np.sqrt(dJ.var() * dtheta_kick.var() / n_paths)
     print(ratios, se(drift) / drift.mean(), dtheta_kick.mean() / se(dtheta_kick),
           sigma ** 2 * av["m_gg"][0] * T / se(dtheta_kick), cov / np.sqrt(dJ.var() * dtheta_kick.var() / n_paths))
+
+
+# --------------------------------------------------------------------------- tables kept per well
+# the tables depend on the well and (xi_max, n, n_theta) only, not on sigma, F, Omega or beta:
+# computed once per well and kept; a fresh QuarticWell object starts with none
+def _counting(monkeypatch):
+    from safebasins.theory import noise_averaging
+
+    calls = []
+    real = noise_averaging.orbit_averages
+    monkeypatch.setattr(noise_averaging, "orbit_averages", lambda *a, **k: calls.append(a[1].size) or real(*a, **k))
+    return calls
+
+
+def test_tables_computed_once_per_well_and_threshold(monkeypatch):
+    from safebasins import theory
+    from safebasins.wells import QuarticWell
+
+    calls = _counting(monkeypatch)
+    w = QuarticWell()
+    kw = dict(t_eval=[1.0], well=w, cells=(16, 20), steps_per_cycle=4)
+    for s in (0.02, 0.04, 0.06):
+        theory.escape_probability([0.1], [0.0], 0.05, 0.9, 0.0, 0.2, noise=s, damping=0.05, **kw)
+    theory.escape_probability([0.1], [0.0], 0.03, 0.8, 1.0, 0.2, noise=0.02, **kw)       # other F, Omega, Psi, beta
+    theory.mean_first_passage([0.1], [0.0], 0.05, 0.9, 0.0, 0.2, noise=0.05, well=w, cells=(16, 20))
+    assert len(calls) == 1
+    assert averaged_diffusion(w, 0.2) is averaged_diffusion(w, 0.2)
+    averaged_diffusion(w, 0.18)                                             # another threshold: its own tables
+    averaged_diffusion(w, 0.2, n=40)                                         # another resolution too
+    assert len(calls) == 3
+    averaged_diffusion(QuarticWell(), 0.2)                                   # another well object: its own
+    assert len(calls) == 4
+
+
+def test_kept_tables_are_read_only_and_the_first_calls_bits():
+    from safebasins.wells import QuarticWell
+
+    kept = averaged_diffusion(QuarticWell(), 0.2, n=50, n_theta=64)
+    fresh = averaged_diffusion(QuarticWell(), 0.2, n=50, n_theta=64)
+    for name in ("J_nodes", "H", "omega", "a", "a_r", "a_t"):
+        np.testing.assert_array_equal(getattr(kept, name), getattr(fresh, name), err_msg=name)
+        with pytest.raises(ValueError, match="read-only"):
+            getattr(kept, name)[0] = 1.0
+
+
+def test_escape_probability_with_kept_tables_is_bitwise_a_cold_solve():
+    # a sweep's later levels reuse the first level's tables: the same bits as a solve from scratch
+    from safebasins import theory
+    from safebasins.wells import QuarticWell
+
+    q0, p0 = np.linspace(-0.8, 0.8, 7), np.linspace(-0.6, 0.6, 5)
+    kw = dict(t_eval=[1.0, 3.0], damping=0.05, grid=True, cells=(24, 30), steps_per_cycle=6)
+    warm = QuarticWell()
+    theory.escape_probability(q0, p0, 0.05, 0.9, 0.0, 0.2, noise=0.02, well=warm, **kw)
+    again = theory.escape_probability(q0, p0, 0.05, 0.9, 0.0, 0.2, noise=0.06, well=warm, **kw)
+    cold = theory.escape_probability(q0, p0, 0.05, 0.9, 0.0, 0.2, noise=0.06, well=QuarticWell(), **kw)
+    np.testing.assert_array_equal(again["P_escape"].values, cold["P_escape"].values)
+    np.testing.assert_array_equal(again["first_passage_mean"].values, cold["first_passage_mean"].values)
+    assert 0.05 < float(cold["P_escape"].mean()) < 0.95          # some escape, some stay: the test can fail
+
+
+def test_unhashable_well_computes_its_tables_every_call(monkeypatch):
+    from safebasins.wells import QuarticWell
+
+    class Unhashable(QuarticWell):
+        __hash__ = None  # type: ignore[assignment]
+
+    calls = _counting(monkeypatch)
+    w = Unhashable()
+    a, b = averaged_diffusion(w, 0.2, n=30, n_theta=32), averaged_diffusion(w, 0.2, n=30, n_theta=32)
+    assert len(calls) == 2 and a is not b
+    np.testing.assert_array_equal(a.a_t, b.a_t)

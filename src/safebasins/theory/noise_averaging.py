@@ -19,9 +19,16 @@ i.e. the action diffusion ``sigma^2 J/omega``, the noise-induced action drift
 ``q_J = omega dq/dE`` at fixed theta is taken by central differences of the well's
 ``phase_point`` (any well with action-angle variables), and the averages by the trapezoidal rule
 over theta (spectrally accurate for the periodic integrand).
+
+None of these tables depends on sigma, F, Omega or the damping (the noise enters the solvers as
+the factor sigma^2 of the diffusion): :func:`averaged_diffusion` computes them once per well and
+``(xi_max, n, n_theta)`` and keeps them (read-only) for the well's lifetime, so a sweep over noise
+levels or forcings shares one set, bit for bit the first call's.
 """
 from __future__ import annotations
 
+import weakref
+from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,10 +37,14 @@ from numpy.typing import ArrayLike
 from safebasins.theory.types import FloatArray
 from safebasins.wells.base import Well
 
-__all__ = ["orbit_averages", "AveragedDiffusion", "averaged_diffusion", "N_THETA"]
+__all__ = ["orbit_averages", "AveragedDiffusion", "averaged_diffusion", "N_THETA", "N_NODES"]
 
 #: angles of the trapezoidal rule of the orbit averages
 N_THETA = 256
+#: action nodes of the tables
+N_NODES = 600
+#: tables kept per well (the most recently used (xi_max, n, n_theta))
+_KEPT = 16
 #: the largest phase of the first harmonic (rad) of a well taken as symmetric
 SHIFT_TOL = 1e-9
 #: relative step of the central difference in the energy (q_J = omega dq/dE at fixed theta)
@@ -105,11 +116,34 @@ class AveragedDiffusion:
         return out
 
 
-def averaged_diffusion(well: Well, xi_max: float, n: int = 600, n_theta: int = N_THETA) -> AveragedDiffusion:
+#: well -> its tables by (xi_max, n, n_theta); a well's entry goes with the well
+_TABLES: weakref.WeakKeyDictionary[Well, OrderedDict[tuple[float, int, int], AveragedDiffusion]] = \
+    weakref.WeakKeyDictionary()
+
+
+def averaged_diffusion(well: Well, xi_max: float, n: int = N_NODES, n_theta: int = N_THETA) -> AveragedDiffusion:
     """:class:`AveragedDiffusion` of a symmetric ``well`` up to the energy ``xi_max`` (< its barrier
     energy), on ``n`` nodes uniform in J (node 0: the well bottom, where ``a_t = a_r = 1/(2
     omega(0))``).  A well whose first harmonic has a phase (an asymmetric well: J-gamma
-    covariance and a sheared frame) is refused, naming ``well``."""
+    covariance and a sheared frame) is refused, naming ``well``.  Computed once per well and
+    ``(xi_max, n, n_theta)`` and then returned again (the same read-only tables; an unhashable
+    well's are computed at every call)."""
+    key = (float(xi_max), int(n), int(n_theta))
+    if type(well).__hash__ is None:
+        return _tables(well, *key)
+    kept = _TABLES.setdefault(well, OrderedDict())
+    if key in kept:
+        kept.move_to_end(key)
+        return kept[key]
+    out = _tables(well, *key)
+    kept[key] = out
+    if len(kept) > _KEPT:
+        kept.popitem(last=False)
+    return out
+
+
+def _tables(well: Well, xi_max: float, n: int, n_theta: int) -> AveragedDiffusion:
+    """The tables of :func:`averaged_diffusion`, computed (read-only arrays)."""
     xi_nodes = _xi_nodes(well, xi_max, n)
     # a numeric well's phase is rounding (1e-16) where it is symmetric; an asymmetric well's is O(sqrt(xi))
     if np.any(np.abs(np.asarray(well.harmonic_shift(xi_nodes[1:]))) > SHIFT_TOL):
@@ -123,7 +157,10 @@ def averaged_diffusion(well: Well, xi_max: float, n: int = 600, n_theta: int = N
     a = np.empty_like(J)
     a[1:] = np.asarray(well.harmonic_amplitude(xi_nodes[1:]), float) / np.sqrt(2.0 * J[1:])
     a[0] = a[1] + (a[1] - a[2]) * J[1] / (J[2] - J[1])      # extrapolated in J (a is smooth there)
-    return AveragedDiffusion(J_nodes=J, H=xi_nodes, omega=om, a=a, a_r=0.5 / om, a_t=a_t)
+    tables = {"J_nodes": J, "H": xi_nodes, "omega": om, "a": a, "a_r": 0.5 / om, "a_t": a_t}
+    for v in tables.values():
+        v.flags.writeable = False       # shared by every later call: no caller may change them
+    return AveragedDiffusion(**tables)
 
 
 def _xi_nodes(well: Well, xi_max: float, n: int) -> FloatArray:
