@@ -65,6 +65,8 @@ def _cases() -> dict[str, dict[str, Any]]:
         "quartic/white/five-point": dict(quartic, noise=0.05, seed=7, variates="five-point"),
         "quartic/white/damped/five-point/40": dict(quartic, noise=0.08, damping=0.1, seed=2 ** 40 + 3,
                                                    variates="five-point", steps=40),
+        "quartic/white/offsets": dict(quartic, noise=0.05, seed=7, variates="five-point", ic_offset=5,
+                                      path_offset=2 ** 31),
         "pendulum/coloured/damped/five-point": dict(pendulum, noise=0.3, noise_time=1.2, damping=0.1, seed=9,
                                                     variates="five-point"),
     }
@@ -85,7 +87,8 @@ def _arguments(case: dict[str, Any]) -> tuple[tuple[Any, ...], dict[str, Any]]:
     args = (pb.code, pb.scheme, q0, p0, PATHS, pb.coefficients(), pb.sine_table(), case["F"], thrE2, CYCLES,
             noise_kernels.step_noise(case["noise"], h, tau, noise_kernels.LAWS[variates]), case["seed"])
     bounds = tuple(case.get("bounds", (-math.inf, math.inf)))
-    kw = dict(shift=energy_shift(case["noise"], h, "shift", tau, variates), bounds=bounds)
+    kw = dict(shift=energy_shift(case["noise"], h, "shift", tau, variates), bounds=bounds,
+              ic_offset=case.get("ic_offset", 0), path_offset=case.get("path_offset", 0))
     return args, kw
 
 

@@ -144,6 +144,42 @@ def test_wilson_interval_closed_form():
     assert math.isclose(lo[2], c - d) and math.isclose(hi[2], c + d)
 
 
+@pytest.mark.parametrize("law", [noise_kernels.GAUSSIAN, noise_kernels.FIVE_POINT])
+def test_chunks_with_offsets_draw_the_whole_runs_streams(law):
+    """ICs 1..3 with ic_offset=1 and paths 20..36 with path_offset=20 are that block of the whole
+    run's escape steps, bitwise; escape_probability over two path chunks, pooled, is the whole
+    run's P_escape; the offsets are recorded and refused by name when out of range."""
+    code, sc = quartic_code(), scheme_code("srkn6b", True)
+    coef = schemes.lane_coefficients([0.9], 16, "srkn6b", 0.05)
+    tab = schemes.sine_table(16, 0.0)
+    q0, p0 = np.array([0.0, 0.3, -0.5, 0.9]), np.array([0.0, 0.1, 0.2, 0.5])
+
+    def run(ics, n_paths, **kw):
+        return noise_kernels.escape_steps(code, sc, q0[ics], p0[ics], n_paths, coef, tab, 0.03, 0.4, 30,
+                                          noise_kernels.StepNoise(0.02, law=law), 11, shift=0.01, **kw)
+    whole = run(slice(0, 4), 37)
+    assert (whole > 0).any() and (whole < 0).any()
+    np.testing.assert_array_equal(run(slice(1, 4), 37, ic_offset=1), whole[1:])
+    np.testing.assert_array_equal(run(slice(0, 4), 17, path_offset=20), whole[:, 20:])
+    np.testing.assert_array_equal(run(slice(2, 3), 5, ic_offset=2, path_offset=30, n_tasks=2, lanes=3),
+                                  whole[2:3, 30:35])
+    assert not np.array_equal(run(slice(1, 4), 37), whole[1:])
+    kw = dict(noise=0.03, xi_max=0.2, t_eval=[5, 20], damping=0.05, seed=3, grid=False,
+              variates="gaussian" if law == noise_kernels.GAUSSIAN else "five-point")
+    q, p = [0.0, 0.3, -0.5], [0.0, 0.1, 0.2]
+    full = escape_probability(q, p, **FORCING, paths=30, **kw)
+    a = escape_probability(q, p, **FORCING, paths=12, **kw)
+    b = escape_probability(q, p, **FORCING, paths=18, path_offset=12, **kw)
+    np.testing.assert_array_equal((12 * a.P_escape + 18 * b.P_escape).values, (30 * full.P_escape).values)
+    assert b.attrs["path_offset"] == 12 and "ic_offset" not in b.attrs and "path_offset" not in a.attrs
+    c = escape_probability(q[1:], p[1:], **FORCING, paths=30, ic_offset=1, **kw)
+    np.testing.assert_array_equal(c.P_escape.values, full.P_escape.values[1:])
+    for bad, name in ((dict(ic_offset=-1), "ic_offset"), (dict(path_offset=2 ** 32 - 5), "path_offset"),
+                      (dict(ic_offset=1.5), "ic_offset")):
+        with pytest.raises(ValueError, match=f"^{name}"):
+            escape_probability(q, p, **FORCING, paths=30, **kw, **bad)
+
+
 GOOD = dict(noise=0.05, paths=10, xi_max=0.2, t_eval=[5])
 
 

@@ -113,11 +113,11 @@ def noise_kernel(well_key: int, scheme_key: int, law: int = noise_kernels.GAUSSI
     (noise_kernels.GAUSSIAN, FIVE_POINT); cached per triple.
 
     Launch: kernel[grid, block](q0, p0, n_paths, coef, FS, SW, total, thrE2, lo, hi, amp, shift, c1,
-    c2, s_eta, k0, k1, wpar, counter, out): q0, p0 (n_ic,) float64; coef (NC,) the scheme's
+    c2, s_eta, k0, k1, i0, m0, wpar, counter, out): q0, p0 (n_ic,) float64; coef (NC,) the scheme's
     coefficients (lane_coefficients, one row); FS (S * W,) the forcing products F * sine_table,
     flat; SW = S * W (uint64); total = cycles * S steps; thrE2 = 2 xi_max; (lo, hi) a displacement
     pair; amp, shift, c1, c2, s_eta: noise_kernels.StepNoise and the energy shift; (k0, k1) the
-    Philox key; wpar the well's (steps.N_WPAR,); counter (1,) int64 = 0; out (n_ic * n_paths,)
+    Philox key; (i0, m0) the counters' offsets of the initial condition and the path; wpar the well's (steps.N_WPAR,); counter (1,) int64 = 0; out (n_ic * n_paths,)
     int64: trajectory j = i * n_paths + m gets its first step beyond (0: the initial condition,
     -1: none within total steps)."""
     code: WellCode = code_of(well_key)
@@ -136,7 +136,7 @@ def noise_kernel(well_key: int, scheme_key: int, law: int = noise_kernels.GAUSSI
 
     def noisy(q0: Floats, p0: Floats, n_paths: Int, coef: Floats, FS: Floats, SW: np.uint64, total: Int,
               thrE2: float, lo: float, hi: float, amp: float, shift: float, c1: float, c2: float, s_eta: float,
-              k0: np.uint64, k1: np.uint64, wpar: Floats, counter: Ints, out: Ints) -> None:
+              k0: np.uint64, k1: np.uint64, i0: Int, m0: Int, wpar: Floats, counter: Ints, out: Ints) -> None:
         w = (wpar[2], wpar[3], wpar[4], wpar[5], wpar[6], wpar[7], wpar[8],
              wpar[9], wpar[10], wpar[11], wpar[12], wpar[13], wpar[14], wpar[15])
         c = flat_coefs(coef, uint64(0))
@@ -147,10 +147,11 @@ def noise_kernel(well_key: int, scheme_key: int, law: int = noise_kernels.GAUSSI
             j = cuda.atomic.add(counter, 0, 1)
             if j >= N:
                 break
-            i = j // n_paths
-            m = j - i * n_paths
-            q = q0[i]
-            p = p0[i]
+            r = j // n_paths
+            m = j - r * n_paths + m0
+            i = r + i0
+            q = q0[r]
+            p = p0[r]
             if beyond(0, wpar, q, energy_w(w, q, p), thrE2, lo, hi):
                 out[j] = 0
                 continue
@@ -184,16 +185,16 @@ def noise_kernel(well_key: int, scheme_key: int, law: int = noise_kernels.GAUSSI
             out[j] = first
 
     sig = ("void(float64[::1], float64[::1], int64, float64[::1], float64[::1], uint64, int64, float64, float64, "
-           "float64, float64, float64, float64, float64, float64, uint64, uint64, float64[::1], int64[::1], "
-           "int64[::1])")
+           "float64, float64, float64, float64, float64, float64, uint64, uint64, int64, int64, float64[::1], "
+           "int64[::1], int64[::1])")
     return cuda.jit(sig)(noisy)
 
 
 def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndarray, n_paths: int, coef: np.ndarray,
                  sintab: np.ndarray, F: float, thrE2: float, cycles: int, noise: noise_kernels.StepNoise, seed: int, *,
                  shift: float = 0.0, bounds: tuple[float, float] = (-np.inf, np.inf), wpar: np.ndarray | None = None,
-                 block: int | None = None, grid: int | None = None, timing: dict[str, Any] | None = None
-                 ) -> np.ndarray:
+                 block: int | None = None, grid: int | None = None, timing: dict[str, Any] | None = None,
+                 ic_offset: int = 0, path_offset: int = 0) -> np.ndarray:
     """noise_kernels.escape_steps on the GPU (the same arguments and result, bitwise): first steps
     beyond the thresholds, shape (len(q0), n_paths), int64.
 
@@ -203,7 +204,8 @@ def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
     a CUDA GPU or the simulator (cuda_engine.require_cuda)."""
     cuda_engine.require_cuda()
     total = int(cycles) * sintab.shape[0]
-    q, FS, k0, k1 = noise_kernels.prepare(code, scheme, q0, coef, sintab, F, seed, total)
+    q, FS, k0, k1 = noise_kernels.prepare(code, scheme, q0, coef, sintab, F, seed, total, n_paths=int(n_paths),
+                                          offsets=(ic_offset, path_offset))
     p = np.ascontiguousarray(p0, dtype=float)
     N = q.size * int(n_paths)
     out = np.full(N, -1, np.int64)
@@ -218,7 +220,8 @@ def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
         args = (cuda.to_device(q), cuda.to_device(p), int(n_paths), cuda.to_device(np.ascontiguousarray(coef).ravel()),
                 cuda.to_device(FS.ravel()), np.uint64(FS.size), total, float(thrE2), float(bounds[0]),
                 float(bounds[1]), float(noise.amp), float(shift), float(noise.c1), float(noise.c2), float(noise.s_eta),
-                k0, k1, cuda.to_device(wp), cuda.to_device(np.zeros(1, np.int64)), d_out)
+                k0, k1, int(ic_offset), int(path_offset), cuda.to_device(wp), cuda.to_device(np.zeros(1, np.int64)),
+                d_out)
         if cuda_kernels.SIMULATOR:
             t0 = time.perf_counter()
             kernel[nblk, blk](*args)

@@ -119,7 +119,8 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
                        seed: int = 0, cycles: int | None = None, noise_time: float = 0.0,
                        steps_per_cycle: int = engine.DEFAULT_STEPS_PER_CYCLE, grid: bool | None = None,
                        correction: str = "shift", integrator: str = engine.DEFAULT_INTEGRATOR,
-                       threads: int | None = None, backend: str = "cpu", variates: str = "gaussian") -> xr.Dataset:
+                       threads: int | None = None, backend: str = "cpu", variates: str = "gaussian",
+                       ic_offset: int = 0, path_offset: int = 0) -> xr.Dataset:
     """Probability of escape within each ``t_eval`` under noise, from ``paths`` paths per initial condition.
 
     Parameters
@@ -152,6 +153,11 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
         through the fifth, so the same weak order 2, at about three times the speed: one Philox
         block serves 16 steps).  The two laws draw different paths: their P_escape agree within the
         weak error and the sampling error, not bitwise.
+    ic_offset, path_offset : integers >= 0 (default 0): the index of the first initial condition and
+        of the first path in the random counters, so that a chunk of a larger ensemble draws that
+        ensemble's streams: the paths m0 .. m0 + paths - 1 of the initial conditions i0, i0 + 1, ...
+        (the initial conditions in the order of the sample, or of the grid flattened with q0
+        outermost).  Chunks run with their offsets give, together, the escape steps of one run.
     threads : numba threads of the CPU backend (None: the current setting); the result does not
         depend on it.
     backend : "cpu" (default: the compiled CPU lanes, the reference), "cuda" (numerics.cuda_noise
@@ -205,6 +211,7 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
         raise ValueError(f"paths must be <= 2^32 (a word of the random counter), got {paths}")
     if Q.size > 2 ** 32:
         raise ValueError(f"q0 and p0: at most 2^32 initial conditions (a word of the random counter), got {Q.size}")
+    noise_kernels.check_offsets((ic_offset, path_offset), Q.size, paths)
 
     problem = ensemble_problem(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=[xi], cycles=cycles,
                                steps_per_cycle=spc, integrator=integrator, well=w, damping=damping)
@@ -214,12 +221,13 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
             float(problem.thrE2[0]), cycles, noise_kernels.step_noise(sigma, h, tau, noise_kernels.LAWS[variates]),
             seed)
     shift = energy_shift(sigma, h, correction, tau, variates)
+    offsets = dict(ic_offset=ic_offset, path_offset=path_offset)
     if gpu is not None:
-        steps = gpu.escape_steps(*args, shift=shift)
+        steps = gpu.escape_steps(*args, shift=shift, **offsets)
     else:
         with engine.thread_count(threads) as nthreads:
             n_tasks = max(1, min(math.ceil(Q.size * paths / LANES), nthreads))
-            steps = noise_kernels.escape_steps(*args, shift=shift, n_tasks=n_tasks, lanes=LANES)
+            steps = noise_kernels.escape_steps(*args, shift=shift, n_tasks=n_tasks, lanes=LANES, **offsets)
     tc = engine.steps_to_cycles(steps, spc)                       # (n_ic, paths), inf: not within cycles
     ts = _survival_axis(cycles)
     k_eval = _counts_within(tc, te)
@@ -256,7 +264,8 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
                        "not escaped within cycles (the mean first-passage time where it is 0, a lower bound "
                        "otherwise)"),
         grid=int(is_grid), escape_criteria=criteria.criteria_text(w), **w.numerics_attrs(),
-        **engine.damping_attrs(damping), **({"noise_time": tau} if tau > 0 else {}))
+        **engine.damping_attrs(damping), **({"noise_time": tau} if tau > 0 else {}),
+        **{k: int(v) for k, v in offsets.items() if v})
     return ds
 
 

@@ -59,7 +59,7 @@ from safebasins.wells import elementary
 from safebasins.wells.compiled import LLVM_INLINE, WellCode, abs_tracking, cpu_jit, fma, mul, well_energy2
 
 __all__ = ["RNG_KEY", "MAX_STEPS", "GAUSSIAN", "FIVE_POINT", "LAWS", "StepNoise", "step_noise", "prepare",
-           "escape_steps", "final_states", "gaussian_pairs", "step_variates"]
+           "escape_steps", "final_states", "gaussian_pairs", "step_variates", "check_offsets"]
 
 #: the numba literal of the random-number and noise code (module docstring)
 RNG_KEY = int(fingerprint([__file__, philox.__file__])[:15], 16) ^ int(elementary.MODULE_HASH[:15], 16)
@@ -238,7 +238,8 @@ def _beyond(well: Any, wpar: Any, q: Any, e: Any, thrE2: Any, lo: Any, hi: Any) 
 @njit(cache=True, nogil=True, error_model="numpy")
 def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: Any, n_tasks: Any, lanes: Any,
                  q0: Any, p0: Any, n_paths: Any, coef: Any, FS: Any, thrE2: Any, lo: Any, hi: Any, cycles: Any,
-                 amp: Any, shift: Any, c1: Any, c2: Any, s_eta: Any, k0: Any, k1: Any, out: Any) -> None:
+                 amp: Any, shift: Any, c1: Any, c2: Any, s_eta: Any, k0: Any, k1: Any, i0: Any, m0: Any,
+                 out: Any) -> None:
     """Trajectories j = task, task + n_tasks, ... (path j % n_paths of initial condition
     j // n_paths): out[j] = the step after which it is first beyond (0: the initial condition,
     -1: not within cycles periods).  Lanes run one forcing period at a time; at the period
@@ -299,9 +300,9 @@ def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: An
                 continue
             Q[nact] = q
             P[nact] = p
-            PATH[nact] = j - i * n_paths
-            E[nact] = mul(s_eta, _gauss2(k0, k1, 0, PATH[nact], i, _ONE)[0])
-            IC[nact] = i
+            PATH[nact] = j - i * n_paths + m0
+            IC[nact] = i + i0
+            E[nact] = mul(s_eta, _gauss2(k0, k1, 0, PATH[nact], IC[nact], _ONE)[0])
             J[nact] = j
             BASE[nact] = 0
             CYC[nact] = 0
@@ -348,7 +349,7 @@ def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: An
 @njit(cache=True, nogil=True, error_model="numpy")
 def _final_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: Any, n_tasks: Any, q0: Any, p0: Any,
                 n_paths: Any, coef: Any, FS: Any, n_steps: Any, amp: Any, c1: Any, c2: Any, s_eta: Any, k0: Any,
-                k1: Any, qo: Any, po: Any, eo: Any) -> None:
+                k1: Any, i0: Any, m0: Any, qo: Any, po: Any, eo: Any) -> None:
     """Plain integration (no escape) of trajectories j = task, task + n_tasks, ... for n_steps
     steps; the same step as _escape_task."""
     S = FS.shape[0]
@@ -357,10 +358,11 @@ def _final_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: Any
     N = q0.shape[0] * n_paths
     H = (S + BLOCK_STEPS - 1) // BLOCK_STEPS
     for j in range(task, N, n_tasks):
-        i = j // n_paths
-        m = j - i * n_paths
-        q = q0[i]
-        p = p0[i]
+        r = j // n_paths
+        m = j - r * n_paths + m0
+        i = r + i0
+        q = q0[r]
+        p = p0[r]
         e = mul(s_eta, _gauss2(k0, k1, 0, m, i, _ONE)[0])
         words = (_ZERO, _ZERO, _ZERO, _ZERO)
         for n in range(n_steps):
@@ -410,11 +412,23 @@ def step_noise(sigma: float, h: float, noise_time: float = 0.0, law: int = GAUSS
                      sigma / math.sqrt(2.0 * noise_time), law)
 
 
+def check_offsets(offsets: tuple[int, int], n_ic: int, n_paths: int) -> None:
+    """ValueError naming ``ic_offset`` or ``path_offset`` unless each is an integer >= 0 and the
+    counter words it starts (n_ic initial conditions, n_paths paths) stay below 2^32."""
+    for what, offset, count in (("ic_offset", offsets[0], n_ic), ("path_offset", offsets[1], n_paths)):
+        if isinstance(offset, bool) or not isinstance(offset, (int, np.integer)) or offset < 0:
+            raise ValueError(f"{what} must be a non-negative integer, got {offset!r}")
+        if offset + count > 2 ** 32:
+            raise ValueError(f"{what}: {offset} + {count} exceeds 2^32 (a word of the random counter)")
+
+
 def prepare(code: WellCode, scheme: SchemeCode, q0: np.ndarray, coef: np.ndarray, sintab: np.ndarray, F: float,
-            seed: int, n_steps: int, name: str = "cycles") -> tuple[np.ndarray, np.ndarray, np.uint64, np.uint64]:
+            seed: int, n_steps: int, name: str = "cycles", n_paths: int = 1, offsets: tuple[int, int] = (0, 0)
+            ) -> tuple[np.ndarray, np.ndarray, np.uint64, np.uint64]:
     """The checks of every backend's arguments (as :func:`escape_steps`; n_steps: the steps of a
     path, set by the argument ``name``) and what they share: (q0 as float64, the forcing products
     F * sintab, the Philox key)."""
+    check_offsets(offsets, int(np.size(q0)), n_paths)
     if n_steps > MAX_STEPS:
         raise ValueError(f"{name}: {n_steps} steps per path exceed {MAX_STEPS} (the random counter's range)")
     if coef.ndim != 2 or coef.shape != (1, scheme.n_coef):
@@ -430,7 +444,8 @@ def prepare(code: WellCode, scheme: SchemeCode, q0: np.ndarray, coef: np.ndarray
 def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndarray, n_paths: int, coef: np.ndarray,
                  sintab: np.ndarray, F: float, thrE2: float, cycles: int, noise: StepNoise, seed: int, *,
                  shift: float = 0.0, bounds: tuple[float, float] = (-math.inf, math.inf),
-                 wpar: np.ndarray | None = None, n_tasks: int = 1, lanes: int = 256) -> np.ndarray:
+                 wpar: np.ndarray | None = None, n_tasks: int = 1, lanes: int = 256, ic_offset: int = 0,
+                 path_offset: int = 0) -> np.ndarray:
     """First steps beyond the thresholds of ``n_paths`` paths from every initial condition,
     shape (len(q0), n_paths), int64 (0: the initial condition is beyond, -1: not within
     ``cycles`` periods of ``sintab.shape[0]`` steps).  code, scheme: the compiled well and scheme
@@ -438,34 +453,39 @@ def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
     table (schemes.sine_table), times F; thrE2 = 2 xi_max; noise: the step's noise coefficients
     (:func:`step_noise`); shift: the
     energy boundary shift per ``|p|`` (module docstring); bounds: a displacement pair (lo, hi);
-    wpar: the well's wpar (None: code.wpar; the barriers are its first two entries).  The
-    result does not depend on n_tasks or lanes."""
-    q, FS, k0, k1 = prepare(code, scheme, q0, coef, sintab, F, seed, int(cycles) * sintab.shape[0])
+    wpar: the well's wpar (None: code.wpar; the barriers are its first two entries); ic_offset,
+    path_offset: the index of the first initial condition and of the first path in the random
+    counters (a chunk of a larger ensemble draws that ensemble's streams).  The result does not
+    depend on n_tasks or lanes."""
+    q, FS, k0, k1 = prepare(code, scheme, q0, coef, sintab, F, seed, int(cycles) * sintab.shape[0],
+                            n_paths=int(n_paths), offsets=(ic_offset, path_offset))
     p = np.ascontiguousarray(p0, dtype=float)
     out = np.full(q.size * int(n_paths), -1, np.int64)
     wp = code.wpar if wpar is None else np.ascontiguousarray(wpar, dtype=float)
     args = [code.key, scheme.key, RNG_KEY, int(noise.law), wp, 0, int(n_tasks), int(lanes), q, p, int(n_paths),
             np.ascontiguousarray(coef), FS, float(thrE2), float(bounds[0]), float(bounds[1]), int(cycles),
-            float(noise.amp), float(shift), float(noise.c1), float(noise.c2), float(noise.s_eta), k0, k1, out]
+            float(noise.amp), float(shift), float(noise.c1), float(noise.c2), float(noise.s_eta), k0, k1,
+            int(ic_offset), int(path_offset), out]
     entry = specialised(_escape_task, args, n_literal=4)
     run_tasks(lambda task: entry(*args[:5], task, *args[6:]), int(n_tasks))
     return out.reshape(q.size, int(n_paths))
 
 
 def final_states(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndarray, n_paths: int, coef: np.ndarray,
-                 sintab: np.ndarray, F: float, n_steps: int, noise: StepNoise, seed: int, n_tasks: int = 1
-                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                 sintab: np.ndarray, F: float, n_steps: int, noise: StepNoise, seed: int, n_tasks: int = 1,
+                 ic_offset: int = 0, path_offset: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(q, p, eta) of every path after ``n_steps`` steps, shape (len(q0), n_paths) each, no escape
     checks (weak-order tests, benchmarks); arguments as :func:`escape_steps`."""
-    q, FS, k0, k1 = prepare(code, scheme, q0, coef, sintab, F, seed, int(n_steps), "n_steps")
+    q, FS, k0, k1 = prepare(code, scheme, q0, coef, sintab, F, seed, int(n_steps), "n_steps", int(n_paths),
+                            (ic_offset, path_offset))
     p = np.ascontiguousarray(p0, dtype=float)
     qo = np.empty(q.size * int(n_paths))
     po = np.empty_like(qo)
     eo = np.empty_like(qo)
     args = [code.key, scheme.key, RNG_KEY, int(noise.law), code.wpar, 0, int(n_tasks), q, p, int(n_paths),
             np.ascontiguousarray(coef),
-            FS, int(n_steps), float(noise.amp), float(noise.c1), float(noise.c2), float(noise.s_eta), k0, k1, qo, po,
-            eo]
+            FS, int(n_steps), float(noise.amp), float(noise.c1), float(noise.c2), float(noise.s_eta), k0, k1,
+            int(ic_offset), int(path_offset), qo, po, eo]
     entry = specialised(_final_task, args, n_literal=4)
     run_tasks(lambda task: entry(*args[:5], task, *args[6:]), int(n_tasks))
     shape = (q.size, int(n_paths))
