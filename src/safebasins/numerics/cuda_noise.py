@@ -117,9 +117,10 @@ def noise_kernel(well_key: int, scheme_key: int, law: int = noise_kernels.GAUSSI
     coefficients (lane_coefficients, one row); FS (S * W,) the forcing products F * sine_table,
     flat; SW = S * W (uint64); total = cycles * S steps; thrE2 = 2 xi_max; (lo, hi) a displacement
     pair; amp, shift, c1, c2, s_eta: noise_kernels.StepNoise and the energy shift; (k0, k1) the
-    Philox key; (i0, m0) the counters' offsets of the initial condition and the path; wpar the well's (steps.N_WPAR,); counter (1,) int64 = 0; out (n_ic * n_paths,)
-    int64: trajectory j = i * n_paths + m gets its first step beyond (0: the initial condition,
-    -1: none within total steps)."""
+    Philox key; (i0, m0) the counters' offsets of the initial condition and the path; wpar the
+    well's (steps.N_WPAR,); counter (1,) int64 = 0; out (n_ic * n_paths,) int64: trajectory
+    j = i * n_paths + m gets its first step beyond (0: the initial condition, -1: none within
+    total steps)."""
     code: WellCode = code_of(well_key)
     sc: SchemeCode = code_of_scheme(scheme_key)
     force, energy_w = code.make(_device)
