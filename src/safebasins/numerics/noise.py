@@ -223,11 +223,12 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
     shift = energy_shift(sigma, h, correction, tau, variates)
     offsets = dict(ic_offset=ic_offset, path_offset=path_offset)
     if gpu is not None:
-        steps = gpu.escape_steps(*args, shift=shift, **offsets)
+        steps = gpu.escape_steps(*args, shift=shift, ic_offset=ic_offset, path_offset=path_offset)
     else:
         with engine.thread_count(threads) as nthreads:
             n_tasks = max(1, min(math.ceil(Q.size * paths / LANES), nthreads))
-            steps = noise_kernels.escape_steps(*args, shift=shift, n_tasks=n_tasks, lanes=LANES, **offsets)
+            steps = noise_kernels.escape_steps(*args, shift=shift, n_tasks=n_tasks, lanes=LANES,
+                                               ic_offset=ic_offset, path_offset=path_offset)
     tc = engine.steps_to_cycles(steps, spc)                       # (n_ic, paths), inf: not within cycles
     ts = _survival_axis(cycles)
     k_eval = _counts_within(tc, te)
