@@ -13,9 +13,13 @@ from safebasins import theory
 from safebasins.analysis import stochastic_erosion
 from safebasins.analysis.agreement import probability_agreement
 from safebasins.analysis.noise_theory import (escape_probability_with_theory, stochastic_erosion_with_theory,
-                                              theory_cycles, theory_reason)
+                                              theory_evaluations, theory_reason)
+from safebasins.core.averaged_theory import theory_cycles
 from safebasins.analysis.stochastic_integrity import stochastic_erosion_theory
 from safebasins.numerics import escape_probability
+from safebasins.theory.noise_averaging import table_evaluations
+from safebasins.theory.noise_escape import solve_evaluations
+from safebasins.wells import QUARTIC, resolve_well
 
 Q0, P0 = np.linspace(-0.95, 0.95, 5), np.linspace(-0.75, 0.75, 4)
 ARGS = (0.01, 0.9, math.pi)
@@ -108,3 +112,29 @@ def test_erosion_is_the_theory_profile() -> None:
         stochastic_erosion_with_theory(prof, Q0, P0, [0.0, 0.02], 0.9, math.pi, **kw, **SOLVER)
     none = stochastic_erosion_with_theory(prof, Q0, P0, [0.0, 0.01], 0.9, math.pi, **kw, theory=False)
     assert none.attrs["theory"] == "none" and not [v for v in none.data_vars if str(v).endswith("_theory")]
+
+
+# --------------------------------------------------------------------------- the cost guards' count
+def test_theory_evaluations_count_the_tables_once_and_each_solve() -> None:
+    kw = dict(noise=[0.01, 0.02], t_eval=[1, 3], n_ics=20, **SOLVER)
+    one = solve_evaluations(20, [1, 3], (16, 20), 6)
+    assert theory_evaluations(solves=2, **kw) == table_evaluations(QUARTIC) + 2 * one
+    # each further solve adds its march, the tables are counted once
+    counts = [theory_evaluations(solves=k, **kw) for k in (1, 2, 3)]
+    assert counts[2] - counts[1] == counts[1] - counts[0] == one > 0
+    # the march grows with the cells and the time steps (the set-up with the cells alone)
+    assert solve_evaluations(20, [1, 3], (32, 40), 6) > 3 * one
+    assert one < solve_evaluations(20, [1, 3], (16, 20), 12) < 2 * one
+    assert solve_evaluations(20, [1, 2.5], (16, 20), 6) == one           # the horizon: the largest t_eval, up
+    assert solve_evaluations(2000, [1, 3], (16, 20), 6) > one            # the ICs count too
+    # a well without closed-form action-angle variables: its tables cost more (orbit quadrature)
+    assert table_evaluations(resolve_well("pendulum")) > 10 * table_evaluations(QUARTIC)
+    assert theory_evaluations(solves=2, well="pendulum", **kw) - theory_evaluations(solves=2, **kw) == (
+        table_evaluations(resolve_well("pendulum")) - table_evaluations(QUARTIC))
+
+
+@pytest.mark.parametrize("over", [dict(theory=False), dict(noise_time=0.5), dict(noise=[0.0, 0.01])],
+                         ids=["no-theory", "coloured", "noise-0"])
+def test_theory_evaluations_zero_where_not_solved(over) -> None:
+    kw = dict(noise=[0.01, 0.02], t_eval=[1, 3], n_ics=20, solves=2, **SOLVER)
+    assert theory_evaluations(**{**kw, **over}) == 0 < theory_evaluations(**kw)

@@ -117,6 +117,23 @@ def test_cost_guard_counts_paths(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_cost_guard_counts_the_theory_per_forcing_and_noise_level(tmp_path):
+    # 1024^2 cells x 100 cycles of 6 steps: one solve fits the analytic budget, 2 F x 2 sigma do not
+    from safebasins.analysis.noise_theory import theory_evaluations
+    from safebasins.pipeline.cost import budgets
+
+    kw = dict(noise=[0.01, 0.02], t_eval=[1, 3, 100], n_ics=20, well="quartic", cells=(1024, 1024), steps_per_cycle=6)
+    budget = budgets()["budget_analytic_evaluations"]
+    assert theory_evaluations(solves=1, **kw) < budget < theory_evaluations(solves=4, **kw)
+    res = CliRunner().invoke(main, [*_without(BASE, "--theory-cells"), "--theory-cells", "1024", "--t-eval", "100",
+                                    "-o", str(tmp_path / "x")])
+    assert res.exit_code == 2, res.output
+    last = res.output.strip().splitlines()[-1]
+    assert f"needs {theory_evaluations(solves=4, **kw):.2e} slow-flow evaluations" in last, last
+    assert "--theory-cells" in last and "--allow-expensive" in last, last
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_help_lists_the_command():
     res = CliRunner().invoke(main, ["--help"])
     assert res.exit_code == 0 and "stochastic-erosion" in res.output

@@ -178,3 +178,37 @@ def test_bad_theory_options_named(tmp_path, args, reason):
     last = res.output.strip().splitlines()[-1]
     assert f"'{args[0]}'" in last and reason in last, last
     assert list(tmp_path.iterdir()) == []
+
+
+# --------------------------------------------------------------------------- the cost guard counts the theory
+# a tiny ensemble (20 ICs x 12 paths) with a far too large theory: 2048^2 cells x 200 cycles of 8 steps
+HUGE_THEORY = ["--theory-cells", "2048", "--t-eval", "200"]
+
+
+def test_cost_guard_refuses_a_huge_theory_naming_its_options(tmp_path):
+    from safebasins.pipeline.config import REPO_ROOT, load_yaml
+    from safebasins.pipeline.cost import analytic_cost
+    from safebasins.pipeline.plan import plan
+    from tests.pipeline.test_config import merged
+
+    res = CliRunner().invoke(main, [*BASE, *HUGE_THEORY, "-o", str(tmp_path / "huge")])
+    assert res.exit_code == 2, res.output
+    last = res.output.strip().splitlines()[-1]
+    assert "slow-flow evaluations" in last and "--theory-cells" in last and "--allow-expensive" in last, last
+    assert list(tmp_path.iterdir()) == []                          # refused before anything ran
+    # the pipeline's count of the same theory (one noise level, 5 x 4 ICs, t_eval 2, 4, 200)
+    base = load_yaml(REPO_ROOT / "config" / "config.yaml")
+    over = {"noise": [0.06], "grid": {"n": [5, 4]}, "t_eval": [2, 4, 200], "cycles": 200, "theory_cells": [2048, 2048]}
+    exp = plan(merged(base, {"noise": {"quartic_escape_probability": over}})).experiments[
+        "noise_quartic_escape_probability"]
+    assert f"needs {analytic_cost(exp):.2e} slow-flow evaluations" in last, last
+
+
+def test_cost_guard_passes_without_the_theory_and_at_the_defaults(tmp_path):
+    # the same horizon without the theory (the ensemble alone is small)
+    res = invoke([*BASE, *HUGE_THEORY, "--no-theory", "--no-plot"], tmp_path, "none")
+    assert res.exit_code == 0, res.output
+    # the default grid (200 x 200 ICs) and the theory's default cells and steps
+    res = invoke([*BASE, "--n", "200", "--paths", "2", "--no-plot"], tmp_path, "default")
+    assert res.exit_code == 0, res.output
+    assert "averaged theory vs ensemble" in res.output

@@ -15,6 +15,7 @@ import pytest
 from safebasins import theory
 from safebasins.analysis import stochastic_erosion
 from safebasins.analysis.agreement import probability_agreement
+from safebasins.analysis.noise_theory import theory_evaluations
 from safebasins.analysis.stochastic_integrity import stochastic_erosion_theory
 from safebasins.numerics import escape_probability
 from safebasins.pipeline.config import ConfigError
@@ -178,11 +179,18 @@ def test_analytic_cost_counts_the_theory(base: dict[str, Any]) -> None:
         return analytic_cost(plan(merged(base, {"noise": {"quartic_escape_probability": {**THEORY, **over}}}
                                          )).experiments[MAP])
 
-    # two noise levels x 16 x 20 cells x 3 cycles of 6 steps
-    assert cost({}) == 2 * 16 * 20 * 3 * 6
-    assert cost({"t_eval": [1, 2.5]}) == 2 * 16 * 20 * 3 * 6      # the theory's horizon: the largest t_eval, up
+    # the library's count (analysis.noise_theory.theory_evaluations, the command line's too): the
+    # tables once, two noise levels x (16 x 20 cells x 3 cycles of 6 steps and 5 x 4 ICs)
+    assert cost({}) == theory_evaluations(noise=[0.01, 0.02], t_eval=[1, 3], n_ics=20, solves=2, well="quartic",
+                                          cells=(16, 20), steps_per_cycle=6)
+    assert cost({"noise": [0.01, 0.02, 0.03]}) - cost({}) == cost({}) - cost({"noise": 0.01}) > 0
+    assert cost({"t_eval": [1, 2.5]}) == cost({})      # the theory's horizon: the largest t_eval, up
+    assert cost({"theory_cells": [32, 40]}) > cost({}) and cost({"theory_steps_per_cycle": 12}) > cost({})
     assert cost({"theory": False}) == cost({"noise_time": 1.0}) == cost({"noise": [0.0, 0.01]}) == 0
-    assert analytic_cost(plan(base).experiments[MAP]) == 3 * 128 * 160 * 50 * 8
+    p = plan(base).experiments[MAP].params
+    nq, np_ = p["grid"]["n"]
+    assert analytic_cost(plan(base).experiments[MAP]) == theory_evaluations(
+        noise=p["noise"], t_eval=p["t_eval"], n_ics=nq * np_, solves=3, well="quartic")
 
 
 def test_erosion_build_is_the_library_call(base: dict[str, Any]) -> None:
@@ -219,5 +227,6 @@ def test_erosion_build_with_the_theory_is_the_library_calls(base: dict[str, Any]
     assert 0 < float(ds["GIM_theory"].min()) < 1          # eroded somewhere, not empty: a profile to compare
     assert ds.attrs["theory_solver"] == ref.attrs["solver"] and list(ds.attrs["theory_cells"]) == [16, 20]
     assert analytic_cost(plan(merged(base, {"noise": {"escape_equation_erosion": QUARTIC_EROSION}}))
-                         .experiments[EROSION]) == 2 * 2 * 16 * 20 * 3 * 6
+                         .experiments[EROSION]) == theory_evaluations(
+        noise=[0.01, 0.02], t_eval=[1, 3], n_ics=20, solves=2 * 2, well="quartic", cells=(16, 20), steps_per_cycle=6)
     assert analytic_cost(plan(base).experiments[EROSION]) == 0           # the default: a noise level 0

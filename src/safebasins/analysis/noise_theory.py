@@ -31,10 +31,12 @@ from safebasins.analysis.stochastic_integrity import stochastic_erosion_theory
 from safebasins.core import cf, checks
 from safebasins.core.averaged_theory import CELLS, STEPS_PER_CYCLE, check_cells, theory_cycles
 from safebasins.theory import escape_probability as theory_escape_probability
+from safebasins.theory.noise_averaging import table_evaluations
+from safebasins.theory.noise_escape import solve_evaluations
 from safebasins.wells import resolve_well
 from safebasins.wells.base import WellLike
 
-__all__ = ["escape_probability_with_theory", "stochastic_erosion_with_theory", "theory_reason",
+__all__ = ["escape_probability_with_theory", "stochastic_erosion_with_theory", "theory_reason", "theory_evaluations",
            "THEORY_MEASURES"]
 
 #: the integrity measures the theory's erosion profile adds (as <measure>_theory)
@@ -57,6 +59,21 @@ def theory_reason(*, theory: bool, noise: float | Sequence[float] | npt.ArrayLik
         return ("not applicable at noise 0 (one of the levels): the averaged diffusion needs sigma > 0; "
                 "at sigma = 0 the theory is the deterministic slow flow (theory.slow_flow_escapes)")
     return None
+
+
+def theory_evaluations(*, noise: float | Sequence[float] | npt.ArrayLike, t_eval: npt.ArrayLike, n_ics: int,
+                       solves: int, well: WellLike = None, noise_time: float = 0.0, theory: bool = True,
+                       cells: tuple[int, int] = CELLS, steps_per_cycle: int = STEPS_PER_CYCLE) -> int:
+    """Upper-bound slow-flow evaluations (safebasins.pipeline.cost's unit) of the averaged theory
+    that :func:`escape_probability_with_theory` (``solves``: the noise levels) or
+    :func:`stochastic_erosion_with_theory` (``solves``: F values x noise levels) add on ``n_ics``
+    initial conditions: the well's coefficient tables once and each solve's march
+    (:func:`safebasins.theory.noise_escape.solve_evaluations`); 0 where :func:`theory_reason` says
+    it is not solved (an upper bound where the solve refuses the well or xi_max).  The pipeline's
+    and the command line's cost guards count the theory with it."""
+    if theory_reason(theory=theory, noise=noise, noise_time=noise_time) is not None:
+        return 0
+    return table_evaluations(resolve_well(well)) + solves * solve_evaluations(n_ics, t_eval, cells, steps_per_cycle)
 
 
 def _refused(exc: ValueError) -> str:

@@ -10,7 +10,7 @@ from typing import Any
 import click
 
 from safebasins.cli.commands import check_step, damping_text, grid_axes, well_label
-from safebasins.cli.noise import noise_options, theory_options, theory_settings
+from safebasins.cli.noise import THEORY_REDUCE, noise_options, theory_options, theory_settings
 from safebasins.cli.options import (FINITE, NONNEG, POSITIVE, THRESHOLD, Deferred, Number, NumberList, common_options,
                                     cost_guard, current_well, damping_option, from_library, grid_options, grid_params,
                                     joined, library_errors, no_fourier, out_option, steps_option, threads_option)
@@ -136,16 +136,21 @@ def stochastic_erosion(F: list[float], Omega: float, Psi: float, xi_max: float, 
     check_step(Omega, steps_per_cycle)
     nq, np_ = params["grid"]["n"]
     horizon = cycles if cycles is not None else max(1, math.ceil(max(t_eval)))
+    # the ensembles, the theory and the figure load numba, scipy and matplotlib: imported when the command runs
+    from safebasins.analysis import stochastic_erosion as profile
+    from safebasins.analysis.noise_theory import stochastic_erosion_with_theory, theory_evaluations
+    from safebasins.plotting.stochastic_erosion import figure_stochastic_erosion
+
     # one ensemble per (F, sigma): paths per IC at sigma > 0 (each step with its random numbers,
-    # pipeline.cost.NOISE_STEP_COST), one deterministic path at sigma = 0
+    # pipeline.cost.NOISE_STEP_COST), one deterministic path at sigma = 0; the averaged theory:
+    # its tables and one solve per (F, sigma) (the pipeline's count)
     step_cost = current_well(ctx).step_cost
     per_ic = noisy * paths * (step_cost + NOISE_STEP_COST) + (len(noise) - noisy) * step_cost
+    settings = theory_settings(theory, theory_cells, theory_steps_per_cycle)
     cost_guard(None, params, allow_expensive, steps=len(F) * nq * np_ * horizon * steps_per_cycle * per_ic,
-               reduce="--n, --paths, --cycles or the --F / --noise lists")
-    # the ensembles and the figure load numba and matplotlib: imported when the command runs
-    from safebasins.analysis import stochastic_erosion as profile
-    from safebasins.analysis.noise_theory import stochastic_erosion_with_theory
-    from safebasins.plotting.stochastic_erosion import figure_stochastic_erosion
+               reduce="--n, --paths, --cycles or the --F / --noise lists", reduce_analytic=THEORY_REDUCE,
+               evaluations=theory_evaluations(noise=noise, t_eval=t_eval, n_ics=nq * np_, solves=len(F) * len(noise),
+                                              well=current_well(ctx), noise_time=noise_time, **settings))
 
     q0, p0 = grid_axes(params["grid"])
     sweep: dict[str, Any] = dict(noise=_one_or_list(noise), epsilon=_one_or_list(epsilon), xi_max=xi_max, t_eval=t_eval,
@@ -155,7 +160,7 @@ def stochastic_erosion(F: list[float], Omega: float, Psi: float, xi_max: float, 
                      conservative=conservative, noise_time=noise_time, steps_per_cycle=steps_per_cycle,
                      threads=threads, **sweep)
         ds = stochastic_erosion_with_theory(ds, q0, p0, _one_or_list(F), Omega, Psi, noise_time=noise_time,
-                                            **sweep, **theory_settings(theory, theory_cells, theory_steps_per_cycle))
+                                            **sweep, **settings)
         ds = finish(ds, title=params["title"], params=params)
         fig = None if no_plot else draw(figure_stochastic_erosion, ds)
     write_outputs([(f"{out}.nc", ds)], fig, f"{out}.png")

@@ -18,12 +18,14 @@ from safebasins.core.averaged_theory import CELLS, MIN_CELLS, STEPS_PER_CYCLE, c
 from safebasins.pipeline.cost import NOISE_STEP_COST
 from safebasins.pipeline.values import fmt
 
-__all__ = ["escape_probability", "theory_options", "noise_options", "theory_settings"]
+__all__ = ["escape_probability", "theory_options", "noise_options", "theory_settings", "THEORY_REDUCE"]
 
 #: the library function whose defaults the options take
 LIBRARY = "safebasins.numerics:escape_probability"
 #: at most this many --t-eval values (one panel each)
 MAX_T_EVAL = 4
+#: what the cost guard suggests where the averaged theory's solve is over the analytic budget
+THEORY_REDUCE = "--theory-cells, --theory-steps-per-cycle or the largest --t-eval (or pass --no-theory)"
 
 
 def theory_options(f: Any) -> Any:
@@ -126,13 +128,18 @@ def escape_probability(F: float, Omega: float, Psi: float, xi_max: float, noise:
     check_step(Omega, steps_per_cycle)
     nq, np_ = params["grid"]["n"]
     horizon = cycles if cycles is not None else max(1, math.ceil(max(t_eval)))
-    # each noisy step: the well's force and the random numbers (pipeline.cost.NOISE_STEP_COST)
+    # the ensemble, its theory and its figure load numba, scipy and matplotlib: imported when the
+    # command runs, so that `safebasins --help` and the other commands start without them
+    from safebasins.analysis.noise_theory import escape_probability_with_theory, theory_evaluations
+
+    # each noisy step: the well's force and the random numbers (pipeline.cost.NOISE_STEP_COST);
+    # the averaged theory: its tables and one solve (the pipeline's count)
     step_cost = current_well(ctx).step_cost + NOISE_STEP_COST
+    settings = theory_settings(theory, theory_cells, theory_steps_per_cycle)
     cost_guard(None, params, allow_expensive, steps=nq * np_ * paths * horizon * steps_per_cycle * step_cost,
-               reduce="--n, --paths or --cycles")
-    # the ensemble and its figure load numba and matplotlib: imported when the command runs, so
-    # that `safebasins --help` and the other commands start without them
-    from safebasins.analysis.noise_theory import escape_probability_with_theory
+               reduce="--n, --paths or --cycles", reduce_analytic=THEORY_REDUCE,
+               evaluations=theory_evaluations(noise=noise, t_eval=t_eval, n_ics=nq * np_, solves=1,
+                                              well=current_well(ctx), noise_time=noise_time, **settings))
     from safebasins.numerics import escape_probability as ensemble
     from safebasins.plotting.noise import figure_escape_probability_levels
 
@@ -143,8 +150,7 @@ def escape_probability(F: float, Omega: float, Psi: float, xi_max: float, noise:
                       steps_per_cycle=steps_per_cycle, grid=True, threads=threads)
         params["cycles"] = int(ds.attrs["cycles"])
         ds = escape_probability_with_theory(ds, F, Omega, Psi, xi_max, damping=damping, well=current_well(ctx),
-                                            noise_time=noise_time,
-                                            **theory_settings(theory, theory_cells, theory_steps_per_cycle))
+                                            noise_time=noise_time, **settings)
         ds = finish(ds, title=params["title"], params=params)
         # the pipeline's figure of stacked noise levels, one row: the theory's contours and notes
         fig = None if no_plot else draw(figure_escape_probability_levels, ds.expand_dims(noise=[noise]))

@@ -395,11 +395,14 @@ def check_writable(prefix: Path) -> None:
 
 
 def cost_guard(kind: str | None, params: Params, allow_expensive: bool, numeric: bool = True,
-               steps: float | None = None, reduce: str = "--n, --cycles or the scanned values") -> None:
+               steps: float | None = None, reduce: str = "--n, --cycles or the scanned values",
+               evaluations: float = 0.0,
+               reduce_analytic: str = "--n, --n-points, --n-gamma/--n-xi or the Omega range") -> None:
     """The pipeline's cost guard (safebasins.pipeline.cost, the config schema's default budgets)
     for one command: a usage error naming --allow-expensive above a budget.  ``steps``: the
     trajectory-steps (in quartic steps) counted by a command that has no pipeline kind (``kind``
-    is then unused); ``reduce``: the options the message suggests reducing."""
+    is then unused), and ``evaluations`` its slow-flow evaluations; ``reduce``,
+    ``reduce_analytic``: the options the messages suggest reducing."""
     from safebasins.pipeline.cost import ANALYTIC_RATE, RATE_PER_CORE, budgets, params_cost
 
     if allow_expensive:
@@ -408,8 +411,6 @@ def cost_guard(kind: str | None, params: Params, allow_expensive: bool, numeric:
         if kind is None:
             raise ValueError("cost_guard: give the pipeline kind of the run or its trajectory-steps")
         steps, evaluations = params_cost(kind, params, numeric)
-    else:
-        evaluations = 0
     b = budgets()
     core_hours = steps / RATE_PER_CORE / 3600
     if core_hours > b["budget_core_hours"]:
@@ -421,8 +422,7 @@ def cost_guard(kind: str | None, params: Params, allow_expensive: bool, numeric:
         raise click.UsageError(
             f"the analytic part of this run needs {evaluations:.2e} slow-flow evaluations (~"
             f"{evaluations / ANALYTIC_RATE / 3600:.3g} h at {ANALYTIC_RATE:.0e}/s), above the budget of "
-            f"{b['budget_analytic_evaluations']:.3g}: reduce --n, --n-points, --n-gamma/--n-xi or the Omega range, "
-            "or pass --allow-expensive")
+            f"{b['budget_analytic_evaluations']:.3g}: reduce {reduce_analytic}, or pass --allow-expensive")
 
 
 # ----------------------------------------------------------------------------------------------

@@ -36,8 +36,9 @@ from numpy.typing import ArrayLike
 
 from safebasins.theory.types import FloatArray
 from safebasins.wells.base import Well
+from safebasins.wells.quartic import QuarticWell
 
-__all__ = ["orbit_averages", "AveragedDiffusion", "averaged_diffusion", "N_THETA", "N_NODES"]
+__all__ = ["orbit_averages", "AveragedDiffusion", "averaged_diffusion", "table_evaluations", "N_THETA", "N_NODES"]
 
 #: angles of the trapezoidal rule of the orbit averages
 N_THETA = 256
@@ -45,6 +46,12 @@ N_THETA = 256
 N_NODES = 600
 #: tables kept per well (the most recently used (xi_max, n, n_theta))
 _KEPT = 16
+#: slow-flow evaluations (safebasins.pipeline.cost's unit, 1e6 per second) per phase point of the
+#: tables: the quartic's closed forms (0.33 s for the default tables, 3 x 600 x 256 points, on one
+#: core of the shared 2.5 GHz Xeon test machine), any other well's orbit quadrature (the pendulum's:
+#: 5.9-10 s, 13-22 us a point)
+CLOSED_FORM_POINT_EVALUATIONS = 1
+QUADRATURE_POINT_EVALUATIONS = 25
 #: the largest phase of the first harmonic (rad) of a well taken as symmetric
 SHIFT_TOL = 1e-9
 #: relative step of the central difference in the energy (q_J = omega dq/dE at fixed theta)
@@ -114,6 +121,14 @@ class AveragedDiffusion:
         Ja = np.asarray(J, float)
         out: FloatArray = np.interp(Ja, self.J_nodes, self.a_t) / (2.0 * Ja)
         return out
+
+
+def table_evaluations(well: Well, n: int = N_NODES, n_theta: int = N_THETA) -> int:
+    """Upper-bound slow-flow evaluations of :func:`averaged_diffusion`'s tables of ``well``: the
+    three phase points (at the energy and its two neighbours of the central difference) per action
+    node and angle."""
+    per = CLOSED_FORM_POINT_EVALUATIONS if isinstance(well, QuarticWell) else QUADRATURE_POINT_EVALUATIONS
+    return 3 * n * n_theta * per
 
 
 #: well -> its tables by (xi_max, n, n_theta); a well's entry goes with the well

@@ -11,6 +11,8 @@ ensembles of :func:`safebasins.numerics.escape_probability`.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import xarray as xr
 from numpy.typing import ArrayLike
@@ -26,12 +28,21 @@ from safebasins.wells import resolve_well
 from safebasins.wells.base import Well
 from safebasins.wells.provenance import api_provenance
 
-__all__ = ["escape_probability", "mean_first_passage", "SCHEMES"]
+__all__ = ["escape_probability", "mean_first_passage", "solve_evaluations", "SCHEMES"]
 
 #: the advection of the time march: semi-Lagrangian (noise_semilagrangian) or the finite volumes'
 SCHEMES = ("semi-lagrangian",) + ADVECTION
 #: how far outside [0, 1] an Eulerian march may go before its oscillations are an error
 RANGE_TOL = 0.02
+#: slow-flow evaluations (safebasins.pipeline.cost's unit, 1e6 per second) of one semi-Lagrangian
+#: solve past its coefficient tables, measured on one core of the shared 2.5 GHz Xeon test machine
+#: (quartic and pendulum, 128 x 160 cells, 21^2 and 201^2 ICs, 1 and 20 cycles): per cell and time
+#: step (0.7-0.8 us), per cell of the set-up (departure points, advection matrix, LU factors: 15 us),
+#: per IC (its action-angle point and the interpolation: up to 5 us) and per IC and time step (0.2 us)
+CELL_STEP_EVALUATIONS = 1
+CELL_SETUP_EVALUATIONS = 20
+IC_EVALUATIONS = 5
+IC_STEP_EVALUATIONS = 0.2
 
 MODEL_TEXT = ("averaged diffusion of the slow flow (gamma, J) under dp = ... + sigma dW: drift dC/dJ, -dC/dgamma - "
               "beta J plus the noise-induced (sigma^2/2) d(J/omega)/dJ; diffusion sigma^2 J/omega (action), sigma^2 "
@@ -60,6 +71,18 @@ def _setup(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_
     ics = checks.initial_conditions(q0, p0, grid)
     diff = averaged_diffusion(w, par["xi_max"])
     return w, par, ics, DiscGrid(n_gamma, n_J, diff.J_max), diff
+
+
+def solve_evaluations(n_ics: int, t_eval: ArrayLike, cells: tuple[int, int] = CELLS,
+                      steps_per_cycle: int = STEPS_PER_CYCLE) -> int:
+    """Upper-bound slow-flow evaluations of one :func:`escape_probability` solve on ``n_ics``
+    initial conditions (its march to the horizon of ``t_eval`` and its set-up; the coefficient
+    tables, shared by the solves of a well, are
+    :func:`~safebasins.theory.noise_averaging.table_evaluations`)."""
+    steps = theory_cycles(t_eval) * steps_per_cycle
+    n_cells = cells[0] * cells[1]
+    return math.ceil(n_cells * (steps * CELL_STEP_EVALUATIONS + CELL_SETUP_EVALUATIONS)
+                     + n_ics * (IC_EVALUATIONS + steps * IC_STEP_EVALUATIONS))
 
 
 def _slow_points(w: Well, Q: FloatArray, P: FloatArray, Psi: float, xi_max: float

@@ -139,22 +139,15 @@ def _theory_settings(params: Params) -> dict[str, Any]:
                 steps_per_cycle=params["theory_steps_per_cycle"])
 
 
-#: slow-flow evaluations per cell and time step of the theory's march (Fig 14's quartic, 128 x 160
-#: cells, 50 cycles of 8 steps: 8.4-10.1 s per noise level on one core of a 2.5 GHz Xeon, about
-#: 1e6 cell-steps per second = pipeline.cost.ANALYTIC_RATE)
-THEORY_CELL_STEP_EVALUATIONS = 1
-
-
 def _theory_cost(params: Params, solves: int) -> int:
-    """The theory's march: cells x time steps per solve (0 where it does not apply; an upper bound
-    for a well the theory refuses at build time)."""
-    from safebasins.analysis.noise_theory import theory_cycles, theory_reason
+    """The theory's tables and ``solves`` solves on the IC grid
+    (safebasins.analysis.noise_theory.theory_evaluations, as the command line counts them)."""
+    from safebasins.analysis.noise_theory import theory_evaluations
 
-    if theory_reason(theory=params["theory"], noise=params["noise"], noise_time=params["noise_time"]) is not None:
-        return 0
-    n_gamma, n_J = params["theory_cells"]
-    steps = theory_cycles(params["t_eval"]) * params["theory_steps_per_cycle"]
-    return solves * n_gamma * n_J * steps * THEORY_CELL_STEP_EVALUATIONS
+    nq, np_ = params["grid"]["n"]
+    return theory_evaluations(noise=params["noise"], t_eval=params["t_eval"], n_ics=nq * np_, solves=solves,
+                              well=values.base_well(params), noise_time=params["noise_time"], theory=params["theory"],
+                              cells=tuple(params["theory_cells"]), steps_per_cycle=params["theory_steps_per_cycle"])
 
 
 # --------------------------------------------------------------------------- escape_probability
