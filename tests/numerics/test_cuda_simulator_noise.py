@@ -65,6 +65,7 @@ def _cases() -> dict[str, dict[str, Any]]:
         "quartic/white/five-point": dict(quartic, noise=0.05, seed=7, variates="five-point"),
         "quartic/white/damped/five-point/40": dict(quartic, noise=0.08, damping=0.1, seed=2 ** 40 + 3,
                                                    variates="five-point", steps=40),
+        "quartic/white/thresholds": dict(quartic, noise=0.05, seed=7, thrE2=[0.25, 0.4, 0.4, 0.6]),
         "quartic/white/offsets": dict(quartic, noise=0.05, seed=7, variates="five-point", ic_offset=5,
                                       path_offset=2 ** 31),
         "pendulum/coloured/damped/five-point": dict(pendulum, noise=0.3, noise_time=1.2, damping=0.1, seed=9,
@@ -82,7 +83,7 @@ def _arguments(case: dict[str, Any]) -> tuple[tuple[Any, ...], dict[str, Any]]:
                           damping=case.get("damping", 0.0))
     h = float(pb.step_sizes()[0])
     tau = case.get("noise_time", 0.0)
-    thrE2 = case.get("thrE2", float(pb.thrE2[0]))
+    thrE2 = np.array(case["thrE2"]) if isinstance(case.get("thrE2"), list) else case.get("thrE2", float(pb.thrE2[0]))
     variates = case.get("variates", "gaussian")
     args = (pb.code, pb.scheme, q0, p0, PATHS, pb.coefficients(), pb.sine_table(), case["F"], thrE2, CYCLES,
             noise_kernels.step_noise(case["noise"], h, tau, noise_kernels.LAWS[variates]), case["seed"])

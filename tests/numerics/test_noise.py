@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import xarray as xr
 import pytest
 from scipy import stats
 
@@ -178,6 +179,52 @@ def test_chunks_with_offsets_draw_the_whole_runs_streams(law):
                       (dict(ic_offset=1.5), "ic_offset")):
         with pytest.raises(ValueError, match=f"^{name}"):
             escape_probability(q, p, **FORCING, paths=30, **kw, **bad)
+
+
+@pytest.mark.parametrize("law", [noise_kernels.GAUSSIAN, noise_kernels.FIVE_POINT])
+def test_several_thresholds_in_one_pass(law):
+    """Energy thresholds 2 xi_max = 0.2, 0.3, 0.3, 0.45 in one pass: each column is the run with that
+    threshold alone, bitwise (the paths do not depend on the thresholds; a trajectory runs until
+    it is beyond the largest); crossings in order, ties equal; a descending array is refused."""
+    code, sc = quartic_code(), scheme_code("srkn6b", True)
+    coef = schemes.lane_coefficients([0.9], 16, "srkn6b", 0.05)
+    tab = schemes.sine_table(16, 0.0)
+    q0, p0 = np.array([0.0, 0.3, -0.5, 0.9, 0.2]), np.array([0.0, 0.1, 0.2, 0.5, 0.5])
+    thr = np.array([0.2, 0.3, 0.3, 0.45])
+
+    def run(t, **kw):
+        return noise_kernels.escape_steps(code, sc, q0, p0, 23, coef, tab, 0.03, t, 30,
+                                          noise_kernels.StepNoise(0.02, law=law), 11, shift=0.01, **kw)
+    many = run(thr, n_tasks=2, lanes=5)
+    assert many.shape == (5, 23, 4)
+    for k, t in enumerate(thr):
+        np.testing.assert_array_equal(many[..., k], run(float(t)))
+    np.testing.assert_array_equal(many[..., 1], many[..., 2])
+    done = np.where(many < 0, np.iinfo(np.int64).max, many)
+    assert (np.diff(done, axis=-1) >= 0).all()
+    assert (many[..., 0] == 0).any() and (many[..., 3] == 0).any() and (many[..., 0] > 0).any()
+    assert ((many[..., 0] > 0) & (many[..., 3] < 0)).any() and (many[..., 0] < many[..., 3]).any()
+    with pytest.raises(ValueError, match="^thrE2"):
+        run(thr[::-1])
+
+
+def test_escape_probability_with_several_xi_max():
+    """xi_max = [0.22, 0.12, 0.18] (not sorted): every variable gains the dimension xi_max, in the
+    caller's order, and each slice is the Dataset of that threshold alone (values and dims)."""
+    kw = dict(noise=0.04, paths=30, t_eval=[3, 8], cycles=8, damping=0.03, seed=6, variates="five-point")
+    xs = [0.22, 0.12, 0.18]
+    many = escape_probability(Q[::2], P[::2], **FORCING, xi_max=xs, **kw)
+    assert list(many.xi_max.values) == xs and "xi_max" not in many.attrs
+    assert many.P_escape.dims == ("q0", "p0", "xi_max", "t_eval")
+    assert many.first_passage_mean.dims == ("q0", "p0", "xi_max")
+    for x in xs:
+        one = escape_probability(Q[::2], P[::2], **FORCING, xi_max=x, **kw)
+        for v in one.data_vars:
+            xr.testing.assert_equal(many[v].sel(xi_max=x, drop=True), one[v])
+    p = many.P_escape.sel(t_eval=8).values
+    assert (p[..., 1] >= p[..., 2]).all() and (p[..., 2] >= p[..., 0]).all() and (p[..., 1] > p[..., 0]).any()
+    with pytest.raises(ValueError, match="^xi_max"):
+        escape_probability(Q, P, **FORCING, xi_max=[0.1, 0.3], **kw)
 
 
 GOOD = dict(noise=0.05, paths=10, xi_max=0.2, t_eval=[5])

@@ -115,12 +115,13 @@ def noise_kernel(well_key: int, scheme_key: int, law: int = noise_kernels.GAUSSI
     Launch: kernel[grid, block](q0, p0, n_paths, coef, FS, SW, total, thrE2, lo, hi, amp, shift, c1,
     c2, s_eta, k0, k1, i0, m0, wpar, counter, out): q0, p0 (n_ic,) float64; coef (NC,) the scheme's
     coefficients (lane_coefficients, one row); FS (S * W,) the forcing products F * sine_table,
-    flat; SW = S * W (uint64); total = cycles * S steps; thrE2 = 2 xi_max; (lo, hi) a displacement
+    flat; SW = S * W (uint64); total = cycles * S steps; thrE2 (K,) the energy thresholds 2 xi_max,
+    ascending; (lo, hi) a displacement
     pair; amp, shift, c1, c2, s_eta: noise_kernels.StepNoise and the energy shift; (k0, k1) the
     Philox key; (i0, m0) the counters' offsets of the initial condition and the path; wpar the
-    well's (steps.N_WPAR,); counter (1,) int64 = 0; out (n_ic * n_paths,) int64: trajectory
-    j = i * n_paths + m gets its first step beyond (0: the initial condition, -1: none within
-    total steps)."""
+    well's (steps.N_WPAR,); counter (1,) int64 = 0; out (n_ic * n_paths * K,) int64, -1 on entry:
+    trajectory j = i * n_paths + m gets its first step beyond threshold k in out[j * K + k] (0: the
+    initial condition, -1: none within total steps)."""
     code: WellCode = code_of(well_key)
     sc: SchemeCode = code_of_scheme(scheme_key)
     force, energy_w = code.make(_device)
@@ -136,12 +137,13 @@ def noise_kernel(well_key: int, scheme_key: int, law: int = noise_kernels.GAUSSI
     BS = noise_kernels.BLOCK_STEPS
 
     def noisy(q0: Floats, p0: Floats, n_paths: Int, coef: Floats, FS: Floats, SW: np.uint64, total: Int,
-              thrE2: float, lo: float, hi: float, amp: float, shift: float, c1: float, c2: float, s_eta: float,
+              thrE2: Floats, lo: float, hi: float, amp: float, shift: float, c1: float, c2: float, s_eta: float,
               k0: np.uint64, k1: np.uint64, i0: Int, m0: Int, wpar: Floats, counter: Ints, out: Ints) -> None:
         w = (wpar[2], wpar[3], wpar[4], wpar[5], wpar[6], wpar[7], wpar[8],
              wpar[9], wpar[10], wpar[11], wpar[12], wpar[13], wpar[14], wpar[15])
         c = flat_coefs(coef, uint64(0))
         N = q0.shape[0] * n_paths
+        K = thrE2.shape[0]
         S = SW // UW
         H = (S + BS - 1) // BS
         while True:
@@ -153,11 +155,15 @@ def noise_kernel(well_key: int, scheme_key: int, law: int = noise_kernels.GAUSSI
             i = r + i0
             q = q0[r]
             p = p0[r]
-            if beyond(0, wpar, q, energy_w(w, q, p), thrE2, lo, hi):
-                out[j] = 0
+            # beyond threshold k implies beyond every lower one (ascending): the next one is watched
+            e0 = energy_w(w, q, p)
+            nx = 0
+            while nx < K and beyond(0, wpar, q, e0, thrE2[nx], lo, hi):
+                out[j * K + nx] = 0
+                nx += 1
+            if nx == K:
                 continue
             e = mul(s_eta, gauss2(k0, k1, 0, m, i, _ONE)[0])
-            first = -1
             o = uint64(0)
             s = uint64(0)                      # the sub-step of the period, and the period
             cyc = uint64(0)
@@ -174,8 +180,11 @@ def noise_kernel(well_key: int, scheme_key: int, law: int = noise_kernels.GAUSSI
                 q, p = step(w, q, fma(amp, z1, p), c, plus(flat_row(FS, o), eta))
                 p = fma(amp, z2, p)
                 e = fma(c2, z2, mul(c1, eta))
-                if beyond(0, wpar, q, fma(shift, abs(p), energy_w(w, q, p)), thrE2, lo, hi):
-                    first = n + 1
+                en = fma(shift, abs(p), energy_w(w, q, p))
+                while nx < K and beyond(0, wpar, q, en, thrE2[nx], lo, hi):
+                    out[j * K + nx] = n + 1
+                    nx += 1
+                if nx == K:
                     break
                 o += UW
                 s += uint64(1)
@@ -183,21 +192,21 @@ def noise_kernel(well_key: int, scheme_key: int, law: int = noise_kernels.GAUSSI
                     o = uint64(0)
                     s = uint64(0)
                     cyc += uint64(1)
-            out[j] = first
 
-    sig = ("void(float64[::1], float64[::1], int64, float64[::1], float64[::1], uint64, int64, float64, float64, "
+    sig = ("void(float64[::1], float64[::1], int64, float64[::1], float64[::1], uint64, int64, float64[::1], float64, "
            "float64, float64, float64, float64, float64, float64, uint64, uint64, int64, int64, float64[::1], "
            "int64[::1], int64[::1])")
     return cuda.jit(sig)(noisy)
 
 
 def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndarray, n_paths: int, coef: np.ndarray,
-                 sintab: np.ndarray, F: float, thrE2: float, cycles: int, noise: noise_kernels.StepNoise, seed: int, *,
-                 shift: float = 0.0, bounds: tuple[float, float] = (-np.inf, np.inf), wpar: np.ndarray | None = None,
-                 block: int | None = None, grid: int | None = None, timing: dict[str, Any] | None = None,
-                 ic_offset: int = 0, path_offset: int = 0) -> np.ndarray:
+                 sintab: np.ndarray, F: float, thrE2: float | np.ndarray, cycles: int, noise: noise_kernels.StepNoise,
+                 seed: int, *, shift: float = 0.0, bounds: tuple[float, float] = (-np.inf, np.inf),
+                 wpar: np.ndarray | None = None, block: int | None = None, grid: int | None = None,
+                 timing: dict[str, Any] | None = None, ic_offset: int = 0, path_offset: int = 0) -> np.ndarray:
     """noise_kernels.escape_steps on the GPU (the same arguments and result, bitwise): first steps
-    beyond the thresholds, shape (len(q0), n_paths), int64.
+    beyond the thresholds, shape (len(q0), n_paths), int64 (an array thrE2 of K thresholds: shape
+    (len(q0), n_paths, K)).
 
     block, grid: threads per block (default 128, the simulator 4) and blocks (default: as many as
     stay resident, the simulator 1); the result does not depend on them.  timing: a dict to
@@ -208,8 +217,9 @@ def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
     q, FS, k0, k1 = noise_kernels.prepare(code, scheme, q0, coef, sintab, F, seed, total, n_paths=int(n_paths),
                                           offsets=(ic_offset, path_offset))
     p = np.ascontiguousarray(p0, dtype=float)
+    thr = noise_kernels.threshold_array(thrE2)
     N = q.size * int(n_paths)
-    out = np.full(N, -1, np.int64)
+    out = np.full(N * thr.size, -1, np.int64)
     if N:
         blk = (checks.check_positive_int("block", block) if block is not None else
                (SIMULATOR_BLOCK if cuda_kernels.SIMULATOR else cuda_kernels.BLOCK))
@@ -219,7 +229,7 @@ def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
         wp = code.wpar if wpar is None else np.ascontiguousarray(wpar, dtype=float)
         d_out = cuda.to_device(out)
         args = (cuda.to_device(q), cuda.to_device(p), int(n_paths), cuda.to_device(np.ascontiguousarray(coef).ravel()),
-                cuda.to_device(FS.ravel()), np.uint64(FS.size), total, float(thrE2), float(bounds[0]),
+                cuda.to_device(FS.ravel()), np.uint64(FS.size), total, cuda.to_device(thr), float(bounds[0]),
                 float(bounds[1]), float(noise.amp), float(shift), float(noise.c1), float(noise.c2), float(noise.s_eta),
                 k0, k1, int(ic_offset), int(path_offset), cuda.to_device(wp), cuda.to_device(np.zeros(1, np.int64)),
                 d_out)
@@ -237,4 +247,4 @@ def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
         out = d_out.copy_to_host()
         if timing is not None:
             timing.update(kernel_s=kernel_s, grid=nblk, block=blk)
-    return out.reshape(q.size, int(n_paths))
+    return out.reshape(q.size, int(n_paths)) if np.ndim(thrE2) == 0 else out.reshape(q.size, int(n_paths), thr.size)

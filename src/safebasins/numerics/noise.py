@@ -139,7 +139,9 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
         step must resolve it: a step h = 2 pi / (Omega steps_per_cycle) > tau is refused.
     paths : paths per initial condition (positive integer).
     xi_max : the energy threshold (a scalar in (0, barrier energy]): escape when H0 > xi_max or q
-        beyond a barrier, checked after every step.
+        beyond a barrier, checked after every step; or a 1-D sequence of thresholds, all from one
+        pass (each path runs until it is beyond the largest): the Dataset's variables gain the
+        dimension ``xi_max`` after the initial conditions'.
     t_eval : evaluation times in forcing cycles (>= 0, up to ``cycles``).
     seed : integer in [0, 2^63): the key of the Philox streams; path m of initial condition i
         draws the same numbers for any threads, lanes or order (numerics.noise_kernels).
@@ -185,7 +187,10 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
     tau = checks.check_scalar("noise_time", noise_time, checks.check_nonnegative)
     paths = checks.check_positive_int("paths", paths)
     w = resolve_well(well)
-    xi = checks.check_scalar("xi_max", w.check_threshold("xi_max", xi_max), checks.check_finite)
+    several = np.ndim(xi_max) > 0
+    xi = engine.thresholds("xi_max", xi_max, w.check_threshold)
+    if xi.size == 0 or not np.isfinite(xi).all():
+        raise ValueError(f"xi_max must be one or more finite energies, got {xi_max!r}")
     te = checks.check_1d("t_eval", t_eval, checks.check_nonnegative)
     cycles = check_cycles("cycles", max(1, math.ceil(float(te.max()))) if cycles is None else cycles)
     if te.max() > cycles:
@@ -213,13 +218,13 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
         raise ValueError(f"q0 and p0: at most 2^32 initial conditions (a word of the random counter), got {Q.size}")
     noise_kernels.check_offsets((ic_offset, path_offset), Q.size, paths)
 
-    problem = ensemble_problem(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=[xi], cycles=cycles,
+    problem = ensemble_problem(Q, P, np.zeros(Q.size, np.int64), [Omega], [F], Psi, xi_max=xi, cycles=cycles,
                                steps_per_cycle=spc, integrator=integrator, well=w, damping=damping)
     h = float(problem.step_sizes()[0])              # (the same h, as the engine forms it)
     # one argument list, either backend (cuda_noise.escape_steps takes noise_kernels.escape_steps's)
     args = (problem.code, problem.scheme, Q, P, paths, problem.coefficients(), problem.sine_table(), F,
-            float(problem.thrE2[0]), cycles, noise_kernels.step_noise(sigma, h, tau, noise_kernels.LAWS[variates]),
-            seed)
+            problem.thrE2 if several else float(problem.thrE2[0]), cycles,
+            noise_kernels.step_noise(sigma, h, tau, noise_kernels.LAWS[variates]), seed)
     shift = energy_shift(sigma, h, correction, tau, variates)
     offsets = dict(ic_offset=ic_offset, path_offset=path_offset)
     if gpu is not None:
@@ -229,35 +234,33 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
             n_tasks = max(1, min(math.ceil(Q.size * paths / LANES), nthreads))
             steps = noise_kernels.escape_steps(*args, shift=shift, n_tasks=n_tasks, lanes=LANES,
                                                ic_offset=ic_offset, path_offset=path_offset)
-    tc = engine.steps_to_cycles(steps, spc)                       # (n_ic, paths), inf: not within cycles
     ts = _survival_axis(cycles)
-    k_eval = _counts_within(tc, te)
-    k_surv = _counts_within(tc, ts)
-    low, high = wilson_interval(k_eval, paths)
-    restricted = np.minimum(tc, float(cycles))
-    # one path has no spread to estimate the standard error from: NaN, as documented
-    sem = restricted.std(axis=1, ddof=1) / math.sqrt(paths) if paths > 1 else np.full(Q.size, np.nan)
+    if several:                 # the sorted thresholds' columns, in the caller's order
+        caller = np.empty_like(steps)
+        caller[..., problem.order_E] = steps
+        stats = [_path_statistics(engine.steps_to_cycles(caller[..., k], spc), te, ts, cycles)
+                 for k in range(xi.size)]
+        # (n_ic, xi_max, ...): the threshold axis after the initial conditions'
+        columns = {name: np.stack([st[name] for st in stats], axis=1) for name in stats[0]}
+    else:
+        columns = _path_statistics(engine.steps_to_cycles(steps, spc), te, ts, cycles)
 
     shape, dims, coords = ic_coords(is_grid, qa, pa, Q, P)
+    if several:
+        coords["xi_max"] = ("xi_max", xi, cf.attrs("xi_max"))
     coords["t_eval"] = ("t_eval", te, cf.attrs("t_eval"))
     coords["t_survival"] = ("t_survival", ts, cf.attrs("t_survival"))
+    thr_dims: tuple[str, ...] = ("xi_max",) if several else ()
 
-    def field(a: np.ndarray, name: str, last: tuple[str, ...] = ()
-              ) -> tuple[tuple[str, ...], np.ndarray, dict[str, str]]:
-        return dims + last, a.reshape(shape + a.shape[1:]), cf.attrs(name)
+    def field(name: str, last: tuple[str, ...] = ()) -> tuple[tuple[str, ...], np.ndarray, dict[str, str]]:
+        a = columns[name]
+        return dims + thr_dims + last, a.reshape(shape + a.shape[1:]), cf.attrs(name)
 
-    data = {
-        "P_escape": field(k_eval / paths, "P_escape", ("t_eval",)),
-        "P_escape_low": field(low, "P_escape_low", ("t_eval",)),
-        "P_escape_high": field(high, "P_escape_high", ("t_eval",)),
-        "survival": field(1.0 - k_surv / paths, "survival", ("t_survival",)),
-        "first_passage_mean": field(restricted.mean(axis=1), "first_passage_mean"),
-        "first_passage_sem": field(sem, "first_passage_sem"),
-        "censored_fraction": field(np.isinf(tc).mean(axis=1), "censored_fraction"),
-    }
+    data = {name: field(name, last) for name, last in _FIELDS.items()}
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(
-        F=F, Omega=Omega, Psi=Psi, xi_max=xi, noise=sigma, paths=paths, seed=seed, cycles=cycles, steps_per_cycle=spc,
+        F=F, Omega=Omega, Psi=Psi, **({} if several else {"xi_max": float(xi[0])}), noise=sigma, paths=paths,
+        seed=seed, cycles=cycles, steps_per_cycle=spc,
         noise_model=_model_text(tau), integrator=engine.integrator_text(integrator, damping),
         noise_scheme=SCHEME_TEXT if tau == 0 else COLOURED_SCHEME_TEXT, variates=variates,
         random_numbers=RNG_TEXTS[variates], boundary_correction=_correction_text(correction, tau, variates),
@@ -268,6 +271,25 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
         **engine.damping_attrs(damping), **({"noise_time": tau} if tau > 0 else {}),
         **{k: int(v) for k, v in offsets.items() if v})
     return ds
+
+
+#: the Dataset's variables and their dimensions after the initial conditions' (and xi_max)
+_FIELDS: dict[str, tuple[str, ...]] = {
+    "P_escape": ("t_eval",), "P_escape_low": ("t_eval",), "P_escape_high": ("t_eval",), "survival": ("t_survival",),
+    "first_passage_mean": (), "first_passage_sem": (), "censored_fraction": ()}
+
+
+def _path_statistics(tc: np.ndarray, te: np.ndarray, ts: np.ndarray, cycles: int) -> dict[str, np.ndarray]:
+    """The _FIELDS of one threshold from the escape cycles tc (n_ic, paths; inf: not within cycles)."""
+    paths = tc.shape[1]
+    k_eval = _counts_within(tc, te)
+    low, high = wilson_interval(k_eval, paths)
+    restricted = np.minimum(tc, float(cycles))
+    # one path has no spread to estimate the standard error from: NaN, as documented
+    sem = restricted.std(axis=1, ddof=1) / math.sqrt(paths) if paths > 1 else np.full(tc.shape[0], np.nan)
+    return {"P_escape": k_eval / paths, "P_escape_low": low, "P_escape_high": high,
+            "survival": 1.0 - _counts_within(tc, ts) / paths, "first_passage_mean": restricted.mean(axis=1),
+            "first_passage_sem": sem, "censored_fraction": np.isinf(tc).mean(axis=1)}
 
 
 def _cuda_backend(backend: str) -> ModuleType | None:

@@ -59,7 +59,8 @@ from safebasins.wells import elementary
 from safebasins.wells.compiled import LLVM_INLINE, WellCode, abs_tracking, cpu_jit, fma, mul, well_energy2
 
 __all__ = ["RNG_KEY", "MAX_STEPS", "GAUSSIAN", "FIVE_POINT", "LAWS", "StepNoise", "step_noise", "prepare",
-           "escape_steps", "final_states", "gaussian_pairs", "step_variates", "check_offsets"]
+           "escape_steps", "final_states", "gaussian_pairs", "step_variates", "check_offsets",
+           "threshold_array"]
 
 #: the numba literal of the random-number and noise code (module docstring)
 RNG_KEY = int(fingerprint([__file__, philox.__file__])[:15], 16) ^ int(elementary.MODULE_HASH[:15], 16)
@@ -241,8 +242,10 @@ def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: An
                  amp: Any, shift: Any, c1: Any, c2: Any, s_eta: Any, k0: Any, k1: Any, i0: Any, m0: Any,
                  out: Any) -> None:
     """Trajectories j = task, task + n_tasks, ... (path j % n_paths of initial condition
-    j // n_paths): out[j] = the step after which it is first beyond (0: the initial condition,
-    -1: not within cycles periods).  Lanes run one forcing period at a time; at the period
+    j // n_paths): out[j * K + k] = the step after which it is first beyond the energy threshold
+    thrE2[k] (sorted ascending; a barrier, a bound or a NaN state is beyond all; 0: the initial
+    condition, -1: not within cycles periods).  A trajectory runs until it is beyond the largest
+    threshold (then beyond all).  Lanes run one forcing period at a time; at the period
     boundary finished lanes are written out and compacted and empty lanes take the next
     trajectories (every lane is at the same sub-step of the period)."""
     S = FS.shape[0]
@@ -266,14 +269,20 @@ def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: An
     PATH = np.zeros(L, np.int64)
     J = np.zeros(L, np.int64)
     BASE = np.zeros(L, np.int64)         # the lane's steps done at the start of this period
-    FIRST = np.zeros(L, np.int64)        # its first step beyond the thresholds (-1: none yet)
+    K = thrE2.shape[0]
+    FIRST = np.zeros((K, L), np.int64)   # its first step beyond each threshold (-1: none yet)
+    FL = FIRST[K - 1]                    # (beyond the largest: beyond all, the trajectory is done)
+    F0 = FIRST[0]
+    EN = np.zeros(L)                     # the lane's checked energy 2 H0 + shift |p| at this step
+    t0 = thrE2[0]
     nxt = np.int64(task)
     nact = np.int64(0)
     while True:
         k = np.int64(0)
         for l in range(nact):
-            if FIRST[l] >= 0 or BASE[l] >= total:
-                out[J[l]] = FIRST[l]
+            if FL[l] >= 0 or BASE[l] >= total:
+                for r in range(K):
+                    out[J[l] * K + r] = FIRST[r, l]
             else:
                 Q[k] = Q[l]
                 P[k] = P[l]
@@ -283,7 +292,8 @@ def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: An
                 J[k] = J[l]
                 BASE[k] = BASE[l]
                 CYC[k] = CYC[l]
-                FIRST[k] = FIRST[l]
+                for r in range(K):
+                    FIRST[r, k] = FIRST[r, l]
                 k += 1
         nact = k
         while nact < L and nxt < N:
@@ -292,11 +302,12 @@ def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: An
             i = j // n_paths
             q = q0[i]
             p = p0[i]
-            if _beyond(well, wpar, q, well_energy2(well, w, q, p), thrE2, lo, hi):
-                out[j] = 0
-                continue
-            if total == 0:
-                out[j] = -1
+            e = well_energy2(well, w, q, p)
+            for r in range(K):
+                FIRST[r, nact] = 0 if _beyond(well, wpar, q, e, thrE2[r], lo, hi) else -1
+            if FL[nact] >= 0 or total == 0:
+                for r in range(K):
+                    out[j * K + r] = FIRST[r, nact]
                 continue
             Q[nact] = q
             P[nact] = p
@@ -306,7 +317,6 @@ def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: An
             J[nact] = j
             BASE[nact] = 0
             CYC[nact] = 0
-            FIRST[nact] = -1
             nact += 1
         if nact == 0:
             break
@@ -339,8 +349,15 @@ def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: An
                 q = Q[l]
                 p = P[l]
                 e = fma(shift, abs(p), well_energy2(well, w, q, p))
-                hit = _beyond(well, wpar, q, e, thrE2, lo, hi) & (FIRST[l] < 0)
-                FIRST[l] = BASE[l] + s + 1 if hit else FIRST[l]
+                EN[l] = e
+                hit = _beyond(well, wpar, q, e, t0, lo, hi) & (F0[l] < 0)
+                F0[l] = BASE[l] + s + 1 if hit else F0[l]
+            for r in range(1, K):        # the further thresholds: one pass each
+                Fr = FIRST[r]
+                t = thrE2[r]
+                for l in range(nact):
+                    hit = _beyond(well, wpar, Q[l], EN[l], t, lo, hi) & (Fr[l] < 0)
+                    Fr[l] = BASE[l] + s + 1 if hit else Fr[l]
         for l in range(nact):
             BASE[l] += S
             CYC[l] += 1
@@ -412,6 +429,15 @@ def step_noise(sigma: float, h: float, noise_time: float = 0.0, law: int = GAUSS
                      sigma / math.sqrt(2.0 * noise_time), law)
 
 
+def threshold_array(thrE2: float | np.ndarray) -> np.ndarray:
+    """The energy thresholds 2 xi_max as a contiguous float64 array: ValueError naming thrE2 unless
+    they are a scalar or a non-empty 1-D array, ascending, without NaN."""
+    thr = np.ascontiguousarray(np.atleast_1d(np.asarray(thrE2, dtype=float)))
+    if thr.ndim != 1 or thr.size == 0 or np.isnan(thr).any() or (np.diff(thr) < 0).any():
+        raise ValueError(f"thrE2 must be a scalar or a non-empty ascending 1-D array without NaN, got {thrE2!r}")
+    return thr
+
+
 def check_offsets(offsets: tuple[int, int], n_ic: int, n_paths: int) -> None:
     """ValueError naming ``ic_offset`` or ``path_offset`` unless each is an integer >= 0 and the
     counter words it starts (n_ic initial conditions, n_paths paths) stay below 2^32."""
@@ -442,33 +468,35 @@ def prepare(code: WellCode, scheme: SchemeCode, q0: np.ndarray, coef: np.ndarray
 
 
 def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndarray, n_paths: int, coef: np.ndarray,
-                 sintab: np.ndarray, F: float, thrE2: float, cycles: int, noise: StepNoise, seed: int, *,
+                 sintab: np.ndarray, F: float, thrE2: float | np.ndarray, cycles: int, noise: StepNoise, seed: int, *,
                  shift: float = 0.0, bounds: tuple[float, float] = (-math.inf, math.inf),
                  wpar: np.ndarray | None = None, n_tasks: int = 1, lanes: int = 256, ic_offset: int = 0,
                  path_offset: int = 0) -> np.ndarray:
     """First steps beyond the thresholds of ``n_paths`` paths from every initial condition,
     shape (len(q0), n_paths), int64 (0: the initial condition is beyond, -1: not within
-    ``cycles`` periods of ``sintab.shape[0]`` steps).  code, scheme: the compiled well and scheme
-    (damped variant for beta > 0); coef: their lane_coefficients (one row); sintab: the forcing
-    table (schemes.sine_table), times F; thrE2 = 2 xi_max; noise: the step's noise coefficients
-    (:func:`step_noise`); shift: the
-    energy boundary shift per ``|p|`` (module docstring); bounds: a displacement pair (lo, hi);
-    wpar: the well's wpar (None: code.wpar; the barriers are its first two entries); ic_offset,
-    path_offset: the index of the first initial condition and of the first path in the random
-    counters (a chunk of a larger ensemble draws that ensemble's streams).  The result does not
+    ``cycles`` periods of ``sintab.shape[0]`` steps); for an array thrE2 of K energy thresholds
+    (ascending), shape (len(q0), n_paths, K), from one pass.  code, scheme: the compiled well and
+    scheme (damped variant for beta > 0); coef: their lane_coefficients (one row); sintab: the
+    forcing table (schemes.sine_table), times F; thrE2 = 2 xi_max (a float or an ascending array);
+    noise: the step's noise coefficients (:func:`step_noise`); shift: the energy boundary shift per
+    ``|p|`` (module docstring); bounds: a displacement pair (lo, hi); wpar: the well's wpar (None:
+    code.wpar; the barriers are its first two entries); ic_offset, path_offset: the index of the
+    first initial condition and of the first path in the random counters (a chunk of a larger
+    ensemble draws that ensemble's streams).  The result does not
     depend on n_tasks or lanes."""
     q, FS, k0, k1 = prepare(code, scheme, q0, coef, sintab, F, seed, int(cycles) * sintab.shape[0],
                             n_paths=int(n_paths), offsets=(ic_offset, path_offset))
     p = np.ascontiguousarray(p0, dtype=float)
-    out = np.full(q.size * int(n_paths), -1, np.int64)
+    thr = threshold_array(thrE2)
+    out = np.full(q.size * int(n_paths) * thr.size, -1, np.int64)
     wp = code.wpar if wpar is None else np.ascontiguousarray(wpar, dtype=float)
     args = [code.key, scheme.key, RNG_KEY, int(noise.law), wp, 0, int(n_tasks), int(lanes), q, p, int(n_paths),
-            np.ascontiguousarray(coef), FS, float(thrE2), float(bounds[0]), float(bounds[1]), int(cycles),
+            np.ascontiguousarray(coef), FS, thr, float(bounds[0]), float(bounds[1]), int(cycles),
             float(noise.amp), float(shift), float(noise.c1), float(noise.c2), float(noise.s_eta), k0, k1,
             int(ic_offset), int(path_offset), out]
     entry = specialised(_escape_task, args, n_literal=4)
     run_tasks(lambda task: entry(*args[:5], task, *args[6:]), int(n_tasks))
-    return out.reshape(q.size, int(n_paths))
+    return out.reshape(q.size, int(n_paths)) if np.ndim(thrE2) == 0 else out.reshape(q.size, int(n_paths), thr.size)
 
 
 def final_states(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndarray, n_paths: int, coef: np.ndarray,
