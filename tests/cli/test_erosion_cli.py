@@ -52,14 +52,17 @@ def test_writes_the_library_profile_with_the_theory(tmp_path):
 
 
 def test_single_values_and_no_theory(tmp_path):
-    """One F, noise, epsilon: no dimension (the library's scalars); --no-theory: the reason stored."""
+    """One F, noise, epsilon: no dimension (the library's scalars); --no-theory: the reason stored;
+    five-point variates passed through to the ensembles."""
     args = [a if a not in ("0,0.01", "0.01,0.02", "0.3,0.5") else a.split(",")[-1] for a in BASE]
-    res = invoke([*args, "--no-theory", "--no-conservative", "--no-plot", "--seed", "5"], tmp_path)
+    res = invoke([*args, "--no-theory", "--no-conservative", "--no-plot", "--seed", "5", "--variates", "five-point"],
+                 tmp_path)
     assert res.exit_code == 0, res.output
     ref = stochastic_erosion(Q0, P0, 0.01, 0.9, math.pi, noise=0.02, epsilon=0.5, paths=12, xi_max=0.18,
-                             t_eval=[1, 3], steps_per_cycle=16, seed=5, conservative=False)
+                             t_eval=[1, 3], steps_per_cycle=16, seed=5, conservative=False, variates="five-point")
     with xr.open_dataset(tmp_path / "er.nc") as ds:
         assert ds["GIM"].dims == ("t_eval",)
+        assert ds.attrs["variates"] == "five-point"
         for k in MEASURES:
             np.testing.assert_array_equal(ds[k].values, ref[k].values, err_msg=k)
         assert ds.attrs["theory"] == "none" and "theory: false" in ds.attrs["theory_reason"]

@@ -39,7 +39,8 @@ def window(well, nq, np_):
     (["--well", "cubic", "--F", "0.06", "--Omega", "0.85", "--xi-max", "0.16", "--noise-time", "0.5",
       "--steps-per-cycle", "24", "--cycles", "5", "--no-plot"], "cubic",
      dict(F=0.06, Omega=0.85, xi_max=0.16, noise_time=0.5, steps_per_cycle=24, cycles=5)),
-], ids=["quartic-white-damped", "cubic-coloured"])
+    (["--variates", "five-point", "--no-theory", "--no-plot"], "quartic", dict(variates="five-point")),
+], ids=["quartic-white-damped", "cubic-coloured", "quartic-five-point"])
 def test_writes_the_library_dataset(tmp_path, extra, well, kw):
     res = invoke([*BASE, *extra], tmp_path)
     assert res.exit_code == 0, res.output
@@ -54,6 +55,7 @@ def test_writes_the_library_dataset(tmp_path, extra, well, kw):
             np.testing.assert_array_equal(ds[v].values, ref[v].values, err_msg=v)
         params = json.loads(ds.attrs["parameters"])
         assert params["command"] == "escape-probability" and params["paths"] == 12
+        assert params["variates"] == ds.attrs["variates"] == kw.get("variates", "gaussian")
         assert params["cycles"] == ref.attrs["cycles"] and ds.attrs["seed"] == kw.get("seed", 0)
         # the command line is this process's sys.argv (in-process runner: pytest's or an xdist
         # worker's), so only its program name is known here; test_cli checks it from a subprocess
@@ -88,6 +90,7 @@ def test_zero_noise_is_the_escape_chart(tmp_path, damping):
     (["--cycles", "3"], "'--t-eval'", "beyond the horizon"),
     (["--t-eval", "1,3,5"], "'--t-eval'", "at most 4"),             # added to BASE's 2,4
     (["--noise-time", "0.01"], "'--noise-time'", "shorter than the step"),      # the library's check, named
+    (["--variates", "uniform"], "'--variates'", "five-point"),
     (["--xi-max", "0.3"], "'--xi-max'", "1/4"),
     (["--Omega", "0.02"], "'--steps-per-cycle'", "steps_per_cycle >="),
 ], ids=lambda v: v if isinstance(v, str) else " ".join(v))

@@ -19,7 +19,7 @@ from safebasins.analysis.noise_theory import theory_evaluations
 from safebasins.analysis.stochastic_integrity import stochastic_erosion_theory
 from safebasins.numerics import escape_probability
 from safebasins.pipeline.config import ConfigError
-from safebasins.pipeline.cost import NOISE_STEP_COST, analytic_cost
+from safebasins.pipeline.cost import NOISE_STEP_COSTS, analytic_cost
 from safebasins.pipeline.kinds.noise import build_escape_probability, build_stochastic_erosion
 from safebasins.pipeline.plan import plan
 from safebasins.pipeline.registry import KINDS, Job
@@ -46,7 +46,7 @@ def test_schema_defaults_are_the_library_defaults() -> None:
     ero = inspect.signature(stochastic_erosion).parameters
     for kind in ("escape_probability", "stochastic_erosion"):
         props = KINDS[kind].schema["properties"]
-        for key in ("cycles", "noise_time", "correction"):
+        for key in ("cycles", "noise_time", "correction", "variates"):
             assert props[key]["default"] == lib[key].default, (kind, key)
     th = inspect.signature(theory.escape_probability).parameters
     for kind in ("escape_probability", "stochastic_erosion"):
@@ -62,13 +62,14 @@ def test_cost_counts_paths_ics_and_steps(base: dict[str, Any]) -> None:
     run = plan(merged(base, {"noise": {"quartic_escape_probability": TINY}}))
     exp = run.experiments[MAP]
     steps = 5 * 4 * 3 * 16
-    assert exp.kind.cost(exp.params) == int(steps * 3 * 6 * (1 + NOISE_STEP_COST))
+    assert exp.kind.cost(exp.params) == int(steps * 3 * 6 * (1 + NOISE_STEP_COSTS["gaussian"]))
     run = plan(merged(base, {"noise": {"escape_equation_erosion": {**TINY, "F": [0.0, 0.01], "noise": [0.0, 0.01],
                                                                    "epsilon": 0.5}}}))
     exp = run.experiments[EROSION]
     # two ensembles at noise 0 (one path each), two noisy ones, in steps of the cubic
     c = resolve_well("cubic").step_cost
-    assert exp.kind.cost(exp.params) == pytest.approx(steps * (2 + 2 * 6 * (1 + NOISE_STEP_COST / c)), abs=1)
+    per_step = 1 + NOISE_STEP_COSTS["gaussian"] / c
+    assert exp.kind.cost(exp.params) == pytest.approx(steps * (2 + 2 * 6 * per_step), abs=1)
     doubled = merged(base, {"noise": {"escape_equation_erosion": {**TINY, "F": [0.0, 0.01], "noise": [0.0, 0.01],
                                                                   "epsilon": 0.5, "paths": 12}}})
     assert plan(doubled).experiments[EROSION].kind.cost(plan(doubled).experiments[EROSION].params) > \
@@ -82,6 +83,8 @@ def test_cost_counts_paths_ics_and_steps(base: dict[str, Any]) -> None:
     ("quartic_escape_probability", {"t_eval": [10, 60]}, "quartic_escape_probability.t_eval"),
     ("quartic_escape_probability", {"t_eval": [10, 10]}, "quartic_escape_probability.t_eval[1]"),
     ("quartic_escape_probability", {"correction": "gobet"}, "quartic_escape_probability.correction"),
+    ("quartic_escape_probability", {"variates": "uniform"}, "quartic_escape_probability.variates"),
+    ("escape_equation_erosion", {"variates": "three-point"}, "escape_equation_erosion.variates"),
     ("quartic_escape_probability", {"noise_time": 0.01}, "quartic_escape_probability.noise_time"),
     ("quartic_escape_probability", {"xi_max": 0.3}, "quartic_escape_probability.xi_max"),
     ("quartic_escape_probability", {"grid": {"q0": [1.0, -1.0]}}, "quartic_escape_probability.grid.q0"),
@@ -123,6 +126,23 @@ def test_map_build_is_the_library_call(base: dict[str, Any]) -> None:
     # a noise level 0: no theory, and the dataset says why
     assert "P_escape_theory" not in ds and ds.attrs["theory"] == "none"
     assert "noise 0" in ds.attrs["theory_reason"]
+
+
+def test_five_point_variates_build_and_cost(base: dict[str, Any]) -> None:
+    """variates: five-point reaches the library call (the dataset is its Dataset, attribute variates)
+    and the cost counts that law's random numbers (NOISE_STEP_COSTS), below the Gaussian's."""
+    five = {**TINY, "noise": [0.02], "variates": "five-point", "theory": False}
+    exp = plan(merged(base, {"noise": {"quartic_escape_probability": five}})).experiments[MAP]
+    gauss = plan(merged(base, {"noise": {"quartic_escape_probability": {**five, "variates": "gaussian"}}})
+                 ).experiments[MAP]
+    assert exp.kind.cost(exp.params) == int(5 * 4 * 3 * 16 * 6 * (1 + NOISE_STEP_COSTS["five-point"]))
+    assert exp.kind.cost(exp.params) < gauss.kind.cost(gauss.params)
+    ds = build_escape_probability(exp.params, {}, Job(threads=1))
+    ref = escape_probability(np.linspace(-0.95, 0.95, 5), np.linspace(-0.75, 0.75, 4), 0.01, 0.9, math.pi, noise=0.02,
+                             paths=6, xi_max=0.18, t_eval=[1, 3], seed=exp.params["seed"], cycles=3, steps_per_cycle=16,
+                             threads=1, variates="five-point")
+    np.testing.assert_array_equal(ds["P_escape"].values[0], ref["P_escape"].values)
+    assert ds.attrs["variates"] == "five-point"
 
 
 THEORY = {**TINY, "noise": [0.01, 0.02], "theory_cells": [16, 20], "theory_steps_per_cycle": 6}

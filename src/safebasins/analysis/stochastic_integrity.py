@@ -86,8 +86,8 @@ ZERO_NOISE = ("at noise = 0 every path is the deterministic trajectory: P_escape
               "conservative basin is the basin, and one path per initial condition is integrated")
 #: ensemble attributes carried into the basins' and profiles' Datasets
 _CARRIED = ("F", "Omega", "Psi", "xi_max", "noise", "noise_time", "paths", "seed", "cycles", "steps_per_cycle",
-            "damping", "noise_model", "noise_scheme", "integrator", "random_numbers", "boundary_correction",
-            "escape_criteria", "theory", "solver")
+            "damping", "noise_model", "noise_scheme", "variates", "integrator", "random_numbers",
+            "boundary_correction", "escape_criteria", "theory", "solver")
 
 
 # --------------------------------------------------------------------------- checks
@@ -348,7 +348,7 @@ def stochastic_erosion(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float | Sequence
     keep_masks : also return ``safe`` (and ``safe_conservative``) and the maps ``P_escape``,
         ``P_escape_high`` over (..., q0, p0).
     ensemble_kwargs : passed to escape_probability (``steps_per_cycle``, ``integrator``,
-        ``correction``, ``noise_time``, ``threads``, ``backend``).
+        ``correction``, ``variates``, ``noise_time``, ``threads``, ``backend``).
 
     Returns
     -------

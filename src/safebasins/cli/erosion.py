@@ -16,7 +16,7 @@ from safebasins.cli.options import (FINITE, NONNEG, POSITIVE, THRESHOLD, Deferre
                                     joined, library_errors, no_fourier, out_option, steps_option, threads_option)
 from safebasins.cli.output import chatter, draw, finish, write_outputs
 from safebasins.core.statistics import certifiable_epsilon, paths_needed
-from safebasins.pipeline.cost import NOISE_STEP_COST
+from safebasins.pipeline.cost import NOISE_STEP_COSTS
 from safebasins.pipeline.values import fmt
 
 __all__ = ["stochastic_erosion"]
@@ -86,7 +86,8 @@ def _one_or_list(v: list[float]) -> float | list[float]:
 @common_options
 @out_option("stochastic_erosion")
 def stochastic_erosion(F: list[float], Omega: float, Psi: float, xi_max: float, noise: list[float],
-                       epsilon: list[float], noise_time: float, paths: int, seed: int, t_eval: list[float],
+                       epsilon: list[float], noise_time: float, paths: int, seed: int, variates: str,
+                       t_eval: list[float],
                        cycles: int | None, conservative: bool, grid: dict[str, list[float]] | None, n: list[int],
                        theory: bool, theory_cells: tuple[int, int], theory_steps_per_cycle: int,
                        steps_per_cycle: int, threads: int | None, damping: float, fourier: str | None,
@@ -124,7 +125,8 @@ def stochastic_erosion(F: list[float], Omega: float, Psi: float, xi_max: float, 
     name = Path(out).name
     params: dict[str, Any] = dict(command="stochastic-erosion", experiment=name, well=well, F=F, Omega=Omega, Psi=Psi,
                                   xi_max=xi_max, damping=damping, noise=noise, epsilon=epsilon, noise_time=noise_time,
-                                  paths=paths, seed=seed, t_eval=t_eval, cycles=cycles, conservative=conservative,
+                                  paths=paths, seed=seed, variates=variates, t_eval=t_eval, cycles=cycles,
+                                  conservative=conservative,
                                   grid=grid_params(grid, n), steps_per_cycle=steps_per_cycle, theory=theory,
                                   theory_cells=list(theory_cells), theory_steps_per_cycle=theory_steps_per_cycle)
     damped, beta = damping_text(damping)
@@ -142,10 +144,10 @@ def stochastic_erosion(F: list[float], Omega: float, Psi: float, xi_max: float, 
     from safebasins.plotting.stochastic_erosion import figure_stochastic_erosion
 
     # one ensemble per (F, sigma): paths per IC at sigma > 0 (each step with its random numbers,
-    # pipeline.cost.NOISE_STEP_COST), one deterministic path at sigma = 0; the averaged theory:
+    # pipeline.cost.NOISE_STEP_COSTS), one deterministic path at sigma = 0; the averaged theory:
     # its tables and one solve per (F, sigma) (the pipeline's count)
     step_cost = current_well(ctx).step_cost
-    per_ic = noisy * paths * (step_cost + NOISE_STEP_COST) + (len(noise) - noisy) * step_cost
+    per_ic = noisy * paths * (step_cost + NOISE_STEP_COSTS[variates]) + (len(noise) - noisy) * step_cost
     settings = theory_settings(theory, theory_cells, theory_steps_per_cycle)
     cost_guard(None, params, allow_expensive, steps=len(F) * nq * np_ * horizon * steps_per_cycle * per_ic,
                reduce="--n, --paths, --cycles or the --F / --noise lists", reduce_analytic=THEORY_REDUCE,
@@ -158,7 +160,7 @@ def stochastic_erosion(F: list[float], Omega: float, Psi: float, xi_max: float, 
     with library_errors(), chatter(verbose):
         ds = profile(q0, p0, _one_or_list(F), Omega, Psi, paths=paths, seed=seed, cycles=cycles,
                      conservative=conservative, noise_time=noise_time, steps_per_cycle=steps_per_cycle,
-                     threads=threads, **sweep)
+                     threads=threads, variates=variates, **sweep)
         ds = stochastic_erosion_with_theory(ds, q0, p0, _one_or_list(F), Omega, Psi, noise_time=noise_time,
                                             **sweep, **settings)
         ds = finish(ds, title=params["title"], params=params)

@@ -9,6 +9,7 @@ numba_cache  where numba caches the compiled kernels of an installed package
 statistics   the Wilson interval of escape counts; what a number of paths certifies
 settling     how many map iterations settle damped transients (analyses and cost estimates)
 averaged_theory  the averaged noise theory's solver defaults, smallest grid and horizon (theory, schemas, CLI)
+noise_variates   the names of the noise variates' laws (numerics, schemas, CLI)
 
 Layers (docs/architecture.md): core -> wells -> numerics | theory -> analysis -> io ->
 plotting | pipeline | explore -> cli; a layer imports only layers below it.

@@ -23,7 +23,7 @@ import numpy as np
 import numpy.typing as npt
 import xarray as xr
 
-from safebasins.core import cf, checks
+from safebasins.core import cf, checks, noise_variates
 from safebasins.core.statistics import WILSON_Z, wilson_interval
 from safebasins.numerics import criteria, engine, noise_kernels, schemes
 from safebasins.numerics.charts import ic_coords
@@ -42,7 +42,7 @@ GOBET_SHIFT = 0.5825971579390106
 #: the variates' laws (noise_kernels): "gaussian" (Box-Muller; the default) or "five-point"
 #: (0, +-sqrt 2, +-2 with probabilities 5/8, 1/8, 1/16: the Gaussian's moments through the fifth, weak
 #: order 2 as well, one Philox block per 16 steps)
-VARIATES = tuple(noise_kernels.LAWS)
+VARIATES = noise_variates.VARIATES
 #: beta_1 per law: the mean overshoot, in units of sigma ``|p|`` sqrt(h), of the random walk whose
 #: steps are a step's two kicks, (Z_1 + Z_2) / sqrt 2, over a level far away (Siegmund's corrected
 #: diffusion approximation: the same shift of the boundary removes the O(sqrt h) bias).  Gaussian:
@@ -119,7 +119,8 @@ def escape_probability(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float, Omega: fl
                        seed: int = 0, cycles: int | None = None, noise_time: float = 0.0,
                        steps_per_cycle: int = engine.DEFAULT_STEPS_PER_CYCLE, grid: bool | None = None,
                        correction: str = "shift", integrator: str = engine.DEFAULT_INTEGRATOR,
-                       threads: int | None = None, backend: str = "cpu", variates: str = "gaussian",
+                       threads: int | None = None, backend: str = "cpu",
+                       variates: str = noise_variates.DEFAULT_VARIATES,
                        ic_offset: int = 0, path_offset: int = 0) -> xr.Dataset:
     """Probability of escape within each ``t_eval`` under noise, from ``paths`` paths per initial condition.
 

@@ -51,6 +51,7 @@ import numpy as np
 from numba import literally, njit
 from numba.extending import overload
 
+from safebasins.core.noise_variates import VARIATES
 from safebasins.numerics import philox
 from safebasins.numerics.kernels import run_tasks, specialised
 from safebasins.numerics.scheme_code import SchemeCode, fingerprint
@@ -75,7 +76,7 @@ _ROUND = 6755399441055744.0
 #: the laws of the variates (module docstring), by their names in the public API
 GAUSSIAN = 0
 FIVE_POINT = 1
-LAWS = {"gaussian": GAUSSIAN, "five-point": FIVE_POINT}
+LAWS = dict(zip(VARIATES, (GAUSSIAN, FIVE_POINT), strict=True))
 _TWO = np.uint64(2)
 #: five-point law: steps per Philox block (16 bytes), the nibble's width and mask
 BLOCK_STEPS = 16

@@ -33,10 +33,12 @@ RATE_PER_CORE = 5.0e8
 #: 2e6 per IC of the quartic, 4e5 of a numeric well, 1e6 per resonance-manifold point, 2e7 per
 #: xi node of F_cr)
 ANALYTIC_RATE = 1.0e6
-#: the random numbers of one step of a noisy ensemble (safebasins.numerics.noise: Philox and a
-#: Box-Muller pair), in steps of the quartic: added to the well's step_cost (benchmarks/bench_noise.py:
-#: the noisy quartic runs at 0.15-0.20 of the deterministic rate)
-NOISE_STEP_COST = 5.0
+#: the random numbers of one step of a noisy ensemble (safebasins.numerics.noise), by the law of
+#: its variates (core.noise_variates), in steps of the quartic: added to the well's step_cost
+#: (benchmarks/bench_noise.py: the noisy quartic runs at 0.15-0.20 of the deterministic rate with
+#: Gaussian variates, a Philox block and a Box-Muller pair a step; at 0.56-0.60 with five-point
+#: variates, a Philox block per 16 steps)
+NOISE_STEP_COSTS = {"gaussian": 5.0, "five-point": 0.8}
 
 
 def exp_cost(exp: Experiment) -> int:
