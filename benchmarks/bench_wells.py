@@ -249,6 +249,9 @@ def wells_only(args):
         best, _ = bench(jobs, args.repeat, rounds)
         print(f"\n=== {integ} (compile or cache load + runs: {time.perf_counter() - t:.0f} s) ===")
         ref = jobs[0]
+        ns = np.array(rounds[ref.name]) / ref.steps() * 1e9
+        print(f"{ref.name}: {best[ref.name] / ref.steps() * 1e9:.2f} ns per trajectory step (best), "
+              f"{np.median(ns):.2f} (median of {ns.size} rounds)")
         for j in jobs[1:]:
             paired = np.array(rounds[j.name]) / j.steps() / (np.array(rounds[ref.name]) / ref.steps())
             ratio = best[j.name] / j.steps() / (best[ref.name] / ref.steps())

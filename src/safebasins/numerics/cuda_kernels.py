@@ -69,7 +69,8 @@ Kernel organisation (one thread = one trajectory at a time)
   parameter sets (bisection) read it from global memory (cached).
 * The well is the kernel factory's compiled well (wells.compiled.WellCode): its force -V'(q) + f and
   energy 2 H0 compiled from the one source (make_step, the coefficients w loaded from `wpar`
-  once per thread) and its escape tests (make_criteria): |q| tracking compares |q| with the
+  once per thread; a split well's V'(q) carried in a register from step to step, as the CPU
+  lanes carry it) and its escape tests (make_criteria): |q| tracking compares |q| with the
   q_max thresholds and the barrier, signed tracking compares q with the bound pairs (lo, hi)
   and the barriers (q_left, q_right), as kernels._check_state.
 """
@@ -129,30 +130,56 @@ fma = compiled.fma
 
 
 # ------------------------------------------------------------------------------- the well and the scheme
-def make_step(code: compiled.WellCode, sc: SchemeCode) -> tuple[Any, Any, Any]:
-    """(step, energy2, flat_coefs) device functions of a compiled well (wells.compiled.WellCode) and a
-    scheme code (scheme_code.SchemeCode): the well's one source and the scheme's one generated
-    source, compiled for the GPU.
+def make_step(code: compiled.WellCode, sc: SchemeCode) -> tuple[Any, Any, Any, Any]:
+    """(step, energy2, flat_coefs, first) device functions of a compiled well
+    (wells.compiled.WellCode) and a scheme code (scheme_code.SchemeCode): the well's one source and
+    the scheme's one generated source, compiled for the GPU.
 
-    step(q, p, c, tab, o, w) -> (q, p) reads the forcing values tab[o], tab[o+1], ... (already
-    multiplied by F; o unsigned) and calls the scheme's step with them; c the coefficient tuple
-    (flat_coefs(coef, o): schemes.lane_coefficients of one parameter set), w the well's 14
-    coefficients (steps.wtuple).  energy2(q, p, w) = 2 H0 of the well."""
+    step(q, p, c, tab, o, w, d) -> (q, p, d, e) reads the forcing values tab[o], tab[o+1], ...
+    (already multiplied by F; o unsigned) and calls the scheme's step with them; c the coefficient
+    tuple (flat_coefs(coef, o): schemes.lane_coefficients of one parameter set), w the well's 14
+    coefficients (steps.wtuple); e = 2 H0 after the step.  A well with a split force
+    (WellCode.split) runs the scheme's split step: d = V'(q) carried from step to step
+    (``first(q, w)`` where a trajectory starts or moves), V(q) of e from the last kick's call (the
+    same bits, fewer evaluations: scheme_code); any other well ignores d (``first`` is 0).
+    energy2(q, p, w) = 2 H0 of the well."""
     energy_w: Callable[[compiled.Coefs, float, float], float]
     force, energy_w = code.make(_device)
-    inner: Step = sc.make(_device, force)
     H = sc.helpers(_device)
     flat_row = H["flat_row"]
-
-    @_device
-    def step(q: float, p: float, c: Row, tab: Floats, o: np.uint64, w: compiled.Coefs) -> tuple[float, float]:
-        return inner(w, q, p, c, flat_row(tab, o))
 
     @_device
     def energy2w(q: float, p: float, w: compiled.Coefs) -> float:
         return energy_w(w, q, p)
 
-    return step, energy2w, H["flat_coefs"]
+    if code.split is None:
+        inner: Step = sc.make(_device, force)
+
+        @_device
+        def step(q: float, p: float, c: Row, tab: Floats, o: np.uint64, w: compiled.Coefs,
+                 d: float) -> tuple[float, float, float, float]:
+            q, p = inner(w, q, p, c, flat_row(tab, o))
+            return q, p, d, energy_w(w, q, p)
+
+        @_device
+        def first(q: float, w: compiled.Coefs) -> float:
+            return 0.0
+    else:
+        gradient, gradient_potential = code.split(_device)
+        split = sc.make_split(_device, gradient, gradient_potential, _device(compiled.force_from))
+        energy2_from = _device(compiled.energy2_from)
+
+        @_device
+        def step(q: float, p: float, c: Row, tab: Floats, o: np.uint64, w: compiled.Coefs,
+                 d: float) -> tuple[float, float, float, float]:
+            q, p, d, v = split(w, q, p, c, flat_row(tab, o), d)
+            return q, p, d, energy2_from(w, v, p)
+
+        @_device
+        def first(q: float, w: compiled.Coefs) -> float:
+            return gradient(w, q)  # type: ignore[no-any-return]  # a device function (numba-cuda dispatcher)
+
+    return step, energy2w, H["flat_coefs"], first
 
 
 # ------------------------------------------------------------------------------- escape bookkeeping
@@ -265,7 +292,7 @@ def ensemble_kernel(integrator: str = "srkn6b", shared_table: bool = True, block
     code = compiled.quartic_code() if well is None else well
     if not isinstance(code, compiled.WellCode):
         raise ValueError(f"well must be a compiled well (wells.compiled.WellCode), got {well!r}")
-    step, energy2w, flat_coefs = make_step(code, sc)
+    step, energy2w, flat_coefs, first = make_step(code, sc)
     crossed, check_state, next_filters = make_criteria(code.abs_tracking)
     NC = np.uint64(sc.n_coef)
     SHARED = bool(shared_table)
@@ -316,6 +343,7 @@ def ensemble_kernel(integrator: str = "srkn6b", shared_table: bool = True, block
         tQ = math.inf
         tN = math.inf
         cf = flat_coefs(coef, uint64(0))
+        d = 0.0
         reload = False
         while True:
             # ---------------------------------------------- take the next trajectory
@@ -373,14 +401,14 @@ def ensemble_kernel(integrator: str = "srkn6b", shared_table: bool = True, block
             if reload:
                 cf = flat_coefs(coef, uint64(k) * NC)
                 tE, tQ, tN = next_filters(iE, iQ, thrE2, nE, thrLo, thrHi, nQ, qL, qR)
+                d = first(q, w)
                 reload = False
             # ---------------------------------------------- one forcing period
             o = uint64(k) * uSW
             base = per * S
             for s in range(S):
-                q, p = step(q, p, cf, tab, o, w)
+                q, p, d, e = step(q, p, cf, tab, o, w, d)
                 o += UW
-                e = energy2w(q, p, w)
                 if crossed(e, q, tE, tQ, tN):
                     iE, iQ = check_state(i, e, q, base + s + 1, thrE2, nE, thrLo, thrHi, nQ, iE, iQ, outE, outQ,
                                          qL, qR)

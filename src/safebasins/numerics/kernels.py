@@ -162,8 +162,8 @@ def _run_task(well: int, scheme: int, shared: bool, wpar: Floats, task: int, n_t
     nE = thrE2.shape[0]
     nQ = thrHi.shape[0]
     L: Int = np.int64(lanes)
-    # lane state: (q, p), the per-lane path's step and amplitude
-    Q, P, HL, FL = lane_f[0], lane_f[1], lane_f[2], lane_f[3]
+    # lane state: (q, p), the per-lane path's step and amplitude; V'(q) of a split well's loops
+    Q, P, HL, FL, D = lane_f[0], lane_f[1], lane_f[2], lane_f[3], lane_f[4]
     # the period is run in G segments; snapshots of (q, p) before each segment and the
     # segment maxima let a crossing be replayed over one segment only.  Segments cost a
     # snapshot per lane each; they pay off only while lanes cross thresholds, so a period
@@ -249,7 +249,7 @@ def _run_task(well: int, scheme: int, shared: bool, wpar: Floats, task: int, n_t
                 SQ[g, l] = Q[l]
                 SP[g, l] = P[l]
             # segment maxima go straight into the rows SME[g], SMQ[g] (, SMN[g])
-            _period(shared, scheme, well, wpar, M, Q, P, SME[g], SMQ[g], SMN[g], coef, FS, HL, CL, FL, sintab,
+            _period(shared, scheme, well, wpar, M, Q, P, D, SME[g], SMQ[g], SMN[g], coef, FS, HL, CL, FL, sintab,
                     seg[g], seg[g + 1])
         # ---------------------------------------------------- period boundary
         # vectorised test first: only lanes whose maxima crossed a threshold (or, for the
@@ -303,9 +303,9 @@ def _run_task(well: int, scheme: int, shared: bool, wpar: Floats, task: int, n_t
             done[l] = d
 
 
-def _period(shared: bool, scheme: int, well: int, wpar: Floats, M: Int, Q: Floats, P: Floats, ME: Floats, MQ: Floats,
-            MN: Floats, coef: Floats, FS: Floats, HL: Floats, CL: Floats, FL: Floats, sintab: Floats, s0: Int,
-            s1: Int) -> None:
+def _period(shared: bool, scheme: int, well: int, wpar: Floats, M: Int, Q: Floats, P: Floats, D: Floats, ME: Floats,
+            MQ: Floats, MN: Floats, coef: Floats, FS: Floats, HL: Floats, CL: Floats, FL: Floats, sintab: Floats,
+            s0: Int, s1: Int) -> None:
     """Steps [s0, s1) of the period: ``_period_shared`` (one parameter set, coef[0] and the
     scaled table FS) when the literal ``shared`` is True, else ``_period_lanes`` (per lane).
     Their bodies are called directly: each compiled function between the task and the loop is
@@ -315,18 +315,19 @@ def _period(shared: bool, scheme: int, well: int, wpar: Floats, M: Int, Q: Float
 
 # Any on an overload's typing function and its implementation alike (see steps._ol_step)
 @overload(_period)
-def _ol_period(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, ME: Any, MQ: Any, MN: Any,
-               coef: Any, FS: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any, s1: Any) -> Callable[..., None]:
+def _ol_period(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, D: Any, ME: Any, MQ: Any,
+               MN: Any, coef: Any, FS: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any,
+               s1: Any) -> Callable[..., None]:
     if not isinstance(shared, types.BooleanLiteral):
         raise errors.TypingError(f"shared must be a compile-time constant (bool literal), got {shared}")
     if shared.literal_value:
-        def impl(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, ME: Any, MQ: Any, MN: Any,
-                 coef: Any, FS: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any, s1: Any) -> None:
-            _period_shared_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, coef[0], FS, s0, s1)
+        def impl(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, D: Any, ME: Any, MQ: Any,
+                 MN: Any, coef: Any, FS: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any, s1: Any) -> None:
+            _period_shared_body(scheme, well, wpar, M, Q, P, D, ME, MQ, MN, coef[0], FS, s0, s1)
     else:
-        def impl(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, ME: Any, MQ: Any, MN: Any,
-                 coef: Any, FS: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any, s1: Any) -> None:
-            _period_lanes_body(scheme, well, wpar, M, Q, P, ME, MQ, MN, HL, CL, FL, sintab, s0, s1)
+        def impl(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, D: Any, ME: Any, MQ: Any,
+                 MN: Any, coef: Any, FS: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any, s1: Any) -> None:
+            _period_lanes_body(scheme, well, wpar, M, Q, P, D, ME, MQ, MN, HL, CL, FL, sintab, s0, s1)
     return impl
 
 
@@ -367,7 +368,7 @@ def _workspace(lanes: int, shared: bool, damped: bool, abs_q: bool, coef: np.nda
         segs[0, g] = g * S // Gmax
         segs[1, g] = S if g > 0 else 0
     FS = Fpar[0] * sintab if shared else np.zeros((1, sintab.shape[1]))      # the shared path's forcing
-    return [FS, segs, _zeros((4, Lmem)), _zeros((4, Gmax, Lmem)), _zeros((Gmax, 1 if abs_q else Lmem)),
+    return [FS, segs, _zeros((5, Lmem)), _zeros((4, Gmax, Lmem)), _zeros((Gmax, 1 if abs_q else Lmem)),
             _zeros((4, Lr), np.int64), _zeros((2, Lr), np.bool_), _zeros((3, Lr)),
             _zeros((coef.shape[1], Lmem if damped else 1))]
 

@@ -8,14 +8,20 @@
   at the scheme's distinct force sub-times), calling ``force(w, q, f_k) = -V'(q) + f_k`` of a well's
   compiled form (wells/compiled.py) and the primitives ``fma`` / ``mul`` (every product that meets an
   add is an explicit fma; the damped ``p *= e`` is a mul: never contracted on the GPU);
+* ``split_step(w, q, p, c, f, d) -> (q, p, d, v)``: the same step for a well with a split force
+  (wells.compiled.WellCode.split), the same bits with fewer evaluations: ``d = V'(q)`` at the start
+  is given (a splitting's first kick, RK's first stage), ``V'`` and ``V`` at the end come from one
+  ``gradient_potential`` call (a splitting's last kick is there) and are returned for the next
+  step's first force and the energy test;
 * the tuple helpers of its arity: ``row(tab, s)`` (a forcing-table row), ``scaled(F, t)`` (F times
   it: the products the shared path precomputes), ``coefs(c)`` (a coefficient row as a tuple),
   ``column(CL, l)`` (a lane's coefficient column), ``from_h(h)`` (undamped: the coefficients formed
   from the step h, the same IEEE products as lane_coefficients), ``flat_row(tab, o)`` and
   ``flat_coefs(coef, o)`` (CUDA: flat arrays at an unsigned offset).
 
-``make(jit, force)`` compiles the step for a target (the CPU lanes: wells.compiled.cpu_jit; CUDA:
-``cuda.jit(device=True)``), ``helpers(jit)`` the tuple helpers.  ``key`` hashes the generated
+``make(jit, force)`` (``make_split(jit, gradient, gradient_potential, force_from)``) compiles the
+step for a target (the CPU lanes: wells.compiled.cpu_jit; CUDA: ``cuda.jit(device=True)``),
+``helpers(jit)`` the tuple helpers.  ``key`` hashes the generated
 source and the engine's (:func:`engine_fingerprint`): the numba literal on which the CPU kernels
 are specialised and cached, as a well's key (wells.compiled.WellCode.key) is the other.
 
@@ -61,12 +67,25 @@ def engine_fingerprint() -> str:
     return fingerprint(ENGINE_FILES)
 
 
-def _splitting_step(s: Splitting, damped: bool) -> list[str]:
+def _force(q: str, f: str, split: str) -> str:
+    """The force at ``q`` with forcing value ``f``: ``force(w, q, f)``; with ``split`` the split
+    form, ``first`` from the carried ``d = V'(q)``, ``last`` from the ``d`` just computed with V(q),
+    ``mid`` calling the gradient."""
+    if not split:
+        return f"force(w, {q}, {f})"
+    return f"force_from(w, {'gradient(w, ' + q + ')' if split == 'mid' else 'd'}, {f})"
+
+
+def _splitting_step(s: Splitting, damped: bool, split: bool = False) -> list[str]:
     nd, nk = len(s.drift_values), len(s.kick_values)
     lines = []
+    last = len(s.kick) - 1
     for k, b in enumerate(s.kick):
         ck = nd + s.kick_values.index(b)
-        lines.append(f"p = fma(c[{ck}], force(w, q, f[{s.times.index(s.kick_times[k])}]), p)")
+        if split and k == last:
+            lines.append("d, v = gradient_potential(w, q)")
+        kind = ("first" if k == 0 else "last" if k == last else "mid") if split else ""
+        lines.append(f"p = fma(c[{ck}], {_force('q', f'f[{s.times.index(s.kick_times[k])}]', kind)}, p)")
         if k < len(s.drift):
             j = s.drift_values.index(s.drift[k])
             lines.append(f"q = fma(c[{j}], p, q)")
@@ -82,7 +101,7 @@ def _sum(names: list[str]) -> str:
     return text
 
 
-def _rk_step(s: RungeKutta, damped: bool) -> list[str]:
+def _rk_step(s: RungeKutta, damped: bool, split: bool = False) -> list[str]:
     lines = []
     P, Q = ["p"], ["q"]
     if damped:
@@ -98,7 +117,7 @@ def _rk_step(s: RungeKutta, damped: bool) -> list[str]:
             lines += [f"q{i + 1} = {qi}", f"p{i + 1} = {pi}"]
             Q.append(f"q{i + 1}")
             P.append(f"p{i + 1}")
-        force = f"force(w, {Q[i]}, f[{s.times.index(s.c[i])}])"
+        force = _force(Q[i], f"f[{s.times.index(s.c[i])}]", ("first" if i == 0 else "mid") if split else "")
         lines.append(f"k{i + 1} = fma(nb, {P[i]}, {force})" if damped else f"k{i + 1} = {force}")
     cw = len(s.stage_values)
     for var, terms in (("q", P), ("p", [f"k{i + 1}" for i in range(len(s.weights))])):
@@ -113,6 +132,8 @@ def _rk_step(s: RungeKutta, damped: bool) -> list[str]:
         total = " + ".join(f"({x})" if " + " in x and not x.startswith("(") else x for x in parts)
         lines.append(f"{var}_new = fma(c[{cw}], {total}, {var})")
     lines += ["q = q_new", "p = p_new"]
+    if split:
+        lines.append("d, v = gradient_potential(w, q)")
     return lines
 
 
@@ -122,6 +143,7 @@ def _tuple(items: list[str]) -> str:
 
 def _source(s: Scheme, damped: bool) -> str:
     body = _splitting_step(s, damped) if isinstance(s, Splitting) else _rk_step(s, damped)
+    split = _splitting_step(s, damped, True) if isinstance(s, Splitting) else _rk_step(s, damped, True)
     n, W = s.n_coef(damped), len(s.times)
     from_h = (_splitting_from_h(s) if isinstance(s, Splitting) else
               _tuple([f"h * C{j}" for j in range(len(s.stage_values) + 1)]))
@@ -129,6 +151,10 @@ def _source(s: Scheme, damped: bool) -> str:
         "def step(w, q, p, c, f):",
         *("    " + line for line in body),
         "    return q, p",
+        "",
+        "def split_step(w, q, p, c, f, d):",
+        *("    " + line for line in split),
+        "    return q, p, d, v",
         "",
         "def row(tab, s):",
         f"    return {_tuple([f'tab[s, {j}]' for j in range(W)])}",
@@ -196,18 +222,28 @@ class SchemeCode:
         """Forcing values per step (the forcing table's width)."""
         return len(self.scheme.times)
 
-    def _namespace(self, force: Callable[..., Any] | None, primitives: dict[str, Any]) -> dict[str, Any]:
-        ns: dict[str, Any] = {"force": force, **primitives, **_constants(self.scheme)}
+    def _namespace(self, well: dict[str, Any], primitives: dict[str, Any]) -> dict[str, Any]:
+        ns: dict[str, Any] = {**well, **primitives, **_constants(self.scheme)}
         exec(compile(self.source, f"<scheme {self.name}{' damped' if self.damped else ''}>", "exec"), ns)
         return ns
 
     def make(self, jit: Callable[..., Any], force: Callable[..., Any]) -> Any:
         """The step compiled with ``jit`` around ``force`` (already compiled for the target)."""
-        return jit(self._namespace(force, {"fma": compiled.fma, "mul": compiled.mul})["step"])
+        return jit(self._namespace({"force": force}, {"fma": compiled.fma, "mul": compiled.mul})["step"])
+
+    def make_split(self, jit: Callable[..., Any], gradient: Callable[..., Any], gradient_potential: Callable[..., Any],
+                   force_from: Callable[..., Any]) -> Any:
+        """``split_step(w, q, p, c, f, d) -> (q, p, d, v)`` compiled with ``jit`` around a split
+        well's functions (wells.compiled.WellCode.split, compiled for the target): the step with
+        ``d = V'(q)`` at its start given, and ``d = V'(q)``, ``v = V(q)`` at its end returned (the
+        next step's ``d``, the energy's V).  The same bits as ``step``: its forces are
+        ``force_from(w, V'(q), f)``, the split code's force."""
+        well = {"gradient": gradient, "gradient_potential": gradient_potential, "force_from": force_from}
+        return jit(self._namespace(well, {"fma": compiled.fma, "mul": compiled.mul})["split_step"])
 
     def helpers(self, jit: Callable[..., Any]) -> dict[str, Any]:
         """The tuple helpers (row, scaled, coefs, column, from_h, flat_row, flat_coefs) compiled with jit."""
-        ns = self._namespace(None, {})
+        ns = self._namespace({}, {})
         return {k: jit(ns[k]) for k in ("row", "scaled", "coefs", "column", "from_h", "flat_row", "flat_coefs")}
 
 

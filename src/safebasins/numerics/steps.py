@@ -32,8 +32,8 @@ from numba.core import errors
 from numba.extending import overload
 
 from safebasins.numerics.scheme_code import SchemeCode, code_of_scheme, scheme_code
-from safebasins.wells.compiled import (LLVM_INLINE, Coefs, WellCode, literal_code, cpu_functions, cpu_jit, quartic_code,
-                                      well_energy2, well_force)
+from safebasins.wells.compiled import (LLVM_INLINE, Coefs, WellCode, cpu_functions, cpu_jit, cpu_split, energy2_from,
+                                      force_from, literal_code, quartic_code, well_energy2, well_force)
 
 #: the engine's float64 and int64 arrays
 Floats = npt.NDArray[np.float64]
@@ -46,6 +46,9 @@ Row = tuple[float, ...]
 Step = Callable[[Coefs, float, float, Row, Row], tuple[float, float]]
 #: ``lane(l, HL, CL)``: lane l's coefficients (cpu_lane)
 Lane = Callable[[int, Floats, Floats], Row]
+#: ``split_step(w, q, p, c, f, d) -> (q, p, d, v)``: a scheme's split step (scheme_code) around a
+#: split well (d = V'(q) at the start; V'(q), V(q) at the end)
+SplitStep = Callable[[Coefs, float, float, Row, Row, float], tuple[float, float, float, float]]
 
 #: kernel key of the paper's quartic (a global constant: numba types it as a literal)
 QUARTIC_KEY = quartic_code().key
@@ -120,6 +123,22 @@ def cpu_step(scheme_key: int, well_key: int) -> Step:
     """The step of scheme code ``scheme_key`` around the force of well code ``well_key``, compiled
     for the CPU lanes (inlined): ``step(w, q, p, c, f) -> (q, p)``."""
     return cast(Step, code_of_scheme(scheme_key).make(cpu_jit, cpu_functions(well_key)[0]))
+
+
+#: a split well's force and energy from V'(q), V(q) (wells.compiled.force_from, energy2_from) for the CPU lanes
+FORCE_FROM = cpu_jit(force_from)
+ENERGY2_FROM = cpu_jit(energy2_from)
+
+
+@functools.cache
+def cpu_split_step(scheme_key: int, well_key: int) -> SplitStep | None:
+    """The split step of scheme code ``scheme_key`` around well code ``well_key``
+    (``split_step(w, q, p, c, f, d) -> (q, p, d, v)``, scheme_code.SchemeCode.make_split) compiled for
+    the CPU lanes (inlined); None for a well without a split force (wells.compiled.WellCode.split)."""
+    split = cpu_split(well_key)
+    if split is None:
+        return None
+    return cast(SplitStep, code_of_scheme(scheme_key).make_split(cpu_jit, *split, FORCE_FROM))
 
 
 def scalar_step(integrator: str = "srkn6b", damped: bool = False, well: WellCode | None = None) -> Step:

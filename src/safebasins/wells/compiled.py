@@ -20,6 +20,13 @@ A well reaches the engines as a :class:`WellCode` (``Well.compiled``, built once
   literal.
 * ``abs_tracking``: a well symmetric about q = 0 may track max |q| (one maximum per lane: the
   quartic's closed-form path, eq (4)); every other code tracks max q and max -q.
+* ``split`` (wells given by ``V`` and ``dV``: :func:`target_code`; None for the quartic and the
+  polynomial codes, whose ``f`` enters an fma): ``split(jit) -> (gradient, gradient_potential)``,
+  ``gradient(w, q) = V'(q)`` and ``gradient_potential(w, q) = (V'(q), V(q))``, with which
+  ``force(w, q, f) == force_from(w, gradient(w, q), f)`` and ``energy2(w, q, p) ==
+  energy2_from(w, V(q), p)`` bit for bit (:func:`force_from`, :func:`energy2_from`: the one
+  final operation of each).  The lane loops carry V'(q) from a step's last kick to the next
+  step's first (same q: first-same-as-last) and take V(q) of the energy test from the same call.
 
 Primitives (one name each, an implementation per target):
 
@@ -63,10 +70,10 @@ if TYPE_CHECKING:
     from numba.core.decorators import _JITOptions   # numba's stubs: the options of njit
 
 __all__ = ["WellCode", "fma", "mul", "fma_cpu", "mul_cpu", "N_WPAR", "quartic_code", "polynomial_code", "callable_code",
-           "target_code",
+           "target_code", "force_from", "energy2_from",
            "well_force", "well_energy2", "abs_tracking", "code_of", "literal_code", "cpu_jit", "cpu_leaf_jit",
            "LLVM_INLINE",
-           "cpu_functions",
+           "cpu_functions", "cpu_split",
            "POLY_DEGREES"]
 
 #: a target's decorator (njit-like, cuda.jit(device=True)): a plain function -> its compiled form
@@ -143,6 +150,7 @@ class WellCode:
     wpar: np.ndarray = field(repr=False)
     abs_tracking: bool
     source: str = field(repr=False)
+    split: Callable[[Jit], tuple[Any, Any]] | None = field(default=None, repr=False)
     key: int = field(init=False)
 
     def __post_init__(self) -> None:
@@ -168,7 +176,7 @@ class WellCode:
 
 @functools.cache
 def _signed_variant(code: WellCode) -> WellCode:
-    return WellCode(code.name, code.make, code.wpar, False, code.source)
+    return WellCode(code.name, code.make, code.wpar, False, code.source, code.split)
 
 
 def code_of(key: int) -> WellCode:
@@ -277,37 +285,75 @@ def polynomial_code(coefficients: ArrayLike, barriers: Sequence[float], name: st
 
 
 # ------------------------------------------------------------------------------- any V, dV
-def _template(V: Callable[[float], float], dV: Callable[[float], float]
-              ) -> tuple[Callable[[Coefs, float, float], float], Callable[[Coefs, float, float], float]]:
-    """force and energy of a well given by scalar functions V, dV (already compiled for the
-    target): the same two lines for every such well."""
+def force_from(w: Coefs, dv: float, f: float) -> float:
+    """-V'(q) + f from dv = V'(q) (a split code's force: one IEEE subtraction)."""
+    return f - dv
+
+
+def energy2_from(w: Coefs, v: float, p: float) -> float:
+    """2 H0 = p^2 + 2 V(q) from v = V(q) (a split code's energy)."""
+    return fma(p, p, 2.0 * v)
+
+
+#: ``functions(jit) -> (V, dV)`` or ``(V, dV, dV_V)`` of :func:`target_code`
+Functions = Callable[[Jit], tuple[Callable[..., Any], ...]]
+
+
+def _template(V: Callable[[float], float], dV: Callable[[float], float], dV_V: Callable[[float], tuple[float, float]],
+              force_of: Callable[[Coefs, float, float], float], energy2_of: Callable[[Coefs, float, float], float]
+              ) -> tuple[Callable[..., Any], ...]:
+    """(force, energy2, gradient, gradient_potential) of a well given by scalar functions V, dV and
+    dV_V(q) = (V'(q), V(q)) (compiled for the target), force_of / energy2_of: :func:`force_from`,
+    :func:`energy2_from` compiled for it: the same lines for every such well."""
     def force(w: Coefs, q: float, f: float) -> float:
-        return f - dV(q)
+        return force_of(w, dV(q), f)
 
     def energy2(w: Coefs, q: float, p: float) -> float:
-        return fma(p, p, 2.0 * V(q))
+        return energy2_of(w, V(q), p)
 
-    return force, energy2
+    def gradient(w: Coefs, q: float) -> float:
+        return dV(q)
+
+    def gradient_potential(w: Coefs, q: float) -> tuple[float, float]:
+        return dV_V(q)
+
+    return force, energy2, gradient, gradient_potential
 
 
-_TEMPLATE_SOURCE = inspect.getsource(_template)
+def _pair(V: Callable[[float], float], dV: Callable[[float], float]) -> Callable[[float], tuple[float, float]]:
+    """dV_V(q) = (dV(q), V(q)) from the two functions (a well without a joint form)."""
+    def dV_V(q: float) -> tuple[float, float]:
+        return dV(q), V(q)
+    return dV_V
 
 
-def target_code(functions: Callable[[Jit], tuple[Callable[[float], float], Callable[[float], float]]],
-                barriers: Sequence[float], name: str, source: str) -> WellCode:
-    """Code of a well from ``functions(jit) -> (V, dV)``: scalar, numba-compilable plain Python
-    functions for the target whose decorator is ``jit`` (each target compiles them; what they
-    call may differ by target, e.g. wells.elementary compiled for it).  ``source`` must identify
-    their arithmetic exactly (the expression well's generated text and the elementary functions'
-    hash; for user functions the LLVM IR of their CPU compilation): it is the cache key of the
-    compiled kernels."""
-    def make(jit: Jit) -> tuple[Any, Any]:
-        V, dV = functions(jit)
+_TEMPLATE_SOURCE = "".join(inspect.getsource(f) for f in (force_from, energy2_from, _template, _pair))
+
+
+def target_code(functions: Functions, barriers: Sequence[float], name: str, source: str) -> WellCode:
+    """Code of a well from ``functions(jit) -> (V, dV)`` or ``(V, dV, dV_V)``: scalar,
+    numba-compilable plain Python functions for the target whose decorator is ``jit`` (each target
+    compiles them; what they call may differ by target, e.g. wells.elementary compiled for it);
+    ``dV_V(q) = (dV(q), V(q))`` with the same bits, sharing their work (absent: the two calls).
+    ``source`` must identify their arithmetic exactly (the expression well's generated text and
+    the elementary functions' hash; for user functions the LLVM IR of their CPU compilation): it
+    is the cache key of the compiled kernels."""
+    @functools.cache
+    def compiled_for(jit: Jit) -> tuple[Any, Any, Any, Any]:
+        fs = functions(jit)
         leaf = cpu_leaf_jit if jit is cpu_jit else jit
-        force, energy2 = _template(leaf(V), leaf(dV))
-        return jit(force), jit(energy2)
+        V, dV = leaf(fs[0]), leaf(fs[1])
+        dV_V = leaf(fs[2]) if len(fs) > 2 else jit(_pair(V, dV))
+        force, energy2, gradient, gradient_potential = _template(V, dV, dV_V, jit(force_from), jit(energy2_from))
+        return jit(force), jit(energy2), jit(gradient), jit(gradient_potential)
 
-    return WellCode(name, make, _wpar(barriers), False, f"{_TEMPLATE_SOURCE}\0{source}")
+    def make(jit: Jit) -> tuple[Any, Any]:
+        return compiled_for(jit)[:2]
+
+    def split(jit: Jit) -> tuple[Any, Any]:
+        return compiled_for(jit)[2:]
+
+    return WellCode(name, make, _wpar(barriers), False, f"{_TEMPLATE_SOURCE}\0{source}", split)
 
 
 def callable_code(V: Callable[[float], float], dV: Callable[[float], float], barriers: Sequence[float], name: str,
@@ -370,6 +416,14 @@ def _cpu_globals(fn: Callable[..., Any]) -> Callable[..., Any]:
 def cpu_functions(key: int) -> tuple[Any, Any]:
     """(force, energy2) of a code compiled for the CPU lanes (inlined into the kernels)."""
     return code_of(key).make(cpu_jit)
+
+
+@functools.cache
+def cpu_split(key: int) -> tuple[Any, Any] | None:
+    """(gradient, gradient_potential) of a split code compiled for the CPU lanes (WellCode.split);
+    None for a code without one."""
+    split = code_of(key).split
+    return None if split is None else split(cpu_jit)
 
 
 def well_force(well: int, w: Coefs, q: float, f: float) -> float:

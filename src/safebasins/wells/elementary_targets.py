@@ -103,7 +103,9 @@ def _cold_functions(context: Any, module: ir.Module, sym: str, fndesc: Any, sig:
     masked vector variants ``sym_v<N>(<N x double>, <N x i1>)``; returns the scalar one."""
     d = ir.DoubleType()
     scalar = ir.Function(module, ir.FunctionType(d, [d]), sym)
-    scalar.linkage = "internal"
+    # the copies numba links into one kernel merge by name: internal ones would be renamed
+    # (sym.58), and the call's vector-variant attribute would no longer name its callee
+    scalar.linkage = "linkonce_odr"
     for a in ("noinline",) + _PURE:
         set.add(scalar.attributes, a)     # llvmlite's add() knows no 'willreturn' / 'memory(none)'
     b = ir.IRBuilder(scalar.append_basic_block())
@@ -113,7 +115,7 @@ def _cold_functions(context: Any, module: ir.Module, sym: str, fndesc: Any, sig:
     for n in VECTOR_WIDTHS:
         vt = ir.VectorType(d, n)
         vf = ir.Function(module, ir.FunctionType(vt, [vt, ir.VectorType(ir.IntType(1), n)]), f"{sym}_v{n}")
-        vf.linkage = "internal"
+        vf.linkage = "linkonce_odr"
         for a in ("noinline",) + _PURE:
             set.add(vf.attributes, a)
         b = ir.IRBuilder(vf.append_basic_block())

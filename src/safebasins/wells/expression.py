@@ -8,6 +8,7 @@ generated Python source of ``V(q)`` and ``dV(q)`` serves every consumer:
 * the theory (action-angle variables by quadrature, :class:`~safebasins.wells.numeric.NumericWell`)
   runs it vectorised on numpy arrays;
 * the compiled engines run it through the well's compiled form (wells.compiled.target_code),
+  with ``dV_V(q) = (V'(q), V(q))`` sharing their calls (wells.expression_joint),
   compiled by numba for the CPU and by numba-cuda for the GPU; every product is written with
   ``mul`` (never contracted into an fma by the GPU compiler) and the functions are those of
   wells.elementary compiled for the target (the same bits on both; ``atan`` and ``asinh``: the
@@ -36,6 +37,7 @@ from safebasins.wells.numeric import NumericWell
 from safebasins.wells import elementary
 from safebasins.wells.compiled import Jit, WellCode, mul, target_code
 from safebasins.wells.expression_forms import Form, exponential_forms
+from safebasins.wells.expression_joint import joint_source
 
 __all__ = ["ExpressionWell", "expression", "FUNCTIONS"]
 
@@ -377,6 +379,13 @@ def _functions(source: str, namespace: dict[str, Any]) -> tuple[Callable[..., An
     return ns["V"], ns["dV"]
 
 
+def _joint_functions(source: str, joint: str, namespace: dict[str, Any]) -> tuple[Callable[..., Any], ...]:
+    """(V, dV, dV_V) of the generated source and its joint form (wells.expression_joint)."""
+    ns = dict(namespace)
+    exec(compile(f"{source}\n\n{joint}", "<safebasins expression well>", "exec"), ns)   # our own generated text
+    return ns["V"], ns["dV"], ns["dV_V"]
+
+
 def _limit(V: Any, q: Any, side: int) -> float | None:
     """Finite limit of V as q -> side * inf, or None (unbounded or oscillating)."""
     sp = _sympy()
@@ -412,11 +421,12 @@ class ExpressionWell(NumericWell):
 
     def _compiled_form(self) -> WellCode:
         source = self.source
+        joint = joint_source(source)
 
-        def functions(jit: Jit) -> tuple[Callable[[float], float], Callable[[float], float]]:
-            return _functions(source, _compiled_namespace(elementary.for_target(jit)))
+        def functions(jit: Jit) -> tuple[Callable[..., Any], ...]:
+            return _joint_functions(source, joint, _compiled_namespace(elementary.for_target(jit)))
 
-        return target_code(functions, self.barriers, self.name, f"{elementary.MODULE_HASH}\0{source}")
+        return target_code(functions, self.barriers, self.name, f"{elementary.MODULE_HASH}\0{source}\0{joint}")
 
     def potential_text(self) -> str:
         return self.formula
@@ -430,7 +440,7 @@ class ExpressionWell(NumericWell):
 def _compiled_namespace(functions: SimpleNamespace) -> dict[str, Any]:
     """The generated source's names in a compiled engine: ``functions`` (wells.elementary compiled
     for the target), the libm functions elementary has not, the wells' ``mul``."""
-    own = {k: getattr(functions, k) for k in (*FUNCTIONS, "pow", *_REWRITE_FUNCTIONS) if k not in _LIBM}
+    own = {k: getattr(functions, k) for k in (*FUNCTIONS, "pow", "sincos", *_REWRITE_FUNCTIONS) if k not in _LIBM}
     return {"mul": mul, "copysign": functions._copysign, **_LIBM, **own}
 
 
