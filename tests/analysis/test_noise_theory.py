@@ -70,13 +70,29 @@ def test_stacked_levels_are_the_single_levels() -> None:
 
 @pytest.mark.parametrize("kw, ens_kw, reason", [
     (dict(theory=False), {}, "theory: false"),
-    (dict(noise_time=1.0), dict(noise_time=1.0), "coloured noise"),
     (dict(well="cubic", xi_max=0.12), dict(well="cubic", xi_max=0.12), "symmetric wells"),
 ])
 def test_no_theory_says_why(kw, ens_kw, reason) -> None:
     out = escape_probability_with_theory(ensemble(0.02, **ens_kw), *ARGS, **{"xi_max": 0.18, **kw}, **SOLVER)
     assert out.attrs["theory"] == "none" and reason in out.attrs["theory_reason"]
     assert "P_escape_theory" not in out
+
+
+def test_coloured_noise_is_the_theory_with_its_correlation_time() -> None:
+    # the ensemble's noise_time reaches the solve: the coloured theory's map, not the white one's
+    kw = dict(noise=0.02, t_eval=[1, 3], **SOLVER)
+    out = escape_probability_with_theory(ensemble(0.02, noise_time=1.0), *ARGS, 0.18, noise_time=1.0, **SOLVER)
+    th = theory.escape_probability(Q0, P0, *ARGS, 0.18, noise_time=1.0, **kw)
+    white = theory.escape_probability(Q0, P0, *ARGS, 0.18, **kw)
+    np.testing.assert_array_equal(out["P_escape_theory"].values, th["P_escape"].values)
+    assert "theory_reason" not in out.attrs and "Ornstein-Uhlenbeck" in out.attrs["theory_model"]
+    assert np.abs(th["P_escape"].values - white["P_escape"].values).max() > 1e-3
+    # the erosion profile's theory too
+    ekw = dict(noise=[0.02], epsilon=[0.5], xi_max=0.18, t_eval=[1, 3], noise_time=1.0)
+    prof = stochastic_erosion(Q0, P0, [0.01], 0.9, math.pi, paths=12, steps_per_cycle=16, **ekw)
+    got = stochastic_erosion_with_theory(prof, Q0, P0, [0.01], 0.9, math.pi, **ekw, **SOLVER)
+    ref = stochastic_erosion_theory(Q0, P0, [0.01], 0.9, math.pi, **ekw, **SOLVER)
+    np.testing.assert_array_equal(got["GIM_theory"].values, ref["GIM"].transpose(*got["GIM"].dims).values)
 
 
 def test_reason_and_horizon() -> None:
@@ -133,8 +149,9 @@ def test_theory_evaluations_count_the_tables_once_and_each_solve() -> None:
         table_evaluations(resolve_well("pendulum")) - table_evaluations(QUARTIC))
 
 
-@pytest.mark.parametrize("over", [dict(theory=False), dict(noise_time=0.5), dict(noise=[0.0, 0.01])],
-                         ids=["no-theory", "coloured", "noise-0"])
+@pytest.mark.parametrize("over", [dict(theory=False), dict(noise=[0.0, 0.01])], ids=["no-theory", "noise-0"])
 def test_theory_evaluations_zero_where_not_solved(over) -> None:
     kw = dict(noise=[0.01, 0.02], t_eval=[1, 3], n_ics=20, solves=2, **SOLVER)
     assert theory_evaluations(**{**kw, **over}) == 0 < theory_evaluations(**kw)
+    # coloured noise: the same tables and solves as white noise
+    assert theory_evaluations(**kw, noise_time=0.5) == theory_evaluations(**kw)

@@ -157,10 +157,9 @@ def test_theory_map_and_agreement_are_the_library_calls(tmp_path):
 
 @pytest.mark.parametrize("extra, reason", [
     (["--no-theory"], "theory: false"),
-    (["--noise-time", "0.5", "--steps-per-cycle", "24"], "coloured noise"),
     (["--noise", "0"], "noise 0"),
     (["--well", "cubic", "--xi-max", "0.16"], "symmetric wells"),        # the theory refuses the well
-], ids=["no-theory", "coloured", "zero-noise", "cubic"])
+], ids=["no-theory", "zero-noise", "cubic"])
 def test_no_theory_says_why(tmp_path, extra, reason):
     res = invoke([*BASE, *THEORY, "--no-plot", *extra], tmp_path)
     assert res.exit_code == 0, res.output

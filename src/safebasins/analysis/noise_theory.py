@@ -2,8 +2,9 @@
 and its stochastic erosion profile, added to the ensembles' Datasets where the theory applies.
 
 The averaged theory (:func:`safebasins.theory.escape_probability`, docs/noise-theory.md) is derived
-for white noise of amplitude sigma > 0 in a symmetric well below the barrier.  Elsewhere (coloured
-noise, a noise level 0, an asymmetric well, xi_max at the barrier, or ``theory=False``) the Dataset
+for white or Ornstein-Uhlenbeck noise of intensity sigma^2 > 0 (correlation time short against the
+slow time) in a symmetric well below the barrier.  Elsewhere (a noise level 0, an asymmetric well,
+xi_max at the barrier, or ``theory=False``) the Dataset
 gets no theory variables but the attributes ``theory = "none"`` and ``theory_reason`` saying why:
 an absent theory is stated, never a silent gap.  Where it applies the Dataset gains
 
@@ -49,12 +50,11 @@ _AGREEMENT = ("P_escape_theory", "P_escape_mean_abs_difference", "P_escape_max_a
 
 
 def theory_reason(*, theory: bool, noise: float | Sequence[float] | npt.ArrayLike, noise_time: float) -> str | None:
-    """Why the theory is not solved (None: it is, unless the well or xi_max is refused by the solve)."""
+    """Why the theory is not solved (None: it is, unless the well or xi_max is refused by the solve);
+    ``noise_time`` (white or coloured noise) is checked, both are solved."""
+    checks.check_nonnegative("noise_time", noise_time)
     if not theory:
         return "not computed (theory: false)"
-    if noise_time > 0:
-        return ("not applicable to coloured noise (noise_time > 0): the averaged theory is derived for white noise "
-                "(docs/noise-theory.md)")
     if (np.atleast_1d(np.asarray(noise, float)) == 0).any():
         return ("not applicable at noise 0 (one of the levels): the averaged diffusion needs sigma > 0; "
                 "at sigma = 0 the theory is the deterministic slow flow (theory.slow_flow_escapes)")
@@ -146,7 +146,8 @@ def escape_probability_with_theory(ensemble: xr.Dataset, F: float, Omega: float,
     for i, s in enumerate(levels if reason is None else []):
         try:
             solve = theory_escape_probability(q0, p0, F, Omega, Psi, xi_max, noise=float(s), t_eval=t_eval,
-                                              damping=damping, well=w, cells=cells_, steps_per_cycle=spc)
+                                              damping=damping, well=w, cells=cells_, steps_per_cycle=spc,
+                                              noise_time=noise_time)
         except ValueError as exc:
             if i > 0:
                 raise
@@ -199,7 +200,7 @@ def stochastic_erosion_with_theory(profile: xr.Dataset, q0: npt.ArrayLike, p0: n
         try:
             solved = stochastic_erosion_theory(q0, p0, F, Omega, Psi, noise=noise, epsilon=epsilon, xi_max=xi_max,
                                                t_eval=t_eval, damping=damping, well=well, bottom=bottom,
-                                               cells=cells_, steps_per_cycle=spc)
+                                               cells=cells_, steps_per_cycle=spc, noise_time=noise_time)
         except ValueError as exc:
             reason = _refused(exc)
     if solved is None:

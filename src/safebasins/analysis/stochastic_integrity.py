@@ -81,7 +81,7 @@ THEORY_DEFINITION = ("safe = P_escape <= epsilon (P_escape of the averaged theor
 NO_CONSERVATIVE = ("none: the averaged theory's P_escape is a deterministic solve with no path counts, so no "
                    "confidence interval and no conservative basin")
 #: the keywords of theory.escape_probability that stochastic_erosion_theory passes on
-THEORY_KWARGS = ("cells", "steps_per_cycle", "advection")
+THEORY_KWARGS = ("cells", "steps_per_cycle", "advection", "noise_time")
 ZERO_NOISE = ("at noise = 0 every path is the deterministic trajectory: P_escape is exact (0 or 1), the "
               "conservative basin is the basin, and one path per initial condition is integrated")
 #: ensemble attributes carried into the basins' and profiles' Datasets
@@ -394,7 +394,7 @@ def stochastic_erosion_theory(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float | S
     Arguments as :func:`stochastic_erosion`, less the ensemble's (``paths``, ``seed``, ``cycles``,
     ``conservative``); ``noise`` > 0 (at noise 0 the theory is the deterministic slow flow,
     :func:`safebasins.theory.slow_flow_escapes`); ``well`` a symmetric well; ``theory_kwargs``:
-    ``cells``, ``steps_per_cycle``, ``advection`` of theory.escape_probability.  ``keep_masks`` adds
+    ``cells``, ``steps_per_cycle``, ``advection``, ``noise_time`` of theory.escape_probability.  ``keep_masks`` adds
     ``safe`` and ``P_escape`` over (..., q0, p0).
 
     Returns

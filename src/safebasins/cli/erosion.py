@@ -99,8 +99,8 @@ def stochastic_erosion(F: list[float], Omega: float, Psi: float, xi_max: float, 
     (safebasins escape-probability; all with the same --seed: common random numbers), and the
     stochastic safe basin {P_escape <= epsilon} at each --t-eval is measured by GIM, LIM and IF
     (Soliman and Thompson's stochastic integrity; with --conservative also the basin of the upper
-    end of the 95% Wilson interval). Where the averaged theory applies (white noise, every --noise
-    > 0, a symmetric well, --xi-max below the barrier) its profile GIM_theory, LIM_theory,
+    end of the 95% Wilson interval). Where the averaged theory applies (white or Ornstein-Uhlenbeck
+    noise, every --noise > 0, a symmetric well, --xi-max below the barrier) its profile GIM_theory, LIM_theory,
     IF_theory is added (docs/noise-theory.md; --no-theory: none, the attribute theory_reason says
     why). PREFIX.nc is the library's dataset over (F, noise, epsilon, t_eval) (a single value: no
     dimension); PREFIX.png draws the profile against sigma and against F at the last --t-eval.

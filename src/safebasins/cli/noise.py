@@ -41,8 +41,9 @@ def theory_options(f: Any) -> Any:
                      help=f"The averaged theory's polar grid: N or N_GAMMAxN_J cells (>= {MIN_CELLS}).")(f)
     return click.option("--theory/--no-theory", "theory", default=True, show_default=True,
                         help="Also solve the averaged theory (docs/noise-theory.md) and store it with its agreement "
-                             "where it applies (white noise, every --noise > 0, a symmetric well, --xi-max below "
-                             "the barrier); elsewhere the dataset's attribute theory_reason says why not.")(f)
+                             "where it applies (white or Ornstein-Uhlenbeck noise, every --noise > 0, a symmetric "
+                             "well, --xi-max below the barrier); elsewhere the dataset's attribute theory_reason "
+                             "says why not.")(f)
 
 
 def noise_options(f: Any) -> Any:
@@ -106,8 +107,8 @@ def escape_probability(F: float, Omega: float, Psi: float, xi_max: float, noise:
     order 2, counter-based random numbers) and escape by the criteria of the escape charts.
     PREFIX.nc is the library's dataset: P_escape(q0, p0, t_eval) with its 95% Wilson interval,
     the survival curve and the restricted mean first-passage time (docs/noise.md), and where the
-    averaged theory applies (white noise, --noise > 0, a symmetric well, --xi-max below the
-    barrier) its map P_escape_theory with the agreement |P_escape_theory - P_escape|
+    averaged theory applies (white or Ornstein-Uhlenbeck noise, --noise > 0, a symmetric well,
+    --xi-max below the barrier) its map P_escape_theory with the agreement |P_escape_theory - P_escape|
     (docs/noise-theory.md; --no-theory: none, and the attribute theory_reason says why);
     PREFIX.png maps P_escape at each --t-eval with the theory's contours.
 

@@ -38,7 +38,8 @@ from safebasins.theory.types import FloatArray
 from safebasins.wells.base import Well
 from safebasins.wells.quartic import QuarticWell
 
-__all__ = ["orbit_averages", "AveragedDiffusion", "averaged_diffusion", "table_evaluations", "N_THETA", "N_NODES"]
+__all__ = ["orbit_averages", "coloured_averages", "spectral_weights", "AveragedDiffusion", "averaged_diffusion",
+           "table_evaluations", "N_THETA", "N_NODES"]
 
 #: angles of the trapezoidal rule of the orbit averages
 N_THETA = 256
@@ -58,12 +59,14 @@ SHIFT_TOL = 1e-9
 _REL_STEP = 1e-6
 
 
-def orbit_averages(well: Well, xi: ArrayLike, n_theta: int = N_THETA) -> dict[str, FloatArray]:
+def orbit_averages(well: Well, xi: ArrayLike, n_theta: int = N_THETA, noise_time: float = 0.0
+                   ) -> dict[str, FloatArray]:
     """Orbit averages of the noise terms at energies ``0 < xi < barrier_energy`` (validated by the
     well): ``J``, ``omega``, ``m_JJ = <(dJ/dp)^2> = <p^2>/omega^2``, ``m_gg = <(dtheta/dp)^2> =
     <q_J^2>``, ``m_gJ = <(dtheta/dp)(dJ/dp)> = -<q_J q_theta>``, and ``drift_J = <d^2J/dp^2>/2 =
     (1 - J domega/dE)/(2 omega)`` (the noise-induced action drift per unit sigma^2), each an array
-    of the shape of xi."""
+    of the shape of xi.  ``noise_time`` tau > 0 (an Ornstein-Uhlenbeck force): the averages
+    weighted by the force's spectrum at the orbit's harmonics (:func:`coloured_averages`)."""
     x = np.asarray(well.check_energy("xi", xi), float)
     if (x <= 0).any():
         raise ValueError("xi must be > 0 for the orbit averages (the angle is undefined at the well bottom)")
@@ -79,10 +82,49 @@ def orbit_averages(well: Well, xi: ArrayLike, n_theta: int = N_THETA) -> dict[st
     # d omega/dE by the same central difference (omega(E) is smooth inside the well)
     om_E = (np.asarray(well.omega(xs + h)) - np.asarray(well.omega(xs - h))) / (2.0 * h)
     J = np.asarray(well.J(xs), float)
+    if noise_time > 0:
+        out = {"J": J, "omega": om, **coloured_averages(q_th, q_J, om, om * om_E, noise_time)}
+        return {k: v.reshape(x.shape) for k, v in out.items()}
     p2 = (p * p).mean(axis=0)
     out = {"J": J, "omega": om, "m_JJ": p2 / om ** 2, "m_gg": (q_J * q_J).mean(axis=0),
            "m_gJ": -(q_J * q_th).mean(axis=0), "drift_J": 0.5 * (1.0 / om - p2 * om_E / om ** 2)}
     return {k: v.reshape(x.shape) for k, v in out.items()}
+
+
+def spectral_weights(k: ArrayLike, omega: ArrayLike, noise_time: float) -> FloatArray:
+    """``w_k = 1 / (1 + k^2 omega^2 tau^2)``: the Ornstein-Uhlenbeck force's spectrum at the
+    harmonic ``k omega`` over its zero-frequency value sigma^2 (1 for white noise, tau = 0)."""
+    kw = np.asarray(k, float) * np.asarray(omega, float) * noise_time
+    out: FloatArray = 1.0 / (1.0 + kw * kw)
+    return out
+
+
+def coloured_averages(q_th: FloatArray, q_J: FloatArray, omega: FloatArray, omega_J: FloatArray,
+                      noise_time: float) -> dict[str, FloatArray]:
+    """The noise coefficients per unit sigma^2 under an Ornstein-Uhlenbeck force of correlation
+    time ``noise_time`` (docs/noise-theory.md), from ``q_theta``, ``q_J`` on uniform angles (axis 0)
+    and ``omega``, ``omega_J = domega/dJ`` per orbit.  With ``c_k``, ``d_k`` the Fourier coefficients
+    of ``q_theta``, ``q_J`` and ``w_k`` the spectral weights: ``m_JJ = sum |c_k|^2 w_k``, ``m_gg =
+    sum |d_k|^2 w_k - omega_J tau Re sum conj(c_k) d_k / (1 - i k omega tau)^2`` (the second term:
+    an action kick shears the phase by omega_J times the lag within a correlation time) and
+    ``drift_J = (1/2) dm_JJ/dJ`` (``d c_k/dJ = i k d_k``; ``w_k`` depends on J through omega).
+    ``m_gJ`` (the J-phase covariance rate) and ``kappa`` (the antisymmetric part of the averaged
+    matrix, whose J-derivative is a phase drift) are what the solver leaves out (diagnostics, O(tau);
+    0 at tau = 0 for a symmetric well)."""
+    n = q_th.shape[0]
+    c = np.fft.fft(q_th, axis=0) / n
+    d = np.fft.fft(q_J, axis=0) / n
+    k = np.fft.fftfreq(n, 1.0 / n)[:, None]
+    w = spectral_weights(k, omega[None, :], noise_time)
+    c2 = (c * c.conj()).real
+    dc2 = 2.0 * (c.conj() * 1j * k * d).real
+    dw = -2.0 * k * k * omega * omega_J * noise_time ** 2 * w * w
+    one = 1.0 / (1.0 - 1j * k * omega * noise_time)             # int_0^inf R(s) e^{i k omega s} ds / sigma^2, x2
+    m_gJ = (-(c.conj() * d + d.conj() * c) * 0.5 * one + 0.5 * omega_J * noise_time * c2 * one * one).real.sum(axis=0)
+    kappa = (0.25 * (c.conj() * d - d.conj() * c) * one + 0.25 * omega_J * noise_time * c2 * one * one).real.sum(0)
+    shear = -omega_J * noise_time * (c.conj() * d * one * one).real.sum(axis=0)
+    return {"m_JJ": (c2 * w).sum(axis=0), "m_gg": ((d * d.conj()).real * w).sum(axis=0) + shear, "m_gJ": m_gJ,
+            "drift_J": 0.5 * (dc2 * w + c2 * dw).sum(axis=0), "kappa": kappa}
 
 
 @dataclass(frozen=True)
@@ -131,19 +173,21 @@ def table_evaluations(well: Well, n: int = N_NODES, n_theta: int = N_THETA) -> i
     return 3 * n * n_theta * per
 
 
-#: well -> its tables by (xi_max, n, n_theta); a well's entry goes with the well
-_TABLES: weakref.WeakKeyDictionary[Well, OrderedDict[tuple[float, int, int], AveragedDiffusion]] = \
+#: well -> its tables by (xi_max, n, n_theta, noise_time); a well's entry goes with the well
+_TABLES: weakref.WeakKeyDictionary[Well, OrderedDict[tuple[float, int, int, float], AveragedDiffusion]] = \
     weakref.WeakKeyDictionary()
 
 
-def averaged_diffusion(well: Well, xi_max: float, n: int = N_NODES, n_theta: int = N_THETA) -> AveragedDiffusion:
+def averaged_diffusion(well: Well, xi_max: float, n: int = N_NODES, n_theta: int = N_THETA,
+                       noise_time: float = 0.0) -> AveragedDiffusion:
     """:class:`AveragedDiffusion` of a symmetric ``well`` up to the energy ``xi_max`` (< its barrier
     energy), on ``n`` nodes uniform in J (node 0: the well bottom, where ``a_t = a_r = 1/(2
     omega(0))``).  A well whose first harmonic has a phase (an asymmetric well: J-gamma
-    covariance and a sheared frame) is refused, naming ``well``.  Computed once per well and
-    ``(xi_max, n, n_theta)`` and then returned again (the same read-only tables; an unhashable
-    well's are computed at every call)."""
-    key = (float(xi_max), int(n), int(n_theta))
+    covariance and a sheared frame) is refused, naming ``well``.  ``noise_time``: tau of an
+    Ornstein-Uhlenbeck force (0: white noise), whose spectral weights enter ``a_r`` and ``a_t``.
+    Computed once per well and ``(xi_max, n, n_theta, noise_time)`` and then returned again (the
+    same read-only tables; an unhashable well's are computed at every call)."""
+    key = (float(xi_max), int(n), int(n_theta), float(noise_time))
     if type(well).__hash__ is None:
         return _tables(well, *key)
     kept = _TABLES.setdefault(well, OrderedDict())
@@ -157,22 +201,28 @@ def averaged_diffusion(well: Well, xi_max: float, n: int = N_NODES, n_theta: int
     return out
 
 
-def _tables(well: Well, xi_max: float, n: int, n_theta: int) -> AveragedDiffusion:
+def _tables(well: Well, xi_max: float, n: int, n_theta: int, noise_time: float) -> AveragedDiffusion:
     """The tables of :func:`averaged_diffusion`, computed (read-only arrays)."""
     xi_nodes = _xi_nodes(well, xi_max, n)
     # a numeric well's phase is rounding (1e-16) where it is symmetric; an asymmetric well's is O(sqrt(xi))
     if np.any(np.abs(np.asarray(well.harmonic_shift(xi_nodes[1:]))) > SHIFT_TOL):
         raise ValueError(f"well: the averaged noise theory covers symmetric wells (q(theta) odd, no phase of the "
                          f"first harmonic); the {well.name} well has one")
-    av = orbit_averages(well, xi_nodes[1:], n_theta)
+    av = orbit_averages(well, xi_nodes[1:], n_theta, noise_time)
     J = np.concatenate([[0.0], av["J"]])
     om = np.asarray(well.omega(xi_nodes), float)
     a_t = np.concatenate([[np.nan], 2.0 * av["J"] * av["m_gg"]])
     a_t[0] = 0.5 / om[0]
+    a_r = 0.5 / om
+    if noise_time > 0:
+        # the spectrum at the orbit's harmonics; at the bottom the linear oscillator's one harmonic
+        a_r = np.concatenate([[0.5 / om[0]], 0.5 * av["m_JJ"] / av["J"]])
+        a_r[0] *= spectral_weights(1, om[0], noise_time)
+        a_t[0] = a_r[0]
     a = np.empty_like(J)
     a[1:] = np.asarray(well.harmonic_amplitude(xi_nodes[1:]), float) / np.sqrt(2.0 * J[1:])
     a[0] = a[1] + (a[1] - a[2]) * J[1] / (J[2] - J[1])      # extrapolated in J (a is smooth there)
-    tables = {"J_nodes": J, "H": xi_nodes, "omega": om, "a": a, "a_r": 0.5 / om, "a_t": a_t}
+    tables = {"J_nodes": J, "H": xi_nodes, "omega": om, "a": a, "a_r": a_r, "a_t": a_t}
     for v in tables.values():
         v.flags.writeable = False       # shared by every later call: no caller may change them
     return AveragedDiffusion(**tables)

@@ -47,11 +47,17 @@ IC_STEP_EVALUATIONS = 0.2
 MODEL_TEXT = ("averaged diffusion of the slow flow (gamma, J) under dp = ... + sigma dW: drift dC/dJ, -dC/dgamma - "
               "beta J plus the noise-induced (sigma^2/2) d(J/omega)/dJ; diffusion sigma^2 J/omega (action), sigma^2 "
               "<q_J^2> (phase), no J-gamma covariance (symmetric well); docs/noise-theory.md")
+COLOURED_MODEL_TEXT = ("averaged diffusion of the slow flow (gamma, J) under an Ornstein-Uhlenbeck force of "
+                       "correlation time tau (noise_time) and intensity sigma^2: drift dC/dJ, -dC/dgamma - beta J "
+                       "plus the noise-induced (sigma^2/2) dm_JJ/dJ; diffusion sigma^2 m_JJ (action), sigma^2 m_gg "
+                       "(phase), the orbit's harmonics k weighted by 1/(1 + k^2 omega^2 tau^2) (m_gg with the shear "
+                       "of the orbits over a correlation time); J-gamma covariance and phase drift of order tau left "
+                       "out; for tau short against the slow time; docs/noise-theory.md")
 
 
 def _setup(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_max: float, noise: float,
            damping: float, well: WellArg, grid: bool | None, cells: tuple[int, int], advection: str,
-           schemes: tuple[str, ...]
+           schemes: tuple[str, ...], noise_time: float
            ) -> tuple[Well, dict[str, float], tuple[bool, FloatArray, FloatArray, FloatArray, FloatArray], DiscGrid,
                       AveragedDiffusion]:
     """Checked arguments (ValueError naming the argument before anything runs)."""
@@ -61,7 +67,8 @@ def _setup(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_
            "Psi": checks.check_scalar("Psi", Psi, checks.check_finite),
            "xi_max": checks.check_scalar("xi_max", xi_max, w.check_analytic_threshold),
            "noise": checks.check_scalar("noise", noise, checks.check_nonnegative),
-           "damping": checks.check_damping(damping)}
+           "damping": checks.check_damping(damping),
+           "noise_time": checks.check_scalar("noise_time", noise_time, checks.check_nonnegative)}
     if par["noise"] == 0:
         raise ValueError("noise must be > 0 for the averaged diffusion; at noise 0 the theory is the deterministic "
                          "slow flow (theory.slow_flow_escapes)")
@@ -69,7 +76,7 @@ def _setup(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_
         raise ValueError(f"advection must be one of {schemes}, got {advection!r}")
     n_gamma, n_J = check_cells(cells)
     ics = checks.initial_conditions(q0, p0, grid)
-    diff = averaged_diffusion(w, par["xi_max"])
+    diff = averaged_diffusion(w, par["xi_max"], noise_time=par["noise_time"])
     return w, par, ics, DiscGrid(n_gamma, n_J, diff.J_max), diff
 
 
@@ -103,7 +110,8 @@ def _coords(is_grid: bool, qa: FloatArray, pa: FloatArray, Q: FloatArray, P: Flo
 
 
 def _attrs(par: dict[str, float], w: Well, grid: DiscGrid, advection: str) -> dict[str, object]:
-    return {**par, "noise_model": MODEL_TEXT, "theory": "averaged (stochastic slow flow)",
+    model = COLOURED_MODEL_TEXT if par["noise_time"] > 0 else MODEL_TEXT
+    return {**par, "noise_model": model, "theory": "averaged (stochastic slow flow)",
             "solver": (f"finite volumes on {grid.n_gamma} x {grid.n_J} cells uniform in (gamma, J) (equal-area polar "
                        f"grid of X + iY = sqrt(2J) e^(i gamma)), {advection} advection, absorbing at J(xi_max)"),
             "escape_criteria": f"averaged energy xi reaches xi_max = {par['xi_max']!r}", **w.numerics_attrs()}
@@ -113,14 +121,18 @@ def _attrs(par: dict[str, float], w: Well, grid: DiscGrid, advection: str) -> di
 def escape_probability(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_max: float, *,
                        noise: float, t_eval: ArrayLike, damping: float = 0.0, well: WellArg = None,
                        grid: bool | None = None, cells: tuple[int, int] = CELLS,
-                       steps_per_cycle: int = STEPS_PER_CYCLE, advection: str = "semi-lagrangian") -> xr.Dataset:
+                       steps_per_cycle: int = STEPS_PER_CYCLE, advection: str = "semi-lagrangian",
+                       noise_time: float = 0.0) -> xr.Dataset:
     """Probability of escape within each ``t_eval`` (forcing cycles) from the averaged theory.
 
     ``q0, p0, grid``: initial conditions at tau = 0 as :func:`safebasins.numerics.escape_probability`
     reads them (1-D axes -> dims (q0, p0), paired -> sample); ``F, Omega, Psi, xi_max``: as
     :func:`~safebasins.theory.slow_flow_escapes`; ``noise``: sigma > 0 of ``dp = ... + sigma dW``;
-    ``damping``: beta >= 0; ``well``: a symmetric well (default the quartic).  ``cells``: the
-    polar grid ``(n_gamma, n_J)``; ``steps_per_cycle``: time steps per forcing cycle;
+    ``noise_time``: tau >= 0, an Ornstein-Uhlenbeck force of correlation time tau and intensity
+    sigma^2 instead (its spectrum at the orbit's harmonics weights the diffusion; valid for tau short
+    against the slow time, docs/noise-theory.md); ``damping``: beta >= 0; ``well``: a symmetric
+    well (default the quartic).  ``cells``: the polar grid ``(n_gamma, n_J)``; ``steps_per_cycle``:
+    time steps per forcing cycle;
     ``advection``: "semi-lagrangian" (default: exact characteristics of the slow flow, quasi-monotone
     bicubic interpolation, Strang-split implicit diffusion; values in [0, 1] at any noise), or the
     finite volumes' BDF2 march with "central" (second order; oscillates where the cell Peclet
@@ -132,7 +144,7 @@ def escape_probability(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi
     numerics' names and horizon); attributes: the parameters, the model and the solver.
     """
     w, par, (is_grid, qa, pa, Q, P), dgrid, diff = _setup(q0, p0, F, Omega, Psi, xi_max, noise, damping, well,
-                                                          grid, cells, advection, SCHEMES)
+                                                          grid, cells, advection, SCHEMES, noise_time)
     te = checks.check_1d("t_eval", t_eval, checks.check_nonnegative)
     spc = checks.check_positive_int("steps_per_cycle", steps_per_cycle)
     cycles = theory_cycles(te)
@@ -169,14 +181,15 @@ def escape_probability(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi
 @api_provenance
 def mean_first_passage(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_max: float, *,
                        noise: float, damping: float = 0.0, well: WellArg = None, grid: bool | None = None,
-                       cells: tuple[int, int] = CELLS, advection: str = "central") -> xr.Dataset:
+                       cells: tuple[int, int] = CELLS, advection: str = "central", noise_time: float = 0.0
+                       ) -> xr.Dataset:
     """Mean first-passage time to ``xi_max`` (forcing cycles) of the averaged theory, from the
     stationary backward equation ``L T = -1`` on the finite volumes (``advection`` "central" or
     "upwind"; a central solution with negative times, unresolved cell Peclet numbers, raises an
     error naming ``cells``); other arguments as :func:`escape_probability`.  Returns a Dataset with
     ``mean_first_passage`` (ic dims; 0 for ICs at or beyond xi_max)."""
     w, par, (is_grid, qa, pa, Q, P), dgrid, diff = _setup(q0, p0, F, Omega, Psi, xi_max, noise, damping, well,
-                                                          grid, cells, advection, ADVECTION)
+                                                          grid, cells, advection, ADVECTION, noise_time)
     inside, gamma, J = _slow_points(w, Q, P, par["Psi"], par["xi_max"])
     M, _ = generator(dgrid, diff, par["F"], par["Omega"], par["damping"], par["noise"], advection)
     W, _ = interpolation(dgrid, gamma, J)

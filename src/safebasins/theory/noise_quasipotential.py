@@ -298,15 +298,17 @@ def attractor_barriers(to_circle: FloatArray, to_saddle: FloatArray, saddle_targ
 
 
 def quasi_potential(F: float, Omega: float, xi_max: float, *, damping: float, well: WellArg = None,
-                    n_rays: int = N_RAYS, step: float = STEP) -> QuasiPotential:
+                    n_rays: int = N_RAYS, step: float = STEP, noise_time: float = 0.0) -> QuasiPotential:
     """Quasi-potential barriers of the averaged noisy slow flow (weak-noise limit).
 
     ``F, Omega, xi_max``: as :func:`~safebasins.theory.escape_probability`; ``damping``: beta > 0
     (the damped slow flow's attractors: the resonant and the non-resonant response, or the well
     bottom at F = 0); ``well``: a symmetric well (default the quartic); ``n_rays``: rays of the
     first pass per attractor (>= 16); ``step``: the RK4 step times the flow's largest rate
-    (<= 0.5).  Returns a :class:`QuasiPotential`: for each attractor inside the escape circle its
-    barrier Delta Phi, with ``T ~ C exp(Delta Phi / sigma^2)`` (C absorbs the time unit) and
+    (<= 0.5); ``noise_time``: tau of an Ornstein-Uhlenbeck force (0: white noise; the same tables as
+    the backward equation's, :func:`~safebasins.theory.noise_averaging.averaged_diffusion`).
+    Returns a :class:`QuasiPotential`: for each attractor inside the escape circle its barrier
+    Delta Phi, with ``T ~ C exp(Delta Phi / sigma^2)`` (C absorbs the time unit) and
     ``P_escape(t) ~ 1 - exp(-t / T)`` once t exceeds the relaxation to the attractor.  At F = 0
     the barrier is ``2 beta xi_max`` (docs/noise-theory.md)."""
     w = resolve_well(well)
@@ -320,7 +322,8 @@ def quasi_potential(F: float, Omega: float, xi_max: float, *, damping: float, we
     h = checks.check_scalar("step", step, checks.check_positive)
     if h > 0.5:
         raise ValueError(f"step must be <= 0.5 (RK4 step times the flow's largest rate), got {step!r}")
-    diff = averaged_diffusion(w, xm)
+    tau = checks.check_scalar("noise_time", noise_time, checks.check_nonnegative)
+    diff = averaged_diffusion(w, xm, noise_time=tau)
     fp = fixed_points(np.array([f]), np.array([Om]), beta, w, xm)
     stable = fp.attracting[0] & (fp.xi[0] < xm)
     saddle = (fp.kind[0] == SADDLE) & (fp.xi[0] < xm)
