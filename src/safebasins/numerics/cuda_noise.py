@@ -107,10 +107,11 @@ def _constant(value: bool) -> Any:
 
 
 @functools.cache
-def noise_kernel(well_key: int, scheme_key: int, law: int = noise_kernels.GAUSSIAN) -> Any:
+def noise_kernel(well_key: int, scheme_key: int, law: int = noise_kernels.GAUSSIAN, coloured: bool = True) -> Any:
     """The compiled kernel of the noisy ensemble for a compiled well and scheme (their keys:
-    wells.compiled.WellCode.key, scheme_code.SchemeCode.key) and a law of the variates
-    (noise_kernels.GAUSSIAN, FIVE_POINT); cached per triple.
+    wells.compiled.WellCode.key, scheme_code.SchemeCode.key), a law of the variates
+    (noise_kernels.GAUSSIAN, FIVE_POINT) and white or coloured noise (white: no eta is carried or
+    added, as on the CPU lanes); cached per combination.
 
     Launch: kernel[grid, block](q0, p0, n_paths, coef, FS, SW, total, thrE2, lo, hi, amp, shift, c1,
     c2, s_eta, k0, k1, i0, m0, wpar, counter, out): q0, p0 (n_ic,) float64; coef (NC,) the scheme's
@@ -176,10 +177,13 @@ def noise_kernel(well_key: int, scheme_key: int, law: int = noise_kernels.GAUSSI
                     if r == 0:
                         words = block(k0, k1, cyc * H + s // BS, m, i)
                     z1, z2 = five2(words[r // 4], r)
-                eta = fma(c2, z1, mul(c1, e))
-                q, p = step(w, q, fma(amp, z1, p), c, plus(flat_row(FS, o), eta))
+                if coloured:
+                    eta = fma(c2, z1, mul(c1, e))
+                    q, p = step(w, q, fma(amp, z1, p), c, plus(flat_row(FS, o), eta))
+                    e = fma(c2, z2, mul(c1, eta))
+                else:
+                    q, p = step(w, q, fma(amp, z1, p), c, flat_row(FS, o))
                 p = fma(amp, z2, p)
-                e = fma(c2, z2, mul(c1, eta))
                 en = fma(shift, abs(p), energy_w(w, q, p))
                 while nx < K and beyond(0, wpar, q, en, thrE2[nx], lo, hi):
                     out[j * K + nx] = n + 1
@@ -223,7 +227,7 @@ def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
     if N:
         blk = (checks.check_positive_int("block", block) if block is not None else
                (SIMULATOR_BLOCK if cuda_kernels.SIMULATOR else cuda_kernels.BLOCK))
-        kernel = noise_kernel(code.key, scheme.key, noise.law)
+        kernel = noise_kernel(code.key, scheme.key, noise.law, noise.coloured)
         nblk = (checks.check_positive_int("grid", grid) if grid is not None else
                 SIMULATOR_GRID if cuda_kernels.SIMULATOR else cuda_engine.launch_grid(kernel, N, blk, 0))
         wp = code.wpar if wpar is None else np.ascontiguousarray(wpar, dtype=float)

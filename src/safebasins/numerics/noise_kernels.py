@@ -35,8 +35,9 @@ b = n ceil(S/16) + floor(s/16), byte r = s mod 16 of its words (w_0, w_1, w_2, w
 t < 4, +2 for t = 4, -2 for t = 5, 0 otherwise).  eta(0) stays Gaussian under either law (one
 draw: its law is the stationary one, not an approximation that vanishes with h).
 
-The kernels are specialised on four numba literals: the well's and the scheme's keys (as the
-engine's, kernels.py), the law of the variates and :data:`RNG_KEY`, a hash of the files inlined from outside the
+The kernels are specialised on five numba literals: the well's and the scheme's keys (as the
+engine's, kernels.py), the law of the variates, whether the noise is coloured (white noise
+carries no eta: nothing is added to the forcing) and :data:`RNG_KEY`, a hash of the files inlined from outside the
 engine's fingerprint (this module, numerics/philox.py, wells.elementary), so a kernel cached
 on disk is never reused after an edit of any of them.
 """
@@ -238,9 +239,9 @@ def _beyond(well: Any, wpar: Any, q: Any, e: Any, thrE2: Any, lo: Any, hi: Any) 
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: Any, n_tasks: Any, lanes: Any,
-                 q0: Any, p0: Any, n_paths: Any, coef: Any, FS: Any, thrE2: Any, lo: Any, hi: Any, cycles: Any,
-                 amp: Any, shift: Any, c1: Any, c2: Any, s_eta: Any, k0: Any, k1: Any, i0: Any, m0: Any,
+def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, coloured: Any, wpar: Any, task: Any, n_tasks: Any,
+                 lanes: Any, q0: Any, p0: Any, n_paths: Any, coef: Any, FS: Any, thrE2: Any, lo: Any, hi: Any,
+                 cycles: Any, amp: Any, shift: Any, c1: Any, c2: Any, s_eta: Any, k0: Any, k1: Any, i0: Any, m0: Any,
                  out: Any) -> None:
     """Trajectories j = task, task + n_tasks, ... (path j % n_paths of initial condition
     j // n_paths): out[j * K + k] = the step after which it is first beyond the energy threshold
@@ -340,12 +341,15 @@ def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: An
             for l in range(nact):
                 z1 = Z1[l]
                 z2 = Z2[l]
-                eta = fma(c2, z1, mul(c1, E[l]))
-                q, p = step(scheme, well, w, Q[l], fma(amp, z1, P[l]), c, _plus(f, eta))
+                if coloured:
+                    eta = fma(c2, z1, mul(c1, E[l]))
+                    q, p = step(scheme, well, w, Q[l], fma(amp, z1, P[l]), c, _plus(f, eta))
+                    E[l] = fma(c2, z2, mul(c1, eta))
+                else:                    # white noise: no eta to carry or add
+                    q, p = step(scheme, well, w, Q[l], fma(amp, z1, P[l]), c, f)
                 p = fma(amp, z2, p)
                 Q[l] = q
                 P[l] = p
-                E[l] = fma(c2, z2, mul(c1, eta))
             for l in range(nact):
                 q = Q[l]
                 p = P[l]
@@ -365,9 +369,9 @@ def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: An
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
-def _final_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: Any, n_tasks: Any, q0: Any, p0: Any,
-                n_paths: Any, coef: Any, FS: Any, n_steps: Any, amp: Any, c1: Any, c2: Any, s_eta: Any, k0: Any,
-                k1: Any, i0: Any, m0: Any, qo: Any, po: Any, eo: Any) -> None:
+def _final_task(well: Any, scheme: Any, rng: Any, law: Any, coloured: Any, wpar: Any, task: Any, n_tasks: Any, q0: Any,
+                p0: Any, n_paths: Any, coef: Any, FS: Any, n_steps: Any, amp: Any, c1: Any, c2: Any, s_eta: Any,
+                k0: Any, k1: Any, i0: Any, m0: Any, qo: Any, po: Any, eo: Any) -> None:
     """Plain integration (no escape) of trajectories j = task, task + n_tasks, ... for n_steps
     steps; the same step as _escape_task."""
     S = FS.shape[0]
@@ -393,10 +397,13 @@ def _final_task(well: Any, scheme: Any, rng: Any, law: Any, wpar: Any, task: Any
                     words = _block(k0, k1, (n // S) * H + s // BLOCK_STEPS, m, i)
                 z1, z2 = _five2(words[r // 4], r)
             f = row(scheme, FS, s)
-            e = fma(c2, z1, mul(c1, e))
-            q, p = step(scheme, well, w, q, fma(amp, z1, p), c, _plus(f, e))
+            if coloured:
+                e = fma(c2, z1, mul(c1, e))
+                q, p = step(scheme, well, w, q, fma(amp, z1, p), c, _plus(f, e))
+                e = fma(c2, z2, mul(c1, e))
+            else:
+                q, p = step(scheme, well, w, q, fma(amp, z1, p), c, f)
             p = fma(amp, z2, p)
-            e = fma(c2, z2, mul(c1, e))
         qo[j] = q
         po[j] = p
         eo[j] = e
@@ -414,6 +421,11 @@ class StepNoise:
     c2: float = 0.0
     s_eta: float = 0.0
     law: int = GAUSSIAN
+
+    @property
+    def coloured(self) -> bool:
+        """Whether the step carries an Ornstein-Uhlenbeck force (else eta = 0 and is not computed)."""
+        return bool(self.c1 != 0.0 or self.c2 != 0.0 or self.s_eta != 0.0)
 
 
 def step_noise(sigma: float, h: float, noise_time: float = 0.0, law: int = GAUSSIAN) -> StepNoise:
@@ -491,12 +503,13 @@ def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
     thr = threshold_array(thrE2)
     out = np.full(q.size * int(n_paths) * thr.size, -1, np.int64)
     wp = code.wpar if wpar is None else np.ascontiguousarray(wpar, dtype=float)
-    args = [code.key, scheme.key, RNG_KEY, int(noise.law), wp, 0, int(n_tasks), int(lanes), q, p, int(n_paths),
+    args = [code.key, scheme.key, RNG_KEY, int(noise.law), noise.coloured, wp, 0, int(n_tasks), int(lanes), q, p,
+            int(n_paths),
             np.ascontiguousarray(coef), FS, thr, float(bounds[0]), float(bounds[1]), int(cycles),
             float(noise.amp), float(shift), float(noise.c1), float(noise.c2), float(noise.s_eta), k0, k1,
             int(ic_offset), int(path_offset), out]
-    entry = specialised(_escape_task, args, n_literal=4)
-    run_tasks(lambda task: entry(*args[:5], task, *args[6:]), int(n_tasks))
+    entry = specialised(_escape_task, args, n_literal=5)
+    run_tasks(lambda task: entry(*args[:6], task, *args[7:]), int(n_tasks))
     return out.reshape(q.size, int(n_paths)) if np.ndim(thrE2) == 0 else out.reshape(q.size, int(n_paths), thr.size)
 
 
@@ -511,11 +524,12 @@ def final_states(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
     qo = np.empty(q.size * int(n_paths))
     po = np.empty_like(qo)
     eo = np.empty_like(qo)
-    args = [code.key, scheme.key, RNG_KEY, int(noise.law), code.wpar, 0, int(n_tasks), q, p, int(n_paths),
+    args = [code.key, scheme.key, RNG_KEY, int(noise.law), noise.coloured, code.wpar, 0, int(n_tasks), q, p,
+            int(n_paths),
             np.ascontiguousarray(coef),
             FS, int(n_steps), float(noise.amp), float(noise.c1), float(noise.c2), float(noise.s_eta), k0, k1,
             int(ic_offset), int(path_offset), qo, po, eo]
-    entry = specialised(_final_task, args, n_literal=4)
-    run_tasks(lambda task: entry(*args[:5], task, *args[6:]), int(n_tasks))
+    entry = specialised(_final_task, args, n_literal=5)
+    run_tasks(lambda task: entry(*args[:6], task, *args[7:]), int(n_tasks))
     shape = (q.size, int(n_paths))
     return qo.reshape(shape), po.reshape(shape), eo.reshape(shape)
