@@ -18,11 +18,13 @@ i.e. the action diffusion ``sigma^2 J/omega``, the noise-induced action drift
 
 ``q_J = omega dq/dE`` at fixed theta is taken by central differences of the well's
 ``phase_point`` (any well with action-angle variables), and the averages by the trapezoidal rule
-over theta (spectrally accurate for the periodic integrand).
+over theta (spectrally accurate for the periodic integrand).  Under an Ornstein-Uhlenbeck force of
+correlation time tau (``noise_time``) each harmonic k of ``q_theta`` and ``q_J`` is weighted by the
+force's spectrum at ``k omega`` (:func:`coloured_averages`, by FFT over the same angles).
 
 None of these tables depends on sigma, F, Omega or the damping (the noise enters the solvers as
 the factor sigma^2 of the diffusion): :func:`averaged_diffusion` computes them once per well and
-``(xi_max, n, n_theta)`` and keeps them (read-only) for the well's lifetime, so a sweep over noise
+``(xi_max, n, n_theta, noise_time)`` and keeps them (read-only) for the well's lifetime, so a sweep over noise
 levels or forcings shares one set, bit for bit the first call's.
 """
 from __future__ import annotations
