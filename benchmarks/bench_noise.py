@@ -5,7 +5,8 @@ Euler-Maruyama, in one process (docs/noise.md).
     python benchmarks/bench_noise.py --full     # 16384 paths x 400 cycles
     python benchmarks/bench_noise.py --gpu      # the CUDA backend only (skipped without a CUDA GPU)
 
-Trajectory-steps per second on one thread, five interleaved rounds (the best of each is kept), for the quartic
+Trajectory-steps per CPU second on one thread, 15 interleaved rounds (the rates: the best round of
+each; the ratios: the median of the ratios formed within each round, with quartiles), for the quartic
 at F = 0.02, Omega = 0.8, ICs near the bottom of the well (nothing escapes: every trajectory runs
 the whole horizon, so steps are counted exactly):
 
@@ -78,16 +79,30 @@ def euler_maruyama(q0, p0, F, Omega, h, sigma, xi2, n_steps, seed):
     return out
 
 
-def best(fns, rounds=5):
-    """The best time of each function over interleaved rounds (a load change on the shared
-    machine then hits every function alike)."""
-    times = [[] for _ in fns]
-    for _ in range(rounds):
+def rounds_of(fns, rounds=15):
+    """CPU times of this process (rounds, len(fns)) of each function, interleaved round by round
+    (every function runs on one thread: CPU time, unlike the wall clock, does not count the time
+    another process holds the core; the functions of one round run back to back, so a ratio formed
+    within a round sees one load)."""
+    times = np.zeros((rounds, len(fns)))
+    for r in range(rounds):
         for k, fn in enumerate(fns):
-            t = time.perf_counter()
+            t = time.process_time()
             fn()
-            times[k].append(time.perf_counter() - t)
-    return [min(t) for t in times]
+            times[r, k] = time.process_time() - t
+    return times
+
+
+def best(fns, rounds=5):
+    """The best CPU time of each function over interleaved rounds."""
+    return list(rounds_of(fns, rounds).min(axis=0))
+
+
+def paired_ratio(times, k, base=0):
+    """Median and quartiles over the rounds of time[base] / time[k] (function k's speed relative to
+    the base's, formed within each round)."""
+    r = times[:, base] / times[:, k]
+    return np.median(r), np.percentile(r, 25), np.percentile(r, 75)
 
 
 # the equal-accuracy problem: q'' + beta q' + q = F sin(Omega t + Psi) + sigma dW/dt from (Q0, P0)
@@ -299,7 +314,9 @@ def main():
     def em():
         return euler_maruyama(q0, p0, F, OMEGA, h, SIGMA, 2 * XI, cycles * S, 7)
     assert (em() < 0).all(), "an Euler-Maruyama path escaped: steps not exact"
-    t_det, t_noise, t_five, t_em = best([deterministic, noisy, five, em])
+    times = rounds_of([deterministic, noisy, five, em])
+    t_det, t_noise, t_five, t_em = times.min(axis=0)
+    ratio_noise, ratio_five = paired_ratio(times, 1), paired_ratio(times, 2)
 
     r_det, r_noise, r_five, r_em = steps / t_det, steps / t_noise, steps / t_five, steps / t_em
     print(f"machine: {machine()}; one thread; {n} trajectories x {cycles} cycles x {S} steps")
@@ -307,13 +324,15 @@ def main():
     print(f"noisy ensemble (SRKN6b + Philox)   : {r_noise:.3e} trajectory-steps/s")
     print(f"  five-point variates              : {r_five:.3e} trajectory-steps/s")
     print(f"numba Euler-Maruyama (weak order 1): {r_em:.3e} trajectory-steps/s")
-    print(f"noisy / deterministic = {r_noise / r_det:.3f} (target >= 0.5); noisy / Euler-Maruyama = "
-          f"{r_noise / r_em:.3f} per step")
-    print(f"five-point / deterministic = {r_five / r_det:.3f} (target >= 0.5)")
-    report("noise_vs_deterministic", round(r_noise / r_det, 3), "noisy / deterministic trajectory-steps per second",
+    print(f"noisy / deterministic = {ratio_noise[0]:.3f} (quartiles {ratio_noise[1]:.3f}-{ratio_noise[2]:.3f} over "
+          f"{len(times)} rounds; target >= 0.5); noisy / Euler-Maruyama = {r_noise / r_em:.3f} per step")
+    print(f"five-point / deterministic = {ratio_five[0]:.3f} (quartiles {ratio_five[1]:.3f}-{ratio_five[2]:.3f}; "
+          f"target >= 0.5)")
+    report("noise_vs_deterministic", round(ratio_noise[0], 3),
+           "noisy / deterministic trajectory-steps per CPU second (median of paired rounds)",
            f"{n} x {cycles} cycles x {S} steps, one thread")
-    report("noise_five_point_vs_deterministic", round(r_five / r_det, 3),
-           "noisy (five-point variates) / deterministic trajectory-steps per second",
+    report("noise_five_point_vs_deterministic", round(ratio_five[0], 3),
+           "noisy (five-point variates) / deterministic trajectory-steps per CPU second (median of paired rounds)",
            f"{n} x {cycles} cycles x {S} steps, one thread")
     report("noise_vs_euler_maruyama_per_step", round(r_noise / r_em, 3),
            "noisy ensemble / numba Euler-Maruyama trajectory-steps per second (per step, not at equal accuracy)",
