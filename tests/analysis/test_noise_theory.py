@@ -70,7 +70,7 @@ def test_stacked_levels_are_the_single_levels() -> None:
 
 @pytest.mark.parametrize("kw, ens_kw, reason", [
     (dict(theory=False), {}, "theory: false"),
-    (dict(well="cubic", xi_max=0.12), dict(well="cubic", xi_max=0.12), "symmetric wells"),
+    (dict(xi_max=0.25), dict(xi_max=0.25), "below the barrier energy"),
 ])
 def test_no_theory_says_why(kw, ens_kw, reason) -> None:
     out = escape_probability_with_theory(ensemble(0.02, **ens_kw), *ARGS, **{"xi_max": 0.18, **kw}, **SOLVER)
@@ -97,7 +97,8 @@ def test_coloured_noise_is_the_theory_with_its_correlation_time() -> None:
 
 def test_reason_and_horizon() -> None:
     assert theory_reason(theory=True, noise=[0.01, 0.02], noise_time=0.0) is None
-    assert "noise 0" in theory_reason(theory=True, noise=[0.0, 0.02], noise_time=0.0)
+    assert theory_reason(theory=True, noise=[0.0, 0.02], noise_time=0.0) is None     # noise 0: the slow flow
+    assert "theory: false" in theory_reason(theory=False, noise=[0.02], noise_time=0.0)
     assert theory_cycles([1, 2.5]) == 3 and theory_cycles([0]) == 1
 
 
@@ -149,9 +150,10 @@ def test_theory_evaluations_count_the_tables_once_and_each_solve() -> None:
         table_evaluations(resolve_well("pendulum")) - table_evaluations(QUARTIC))
 
 
-@pytest.mark.parametrize("over", [dict(theory=False), dict(noise=[0.0, 0.01])], ids=["no-theory", "noise-0"])
-def test_theory_evaluations_zero_where_not_solved(over) -> None:
+def test_theory_evaluations_zero_where_not_solved() -> None:
     kw = dict(noise=[0.01, 0.02], t_eval=[1, 3], n_ics=20, solves=2, **SOLVER)
-    assert theory_evaluations(**{**kw, **over}) == 0 < theory_evaluations(**kw)
+    assert theory_evaluations(**{**kw, "theory": False}) == 0 < theory_evaluations(**kw)
+    # a noise level 0 is solved (the noise-free slow flow), counted as a solve: an upper bound
+    assert theory_evaluations(**{**kw, "noise": [0.0, 0.01]}) == theory_evaluations(**kw)
     # coloured noise: the same tables and solves as white noise
     assert theory_evaluations(**kw, noise_time=0.5) == theory_evaluations(**kw)

@@ -70,12 +70,12 @@ def test_single_values_and_no_theory(tmp_path):
     assert not (tmp_path / "er.png").exists()
 
 
-def test_zero_noise_level_has_no_theory(tmp_path):
+def test_zero_noise_level_has_the_noise_free_theory(tmp_path):
     res = invoke([*_without(BASE, "--noise"), "--noise", "0,0.02", "--no-plot"], tmp_path)
     assert res.exit_code == 0, res.output
     with xr.open_dataset(tmp_path / "er.nc") as ds:
-        assert ds.attrs["theory"] == "none" and "noise 0" in ds.attrs["theory_reason"]
-        assert ds["GIM"].sel(noise=0.0).notnull().all()
+        assert "theory_reason" not in ds.attrs
+        assert ds["GIM"].sel(noise=0.0).notnull().all() and ds["GIM_theory"].sel(noise=0.0).notnull().all()
 
 
 @pytest.mark.parametrize("args, option, reason", [

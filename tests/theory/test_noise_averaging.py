@@ -19,6 +19,7 @@ Independent routes:
 import numpy as np
 import pytest
 
+from safebasins.theory.damped import shift_derivative
 from safebasins.theory.noise_averaging import averaged_diffusion, orbit_averages
 from safebasins.wells import QUARTIC, resolve_well
 
@@ -71,37 +72,85 @@ def test_numeric_symmetric_well_accepted():
     assert d.a_t[0] == d.a_r[0] == pytest.approx(0.5, abs=1e-12) and np.all(d.a_t[1:] > d.a_r[1:])
 
 
-def test_asymmetric_well_refused():
-    with pytest.raises(ValueError, match="well"):
-        averaged_diffusion(resolve_well("cubic"), 0.1)
+def test_asymmetric_well_in_the_sheared_phase():
+    cub = resolve_well("cubic")
+    xi = np.array([1e-3, 0.02, 0.06, 0.1, 0.14])
+    g = orbit_averages(cub, xi)
+    s = orbit_averages(cub, xi, sheared=True)
+    # in the angle theta the J-phase covariance is of the size of the diffusions ...
+    assert np.all(np.abs(g["m_gJ"]) / np.sqrt(g["m_JJ"] * g["m_gg"]) > 0.02)
+    # ... in phi = theta + delta(J) it vanishes (time reversal about the turning point)
+    assert np.max(np.abs(s["m_gJ"]) / np.sqrt(s["m_JJ"] * s["m_gg"])) < 1e-6
+    # the sheared averages by the chain rule from theta's: dphi/dp = dtheta/dp + delta_J dJ/dp
+    dJ = shift_derivative(cub, xi) * cub.omega(xi)
+    assert np.allclose(s["m_gg"], g["m_gg"] + 2 * dJ * g["m_gJ"] + dJ ** 2 * g["m_JJ"], rtol=1e-6)
+    assert np.allclose(s["m_gJ"] + 1.0, 1.0 + g["m_gJ"] + dJ * g["m_JJ"], atol=1e-8)
+    for k in ("m_JJ", "drift_J"):
+        assert np.array_equal(s[k], g[k])
+    d = averaged_diffusion(cub, 0.12)
+    assert not d.symmetric and averaged_diffusion(QUARTIC, 0.12).symmetric
+    # isotropic at the bottom, smooth there: a_t -> a_r, d ~ sqrt(2J) (d_r finite), d = J ddelta/dJ
+    assert d.a_t[0] == d.a_r[0] and abs(d.a_t[1] - d.a_r[1]) < 1e-3 and np.all(np.isfinite(d.d_r))
+    Jq = np.array([0.02, 0.06, 0.1])
+    x = np.interp(Jq, d.J_nodes, d.H)
+    assert np.allclose(d.d(Jq), Jq * cub.omega(x) * shift_derivative(cub, x), rtol=1e-3)
+    assert np.allclose(d.m_gg(Jq), orbit_averages(cub, x, sheared=True)["m_gg"], rtol=1e-3)
+
+
+def _kicked(well, xi0, sigma, n_paths, steps, seed, periods=4):
+    """The unforced, undamped noisy well integrated exactly between noise kicks, from a uniform
+    phase on the orbit xi0: ``(T, J, martingale, dtheta, dphi)`` over ``periods`` periods, with
+    the kicks' phase jumps in theta and in the sheared phi = theta + delta(xi)."""
+    T = periods * 2 * np.pi / float(well.omega(xi0))
+    h = T / steps
+    a = sigma * np.sqrt(h / 2)
+    rng = np.random.default_rng(seed)
+    theta = rng.uniform(0, 2 * np.pi, n_paths)
+    xi = np.full(n_paths, xi0)
+    dtheta_kick = np.zeros(n_paths)
+    dphi_kick = np.zeros(n_paths)
+    martingale = np.zeros(n_paths)        # sum of (dJ/dp) a Z = (p/omega) a Z: mean 0, removes the noise of dJ
+
+    def kick(theta, xi):
+        q, p = well.phase_point(theta, xi)
+        dp = a * rng.standard_normal(n_paths)
+        th1, xi1 = well.angle_energy(q, p + dp)
+        jump = np.angle(np.exp(1j * (th1 - theta)))
+        return th1, xi1, jump, jump + well.harmonic_shift(xi1) - well.harmonic_shift(xi), p / well.omega(xi) * dp
+
+    for _ in range(steps):
+        theta, xi, d1, s1, m1 = kick(theta, xi)
+        theta = theta + well.omega(xi) * h
+        theta, xi, d2, s2, m2 = kick(theta, xi)
+        dtheta_kick += d1 + d2
+        dphi_kick += s1 + s2
+        martingale += m1 + m2
+    return T, well.J(xi) - well.J(xi0), martingale, dtheta_kick, dphi_kick
+
+
+def test_asymmetric_coefficients_against_the_noisy_dynamics():
+    # the escape equation's well: in theta the J-phase covariance is sigma^2 m_gJ (nonzero), in the
+    # sheared phi it vanishes, and phi's diffusion is the sheared m_gg
+    cub = resolve_well("cubic")
+    xi0, sigma, n = 0.08, 0.01, 10000
+    T, dJ, _, dth, dphi = _kicked(cub, xi0, sigma, n, 16, 11)
+    g = orbit_averages(cub, np.array([xi0]))
+    s = orbit_averages(cub, np.array([xi0]), sheared=True)
+    cov = lambda x, y: np.mean((x - x.mean()) * (y - y.mean()))
+    se_cov = lambda x, y: np.sqrt(x.var() * y.var() / n)
+    # over 12 seeds (mean +- sd of one seed): action variance 1.014 +- 0.018, theta covariance
+    # 1.036 +- 0.042, phi variance 1.018 +- 0.016 of the averages, the phi covariance -0.1 +- 1.2 of its
+    # standard error; the bounds are about 5 sd of one seed
+    assert abs(dJ.var() / (sigma ** 2 * g["m_JJ"][0] * T) - 1) < 0.1
+    assert abs(cov(dJ, dth) / (sigma ** 2 * g["m_gJ"][0] * T) - 1) < 0.2
+    assert abs(cov(dJ, dth)) > 10 * se_cov(dJ, dth)
+    assert abs(dphi.var() / (sigma ** 2 * s["m_gg"][0] * T) - 1) < 0.1
+    assert abs(cov(dJ, dphi)) < 3 * se_cov(dJ, dphi)
 
 
 def test_coefficients_against_the_noisy_dynamics():
     xi0, sigma, n_paths = 0.1, 0.01, 10000
-    om0 = float(QUARTIC.omega(xi0))
-    T = 4 * 2 * np.pi / om0
-    steps = 64
-    h = T / steps
-    a = sigma * np.sqrt(h / 2)
-    rng = np.random.default_rng(7)
-    theta = rng.uniform(0, 2 * np.pi, n_paths)
-    xi = np.full(n_paths, xi0)
-    dtheta_kick = np.zeros(n_paths)
-    martingale = np.zeros(n_paths)        # sum of (dJ/dp) a Z = (p/omega) a Z: mean 0, removes the noise of dJ
-
-    def kick(theta, xi):
-        q, p = QUARTIC.phase_point(theta, xi)
-        dp = a * rng.standard_normal(n_paths)
-        th1, xi1 = QUARTIC.angle_energy(q, p + dp)
-        return th1, xi1, np.angle(np.exp(1j * (th1 - theta))), p / QUARTIC.omega(xi) * dp
-
-    for _ in range(steps):
-        theta, xi, d1, m1 = kick(theta, xi)
-        theta = theta + QUARTIC.omega(xi) * h
-        theta, xi, d2, m2 = kick(theta, xi)
-        dtheta_kick += d1 + d2
-        martingale += m1 + m2
-    dJ = QUARTIC.J(xi) - QUARTIC.J(xi0)
+    T, dJ, martingale, dtheta_kick, _ = _kicked(QUARTIC, xi0, sigma, n_paths, 64, 7)
     av = orbit_averages(QUARTIC, np.array([xi0]))
     se = lambda x: x.std(ddof=1) / np.sqrt(n_paths)
     drift = dJ - martingale

@@ -128,7 +128,7 @@ def test_semi_lagrangian_against_central_and_in_range():
         theory.mean_first_passage(q0, p0, 0.03, 0.9, np.pi, 0.18, noise=0.0025, cells=(64, 80))
 
 
-@pytest.mark.parametrize("kw, name", [({"noise": 0.0}, "noise"), ({"noise": -1.0}, "noise"),
+@pytest.mark.parametrize("kw, name", [({"noise": -1.0}, "noise"),
                                       ({"t_eval": [-1.0]}, "t_eval"), ({"cells": (4, 40)}, "cells"),
                                       ({"advection": "quick"}, "advection"), ({"damping": -0.1}, "damping"),
                                       ({"steps_per_cycle": 0}, "steps_per_cycle")])
@@ -136,6 +136,41 @@ def test_bad_input_named(kw, name):
     args = {"noise": 0.01, "t_eval": [1.0]} | kw
     with pytest.raises(ValueError, match=name):
         theory.escape_probability([0.1], [0.1], 0.01, 0.9, 0.0, 0.18, **args)
+
+
+def test_mean_first_passage_needs_noise():
+    with pytest.raises(ValueError, match="noise must be > 0"):
+        theory.mean_first_passage([0.1], [0.1], 0.01, 0.9, 0.0, 0.18, noise=0.0)
+
+
+@pytest.mark.parametrize("well, F, xi_max, beta, window", [
+    ("quartic", 0.01, 0.18, 0.0, (0.95, 0.75)),
+    ("cubic", 0.005, 0.12, 0.0, (0.46, 0.52)),
+    ("cubic", 0.005, 0.12, 0.05, (0.46, 0.52)),       # the sheared frame's damping drift -beta d
+])
+def test_noise_free_limit_is_the_slow_flow(well, F, xi_max, beta, window):
+    # noise 0: each IC's slow trajectory; at a long horizon its escape is the slow flow's own
+    # classification (level curves of C, or the damped flow's attractors: an independent route)
+    q = np.linspace(-window[0], 1.5 * window[0] if well == "cubic" else window[0], 25)
+    p = np.linspace(-window[1], window[1], 21)
+    ds = theory.escape_probability(q, p, F, 0.9, np.pi, xi_max, noise=0.0, t_eval=[5, 300], well=well,
+                                   damping=beta, cells=(16, 20), steps_per_cycle=4)
+    P = ds["P_escape"].values
+    assert set(np.unique(P)) <= {0.0, 1.0} and (P[..., 0] <= P[..., 1]).all()
+    det = theory.slow_flow_escapes(q[:, None], p[None, :], F, 0.9, np.pi, xi_max, well=well, damping=beta)
+    assert 0 < det.mean() < 1 and np.array_equal(P[..., 1].astype(bool), det)
+    fp = ds["first_passage_mean"].values
+    assert np.all(fp[P[..., 1] == 0] == 300) and np.all(fp[P[..., 1] == 1] <= 300)
+
+
+def test_small_noise_tends_to_the_noise_free_limit():
+    q, p = np.linspace(-0.95, 0.95, 21), np.linspace(-0.75, 0.75, 17)
+    kw = dict(t_eval=[20], cells=(64, 80))
+    P0 = theory.escape_probability(q, p, 0.01, 0.9, np.pi, 0.18, noise=0.0, **kw)["P_escape"].values
+    d = [np.abs(theory.escape_probability(q, p, 0.01, 0.9, np.pi, 0.18, noise=s, **kw)["P_escape"].values - P0).mean()
+         for s in (0.004, 0.002, 0.001)]
+    print(d)
+    assert d[0] > d[1] > d[2]
 
 
 def test_bad_threshold_named():

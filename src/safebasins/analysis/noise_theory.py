@@ -2,9 +2,9 @@
 and its stochastic erosion profile, added to the ensembles' Datasets where the theory applies.
 
 The averaged theory (:func:`safebasins.theory.escape_probability`, docs/noise-theory.md) is derived
-for white or Ornstein-Uhlenbeck noise of intensity sigma^2 > 0 (correlation time short against the
-slow time) in a symmetric well below the barrier.  Elsewhere (a noise level 0, an asymmetric well,
-xi_max at the barrier, or ``theory=False``) the Dataset
+for white or Ornstein-Uhlenbeck noise of intensity sigma^2 (correlation time short against the
+slow time; at sigma = 0 it is the deterministic slow flow) in any well below the barrier.  Elsewhere
+(xi_max at the barrier, or ``theory=False``) the Dataset
 gets no theory variables but the attributes ``theory = "none"`` and ``theory_reason`` saying why:
 an absent theory is stated, never a silent gap.  Where it applies the Dataset gains
 
@@ -42,7 +42,7 @@ __all__ = ["escape_probability_with_theory", "stochastic_erosion_with_theory", "
 
 #: the integrity measures the theory's erosion profile adds (as <measure>_theory)
 THEORY_MEASURES = ("GIM", "LIM", "IF")
-#: the theory's refusals (a ValueError naming one of these arguments): an asymmetric well, xi_max at the barrier
+#: the theory's refusals (a ValueError naming one of these arguments): the well, xi_max at the barrier
 _REFUSALS = ("well:", "xi_max ")
 #: the per-level summaries of probability_agreement stored as variables (stacked over noise)
 _LEVEL_SUMMARIES = ("P_escape_mean_abs_difference_uncertain", "P_escape_theory_within_wilson")
@@ -55,9 +55,6 @@ def theory_reason(*, theory: bool, noise: float | Sequence[float] | npt.ArrayLik
     checks.check_nonnegative("noise_time", noise_time)
     if not theory:
         return "not computed (theory: false)"
-    if (np.atleast_1d(np.asarray(noise, float)) == 0).any():
-        return ("not applicable at noise 0 (one of the levels): the averaged diffusion needs sigma > 0; "
-                "at sigma = 0 the theory is the deterministic slow flow (theory.slow_flow_escapes)")
     return None
 
 

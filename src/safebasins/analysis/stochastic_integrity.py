@@ -392,8 +392,8 @@ def stochastic_erosion_theory(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float | S
     conservative basin).
 
     Arguments as :func:`stochastic_erosion`, less the ensemble's (``paths``, ``seed``, ``cycles``,
-    ``conservative``); ``noise`` > 0 (at noise 0 the theory is the deterministic slow flow,
-    :func:`safebasins.theory.slow_flow_escapes`); ``well`` a symmetric well; ``theory_kwargs``:
+    ``conservative``); ``noise`` >= 0 (at noise 0 the deterministic slow flow's first passages);
+    ``well`` any well; ``theory_kwargs``:
     ``cells``, ``steps_per_cycle``, ``advection``, ``noise_time`` of theory.escape_probability.  ``keep_masks`` adds
     ``safe`` and ``P_escape`` over (..., q0, p0).
 
@@ -405,9 +405,6 @@ def stochastic_erosion_theory(q0: npt.ArrayLike, p0: npt.ArrayLike, F: float | S
     grid_spacing(q0, p0)
     Fs, F_scalar = _check_sweep("F", F)
     sig, sig_scalar = _check_sweep("noise", noise)
-    if (sig == 0).any():
-        raise ValueError("noise must be > 0 for the averaged theory (at noise 0 it is the deterministic slow flow, "
-                         "theory.slow_flow_escapes); got " + checks.value_repr(noise))
     _check_epsilon(epsilon)
     _check_bool("keep_masks", keep_masks)
     unknown = sorted(set(theory_kwargs) - set(THEORY_KWARGS))

@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from safebasins.theory.damped import shift_derivative
 from safebasins.theory.types import FloatArray
 from safebasins.wells.base import Well
 from safebasins.wells.quartic import QuarticWell
@@ -61,14 +62,19 @@ SHIFT_TOL = 1e-9
 _REL_STEP = 1e-6
 
 
-def orbit_averages(well: Well, xi: ArrayLike, n_theta: int = N_THETA, noise_time: float = 0.0
-                   ) -> dict[str, FloatArray]:
+def orbit_averages(well: Well, xi: ArrayLike, n_theta: int = N_THETA, noise_time: float = 0.0,
+                   sheared: bool = False) -> dict[str, FloatArray]:
     """Orbit averages of the noise terms at energies ``0 < xi < barrier_energy`` (validated by the
     well): ``J``, ``omega``, ``m_JJ = <(dJ/dp)^2> = <p^2>/omega^2``, ``m_gg = <(dtheta/dp)^2> =
     <q_J^2>``, ``m_gJ = <(dtheta/dp)(dJ/dp)> = -<q_J q_theta>``, and ``drift_J = <d^2J/dp^2>/2 =
     (1 - J domega/dE)/(2 omega)`` (the noise-induced action drift per unit sigma^2), each an array
     of the shape of xi.  ``noise_time`` tau > 0 (an Ornstein-Uhlenbeck force): the averages
-    weighted by the force's spectrum at the orbit's harmonics (:func:`coloured_averages`)."""
+    weighted by the force's spectrum at the orbit's harmonics (:func:`coloured_averages`).
+
+    ``sheared``: the phase terms for the sheared angle ``phi = theta + delta(J)`` (``delta`` the
+    phase of the first harmonic, ``well.harmonic_shift``) instead of theta: ``q_J`` taken at fixed
+    phi, so ``m_gg = <(dphi/dp)^2>`` and ``m_gJ = <(dphi/dp)(dJ/dp)>``; the regular frame of an
+    asymmetric well, where ``m_gJ`` vanishes (time reversal, docs/noise-theory.md)."""
     x = np.asarray(well.check_energy("xi", xi), float)
     if (x <= 0).any():
         raise ValueError("xi must be > 0 for the orbit averages (the angle is undefined at the well bottom)")
@@ -76,8 +82,16 @@ def orbit_averages(well: Well, xi: ArrayLike, n_theta: int = N_THETA, noise_time
     xs = x.reshape(-1)
     h = _REL_STEP * np.minimum(xs, well.barrier_energy - xs)
     q, p = well.phase_point(th[:, None], xs[None, :])
-    q_hi, _ = well.phase_point(th[:, None], (xs + h)[None, :])
-    q_lo, _ = well.phase_point(th[:, None], (xs - h)[None, :])
+    if sheared:
+        # theta = phi - delta(J): at fixed phi the angle moves with the energy by -d delta
+        d0 = np.asarray(well.harmonic_shift(xs), float)
+        d_hi = np.asarray(well.harmonic_shift(xs + h), float) - d0
+        d_lo = np.asarray(well.harmonic_shift(xs - h), float) - d0
+        q_hi, _ = well.phase_point(th[:, None] - d_hi[None, :], (xs + h)[None, :])
+        q_lo, _ = well.phase_point(th[:, None] - d_lo[None, :], (xs - h)[None, :])
+    else:
+        q_hi, _ = well.phase_point(th[:, None], (xs + h)[None, :])
+        q_lo, _ = well.phase_point(th[:, None], (xs - h)[None, :])
     om = np.asarray(well.omega(xs), float)
     q_J = om * (q_hi - q_lo) / (2.0 * h)
     q_th = p / om
@@ -131,11 +145,14 @@ def coloured_averages(q_th: FloatArray, q_J: FloatArray, omega: FloatArray, omeg
 
 @dataclass(frozen=True)
 class AveragedDiffusion:
-    """The averaged diffusion of one symmetric well on ``0 <= J <= J_max``: tables over the action
+    """The averaged diffusion of one well on ``0 <= J <= J_max``: tables over the action
     ``J_nodes`` of the energy ``H``, ``omega``, the first-harmonic amplitude over the radius
-    ``a = A / sqrt(2 J)`` (C = H - Omega J - F A cos gamma; a is smooth at J = 0, A is not) and the
+    ``a = A / sqrt(2 J)`` (C = H - Omega J - F A cos phi; a is smooth at J = 0, A is not) and the
     regular frame's radial and tangential coefficients ``a_r = 1/(2 omega)``, ``a_t = 2 J m_gg``
-    (smooth at J = 0); linear interpolation in J."""
+    (smooth at J = 0); linear interpolation in J.  The phase is the sheared ``phi = gamma +
+    delta(J)`` (docs/damping.md; phi = gamma for a symmetric well, ``d_r`` None); an asymmetric
+    well's ``d_r = d / sqrt(2 J)``, ``d = J ddelta/dJ``, turns the damping into the phase drift
+    ``-beta d`` (smooth at J = 0, where ``d ~ sqrt(2 J)``)."""
 
     J_nodes: FloatArray
     H: FloatArray
@@ -143,6 +160,20 @@ class AveragedDiffusion:
     a: FloatArray
     a_r: FloatArray
     a_t: FloatArray
+    d_r: FloatArray | None = None
+
+    @property
+    def symmetric(self) -> bool:
+        """Whether the well is symmetric (phi = gamma: no shear of the phase)."""
+        return self.d_r is None
+
+    def d(self, J: ArrayLike) -> FloatArray:
+        """``d = J ddelta/dJ`` at actions ``0 <= J <= J_max`` (0 for a symmetric well)."""
+        Ja = np.asarray(J, float)
+        if self.d_r is None:
+            return np.zeros_like(Ja)
+        out: FloatArray = np.interp(Ja, self.J_nodes, self.d_r) * np.sqrt(2.0 * Ja)
+        return out
 
     @property
     def J_max(self) -> float:
@@ -182,10 +213,10 @@ _TABLES: weakref.WeakKeyDictionary[Well, OrderedDict[tuple[float, int, int, floa
 
 def averaged_diffusion(well: Well, xi_max: float, n: int = N_NODES, n_theta: int = N_THETA,
                        noise_time: float = 0.0) -> AveragedDiffusion:
-    """:class:`AveragedDiffusion` of a symmetric ``well`` up to the energy ``xi_max`` (< its barrier
+    """:class:`AveragedDiffusion` of ``well`` up to the energy ``xi_max`` (< its barrier
     energy), on ``n`` nodes uniform in J (node 0: the well bottom, where ``a_t = a_r = 1/(2
-    omega(0))``).  A well whose first harmonic has a phase (an asymmetric well: J-gamma
-    covariance and a sheared frame) is refused, naming ``well``.  ``noise_time``: tau of an
+    omega(0))``).  A well whose first harmonic has a phase (an asymmetric well) gets its tables
+    in the sheared phase, where the J-phase covariance vanishes as in a symmetric well.  ``noise_time``: tau of an
     Ornstein-Uhlenbeck force (0: white noise), whose spectral weights enter ``a_r`` and ``a_t``.
     Computed once per well and ``(xi_max, n, n_theta, noise_time)`` and then returned again (the
     same read-only tables; an unhashable well's are computed at every call)."""
@@ -207,10 +238,8 @@ def _tables(well: Well, xi_max: float, n: int, n_theta: int, noise_time: float) 
     """The tables of :func:`averaged_diffusion`, computed (read-only arrays)."""
     xi_nodes = _xi_nodes(well, xi_max, n)
     # a numeric well's phase is rounding (1e-16) where it is symmetric; an asymmetric well's is O(sqrt(xi))
-    if np.any(np.abs(np.asarray(well.harmonic_shift(xi_nodes[1:]))) > SHIFT_TOL):
-        raise ValueError(f"well: the averaged noise theory covers symmetric wells (q(theta) odd, no phase of the "
-                         f"first harmonic); the {well.name} well has one")
-    av = orbit_averages(well, xi_nodes[1:], n_theta, noise_time)
+    sheared = bool(np.any(np.abs(np.asarray(well.harmonic_shift(xi_nodes[1:]))) > SHIFT_TOL))
+    av = orbit_averages(well, xi_nodes[1:], n_theta, noise_time, sheared=sheared)
     J = np.concatenate([[0.0], av["J"]])
     om = np.asarray(well.omega(xi_nodes), float)
     a_t = np.concatenate([[np.nan], 2.0 * av["J"] * av["m_gg"]])
@@ -225,6 +254,11 @@ def _tables(well: Well, xi_max: float, n: int, n_theta: int, noise_time: float) 
     a[1:] = np.asarray(well.harmonic_amplitude(xi_nodes[1:]), float) / np.sqrt(2.0 * J[1:])
     a[0] = a[1] + (a[1] - a[2]) * J[1] / (J[2] - J[1])      # extrapolated in J (a is smooth there)
     tables = {"J_nodes": J, "H": xi_nodes, "omega": om, "a": a, "a_r": a_r, "a_t": a_t}
+    if sheared:
+        d_r = np.empty_like(J)
+        d_r[1:] = J[1:] * om[1:] * shift_derivative(well, xi_nodes[1:]) / np.sqrt(2.0 * J[1:])
+        d_r[0] = d_r[1] + (d_r[1] - d_r[2]) * J[1] / (J[2] - J[1])
+        tables["d_r"] = d_r
     for v in tables.values():
         v.flags.writeable = False       # shared by every later call: no caller may change them
     return AveragedDiffusion(**tables)

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike
 from safebasins.core import cf, checks
 from safebasins.core.averaged_theory import CELLS, STEPS_PER_CYCLE, check_cells, theory_cycles
 from safebasins.theory.noise_averaging import AveragedDiffusion, averaged_diffusion
-from safebasins.theory.noise_semilagrangian import march_escape_sl
+from safebasins.theory.noise_semilagrangian import escape_times, march_escape_sl
 from safebasins.theory.noise_solver import ADVECTION, DiscGrid, generator, interpolation, march_escape, \
     solve_first_passage
 from safebasins.theory.types import FloatArray, WellArg
@@ -46,13 +46,18 @@ IC_STEP_EVALUATIONS = 0.2
 
 MODEL_TEXT = ("averaged diffusion of the slow flow (gamma, J) under dp = ... + sigma dW: drift dC/dJ, -dC/dgamma - "
               "beta J plus the noise-induced (sigma^2/2) d(J/omega)/dJ; diffusion sigma^2 J/omega (action), sigma^2 "
-              "<q_J^2> (phase), no J-gamma covariance (symmetric well); docs/noise-theory.md")
+              "<q_J^2> (phase), no J-phase covariance (for an asymmetric well in the sheared phase gamma + delta(J), "
+              "where it vanishes); docs/noise-theory.md")
 COLOURED_MODEL_TEXT = ("averaged diffusion of the slow flow (gamma, J) under an Ornstein-Uhlenbeck force of "
                        "correlation time tau (noise_time) and intensity sigma^2: drift dC/dJ, -dC/dgamma - beta J "
                        "plus the noise-induced (sigma^2/2) dm_JJ/dJ; diffusion sigma^2 m_JJ (action), sigma^2 m_gg "
                        "(phase), the orbit's harmonics k weighted by 1/(1 + k^2 omega^2 tau^2) (m_gg with the shear "
                        "of the orbits over a correlation time); J-gamma covariance and phase drift of order tau left "
                        "out; for tau short against the slow time; docs/noise-theory.md")
+
+NOISE_FREE_TEXT = ("the averaged theory at sigma = 0: the deterministic slow flow (gamma, J) (drift dC/dJ, -dC/dgamma "
+                   "- beta J), P_escape 0 or 1 from each initial condition's first passage of xi_max; "
+                   "docs/noise-theory.md")
 
 
 def _setup(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_max: float, noise: float,
@@ -69,9 +74,6 @@ def _setup(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi: float, xi_
            "noise": checks.check_scalar("noise", noise, checks.check_nonnegative),
            "damping": checks.check_damping(damping),
            "noise_time": checks.check_scalar("noise_time", noise_time, checks.check_nonnegative)}
-    if par["noise"] == 0:
-        raise ValueError("noise must be > 0 for the averaged diffusion; at noise 0 the theory is the deterministic "
-                         "slow flow (theory.slow_flow_escapes)")
     if advection not in schemes:
         raise ValueError(f"advection must be one of {schemes}, got {advection!r}")
     n_gamma, n_J = check_cells(cells)
@@ -92,13 +94,17 @@ def solve_evaluations(n_ics: int, t_eval: ArrayLike, cells: tuple[int, int] = CE
                      + n_ics * (IC_EVALUATIONS + steps * IC_STEP_EVALUATIONS))
 
 
-def _slow_points(w: Well, Q: FloatArray, P: FloatArray, Psi: float, xi_max: float
+def _slow_points(w: Well, Q: FloatArray, P: FloatArray, Psi: float, xi_max: float, diff: AveragedDiffusion
                  ) -> tuple[np.ndarray, FloatArray, FloatArray]:
-    """``(inside, gamma, J)`` of the ICs inside the well and below xi_max."""
+    """``(inside, phase, J)`` of the ICs inside the well and below xi_max; the phase of the
+    tables: gamma, or for an asymmetric well the sheared ``gamma + delta(xi)``."""
     H = np.asarray(w.H0(Q, P), float)
     inside = np.asarray(w.in_well(Q), bool) & (H < xi_max)
     theta, xi = w.angle_energy(Q[inside], P[inside])
-    return inside, np.asarray(theta, float) - Psi, np.asarray(w.J(xi), float)
+    phase = np.asarray(theta, float) - Psi
+    if not diff.symmetric:
+        phase = phase + np.asarray(w.harmonic_shift(xi), float)
+    return inside, phase, np.asarray(w.J(xi), float)
 
 
 def _coords(is_grid: bool, qa: FloatArray, pa: FloatArray, Q: FloatArray, P: FloatArray
@@ -111,9 +117,12 @@ def _coords(is_grid: bool, qa: FloatArray, pa: FloatArray, Q: FloatArray, P: Flo
 
 def _attrs(par: dict[str, float], w: Well, grid: DiscGrid, advection: str) -> dict[str, object]:
     model = COLOURED_MODEL_TEXT if par["noise_time"] > 0 else MODEL_TEXT
-    return {**par, "noise_model": model, "theory": "averaged (stochastic slow flow)",
-            "solver": (f"finite volumes on {grid.n_gamma} x {grid.n_J} cells uniform in (gamma, J) (equal-area polar "
-                       f"grid of X + iY = sqrt(2J) e^(i gamma)), {advection} advection, absorbing at J(xi_max)"),
+    solver = (f"finite volumes on {grid.n_gamma} x {grid.n_J} cells uniform in (gamma, J) (equal-area polar "
+              f"grid of X + iY = sqrt(2J) e^(i gamma)), {advection} advection, absorbing at J(xi_max)")
+    if par["noise"] == 0:
+        model, solver = NOISE_FREE_TEXT, ("RK4 along each initial condition's slow trajectory (the semi-Lagrangian "
+                                          "march's characteristics), escape at its first passage of J(xi_max)")
+    return {**par, "noise_model": model, "theory": "averaged (stochastic slow flow)", "solver": solver,
             "escape_criteria": f"averaged energy xi reaches xi_max = {par['xi_max']!r}", **w.numerics_attrs()}
 
 
@@ -127,11 +136,13 @@ def escape_probability(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi
 
     ``q0, p0, grid``: initial conditions at tau = 0 as :func:`safebasins.numerics.escape_probability`
     reads them (1-D axes -> dims (q0, p0), paired -> sample); ``F, Omega, Psi, xi_max``: as
-    :func:`~safebasins.theory.slow_flow_escapes`; ``noise``: sigma > 0 of ``dp = ... + sigma dW``;
+    :func:`~safebasins.theory.slow_flow_escapes`; ``noise``: sigma >= 0 of ``dp = ... + sigma dW``
+    (0: the noise-free slow flow, P_escape 0 or 1 from each IC's slow trajectory);
     ``noise_time``: tau >= 0, an Ornstein-Uhlenbeck force of correlation time tau and intensity
     sigma^2 instead (its spectrum at the orbit's harmonics weights the diffusion; valid for tau short
-    against the slow time, docs/noise-theory.md); ``damping``: beta >= 0; ``well``: a symmetric
-    well (default the quartic).  ``cells``: the polar grid ``(n_gamma, n_J)``; ``steps_per_cycle``:
+    against the slow time, docs/noise-theory.md); ``damping``: beta >= 0; ``well``: any well
+    (default the quartic; an asymmetric well is solved in its sheared phase).  ``cells``: the polar
+    grid ``(n_gamma, n_J)``; ``steps_per_cycle``:
     time steps per forcing cycle;
     ``advection``: "semi-lagrangian" (default: exact characteristics of the slow flow, quasi-monotone
     bicubic interpolation, Strang-split implicit diffusion; values in [0, 1] at any noise), or the
@@ -148,9 +159,15 @@ def escape_probability(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi
     te = checks.check_1d("t_eval", t_eval, checks.check_nonnegative)
     spc = checks.check_positive_int("steps_per_cycle", steps_per_cycle)
     cycles = theory_cycles(te)
-    inside, gamma, J = _slow_points(w, Q, P, par["Psi"], par["xi_max"])
-    W, w_b = interpolation(dgrid, gamma, J)
+    inside, gamma, J = _slow_points(w, Q, P, par["Psi"], par["xi_max"], diff)
     period = 2.0 * np.pi / par["Omega"]
+    if par["noise"] == 0:
+        # the noise-free limit: each IC's slow trajectory, P = 1 from its first passage on
+        T = escape_times(diff, par["F"], par["Omega"], par["damping"], gamma, J, cycles * period, cycles * spc)
+        return _dataset(par, w, dgrid, advection, is_grid, qa, pa, Q, P, te, inside,
+                        (T[:, None] <= te[None, :] * period).astype(float), np.minimum(T / period, cycles),
+                        cycles, spc)
+    W, w_b = interpolation(dgrid, gamma, J)
     if advection == "semi-lagrangian":
         t, Pt = march_escape_sl(dgrid, diff, par["F"], par["Omega"], par["damping"], par["noise"], W, w_b,
                                 cycles * period, cycles * spc)
@@ -165,6 +182,13 @@ def escape_probability(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi
     P_in = np.stack([np.interp(te, t, col) for col in Pt.T]) if Pt.shape[1] else np.zeros((0, te.size))
     surv = 1.0 - Pt
     fp_in = np.sum(0.5 * (surv[1:] + surv[:-1]) * np.diff(t)[:, None], axis=0)
+    return _dataset(par, w, dgrid, advection, is_grid, qa, pa, Q, P, te, inside, P_in, fp_in, cycles, spc)
+
+
+def _dataset(par: dict[str, float], w: Well, dgrid: DiscGrid, advection: str, is_grid: bool, qa: FloatArray,
+             pa: FloatArray, Q: FloatArray, P: FloatArray, te: FloatArray, inside: np.ndarray, P_in: FloatArray,
+             fp_in: FloatArray, cycles: int, spc: int) -> xr.Dataset:
+    """:func:`escape_probability`'s Dataset from the values at the ICs inside (the others escape at 0)."""
     P_all = np.ones((Q.size, te.size))
     P_all[inside] = P_in
     fp = np.zeros(Q.size)
@@ -188,9 +212,12 @@ def mean_first_passage(q0: ArrayLike, p0: ArrayLike, F: float, Omega: float, Psi
     "upwind"; a central solution with negative times, unresolved cell Peclet numbers, raises an
     error naming ``cells``); other arguments as :func:`escape_probability`.  Returns a Dataset with
     ``mean_first_passage`` (ic dims; 0 for ICs at or beyond xi_max)."""
+    if checks.check_scalar("noise", noise, checks.check_nonnegative) == 0:
+        raise ValueError("noise must be > 0 for the mean first-passage time (at noise 0 a slow trajectory that "
+                         "settles never escapes); escape_probability gives the noise-free first passages")
     w, par, (is_grid, qa, pa, Q, P), dgrid, diff = _setup(q0, p0, F, Omega, Psi, xi_max, noise, damping, well,
                                                           grid, cells, advection, ADVECTION, noise_time)
-    inside, gamma, J = _slow_points(w, Q, P, par["Psi"], par["xi_max"])
+    inside, gamma, J = _slow_points(w, Q, P, par["Psi"], par["xi_max"], diff)
     M, _ = generator(dgrid, diff, par["F"], par["Omega"], par["damping"], par["noise"], advection)
     W, _ = interpolation(dgrid, gamma, J)
     T_in, T_min = solve_first_passage(M, W)

@@ -324,6 +324,9 @@ def quasi_potential(F: float, Omega: float, xi_max: float, *, damping: float, we
         raise ValueError(f"step must be <= 0.5 (RK4 step times the flow's largest rate), got {step!r}")
     tau = checks.check_scalar("noise_time", noise_time, checks.check_nonnegative)
     diff = averaged_diffusion(w, xm, noise_time=tau)
+    if not diff.symmetric:
+        raise ValueError(f"well: the quasi-potential is computed for symmetric wells; the {w.name} well's first "
+                         "harmonic has a phase (its backward equation, theory.escape_probability, covers it)")
     fp = fixed_points(np.array([f]), np.array([Om]), beta, w, xm)
     stable = fp.attracting[0] & (fp.xi[0] < xm)
     saddle = (fp.kind[0] == SADDLE) & (fp.xi[0] < xm)

@@ -21,18 +21,21 @@ from safebasins.theory.noise_averaging import AveragedDiffusion
 from safebasins.theory.noise_solver import DiscGrid, generator, interpolation, row_range
 from safebasins.theory.types import FloatArray
 
-__all__ = ["departure_points", "advection_matrix", "march_escape_sl"]
+__all__ = ["departure_points", "advection_matrix", "march_escape_sl", "escape_times"]
 
 
 def _flow(X: FloatArray, Y: FloatArray, diff: AveragedDiffusion, a_J: FloatArray, F: float, Omega: float,
           beta: float) -> tuple[FloatArray, FloatArray]:
-    """The slow flow in the regular frame (symmetric well): with ``a = A/r`` and ``e = da/dJ``,
-    ``X' = -(beta/2) X - (omega - Omega) Y + F e X Y``, ``Y' = (omega - Omega) X - (beta/2) Y - F (a + e X^2)``."""
+    """The slow flow in the regular (sheared) frame: with ``a = A/r``, ``e = da/dJ`` and the detuning
+    ``w = omega - beta d - Omega`` (d = 0 for a symmetric well; docs/damping.md),
+    ``X' = -(beta/2) X - w Y + F e X Y``, ``Y' = w X - (beta/2) Y - F (a + e X^2)``."""
     J = np.minimum(0.5 * (X * X + Y * Y), diff.J_max)
     om = np.interp(J, diff.J_nodes, diff.omega)
     a = np.interp(J, diff.J_nodes, diff.a)
     e = np.interp(J, diff.J_nodes, a_J)
     det = om - Omega
+    if not diff.symmetric:
+        det = det - beta * diff.d(J)
     return -0.5 * beta * X - det * Y + F * e * X * Y, det * X - 0.5 * beta * Y - F * (a + e * X * X)
 
 
@@ -57,6 +60,35 @@ def departure_points(grid: DiscGrid, diff: AveragedDiffusion, F: float, Omega: f
         escaped |= 0.5 * (X * X + Y * Y) >= diff.J_max
     J = np.minimum(0.5 * (X * X + Y * Y), diff.J_max)
     return np.mod(np.arctan2(Y, X), 2.0 * np.pi), J, escaped
+
+
+def escape_times(diff: AveragedDiffusion, F: float, Omega: float, beta: float, phase: FloatArray, J: FloatArray,
+                 t_end: float, steps: int, substeps: int = 8) -> FloatArray:
+    """First times at which the noise-free slow flow from the points ``(phase, J)`` (the tables'
+    phase) reaches J_max, on ``steps`` x ``substeps`` RK4 steps to ``t_end`` (the march's
+    characteristics; the time of the first substep at or past J_max); inf where it does not."""
+    r = np.sqrt(2.0 * J)
+    X, Y = r * np.cos(phase), r * np.sin(phase)
+    a_J = np.gradient(diff.a, diff.J_nodes)
+    n = steps * substeps
+    h = t_end / n
+    out = np.full(X.size, np.inf)
+    live = J < diff.J_max
+    out[~live] = 0.0
+    for k in range(1, n + 1):
+        if not live.any():
+            break
+        x, y = X[live], Y[live]
+        k1 = _flow(x, y, diff, a_J, F, Omega, beta)
+        k2 = _flow(x + 0.5 * h * k1[0], y + 0.5 * h * k1[1], diff, a_J, F, Omega, beta)
+        k3 = _flow(x + 0.5 * h * k2[0], y + 0.5 * h * k2[1], diff, a_J, F, Omega, beta)
+        k4 = _flow(x + h * k3[0], y + h * k3[1], diff, a_J, F, Omega, beta)
+        X[live] = x + h / 6.0 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
+        Y[live] = y + h / 6.0 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+        hit = live & (0.5 * (X * X + Y * Y) >= diff.J_max)
+        out[hit] = k * h
+        live &= ~hit
+    return out
 
 
 def _cubic_weights(f: FloatArray) -> FloatArray:

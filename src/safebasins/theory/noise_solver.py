@@ -4,15 +4,19 @@ The averaged generator in the canonical pair ``(gamma, J)`` (equal to the area o
 frame ``X + i Y = sqrt(2 J) e^{i gamma}``: ``dX dY = dgamma dJ``) is
 
     L u = b . grad u + (sigma^2/2) div(m grad u),
-    b = (dC/dJ, -dC/dgamma - beta J),    m = diag(m_gg, m_JJ)    (symmetric well),
+    b = (dC/dJ - beta d(J), -dC/dgamma - beta J),    m = diag(m_gg, m_JJ),
 
-with the first integral ``C = H(J) - Omega J - F A(J) cos gamma`` of the slow flow.  Finite volumes
+with the first integral ``C = H(J) - Omega J - F A(J) cos gamma`` of the slow flow; for an
+asymmetric well gamma stands for the sheared phase ``phi = gamma + delta(J)`` (docs/damping.md:
+``d = J ddelta/dJ``, 0 for a symmetric well), in which the averaged noise has no J-phase
+covariance either (time reversal, docs/noise-theory.md).  Finite volumes
 on cells uniform in ``(gamma, J)`` are a polar grid of equal-area cells in ``(X, Y)`` (rings of
 equal area, the innermost ring wedges meeting at the well bottom, whose inner face has no length:
 no boundary condition is needed there).  Fluxes:
 
 * the Hamiltonian part through each face is the difference of C at the face's two corners (so the
-  discrete velocity is exactly divergence-free), the damping's ``-beta J`` at the J-faces; the face
+  discrete velocity is exactly divergence-free), the damping's ``-beta J`` at the J-faces and
+  ``-beta d`` at the gamma-faces (the same on every face of a ring: divergence-free); the face
   value is the mean of the two cells (``advection="central"``: no numerical diffusion, second order)
   or the downstream cell's (``"upwind"``: monotone, first order);
 * the diffusion by two-point differences with ``m_JJ = J/omega`` at the J-faces (0 at J = 0) and
@@ -84,6 +88,9 @@ def generator(grid: DiscGrid, diff: AveragedDiffusion, F: float, Omega: float, b
     # outward fluxes (area per time) through the upper J-face of ring i and the upper gamma-face of sector j
     phi_J = -(C[:, 1:] - C[:, :-1]) - beta * J_f[:, None] * dg                            # (nJ+1, ng)
     phi_g = C[1:, 1:] - C[:-1, 1:]                                                          # (nJ, ng)
+    if not diff.symmetric:
+        # the sheared phase's damping drift -beta d(J) (d = J ddelta/dJ) through the gamma-faces
+        phi_g = phi_g - (beta * dJ) * diff.d(J_c)[:, None]
     if advection == "none":
         phi_J, phi_g = np.zeros_like(phi_J), np.zeros_like(phi_g)
     _, _, _, _, at_c = diff.at(J_c)
