@@ -141,7 +141,8 @@ def test_poisson_law_against_the_sde_ensemble(forced):
 
 @pytest.mark.parametrize("kw, name", [(dict(damping=0.0), "damping"), (dict(F=-1.0), "F"),
                                       (dict(F=0.2), "F"), (dict(n_rays=4), "n_rays"), (dict(step=2.0), "step"),
-                                      (dict(xi_max=0.3), "xi_max")])
+                                      (dict(xi_max=0.3), "xi_max"),
+                                      (dict(well="cubic"), "well: the quasi-potential is computed for symmetric")])
 def test_bad_input_named(kw, name):
     args = dict(F=0.01, Omega=0.9, xi_max=0.09, damping=0.02) | kw
     with pytest.raises(ValueError, match=name):

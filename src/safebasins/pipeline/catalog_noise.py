@@ -33,9 +33,9 @@ DECLARATIONS: tuple[Declaration, ...] = (
                  "conservative one (the upper end of the 95% Wilson interval <= ε: safe with 95% confidence), "
                  "against σ at each F and against F at each σ, one ensemble per (F, σ), every one with the same "
                  "seed (common random numbers)."),
-        look=("Solid: the basin {P_escape <= ε}; dashed: the conservative basin, below it; crosses, where the "
-              "averaged theory applies (white or Ornstein-Uhlenbeck noise, every σ > 0, a symmetric well; the notes "
-              "say when it does not): the theory's basin. At σ = 0 the profile is "
+        look=("Solid: the basin {P_escape <= ε}; dashed: the conservative basin, below it; crosses: the averaged "
+              "theory's basin (white or Ornstein-Uhlenbeck noise, the asymmetric well in its sheared phase; at σ = 0 "
+              "the noise-free slow flow; the notes say when it is absent). At σ = 0 the profile is "
               "the deterministic erosion. Expect the integrity to fall with σ at every F, faster where the "
               "deterministic basin is already eroded, and the LIM to fall in steps (it is a grid radius).")),
 )
