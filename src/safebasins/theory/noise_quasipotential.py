@@ -1,7 +1,8 @@
 """Weak-noise limit of the averaged diffusion: the quasi-potential of the damped slow flow and its
 Arrhenius law (docs/noise-theory.md, "The weak-noise limit").
 
-In the regular frame ``x = (X, Y) = sqrt(2J) (cos gamma, sin gamma)`` the averaged diffusion
+In the regular frame ``x = (X, Y) = sqrt(2J) (cos phi, sin phi)`` (phi = gamma for a symmetric well,
+the sheared ``gamma + delta(J)`` for an asymmetric one: docs/noise-theory.md) the averaged diffusion
 (:mod:`safebasins.theory.noise_averaging`) is ``dx = b dt + sigma s dW`` with ``s s^T = A``,
 ``A = a_t I + c x x^T``, ``c = (a_r - a_t)/(2J)``; ``b`` is the damped slow flow
 (:func:`safebasins.theory.damped.flow_tilde`; its O(sigma^2) noise-induced part changes only the
@@ -78,33 +79,40 @@ _DRIFT_KEY = int(hashlib.blake2b(Path(damped.__file__).read_bytes(), digest_size
 
 
 def coefficient_table(diff: AveragedDiffusion, n: int = TABLE_NODES) -> FloatArray:
-    """Columns ``omega, omega', a, a', a'', a_t, a_t', c, c'`` (primes: d/dJ; ``a = A/sqrt(2J)``,
-    ``c = (a_r - a_t)/(2J)``) of an :class:`AveragedDiffusion` on ``n`` nodes uniform in
+    """Columns ``omega, omega', a, a', a'', a_t, a_t', c, c', d_r, d_r'`` (primes: d/dJ; ``a =
+    A/sqrt(2J)``, ``c = (a_r - a_t)/(2J)``, ``d_r = d/sqrt(2J)`` the sheared phase's damping
+    drift, 0 for a symmetric well) of an :class:`AveragedDiffusion` on ``n`` nodes uniform in
     ``[0, J_max]``, from one cubic spline of its tables (so the rays' derivatives are consistent)."""
     J = diff.J_nodes
     c = np.empty_like(J)
     c[1:] = (diff.a_r[1:] - diff.a_t[1:]) / (2.0 * J[1:])
     c[0] = c[1] + (c[1] - c[2]) * J[1] / (J[2] - J[1])       # smooth at J = 0: extrapolated
-    sp = CubicSpline(J, np.stack([diff.omega, diff.a, diff.a_t, c], axis=1))
+    d_r = np.zeros_like(J) if diff.d_r is None else diff.d_r
+    sp = CubicSpline(J, np.stack([diff.omega, diff.a, diff.a_t, c, d_r], axis=1))
     Jn = np.linspace(0.0, diff.J_max, n)
     v, d1, d2 = sp(Jn), sp(Jn, 1), sp(Jn, 2)
     return np.ascontiguousarray(np.stack([v[:, 0], d1[:, 0], v[:, 1], d1[:, 1], d2[:, 1], v[:, 2], d1[:, 2],
-                                          v[:, 3], d1[:, 3]], axis=1))
+                                          v[:, 3], d1[:, 3], v[:, 4], d1[:, 4]], axis=1))
 
 
 @njit
 def _flow(tab, J_max, X, Y, F, Om, beta):  # type: ignore[no-untyped-def]
     """Drift (bX, bY), its Jacobian (dbX/dX, dbX/dY, dbY/dX, dbY/dY) and the diffusion's
-    (a_t, c, a_t', c') at one point.  With ``g = omega - Omega``, ``e = a'``:
-    ``bX = -(beta/2) X - g Y + F e X Y``, ``bY = g X - (beta/2) Y - F (a + e X^2)``."""
+    (a_t, c, a_t', c') at one point.  With ``g = omega - beta d - Omega``, ``e = a'``:
+    ``bX = -(beta/2) X - g Y + F e X Y``, ``bY = g X - (beta/2) Y - F (a + e X^2)`` (d = 0 for a
+    symmetric well; ``d ~ sqrt(2J)`` at the bottom, where ``g'`` ~ 1/sqrt(J) multiplies terms O(J))."""
     J = min(0.5 * (X * X + Y * Y), J_max)
     u = J / J_max * (tab.shape[0] - 1)
     i = min(int(u), tab.shape[0] - 2)
     f = u - i
     r = tab[i] + f * (tab[i + 1] - tab[i])
     om, om1, a, e, e1 = r[0], r[1], r[2], r[3], r[4]
-    bX, bY = _flow_tilde(X, Y, F, Om, beta, om, a, e, 0.0)
-    g = om - Om
+    rr = math.sqrt(2.0 * J)
+    d = r[9] * rr
+    if rr > 0.0:
+        om1 = om1 - beta * (r[10] * rr + r[9] / rr)         # dg/dJ
+    bX, bY = _flow_tilde(X, Y, F, Om, beta, om, a, e, d)
+    g = om - beta * d - Om
     jxx = -0.5 * beta - om1 * X * Y + F * (e1 * X * X * Y + e * Y)
     jxy = -g - om1 * Y * Y + F * (e1 * X * Y * Y + e * X)
     jyx = g + om1 * X * X - F * (3.0 * e * X + e1 * X * X * X)
@@ -303,7 +311,8 @@ def quasi_potential(F: float, Omega: float, xi_max: float, *, damping: float, we
 
     ``F, Omega, xi_max``: as :func:`~safebasins.theory.escape_probability`; ``damping``: beta > 0
     (the damped slow flow's attractors: the resonant and the non-resonant response, or the well
-    bottom at F = 0); ``well``: a symmetric well (default the quartic); ``n_rays``: rays of the
+    bottom at F = 0); ``well``: any well (default the quartic; an asymmetric one in its sheared phase,
+    like the fixed points); ``n_rays``: rays of the
     first pass per attractor (>= 16); ``step``: the RK4 step times the flow's largest rate
     (<= 0.5); ``noise_time``: tau of an Ornstein-Uhlenbeck force (0: white noise; the same tables as
     the backward equation's, :func:`~safebasins.theory.noise_averaging.averaged_diffusion`).
@@ -324,9 +333,6 @@ def quasi_potential(F: float, Omega: float, xi_max: float, *, damping: float, we
         raise ValueError(f"step must be <= 0.5 (RK4 step times the flow's largest rate), got {step!r}")
     tau = checks.check_scalar("noise_time", noise_time, checks.check_nonnegative)
     diff = averaged_diffusion(w, xm, noise_time=tau)
-    if not diff.symmetric:
-        raise ValueError(f"well: the quasi-potential is computed for symmetric wells; the {w.name} well's first "
-                         "harmonic has a phase (its backward equation, theory.escape_probability, covers it)")
     fp = fixed_points(np.array([f]), np.array([Om]), beta, w, xm)
     stable = fp.attracting[0] & (fp.xi[0] < xm)
     saddle = (fp.kind[0] == SADDLE) & (fp.xi[0] < xm)
