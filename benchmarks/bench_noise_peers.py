@@ -19,12 +19,19 @@ bottom of the well (q, p) = (0, 0); escape when H0 > xi_max = 0.25 or |q| > 1, c
 every step (the criteria of escape_chart); the quantity is P_escape within 50 forcing cycles
 (~0.55).
 
+safebasins runs under each law of its variates (numerics.noise.VARIATES: "gaussian", Box-Muller
+normals, the default; "five-point", 0, +-sqrt 2, +-2 from four random bits, the Gaussian's moments
+through the fifth): one set of rows per law, the same step search, accuracy criterion and boundary
+shift rule (each law's shift is the library's, BOUNDARY_SHIFTS); the table names each row's law
+(the peers draw normals) and gives every time against each law's row.
+
 Monitoring: a step-wise check of the threshold misses crossings between steps, an O(sqrt(h))
 bias of every scheme. safebasins corrects it (the boundary shift, docs/noise.md); the peers, as
 a researcher gets them, do not (a diffrax Event, sdeint's trajectory, a hand-written loop). The
-table compares each method as shipped; two extra rows put both sides under the same rule
-(safebasins uncorrected; the numba Euler-Maruyama with the same shift), and a BENCH line gives the
-smaller of the two same-rule ratios.
+table compares each method as shipped; extra rows put both sides under the same rule
+(safebasins uncorrected, per law; the numba Euler-Maruyama with the Gaussian shift), and a BENCH
+line per law gives the smaller of the two same-rule ratios against the numba Euler-Maruyama,
+symplectic (the fastest peer in the runs of docs/noise.md).
 
 Accuracy criterion: |P_escape - P_ref| <= TOL = 0.02 with N = 8000 paths per method and step
 (standard error of the difference ~0.006: TOL is ~3.3 of them). P_ref: safebasins, 128 steps
@@ -38,8 +45,9 @@ the cap: its ratio is then a lower bound (">=").
 
 Methods (one thread each, the same process; jax is held to one thread with XLA_FLAGS):
 
-* safebasins: numerics.escape_probability (SRKN6b Strang splitting, Philox), threads = 1; also
-  threads = all cores at the same step (the last ratio column: peer on one thread / ours on all);
+* safebasins: numerics.escape_probability (SRKN6b Strang splitting, Philox), each law of the
+  variates, threads = 1; also threads = all cores at the same step (the ratio columns marked with
+  the core count: peer on one thread / ours on all);
 * numba: hand-written @njit Euler-Maruyama, numba's np.random normals, one loop per path:
   symplectic (p then q, the stronger variant for a Hamiltonian drift) and plain (q and p from the
   old state, the textbook scheme, which is what sdeint's itoEuler and diffrax's Euler integrate);
@@ -48,7 +56,7 @@ Methods (one thread each, the same process; jax is held to one thread with XLA_F
   excluded, printed. Both are slow on the CPU (~3e5 steps/s under vmap), so they run fewer paths
   and their time is scaled to N: Euler 500 paths at the plain Euler-Maruyama's step (the same
   map); ShARK 1500 paths a step (standard error ~0.013), searched from the uncorrected
-  splitting's step (below it the monitoring bias alone exceeds TOL for any scheme);
+  Gaussian splitting's step (below it the monitoring bias alone exceeds TOL for any scheme);
 * sdeint: itoEuler, pure Python: 4 paths are timed and the time scaled to N (its step is the
   plain Euler-Maruyama's: the same map, checked on one path to 1e-12 with the same increments).
   itoSRI2 is not run (its accuracy would need a search over thousands of pure-Python paths).
@@ -94,7 +102,7 @@ import yaml  # noqa: E402
 from _report import machine, report  # noqa: E402
 
 from safebasins.numerics import escape_probability  # noqa: E402
-from safebasins.numerics.noise import GOBET_SHIFT  # noqa: E402
+from safebasins.numerics.noise import GOBET_SHIFT, VARIATES  # noqa: E402
 
 jax.config.update("jax_enable_x64", True)
 
@@ -113,10 +121,16 @@ def step(S):
 
 
 # ---------------------------------------------------------------- safebasins
-def ours(S, paths, threads=1, seed=1, correction="shift"):
+def ours(S, paths, threads=1, seed=1, correction="shift", variates="gaussian"):
     ds = escape_probability(Q0, P0, F, OMEGA, PSI, noise=SIGMA, paths=paths, xi_max=XI, t_eval=[CYCLES],
-                            steps_per_cycle=S, threads=threads, seed=seed, correction=correction, grid=False)
+                            steps_per_cycle=S, threads=threads, seed=seed, correction=correction, grid=False,
+                            variates=variates)
     return float(ds.P_escape.values.ravel()[0])
+
+
+def ours_row(law, correction):
+    """The table's name of safebasins' row under the variates' law ``law`` and ``correction``."""
+    return f"safebasins {law}, " + ("shift" if correction == "shift" else "uncorrected")
 
 
 # ---------------------------------------------------------------- numba Euler-Maruyama
@@ -233,7 +247,7 @@ def search(name, fn, S0, S_cap, ref):
         P = fn(S)
         dt = time.perf_counter() - t
         ok = abs(P - ref) <= TOL
-        print(f"  {name:28s} {S:5d} steps/cycle: P = {P:.4f} (bias {P - ref:+.4f}), {dt:7.2f} s"
+        print(f"  {name:34s} {S:5d} steps/cycle: P = {P:.4f} (bias {P - ref:+.4f}), {dt:7.2f} s"
               f"{'  <- reaches TOL' if ok else ''}", flush=True)
         if ok or S >= S_cap:
             return S, P, dt, ok
@@ -251,8 +265,9 @@ def main():
     print("torchsde: not run (PyPI's torch wheel pulls the CUDA stack, several GB; CPU wheel not on PyPI)")
 
     t = time.perf_counter()
-    ours(16, 64)
-    ours(16, 64, threads=ncores)
+    for law in VARIATES:
+        ours(16, 64, variates=law)
+        ours(16, 64, threads=ncores, variates=law)
     _em(64, 0.1, 10, SIGMA, F, OMEGA, PSI, XI, 0.0, True, 0)
     _em(64, 0.1, 10, SIGMA, F, OMEGA, PSI, XI, 0.0, False, 0)
     print(f"compile (safebasins, numba EM; excluded): {time.perf_counter() - t:.1f} s", flush=True)
@@ -274,9 +289,11 @@ def main():
     print(f"reference: P_ref = {ref:.4f} +- {se:.4f} (safebasins, {S_REF} steps/cycle, {N_REF} paths, shift; "
           f"{S_REF // 2} steps/cycle: {ref64:.4f}; {time.perf_counter() - t:.1f} s)", flush=True)
 
-    methods = {
-        "safebasins (shift)": (lambda S: ours(S, N), 8, S_CAP),
-        "safebasins (no correction)": (lambda S: ours(S, N, correction="none"), 8, S_CAP),
+    # safebasins starts at 8: the coarsest power of two its step limit accepts for the quartic
+    law_of = {ours_row(law, c): law for law in VARIATES for c in ("shift", "none")}
+    methods = {ours_row(law, c): (lambda S, c=c, law=law: ours(S, N, correction=c, variates=law), 8, S_CAP)
+               for law in VARIATES for c in ("shift", "none")}
+    methods |= {
         "numba EM, symplectic": (lambda S: numba_em(S, N, True), 16, S_CAP),
         "numba EM, symplectic+shift": (lambda S: numba_em(S, N, True, True), 16, S_CAP),
         "numba EM, plain": (lambda S: numba_em(S, N, False), S_CAP // 2, S_CAP),
@@ -292,17 +309,19 @@ def main():
         t = time.perf_counter()
         fn(S)
         times[name] = min(found[name][2], time.perf_counter() - t)
-    S_ours = found["safebasins (shift)"][0]
-    for name in ("safebasins (shift)", "safebasins (no correction)"):     # short runs: best of three more
+    for name in law_of:                                               # short runs: best of three more
         for _ in range(3):
             t = time.perf_counter()
             methods[name][0](found[name][0])
             times[name] = min(times[name], time.perf_counter() - t)
-    t_ours_all = math.inf
+    S_ours = {law: found[ours_row(law, "shift")][0] for law in VARIATES}
+    t_ours = {law: times[ours_row(law, "shift")] for law in VARIATES}
+    t_ours_all = dict.fromkeys(VARIATES, math.inf)
     for _ in range(3):
-        t = time.perf_counter()
-        ours(S_ours, N, threads=ncores)
-        t_ours_all = min(t_ours_all, time.perf_counter() - t)
+        for law in VARIATES:
+            t = time.perf_counter()
+            ours(S_ours[law], N, threads=ncores, variates=law)
+            t_ours_all[law] = min(t_ours_all[law], time.perf_counter() - t)
     # the slow peers: fewer paths, time scaled to N
     S_plain, _, _, plain_ok = found["numba EM, plain"]
     print(f"diffrax Euler and sdeint.itoEuler are the plain Euler-Maruyama map: its step ({S_plain}), "
@@ -310,13 +329,13 @@ def main():
     t = time.perf_counter()
     P = diffrax_em(runners["diffrax Euler"], S_plain, B_EULER)
     dt = time.perf_counter() - t
-    print(f"  {'diffrax Euler':28s} {S_plain:5d} steps/cycle: P = {P:.4f} ({B_EULER} paths), {dt:7.2f} s", flush=True)
+    print(f"  {'diffrax Euler':34s} {S_plain:5d} steps/cycle: P = {P:.4f} ({B_EULER} paths), {dt:7.2f} s", flush=True)
     found["diffrax Euler"] = (S_plain, P, dt * N / B_EULER, plain_ok)
     t = time.perf_counter()
     sdeint_paths(S_plain, K_SDEINT)
     found["sdeint itoEuler"] = (S_plain, float("nan"), (time.perf_counter() - t) * N / K_SDEINT, plain_ok)
     # ShARK checks at the steps only (an O(sqrt(h)) bias for every scheme): from the uncorrected splitting's step
-    S_none = found["safebasins (no correction)"][0]
+    S_none = found[ours_row("gaussian", "none")][0]
     print(f"diffrax ShARK: {B_SHARK} paths a step (standard error ~{0.5 / math.sqrt(B_SHARK):.3f}), from the "
           f"uncorrected splitting's step {S_none} (the monitoring bias is the same for every scheme), scaled to {N}:")
     S, P, dt, ok = search("diffrax ShARK", lambda S: diffrax_em(runners["diffrax ShARK"], S, B_SHARK), S_none,
@@ -325,33 +344,40 @@ def main():
     for name in ("diffrax Euler", "sdeint itoEuler", "diffrax ShARK"):
         times[name] = found[name][2]
 
-    t_ours = times["safebasins (shift)"]
-    print(f"\n{'method':28s} {'steps/cycle':>11s} {'P':>7s} {'bias':>8s} {'time N paths':>13s} "
-          f"{'peer/ours 1t':>13s} {f'peer/ours {ncores}t':>13s}")
+    print(f"\n{'method':34s} {'variates':10s} {'steps/cycle':>11s} {'P':>7s} {'bias':>8s} {'time N paths':>13s}"
+          + "".join(f" {f'/{law} {n}t':>15s}" for law in VARIATES for n in (1, ncores)))
     for name, (S, P, _, ok) in found.items():
         geq = "" if ok else ">="
         Ps, bias = (f"{P:7.4f}", f"{P - ref:+.4f}") if P == P else ("-", "-")
-        print(f"{name:28s} {S:>9d}{'' if ok else '*':2s} {Ps:>7s} {bias:>8s} {times[name]:11.2f} s "
-              f"{geq + format(times[name] / t_ours, '.1f'):>13s} {geq + format(times[name] / t_ours_all, '.1f'):>13s}")
-    print(f"safebasins on {ncores} threads at {S_ours} steps/cycle: {t_ours_all:.2f} s; * = TOL not reached at the "
-          f"cap (time at the cap: the ratio is a lower bound); diffrax Euler, ShARK, sdeint: "
-          f"{B_EULER}, {B_SHARK}, {K_SDEINT} paths timed, scaled to {N}")
-    # the same threshold rule for both: checked at the steps (no correction), or both shifted
-    same_raw = times["numba EM, symplectic"] / times["safebasins (no correction)"]
-    same_shift = times["numba EM, symplectic+shift"] / t_ours
-    print(f"same threshold rule: numba EM symplectic / safebasins, both uncorrected: {same_raw:.1f}; both shifted: "
-          f"{same_shift:.1f}")
-    report("noise_peers_numba_EM_symplectic_same_rule", round(min(same_raw, same_shift), 1),
-           f"time of numba EM, symplectic / time of the noisy ensemble, both with the same threshold rule (the smaller "
-           f"of: both uncorrected, both shifted) at |P_escape bias| <= {TOL}",
-           f"quartic Fig 14 forcing, sigma {SIGMA}, {CYCLES} cycles, {N} paths, one thread each")
-    for name in ("numba EM, symplectic", "numba EM, plain", "diffrax Euler", "diffrax ShARK", "sdeint itoEuler"):
-        r = times[name] / t_ours
-        report("noise_peers_" + name.split()[0].lower() + "_" + "_".join(name.split()[1:]).replace(",", ""),
-               round(r, 1), f"time of {name} / time of the noisy ensemble (one thread each) at equal weak accuracy "
-               f"(|P_escape bias| <= {TOL}){'' if found[name][3] else ', lower bound: TOL not reached at the cap'}",
-               f"quartic Fig 14 forcing, sigma {SIGMA}, {CYCLES} cycles, {N} paths; steps/cycle {found[name][0]} "
-               f"vs {S_ours}")
+        print(f"{name:34s} {law_of.get(name, 'normal'):10s} {S:>9d}{'' if ok else '*':2s} {Ps:>7s} {bias:>8s} "
+              f"{times[name]:11.2f} s" + "".join(f" {geq + format(times[name] / t, '.1f'):>15s}" for law in VARIATES
+                                               for t in (t_ours[law], t_ours_all[law])))
+    print("; ".join(f"safebasins {law} on {ncores} threads at {S_ours[law]} steps/cycle: {t_ours_all[law]:.2f} s"
+                    for law in VARIATES)
+          + f"; /<law> columns: time / safebasins' shifted row of that law on 1 or {ncores} threads; * = TOL not "
+          f"reached at the cap (time at the cap: the ratio is a lower bound); diffrax Euler, ShARK, sdeint: "
+          f"{B_EULER}, {B_SHARK}, {K_SDEINT} paths timed, scaled to {N}; 'normal': the peer's Gaussian increments")
+    for law in VARIATES:
+        # the same threshold rule for both: checked at the steps (no correction), or both shifted
+        same_raw = times["numba EM, symplectic"] / times[ours_row(law, "none")]
+        same_shift = times["numba EM, symplectic+shift"] / t_ours[law]
+        print(f"same threshold rule, safebasins {law}: numba EM symplectic / safebasins, both uncorrected: "
+              f"{same_raw:.1f}; both shifted: {same_shift:.1f}")
+        report(f"noise_peers_numba_EM_symplectic_same_rule_{law.replace('-', '_')}",
+               round(min(same_raw, same_shift), 1),
+               f"time of numba EM, symplectic / time of the noisy ensemble with {law} variates, both with the same "
+               f"threshold rule (the smaller of: both uncorrected, both shifted) at |P_escape bias| <= {TOL}",
+               f"quartic Fig 14 forcing, sigma {SIGMA}, {CYCLES} cycles, {N} paths, one thread each")
+    for law in VARIATES:
+        for name in ("numba EM, symplectic", "numba EM, plain", "diffrax Euler", "diffrax ShARK", "sdeint itoEuler"):
+            r = times[name] / t_ours[law]
+            report("noise_peers_" + name.split()[0].lower() + "_" + "_".join(name.split()[1:]).replace(",", "")
+                   + "_vs_" + law.replace("-", "_"),
+                   round(r, 1), f"time of {name} / time of the noisy ensemble with {law} variates (one thread each) at "
+                   f"equal weak accuracy (|P_escape bias| <= {TOL})"
+                   f"{'' if found[name][3] else ', lower bound: TOL not reached at the cap'}",
+                   f"quartic Fig 14 forcing, sigma {SIGMA}, {CYCLES} cycles, {N} paths; steps/cycle {found[name][0]} "
+                   f"vs {S_ours[law]}")
 
 
 if __name__ == "__main__":
