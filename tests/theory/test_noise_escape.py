@@ -23,11 +23,13 @@ Independent routes and the measured errors (the bounds below leave a margin):
 import numpy as np
 import pytest
 from scipy import integrate, special
+from scipy.integrate import solve_ivp
 
 from safebasins import theory
+from safebasins.theory.damped import rhs_exact
 from safebasins.theory.noise_averaging import AveragedDiffusion
 from safebasins.theory.noise_solver import DiscGrid, generator, interpolation, march_escape, solve_first_passage
-from safebasins.wells import QUARTIC
+from safebasins.wells import QUARTIC, resolve_well
 
 
 def _linear(J_max, omega=1.0):
@@ -161,6 +163,39 @@ def test_noise_free_limit_is_the_slow_flow(well, F, xi_max, beta, window):
     assert 0 < det.mean() < 1 and np.array_equal(P[..., 1].astype(bool), det)
     fp = ds["first_passage_mean"].values
     assert np.all(fp[P[..., 1] == 0] == 300) and np.all(fp[P[..., 1] == 1] <= 300)
+
+
+@pytest.mark.parametrize("well, F, beta, ics", [
+    ("quartic", 0.01, 0.0, [(-0.65, 0.0), (-0.6, 0.25), (-0.3, 0.0)]),
+    ("cubic", 0.005, 0.005, [(-0.36, 0.173), (-0.11, -0.47), (0.44, -0.025), (0.0, 0.0)]),
+])
+def test_noise_free_first_passage_times_against_dop853(well, F, beta, ics):
+    # the slow trajectory's first passage of xi_max against scipy's DOP853 on the well's exact slow
+    # flow (damped.rhs_exact, in the sheared frame: phase theta - Psi + delta(xi)); the march's times
+    # are the first RK4 substep at or past the threshold (1/64 cycle at 8 steps per cycle)
+    w = resolve_well(well)
+    xi_max = 0.18 if well == "quartic" else 0.12
+    q, p = np.array([c[0] for c in ics]), np.array([c[1] for c in ics])
+    ds = theory.escape_probability(q, p, F, 0.9, np.pi, xi_max, noise=0.0, t_eval=[200], well=w, damping=beta,
+                                   grid=False, cells=(16, 20))
+    period = 2 * np.pi / 0.9
+    J_max = float(w.J(xi_max))
+    hit = 0
+    for k, (q0, p0) in enumerate(ics):
+        theta, xi = w.angle_energy(np.array(q0), np.array(p0))
+        phi = float(theta) - np.pi + float(w.harmonic_shift(xi))
+        r = np.sqrt(2 * float(w.J(xi)))
+        event = lambda t, y: 0.5 * (y[0] ** 2 + y[1] ** 2) - J_max
+        event.terminal = True
+        sol = solve_ivp(lambda t, y: rhs_exact(w, np.array(y[0]), np.array(y[1]), F, 0.9, beta), (0, 200 * period),
+                        [r * np.cos(phi), r * np.sin(phi)], method="DOP853", rtol=1e-9, atol=1e-12, events=event)
+        got = float(ds["first_passage_mean"][k])
+        if sol.t_events[0].size:
+            hit += 1
+            assert 0 <= got - sol.t_events[0][0] / period <= 1 / 64 + 0.01, (q0, p0)
+        else:
+            assert got == 200 and float(ds["P_escape"][k, 0]) == 0
+    assert hit >= 2
 
 
 def test_small_noise_tends_to_the_noise_free_limit():
