@@ -48,9 +48,10 @@ Methods (one thread each, the same process; jax is held to one thread with XLA_F
 * safebasins: numerics.escape_probability (SRKN6b Strang splitting, Philox), each law of the
   variates, threads = 1; also threads = all cores at the same step (the ratio columns marked with
   the core count: peer on one thread / ours on all);
-* numba: hand-written @njit Euler-Maruyama, numba's np.random normals, one loop per path:
-  symplectic (p then q, the stronger variant for a Hamiltonian drift) and plain (q and p from the
-  old state, the textbook scheme, which is what sdeint's itoEuler and diffrax's Euler integrate);
+* numba: hand-written @njit Euler-Maruyama (serial: one thread), numba's np.random normals, one
+  loop per path: symplectic (p then q, the stronger variant for a Hamiltonian drift) and plain (q
+  and p from the old state, the textbook scheme, which is what sdeint's itoEuler and diffrax's
+  Euler integrate);
 * diffrax: Euler and ShARK (additive-noise Runge-Kutta, space-time Levy area), jax.jit of
   jax.vmap over the paths, UnsafeBrownianPath, an Event ends each path at escape; compile time
   excluded, printed. Both are slow on the CPU (~3e5 steps/s under vmap), so they run fewer paths
@@ -76,7 +77,7 @@ os.environ.setdefault("XLA_FLAGS", "--xla_cpu_multi_thread_eigen=false intra_op_
 _MISSING = []
 try:
     import numba
-    from numba import njit, prange
+    from numba import njit
 except ImportError:
     _MISSING.append("numba")
 try:
@@ -134,13 +135,13 @@ def ours_row(law, correction):
 
 
 # ---------------------------------------------------------------- numba Euler-Maruyama
-@njit(parallel=True, cache=False)
+@njit(cache=False)
 def _em(n_paths, h, n_steps, sigma, F, Omega, Psi, xi, shift, symplectic, seed):
     """Escaped within n_steps, per path (0/1); shift: the boundary shift's factor (0: none)."""
     out = np.zeros(n_paths, np.int64)
     sh = sigma * math.sqrt(h)
-    for j in prange(n_paths):
-        np.random.seed(seed + j)  # noqa: NPY002  (numba's per-thread generator, one stream a path)
+    for j in range(n_paths):  # one thread, as every row (a prange would take all cores)
+        np.random.seed(seed + j)  # noqa: NPY002  (one stream a path)
         q, p = 0.0, 0.0
         for n in range(n_steps):
             f = q * q * q - q + F * math.sin(Omega * n * h + Psi)
