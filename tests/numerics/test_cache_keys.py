@@ -15,11 +15,12 @@ from pathlib import Path
 from numba.core.caching import NullCache
 from numba.core.registry import CPUDispatcher
 
+from safebasins.core import numba_target
 from safebasins.numerics import kernels, periods, scheme_code, schemes, steps
 from safebasins.wells import compiled
 from tests.import_graph import SRC, closure, graph
 
-ENGINE_MODULES = (kernels, periods, scheme_code, schemes, steps, compiled)
+ENGINE_MODULES = (kernels, periods, scheme_code, schemes, steps, compiled, numba_target)
 #: cached dispatchers that inline nothing from another file (keyed by their own file alone)
 SELF_CONTAINED = {"safebasins.wells.compiled._fma_python", "safebasins.numerics.steps.wtuple"}
 

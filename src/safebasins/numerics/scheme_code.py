@@ -40,14 +40,16 @@ from typing import Any
 
 import numpy as np
 
+from safebasins.core import numba_target
 from safebasins.numerics.schemes import RungeKutta, Scheme, Splitting, scheme_of
 from safebasins.wells import compiled
 
 __all__ = ["SchemeCode", "scheme_code", "code_of_scheme", "engine_fingerprint", "fingerprint", "ENGINE_FILES"]
 
-#: the source files inlined into the engine's cached CPU kernels (tests/numerics/test_cache_keys.py
-#: checks the list against the modules the kernels import)
-ENGINE_FILES = (compiled.__file__, *(str(Path(__file__).with_name(name)) for name in
+#: the source files inlined into the engine's cached CPU kernels, and the one that sets the vector
+#: width they are compiled for (tests/numerics/test_cache_keys.py checks the list against the
+#: modules the kernels import)
+ENGINE_FILES = (compiled.__file__, numba_target.__file__, *(str(Path(__file__).with_name(name)) for name in
                 ("schemes.py", "scheme_code.py", "steps.py", "periods.py", "kernels.py")))
 
 

@@ -66,8 +66,13 @@ from numba import njit, types
 from numba.core import errors
 from numba.extending import intrinsic, overload
 
+from safebasins.core import numba_target
+
 if TYPE_CHECKING:
     from numba.core.decorators import _JITOptions   # numba's stubs: the options of njit
+
+# before the package's first kernel: numba's CPU target takes its vector width when it is created
+numba_target.configure()
 
 __all__ = ["WellCode", "fma", "mul", "fma_cpu", "mul_cpu", "N_WPAR", "quartic_code", "polynomial_code", "callable_code",
            "target_code", "force_from", "energy2_from",

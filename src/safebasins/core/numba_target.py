@@ -1,0 +1,63 @@
+"""The vector width numba compiles the package's kernels for: 512 bits on a CPU with AVX-512.
+
+LLVM tunes the Intel AVX-512 cores (Skylake-X, Cascade Lake, Ice Lake, Sapphire Rapids) with
+``prefer-256-bit``, so its loop vectoriser fills 256-bit registers (4 doubles) where the CPU has
+512-bit ones (8).  The engine's lane loops (every well's force, the elementary functions) are
+elementwise arithmetic: wider vectors change no bit of a result and, on a Cascade Lake, make a
+step about 1.6x faster for the quartic and the transcendental wells alike
+(benchmarks/bench_wells.py).
+
+:func:`configure` therefore gives numba the host's feature string with ``-prefer-256-bit``
+appended, on a CPU with ``avx512f`` only, and leaves numba alone where the user chose its target
+(``NUMBA_CPU_NAME``, ``NUMBA_CPU_FEATURES`` or numba's config file; ``NUMBA_ENABLE_AVX=0``
+removes ``avx512f`` from the host's features) or where numba's CPU target already exists in the
+process (code compiled before the package was imported: its features stay, one set per process).
+The feature string is part of numba's cache key (the codegen's ``magic_tuple``), so a kernel
+cached by a 256-bit process is never loaded by a 512-bit one, nor the reverse.
+"""
+from __future__ import annotations
+
+from numba.core import config
+from numba.core.codegen import get_host_cpu_features
+from numba.core.registry import cpu_target
+
+__all__ = ["PREFER_256", "wide_vector_features", "compiled_features", "configure"]
+
+#: LLVM's tuning feature that caps the loop vectoriser at 256 bits on AVX-512 cores
+PREFER_256 = "prefer-256-bit"
+
+
+def wide_vector_features(host_features: str) -> str | None:
+    """``host_features`` (LLVM's ``+name,-name,...``) with 512-bit vectors preferred: any
+    ``prefer-256-bit`` entry replaced by ``-prefer-256-bit`` at the end; None where the string
+    does not enable ``avx512f`` (nothing to widen)."""
+    flags = [f for f in host_features.split(",") if f]
+    if "+avx512f" not in flags:
+        return None
+    return ",".join([*(f for f in flags if f[1:] != PREFER_256), "-" + PREFER_256])
+
+
+def compiled_features() -> str:
+    """The feature string numba's CPU target compiles with in this process (the one its cache
+    key holds); creates the target when it does not exist yet."""
+    features: str = cpu_target.target_context.codegen().magic_tuple()[2]
+    return features
+
+
+def configure() -> str | None:
+    """Make numba's CPU target prefer 512-bit vectors on this host (see the module docstring),
+    before the package compiles or loads a kernel.  Returns the feature string set, None where
+    numba was left as it was."""
+    # numba.config sets CPU_NAME and CPU_FEATURES from the environment: not declared to mypy
+    if config.CPU_NAME is not None or config.CPU_FEATURES is not None:  # type: ignore[attr-defined]
+        return None                                                      # the user's choice
+    wide = wide_vector_features(get_host_cpu_features())
+    if wide is None:
+        return None
+    config.CPU_FEATURES = wide  # type: ignore[attr-defined]
+    # the target reads the features once, when it is created: created here, a later reload of
+    # numba's config (any change of a NUMBA_ variable) cannot undo them
+    if compiled_features() != wide:         # the target existed already, with its own features
+        config.CPU_FEATURES = None  # type: ignore[attr-defined]
+        return None
+    return wide
