@@ -6,7 +6,7 @@ The peers are not dependencies of safebasins: run it from a separate environment
     python3 -m venv /tmp/peers
     /tmp/peers/bin/pip install diffrax jax sdeint numba numpy scipy xarray netCDF4 matplotlib pyyaml \\
         jsonschema nbformat rocrate click tqdm sympy
-    PYTHONPATH=src /tmp/peers/bin/python benchmarks/bench_noise_peers.py           # ~6 min on 2 cores
+    PYTHONPATH=src /tmp/peers/bin/python benchmarks/bench_noise_peers.py           # ~1.5 min on 2 cores
 
 It stops with an error naming the package when numba, jax, diffrax or sdeint is missing (a table
 with a peer silently absent would read as a win). torchsde is not run: on PyPI it needs torch,
@@ -54,15 +54,15 @@ Methods (one thread each, the same process; jax is held to one thread with XLA_F
   Euler integrate);
 * diffrax: Euler and ShARK (additive-noise Runge-Kutta, space-time Levy area), jax.jit of
   jax.vmap over the paths, UnsafeBrownianPath, an Event ends each path at escape; compile time
-  excluded, printed. Both are slow on the CPU (~3e5 steps/s under vmap), so they run fewer paths
-  and their time is scaled to N: Euler 500 paths at the plain Euler-Maruyama's step (the same
-  map); ShARK 1500 paths a step (standard error ~0.013), searched from the uncorrected
+  excluded, printed. Both are slow on the CPU (~0.7-1.4e6 path-steps/s under vmap), so they run
+  fewer paths and their time is scaled to N: Euler 500 paths at the plain Euler-Maruyama's step
+  (the same map); ShARK 1500 paths a step (standard error ~0.013), searched from the uncorrected
   Gaussian splitting's step (below it the monitoring bias alone exceeds TOL for any scheme);
 * sdeint: itoEuler, pure Python: 4 paths are timed and the time scaled to N (its step is the
   plain Euler-Maruyama's: the same map, checked on one path to 1e-12 with the same increments).
   itoSRI2 is not run (its accuracy would need a search over thousands of pure-Python paths).
 
-The whole run takes ~6 min on 2 cores (the reference ~30 s, diffrax ~3 min).
+The whole run takes ~1.5 min on 2 cores under load (the reference ~10 s, diffrax ~30 s).
 """
 from __future__ import annotations
 
