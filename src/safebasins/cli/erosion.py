@@ -100,10 +100,11 @@ def stochastic_erosion(F: list[float], Omega: float, Psi: float, xi_max: float, 
     stochastic safe basin {P_escape <= epsilon} at each --t-eval is measured by GIM, LIM and IF
     (Soliman and Thompson's stochastic integrity; with --conservative also the basin of the upper
     end of the 95% Wilson interval). Where the averaged theory applies (white or Ornstein-Uhlenbeck
-    noise, every --noise > 0, a symmetric well, --xi-max below the barrier) its profile GIM_theory, LIM_theory,
-    IF_theory is added (docs/noise-theory.md; --no-theory: none, the attribute theory_reason says
-    why). PREFIX.nc is the library's dataset over (F, noise, epsilon, t_eval) (a single value: no
-    dimension); PREFIX.png draws the profile against sigma and against F at the last --t-eval.
+    noise, any well, --xi-max below the barrier; at --noise 0 the noise-free slow flow) its profile
+    GIM_theory, LIM_theory, IF_theory is added (docs/noise-theory.md; --no-theory: none, the
+    attribute theory_reason says why). PREFIX.nc is the library's dataset over (F, noise, epsilon,
+    t_eval) (a single value: no dimension); PREFIX.png draws the profile against sigma and
+    against F at the last --t-eval.
 
     Example: safebasins stochastic-erosion --F 0.02,0.05 --Omega 0.9 --xi-max 0.2 --damping 0.05
     --noise 0.02,0.04,0.06 --epsilon 0.1 --t-eval 5 --n 41 --paths 200

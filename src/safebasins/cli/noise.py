@@ -107,8 +107,8 @@ def escape_probability(F: float, Omega: float, Psi: float, xi_max: float, noise:
     order 2, counter-based random numbers) and escape by the criteria of the escape charts.
     PREFIX.nc is the library's dataset: P_escape(q0, p0, t_eval) with its 95% Wilson interval,
     the survival curve and the restricted mean first-passage time (docs/noise.md), and where the
-    averaged theory applies (white or Ornstein-Uhlenbeck noise, --noise > 0, a symmetric well,
-    --xi-max below the barrier) its map P_escape_theory with the agreement |P_escape_theory - P_escape|
+    averaged theory applies (white or Ornstein-Uhlenbeck noise, any well, --xi-max below the barrier;
+    at --noise 0 the noise-free slow flow) its map P_escape_theory with the agreement |P_escape_theory - P_escape|
     (docs/noise-theory.md; --no-theory: none, and the attribute theory_reason says why);
     PREFIX.png maps P_escape at each --t-eval with the theory's contours.
 

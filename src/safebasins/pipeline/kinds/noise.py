@@ -115,8 +115,8 @@ def _ensemble_kwargs(params: Params, job: Job) -> dict[str, Any]:
 
 # --------------------------------------------------------------------------- the averaged theory (both kinds)
 #: where the averaged theory applies (the schema's and the docs' words)
-THEORY_APPLIES = ("white or Ornstein-Uhlenbeck noise (noise_time short against the slow time), every noise level "
-                  "> 0, a symmetric well and xi_max below the "
+THEORY_APPLIES = ("white or Ornstein-Uhlenbeck noise (noise_time short against the slow time; at noise 0 the "
+                  "noise-free slow flow), any well (an asymmetric one in its sheared phase) and xi_max below the "
                   "barrier; elsewhere, or with false, the dataset's attribute theory is 'none' and theory_reason "
                   "says why")
 
