@@ -148,6 +148,28 @@ def test_arrhenius_slope_asymmetric_well():
     assert abs(slope[-1] - 1) < 0.03 and abs(slope[-1] - 1) < abs(slope[0] - 1)
 
 
+def test_two_attractors_and_a_saddle_asymmetric_well():
+    """The cubic at F = 0.01, beta = 0.02, xi_max = 0.1: the bottom's attractor, a resonant one just
+    inside the circle (barrier 1.2e-6) and a saddle between them whose other branch escapes.  The
+    rays reach the saddle only after extra refinement passes; the bottom attractor's barrier (via the
+    saddle, 2.021e-3) against the backward equation's Arrhenius slope: measured 0.983, 1.006, 1.021,
+    1.036 of it between sigma = 0.02, 0.016, 0.013, 0.011, 0.0095."""
+    k = dict(F=0.01, Omega=0.9, xi_max=0.1, damping=0.02)
+    qp = theory.quasi_potential(k["F"], k["Omega"], k["xi_max"], damping=k["damping"], well=CUBIC)
+    assert qp.attractors.shape == (2, 2) and qp.saddles.shape == (1, 2) and qp.exit_set == ("chain", "chain")
+    assert np.isfinite(qp.to_saddle[0, 0]) and qp.barrier[0] == pytest.approx(qp.to_saddle[0, 0])
+    assert qp.barrier[1] < 1e-3 * qp.barrier[0]
+    X, Y = qp.attractors[0]
+    xi = float(xi_of_J(CUBIC, 0.5 * (X * X + Y * Y)))
+    q0, p0 = CUBIC.phase_point(np.arctan2(Y, X) - float(CUBIC.harmonic_shift(xi)), xi)
+    sig = np.array([0.02, 0.016, 0.013])
+    T = [float(theory.mean_first_passage([float(q0)], [float(p0)], k["F"], k["Omega"], 0.0, k["xi_max"], noise=s,
+                                         damping=k["damping"], grid=False, well=CUBIC)["mean_first_passage"][0])
+         for s in sig]
+    slope = np.diff(np.log(T)) / np.diff(1 / sig ** 2) / qp.barrier[0]
+    assert abs(slope[-1] - 1) < 0.03
+
+
 def test_poisson_law_against_the_sde_ensemble(forced):
     """Once relaxed, escape is a Poisson event: the full equation's ensemble (2000 paths) at
     sigma = 0.025 (barrier / sigma^2 = 3.5) against 1 - exp(-t/T), T from the backward equation

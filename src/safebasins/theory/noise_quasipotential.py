@@ -52,6 +52,8 @@ __all__ = ["QuasiPotential", "quasi_potential", "attractor_barriers", "coefficie
 N_RAYS = 128
 REFINE_RAYS = 24
 REFINE_PASSES = 3
+#: further passes (at most) while a saddle that sets a barrier is not yet reached by the rays
+EXTRA_PASSES = 5
 #: semi-major axis of the start ellipse over the escape radius sqrt(2 J_max)
 START = 0.02
 #: RK4 step times the largest rate of the linearised flow in the disc
@@ -385,6 +387,20 @@ def _branches(pb: _Problem, saddles: FloatArray, attractors: FloatArray, dt: flo
     return flag.reshape(S, 2)
 
 
+def _unreached(targets: NDArray[np.intp], sad_d: FloatArray, sad_phi: FloatArray, best_c: FloatArray, R: float,
+               K: int) -> list[tuple[int, int]]:
+    """(attractor, saddle) pairs whose saddle the rays have not reached although it may set the
+    attractor's barrier: an unreached saddle may be left out only where the rays' Phi beside it is
+    well above the circle's (one attractor, the saddle's other branch escaping)."""
+    out = []
+    for j in range(targets.shape[0]):
+        for k in targets[j][targets[j] >= 0]:
+            irrelevant = K == 1 and ESCAPE in targets[j] and sad_phi[k, j] > (1.0 + SADDLE_MARGIN) * best_c[k]
+            if sad_d[k, j] > SADDLE_TOL * R and not irrelevant:
+                out.append((int(k), j))
+    return out
+
+
 def _solve(pb: _Problem, atts: FloatArray, sads: FloatArray, xm: float, n_rays: int, step: float) -> QuasiPotential:
     K, S = atts.shape[0], sads.shape[0]
     R = math.sqrt(2.0 * pb.J_max)
@@ -411,7 +427,14 @@ def _solve(pb: _Problem, atts: FloatArray, sads: FloatArray, xm: float, n_rays: 
     width = np.full(K, 2.0 * np.pi / n_rays)
     sad_width = np.full((K, S), 2.0 * np.pi / n_rays)
     ref = np.linspace(-1.0, 1.0, REFINE_RAYS)
-    for _ in range(REFINE_PASSES + 1):
+    targets = _branches(pb, sads, atts, dt, 4 * steps, R)
+    for j in range(S):
+        if UNDECIDED in targets[j]:
+            raise RuntimeError(f"a branch of saddle {j} neither escapes nor reaches an attractor within the time limit")
+    passes = 0
+    while passes <= REFINE_PASSES or (passes <= REFINE_PASSES + EXTRA_PASSES
+                                      and _unreached(targets, sad_d, sad_phi, best_c, R, K)):
+        passes += 1
         owner = np.concatenate([np.full(p.size, k) for k, p in enumerate(params)])
         s_all = np.concatenate(params)
         exits, near_d, near_phi = pb.shoot(np.concatenate([starts(k, p) for k, p in enumerate(params)]), owner,
@@ -436,18 +459,12 @@ def _solve(pb: _Problem, atts: FloatArray, sads: FloatArray, xm: float, n_rays: 
             sad_width[k] *= 2.0 / (REFINE_RAYS - 1)
             width[k] *= 2.0 / (REFINE_RAYS - 1)
             params.append(np.concatenate(nxt))
-    targets = _branches(pb, sads, atts, dt, 4 * steps, R)
     reached = sad_d <= SADDLE_TOL * R
-    for j in range(S):
-        if UNDECIDED in targets[j]:
-            raise RuntimeError(f"a branch of saddle {j} neither escapes nor reaches an attractor within the time limit")
-        for k in targets[j][targets[j] >= 0]:
-            # an unreached saddle may be left out only where the rays' Phi beside it is well above
-            # the circle's (one attractor, the saddle's other branch escaping)
-            irrelevant = K == 1 and ESCAPE in targets[j] and sad_phi[k, j] > (1.0 + SADDLE_MARGIN) * best_c[k]
-            if not reached[k, j] and not irrelevant:
-                raise RuntimeError(f"the rays of attractor {k} pass saddle {j} no closer than "
-                                   f"{sad_d[k, j] / R:.2g} of the escape radius; raise n_rays")
+    missed = _unreached(targets, sad_d, sad_phi, best_c, R, K)
+    if missed:
+        k, j = missed[0]
+        raise RuntimeError(f"the rays of attractor {k} pass saddle {j} no closer than "
+                           f"{sad_d[k, j] / R:.2g} of the escape radius; raise n_rays")
     to_saddle = np.where(reached, sad_phi, np.inf)
     barrier, sets = attractor_barriers(best_c, to_saddle, targets)
     if not np.isfinite(barrier).all():
