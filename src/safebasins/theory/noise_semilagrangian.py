@@ -17,6 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from safebasins.theory.damped import flow_tilde
 from safebasins.theory.noise_averaging import AveragedDiffusion
 from safebasins.theory.noise_solver import DiscGrid, generator, interpolation, row_range
 from safebasins.theory.types import FloatArray
@@ -26,17 +27,23 @@ __all__ = ["departure_points", "advection_matrix", "march_escape_sl", "escape_ti
 
 def _flow(X: FloatArray, Y: FloatArray, diff: AveragedDiffusion, a_J: FloatArray, F: float, Omega: float,
           beta: float) -> tuple[FloatArray, FloatArray]:
-    """The slow flow in the regular (sheared) frame: with ``a = A/r``, ``e = da/dJ`` and the detuning
-    ``w = omega - beta d - Omega`` (d = 0 for a symmetric well; docs/damping.md),
-    ``X' = -(beta/2) X - w Y + F e X Y``, ``Y' = w X - (beta/2) Y - F (a + e X^2)``."""
+    """The slow flow in the regular (sheared) frame (:func:`~safebasins.theory.damped.flow_tilde`)
+    with the tables' coefficients at ``J = (X^2 + Y^2)/2`` (``e = da/dJ``; d = 0 for a symmetric well)."""
     J = np.minimum(0.5 * (X * X + Y * Y), diff.J_max)
     om = np.interp(J, diff.J_nodes, diff.omega)
     a = np.interp(J, diff.J_nodes, diff.a)
     e = np.interp(J, diff.J_nodes, a_J)
-    det = om - Omega
-    if not diff.symmetric:
-        det = det - beta * diff.d(J)
-    return -0.5 * beta * X - det * Y + F * e * X * Y, det * X - 0.5 * beta * Y - F * (a + e * X * X)
+    return flow_tilde(X, Y, F, Omega, beta, om, a, e, diff.d(J))
+
+
+def _rk4(X: FloatArray, Y: FloatArray, h: float, diff: AveragedDiffusion, a_J: FloatArray, F: float, Omega: float,
+         beta: float) -> tuple[FloatArray, FloatArray]:
+    """One RK4 step of :func:`_flow`."""
+    k1 = _flow(X, Y, diff, a_J, F, Omega, beta)
+    k2 = _flow(X + 0.5 * h * k1[0], Y + 0.5 * h * k1[1], diff, a_J, F, Omega, beta)
+    k3 = _flow(X + 0.5 * h * k2[0], Y + 0.5 * h * k2[1], diff, a_J, F, Omega, beta)
+    k4 = _flow(X + h * k3[0], Y + h * k3[1], diff, a_J, F, Omega, beta)
+    return X + h / 6.0 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]), Y + h / 6.0 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
 
 
 def departure_points(grid: DiscGrid, diff: AveragedDiffusion, F: float, Omega: float, beta: float, dt: float,
@@ -51,12 +58,7 @@ def departure_points(grid: DiscGrid, diff: AveragedDiffusion, F: float, Omega: f
     h = dt / substeps
     escaped = np.zeros(X.size, bool)
     for _ in range(substeps):
-        k1 = _flow(X, Y, diff, a_J, F, Omega, beta)
-        k2 = _flow(X + 0.5 * h * k1[0], Y + 0.5 * h * k1[1], diff, a_J, F, Omega, beta)
-        k3 = _flow(X + 0.5 * h * k2[0], Y + 0.5 * h * k2[1], diff, a_J, F, Omega, beta)
-        k4 = _flow(X + h * k3[0], Y + h * k3[1], diff, a_J, F, Omega, beta)
-        X = X + h / 6.0 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
-        Y = Y + h / 6.0 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+        X, Y = _rk4(X, Y, h, diff, a_J, F, Omega, beta)
         escaped |= 0.5 * (X * X + Y * Y) >= diff.J_max
     J = np.minimum(0.5 * (X * X + Y * Y), diff.J_max)
     return np.mod(np.arctan2(Y, X), 2.0 * np.pi), J, escaped
@@ -78,13 +80,7 @@ def escape_times(diff: AveragedDiffusion, F: float, Omega: float, beta: float, p
     for k in range(1, n + 1):
         if not live.any():
             break
-        x, y = X[live], Y[live]
-        k1 = _flow(x, y, diff, a_J, F, Omega, beta)
-        k2 = _flow(x + 0.5 * h * k1[0], y + 0.5 * h * k1[1], diff, a_J, F, Omega, beta)
-        k3 = _flow(x + 0.5 * h * k2[0], y + 0.5 * h * k2[1], diff, a_J, F, Omega, beta)
-        k4 = _flow(x + h * k3[0], y + h * k3[1], diff, a_J, F, Omega, beta)
-        X[live] = x + h / 6.0 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
-        Y[live] = y + h / 6.0 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+        X[live], Y[live] = _rk4(X[live], Y[live], h, diff, a_J, F, Omega, beta)
         hit = live & (0.5 * (X * X + Y * Y) >= diff.J_max)
         out[hit] = k * h
         live &= ~hit
