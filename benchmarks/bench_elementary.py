@@ -4,6 +4,7 @@ and their speed against the platform's libm, in one process (docs/elementary.md)
     python benchmarks/bench_elementary.py                    # accuracy (1e5 samples per function) and speed
     python benchmarks/bench_elementary.py --samples 1000000 --only sin,cos
     python benchmarks/bench_elementary.py --no-accuracy      # speed only
+    python benchmarks/bench_elementary.py --no-accuracy --before HEAD~1   # speed before / after
 
 Accuracy: the largest error in ulps against mpmath (~100 bits beyond double) over the samples of
 tests/wells/elementary_reference.py (the whole domain of each function, every binade down to the
@@ -11,13 +12,20 @@ subnormals and up to overflow) and its hard points, for the CPU compilation; the
 assert is elementary.ULP_BOUNDS.  Speed: ns per call in an njit loop over 4096 arguments (uniform
 in [-10, 10], log in (0, 20], pow with y in [-3, 3]), the best of --repeat interleaved runs,
 elementary (vectorised lanes) against numba's math.* (libm: glibc), both on the same arrays.
+With --before REV: also wells/elementary.py of git revision REV (its sibling modules today's),
+compiled for the CPU beside today's in this process and timed in the same interleaved rounds;
+the column after/before is today's time over REV's, and the bits of both on the speed arrays
+are compared (a change meant to keep the bits must print "bits equal").
 """
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import math
 import os
+import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -30,6 +38,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from safebasins.wells import elementary  # noqa: E402
+from safebasins.wells.compiled import fma_cpu, mul_cpu  # noqa: E402
+from safebasins.wells.elementary_targets import as_bits_cpu, cold_call_cpu, compile_code, from_bits_cpu  # noqa: E402
 from tests.wells import elementary_reference as ref  # noqa: E402
 
 
@@ -81,14 +91,36 @@ def _libm(name: str) -> Any:
     return None if g is None else njit(lambda x: g(x))
 
 
-def speed(names: list[str], repeat: int) -> None:
+def before_cpu(rev: str) -> Any:
+    """wells/elementary.py of git revision ``rev`` compiled for the CPU as today's elementary.cpu()
+    compiles today's (the sibling modules and the primitives today's): a namespace of dispatchers."""
+    src = subprocess.run(["git", "show", f"{rev}:src/safebasins/wells/elementary.py"], cwd=ROOT, check=True,
+                         capture_output=True, text=True).stdout
+    path = Path(tempfile.mkdtemp(prefix="safebasins_elementary_before")) / "elementary_before.py"
+    path.write_text(src)
+    spec = importlib.util.spec_from_file_location("elementary_before", path)
+    assert spec is not None and spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules["elementary_before"] = mod
+    spec.loader.exec_module(mod)
+    prims = {"fma": fma_cpu, "mul": mul_cpu, "as_bits": as_bits_cpu, "from_bits": from_bits_cpu}
+    # its rare paths as today's: masked cold calls (symbols of their own)
+    modules = (mod, *elementary._MODULES[1:])
+    cold = {k: (lambda ns, k=k: cold_call_cpu(getattr(ns, k), f"before{k}"))
+            for k in ("_sin_huge", "_cos_huge") if any(k in vars(m) for m in modules)}
+    return compile_code(modules, njit(error_model="numpy", forceinline=True), prims, cold)
+
+
+def speed(names: list[str], repeat: int, before: str | None = None) -> None:
     rng = np.random.default_rng(0)
     x = rng.uniform(-10.0, 10.0, 4096)
     pos = rng.uniform(1e-3, 20.0, 4096)
     y = rng.uniform(-3.0, 3.0, 4096)
     out = np.empty_like(x)
-    print(f"\n{'function':9s} {'elementary ns':>14s} {'libm ns':>9s} {'ratio':>6s}")
     cpu = elementary.cpu()
+    old = before_cpu(before) if before else None
+    extra = f" {'before ns':>9s} {'after/before':>12s}  bits" if old else ""
+    print(f"\n{'function':9s} {'elementary ns':>14s} {'libm ns':>9s} {'ratio':>6s}{extra}")
     for name in names:
         if name in ("powi", "sincos"):
             continue
@@ -98,9 +130,13 @@ def speed(names: list[str], repeat: int) -> None:
         lib = _libm(name)
         if lib is not None:
             jobs["libm"] = _loops(lib, two)
+        if old is not None:
+            jobs["before"] = _loops(getattr(old, name), two)
         best = dict.fromkeys(jobs, math.inf)
-        for fn in jobs.values():
+        outs = {}
+        for k, fn in jobs.items():
             fn(arg, y, out)
+            outs[k] = out.copy()
         for _ in range(repeat):
             for k, fn in jobs.items():
                 t = time.perf_counter()
@@ -108,7 +144,12 @@ def speed(names: list[str], repeat: int) -> None:
                     fn(arg, y, out)
                 best[k] = min(best[k], (time.perf_counter() - t) / (50 * arg.size) * 1e9)
         lm = best.get("libm", math.nan)
-        print(f"{name:9s} {best['elementary']:14.2f} {lm:9.2f} {best['elementary'] / lm:6.2f}", flush=True)
+        line = f"{name:9s} {best['elementary']:14.2f} {lm:9.2f} {best['elementary'] / lm:6.2f}"
+        if old is not None:
+            same = np.array_equal(outs["elementary"].view(np.int64), outs["before"].view(np.int64))
+            line += (f" {best['before']:9.2f} {best['elementary'] / best['before']:12.2f}  "
+                     f"{'bits equal' if same else 'BITS DIFFER'}")
+        print(line, flush=True)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -118,13 +159,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeat", type=int, default=7)
     ap.add_argument("--no-accuracy", action="store_true")
     ap.add_argument("--no-speed", action="store_true")
+    ap.add_argument("--before", default=None, help="git revision: also time its wells/elementary.py (after/before)")
     a = ap.parse_args(argv)
     names = a.only.split(",")
     print("machine:", machine())
     if not a.no_accuracy:
         accuracy(names, a.samples)
     if not a.no_speed:
-        speed(names, a.repeat)
+        speed(names, a.repeat, a.before)
     print("machine after:", machine())
     return 0
 

@@ -31,7 +31,9 @@ Generated code before / after (``--wells-only --sources-before REV``): only the 
 quartic and the non-polynomial wells, each expression well also compiled from the V, dV source
 that wells/expression.py of git revision REV generates for it (imported from a temporary file
 beside today's package), both in this process, interleaved; ratios to the quartic paired per
-round.
+round.  Elementary functions before / after (``--wells-only --elementary-before REV``): each
+expression well also compiled with today's source around wells/elementary.py of revision REV
+(bench_elementary.before_cpu), likewise.
 
 Measured (docs/numerics.md, "Wells"), AMD EPYC (AVX-512), 1 thread, SRKN6b, with one compiled form per well:
 quartic after / before 1.020 dense, 0.957 chart (escape steps equal); time per step vs the quartic:
@@ -223,6 +225,24 @@ def code_before(well, before):
                                 f"{elementary.MODULE_HASH}\0{source}"), source
 
 
+def code_elementary_before(well, rev):
+    """The compiled form of expression well ``well`` (today's source and joint form) around
+    wells/elementary.py of git revision ``rev`` (bench_elementary.before_cpu)."""
+    import bench_elementary  # noqa: PLC0415  (beside this script; imports the test references)
+
+    X = sys.modules["safebasins.wells.expression"]
+    old = bench_elementary.before_cpu(rev)
+    source, joint = well.source, X.joint_source(well.source)
+
+    def functions(jit):
+        assert jit is compiled.cpu_jit, "the elementary functions before are compiled for the CPU only"
+        return X._joint_functions(source, joint, X._compiled_namespace(old))
+    text = subprocess.run(["git", "show", f"{rev}:src/safebasins/wells/elementary.py"], cwd=ROOT, check=True,
+                          capture_output=True, text=True).stdout
+    return compiled.target_code(functions, well.barriers, f"{well.name} (elementary {rev})",
+                                f"elementary {text}\0{elementary.MODULE_HASH}\0{source}\0{joint}")
+
+
 def wells_only(args):
     """Dense jobs of the quartic and the non-polynomial wells, today's generated code and (with
     --sources-before) the code of that revision's wells/expression.py, interleaved."""
@@ -243,6 +263,9 @@ def wells_only(args):
             if before is not None:
                 code, source = code_before(w, before)
                 print(f"{k}: today's source\n{w.source}\n{k}: source of {args.sources_before}\n{source}")
+                jobs.append(Job(f"{k} dense, before", kernels, *ics, **kw, code=code))
+            elif args.elementary_before:
+                code = code_elementary_before(w, args.elementary_before)
                 jobs.append(Job(f"{k} dense, before", kernels, *ics, **kw, code=code))
         t = time.perf_counter()
         rounds = {}
@@ -283,6 +306,9 @@ def main(argv=None):
                     help="only the dense jobs of the quartic and the non-polynomial wells")
     ap.add_argument("--sources-before", default=None,
                     help="with --wells-only: also each expression well's code as this git revision generated it")
+    ap.add_argument("--elementary-before", default=None,
+                    help="with --wells-only: also each expression well around this git revision's "
+                         "wells/elementary.py (CPU)")
     ap.add_argument("--wells", nargs="+", default=list(TRANSCENDENTAL), choices=list(TRANSCENDENTAL),
                     help="with --wells-only: which wells")
     args = ap.parse_args(argv)

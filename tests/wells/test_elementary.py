@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from numba import cuda
+from numba import cuda, njit
 
 from safebasins.wells import elementary
 from tests.wells import elementary_reference as ref
@@ -212,3 +212,50 @@ def _same_bits(a: np.ndarray, b: np.ndarray) -> bool:
 
 if __name__ == "__main__":
     _simulator_child()
+
+
+#: the rare paths a vectorised loop calls out of line (masked: only the lanes that need them), by function
+COLD_PATHS = {"sin": ("_sin_huge",), "cos": ("_cos_huge",), "exp": ("_exp_tiny",), "pow": ("_pow_tiny",)}
+
+
+@pytest.mark.parametrize("name", sorted(COLD_PATHS))
+def test_rare_paths_are_masked_calls_out_of_the_lanes(name: str) -> None:
+    """A loop over the function vectorises and reaches its rare paths (huge sin/cos arguments,
+    results near the subnormal range) through their masked vector variants, not inline (inline,
+    exp's subnormal rounding doubled its cost on AVX2); lanes on both paths in one vector give
+    the bits of the Python source, argument by argument."""
+    f = getattr(elementary.cpu(), name)
+    rng = np.random.default_rng(3)
+    if name == "pow":
+        tiny = rng.uniform(1e-3, 0.99, 64)
+        x = np.concatenate([tiny, rng.uniform(0.5, 20.0, 64)])
+        y = np.concatenate([rng.uniform(-744.0, -709.0, 64) / np.log(tiny), rng.uniform(-3.0, 3.0, 64)])
+        order = rng.permutation(x.size)                  # y log x near -745..-709 (subnormal) and normal
+        x, y = x[order], y[order]
+
+        @njit
+        def loop2(x: np.ndarray, y: np.ndarray, out: np.ndarray) -> None:
+            for i in range(x.size):
+                out[i] = f(x[i], y[i])
+        loop, args = loop2, (x, y)
+    else:
+        rare = rng.uniform(2.0 ** 31, 1e300, 64) if name in ("sin", "cos") else rng.uniform(-745.0, -708.0, 64)
+        x = np.concatenate([rare, rng.uniform(-20.0, 20.0, 64)])
+        rng.shuffle(x)
+        @njit
+        def loop1(x: np.ndarray, out: np.ndarray) -> None:
+            for i in range(x.size):
+                out[i] = f(x[i])
+        loop = loop1
+        args = (x,)
+    out = np.empty(x.size)
+    loop(*args, out)
+    ir = loop.inspect_llvm(loop.signatures[0])
+    assert "vector.body" in ir
+    for path in COLD_PATHS[name]:
+        assert f"@safebasins_cold_{path}_v" in ir, f"{path} is not a masked vector call"
+    py = getattr(elementary, name)
+    want = np.array([py(*(float(a[i]) for a in args)) for i in range(x.size)])
+    assert np.array_equal(out.view(np.int64), want.view(np.int64))
+    if name in ("exp", "pow"):
+        assert np.any((out != 0.0) & (np.abs(out) < 2.2250738585072014e-308)), "no lane took the subnormal path"

@@ -14,8 +14,10 @@ with selects rather than branches, so that a loop calling them vectorises on the
   faithful minimax kernels on [-pi/4, pi/4] (double-double kernels on the huge-argument path).
 * exp, expm1: x = n ln2 + r_h + r_l (r_h exact, r_l = -n LN2_LO not normalised), e^r - 1 - r_h
   by a minimax polynomial with r_h^2/2 exact, r_l added as r_l e^r_h; 2^n applied in two factors
-  (no spurious overflow), one rounding in the subnormal range; faithful.  exp_expm1: both, with
-  their bits, from one reduction.
+  (no spurious overflow), one rounding in the subnormal range (exp's and pow's: a path of its
+  own, on the CPU a masked call, which costs less than the path inline); faithful.  exp_expm1:
+  both, with their bits, from one reduction (its subnormal path inline: in the engine's steps
+  the call costs more).
 * log, log1p: x = 2^E z, z in [sqrt(1/2), sqrt(2)), log z = 2 atanh(s), s = (z-1)/(z+1) as a
   double-double, minimax polynomial in s^2.
 * cosh, sinh, tanh: from the double-double e^|x| and its reciprocal (sinh below 1/4 by its own
@@ -208,13 +210,24 @@ def _exp_fast(x: float) -> tuple[int, float, float]:
     return as_bits(k) - _SHIFT_BITS, rh, t + fma(rl, rh + t, rl)
 
 
+def _exp_tiny(x: float) -> float:
+    """e^x for ``-746 <= x <= 710`` with exp's rounding into the subnormal range (:func:`_exp_finish`):
+    exp's path where 2^n <= 2^-1022, out of the lanes' way (its arithmetic costs more than the
+    normal path's)."""
+    n, rh, t = _exp_fast(x)
+    bh, be = _fast_two_sum(1.0, rh)
+    return _exp_finish(n, bh, be + t)
+
+
 def exp(x: float) -> float:
     """e^x."""
     xc = x if x > -746.0 else -746.0                 # NaN -> -746 here, restored at the end
     xc = xc if xc < 710.0 else 710.0
     n, rh, t = _exp_fast(xc)
     bh, be = _fast_two_sum(1.0, rh)
-    res = _exp_finish(n, bh, be + t)
+    res = _scale(n, bh + (be + t))
+    if n <= -1022:                                   # maybe subnormal: rare, on the CPU a masked cold call
+        res = _exp_tiny(xc)
     return x + x if x != x else res
 
 
@@ -254,7 +267,7 @@ def exp_expm1(x: float) -> tuple[float, float]:
     xc = xc if xc < 710.0 else 710.0
     n, rh, t = _exp_fast(xc)
     bh, be = _fast_two_sum(1.0, rh)
-    e = _exp_finish(n, bh, be + t)
+    e = _exp_finish(n, bh, be + t)                 # inline: a masked call here costs the engine's steps more
     return (x + x if x != x else e), _expm1_finish(x, n, rh, t, e)
 
 
@@ -400,6 +413,14 @@ def _parity(y: float) -> tuple[bool, bool]:
     return integer, integer & ((as_bits(k) & 1) == 1) & (ay < _P53)
 
 
+def _pow_tiny(eh: float, el: float) -> float:
+    """e^(e_h + e_l) for ``-746 <= e_h <= 710`` with exp's rounding into the subnormal range: pow's
+    path where 2^n <= 2^-1022, out of the lanes' way (as :func:`_exp_tiny`)."""
+    n, rh, rl = _exp_reduce(eh, el)
+    bh, bl = _exp_poly(rh, rl)
+    return _exp_finish(n, bh, bl)
+
+
 def pow(x: float, y: float) -> float:
     """x^y (C99 Annex F special cases: pow(x, 0) = pow(1, y) = 1 even for NaN, ...)."""
     ax = abs(x)
@@ -408,9 +429,12 @@ def pow(x: float, y: float) -> float:
     tl = fma(y, lh, -th) + mul(y, ll)
     big = th > 710.0
     small = not (th > -746.0)                        # NaN too: a finite path, replaced below
-    n, rh, rl = _exp_reduce(710.0 if big else (-746.0 if small else th), 0.0 if big | small else tl)
+    eh, el = (710.0 if big else (-746.0 if small else th)), (0.0 if big | small else tl)
+    n, rh, rl = _exp_reduce(eh, el)
     bh, bl = _exp_poly(rh, rl)
-    res = _exp_finish(n, bh, bl)
+    res = _scale(n, bh + bl)
+    if n <= -1022:                                   # maybe subnormal: rare, on the CPU a masked cold call
+        res = _pow_tiny(eh, el)
     integer, odd = _parity(y)
     negative = as_bits(x) < 0
     res = -res if negative & odd else res
@@ -457,18 +481,20 @@ NOT_CODE = ("cpu", "cuda_device", "for_target", "_cold", "_cpu_function")
 _MODULES = (sys.modules[__name__], elementary_dd, elementary_reduction, elementary_trig)
 
 
-def _cold(ns: SimpleNamespace, name: str) -> Any:
-    """The masked cold call (CPU) of the compiled function ``name`` of ``ns``."""
-    return cold_call_cpu(getattr(ns, name), name)
+def _cold(ns: SimpleNamespace, name: str, nargs: int = 1) -> Any:
+    """The masked cold call (CPU) of the compiled function ``name`` of ``ns`` (``nargs`` floats)."""
+    return cold_call_cpu(getattr(ns, name), name, nargs)
 
 
 @functools.cache
 def cpu() -> SimpleNamespace:
     """The functions compiled for the CPU (njit, numpy error model: a division never raises), fma,
-    mul and the bit casts bound to their CPU intrinsics; the huge-argument sin/cos paths as masked
-    cold calls.  A namespace of dispatchers: ``cpu().sin`` etc."""
+    mul and the bit casts bound to their CPU intrinsics; the rare paths (sin/cos of huge arguments,
+    exp's and pow's results near the subnormal range) as masked cold calls.  A namespace of
+    dispatchers: ``cpu().sin`` etc."""
     prims = {"fma": fma_cpu, "mul": mul_cpu, "as_bits": as_bits_cpu, "from_bits": from_bits_cpu}
-    cold = {k: functools.partial(_cold, name=k) for k in ("_sin_huge", "_cos_huge")}
+    cold = {k: functools.partial(_cold, name=k, nargs=n)
+            for k, n in (("_sin_huge", 1), ("_cos_huge", 1), ("_exp_tiny", 1), ("_pow_tiny", 2))}
     return compile_code(_MODULES, njit(error_model="numpy", forceinline=True), prims, cold)
 
 

@@ -99,34 +99,35 @@ _PURE = ("nounwind", "willreturn", "memory(none)" if llvm.llvm_version_info >= (
 
 
 def _cold_functions(context: Any, module: ir.Module, sym: str, fndesc: Any, sig: Any) -> ir.Function:
-    """The scalar function ``sym(double) -> double`` (out of line, calling the compiled code) and its
-    masked vector variants ``sym_v<N>(<N x double>, <N x i1>)``; returns the scalar one."""
+    """The scalar function ``sym(double, ...) -> double`` (out of line, calling the compiled code) and
+    its masked vector variants ``sym_v<N>(<N x double>, ..., <N x i1>)``; returns the scalar one."""
     d = ir.DoubleType()
-    scalar = ir.Function(module, ir.FunctionType(d, [d]), sym)
+    k = len(sig.args)
+    scalar = ir.Function(module, ir.FunctionType(d, [d] * k), sym)
     # the copies numba links into one kernel merge by name: internal ones would be renamed
     # (sym.58), and the call's vector-variant attribute would no longer name its callee
     scalar.linkage = "linkonce_odr"
     for a in ("noinline",) + _PURE:
         set.add(scalar.attributes, a)     # llvmlite's add() knows no 'willreturn' / 'memory(none)'
     b = ir.IRBuilder(scalar.append_basic_block())
-    _, res = context.call_internal_no_propagate(b, fndesc, sig, [scalar.args[0]])
+    _, res = context.call_internal_no_propagate(b, fndesc, sig, list(scalar.args))
     b.ret(res)
     used = []
     for n in VECTOR_WIDTHS:
         vt = ir.VectorType(d, n)
-        vf = ir.Function(module, ir.FunctionType(vt, [vt, ir.VectorType(ir.IntType(1), n)]), f"{sym}_v{n}")
+        vf = ir.Function(module, ir.FunctionType(vt, [vt] * k + [ir.VectorType(ir.IntType(1), n)]), f"{sym}_v{n}")
         vf.linkage = "linkonce_odr"
         for a in ("noinline",) + _PURE:
             set.add(vf.attributes, a)
         b = ir.IRBuilder(vf.append_basic_block())
-        acc = vf.args[0]
+        acc = vf.args[0]       # the result vector: masked-off lanes keep the first argument
         for i in range(n):
             lane = ir.Constant(ir.IntType(32), i)
             before = b.block
             then, after = b.append_basic_block(), b.append_basic_block()
-            b.cbranch(b.extract_element(vf.args[1], lane), then, after)
+            b.cbranch(b.extract_element(vf.args[k], lane), then, after)
             b.position_at_end(then)
-            new = b.insert_element(acc, b.call(scalar, [b.extract_element(acc, lane)]), lane)
+            new = b.insert_element(acc, b.call(scalar, [b.extract_element(a, lane) for a in vf.args[:k]]), lane)
             b.branch(after)
             b.position_at_end(after)
             phi = b.phi(vt)
@@ -154,26 +155,34 @@ def _keep_alive(module: ir.Module, functions: list[ir.Function]) -> None:
     module.globals[keep.name] = keep
 
 
-def cold_call_cpu(dispatcher: Any, name: str) -> Any:
-    """An intrinsic calling the compiled ``dispatcher(x)`` (float -> float, pure) out of line, with
-    masked vector variants: in a vectorised loop only the lanes that reach the call make it."""
-    sig = types.float64(types.float64)
+def cold_call_cpu(dispatcher: Any, name: str, nargs: int = 1) -> Any:
+    """An intrinsic calling the compiled ``dispatcher(x, ...)`` (``nargs`` floats -> float, pure) out
+    of line, with masked vector variants: in a vectorised loop only the lanes that reach the call
+    make it."""
+    sig = types.float64(*(types.float64,) * nargs)
     sym = f"safebasins_cold_{name}"
-    variants = ",".join(f"_ZGV_LLVM_M{n}v_{sym}({sym}_v{n})" for n in VECTOR_WIDTHS)
+    variants = ",".join(f"_ZGV_LLVM_M{n}{'v' * nargs}_{sym}({sym}_v{n})" for n in VECTOR_WIDTHS)
 
-    @intrinsic
-    def cold(typingctx: Any, x: Any) -> Any:
-        def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
-            cres = context.compile_subroutine(builder, dispatcher.py_func, sig)
-            fn = builder.module.globals.get(sym)
-            if fn is None:
-                fn = _cold_functions(context, builder.module, sym, cres.fndesc, sig)
-            call = builder.call(fn, [context.cast(builder, args[0], signature.args[0], types.float64)])
-            set.add(call.attributes, "nounwind")
-            set.add(call.attributes, f'"vector-function-abi-variant"="{variants}"')
-            return call
-        return sig, codegen
+    def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
+        cres = context.compile_subroutine(builder, dispatcher.py_func, sig)
+        fn = builder.module.globals.get(sym)
+        if fn is None:
+            fn = _cold_functions(context, builder.module, sym, cres.fndesc, sig)
+        call = builder.call(fn, [context.cast(builder, a, t, types.float64) for a, t in zip(args, signature.args)])
+        set.add(call.attributes, "nounwind")
+        set.add(call.attributes, f'"vector-function-abi-variant"="{variants}"')
+        return call
 
+    if nargs == 1:
+        @intrinsic
+        def cold(typingctx: Any, x: Any) -> Any:
+            return sig, codegen
+    elif nargs == 2:
+        @intrinsic
+        def cold(typingctx: Any, x: Any, y: Any) -> Any:
+            return sig, codegen
+    else:
+        raise ValueError(f"cold_call_cpu: nargs must be 1 or 2, got {nargs!r}")
     return cold
 
 
