@@ -91,9 +91,10 @@ def _libm(name: str) -> Any:
     return None if g is None else njit(lambda x: g(x))
 
 
-def before_cpu(rev: str) -> Any:
+def before_cpu(rev: str) -> tuple[Any, str]:
     """wells/elementary.py of git revision ``rev`` compiled for the CPU as today's elementary.cpu()
-    compiles today's (the sibling modules and the primitives today's): a namespace of dispatchers."""
+    compiles today's (the sibling modules and the primitives today's): (a namespace of
+    dispatchers, the module's source)."""
     src = subprocess.run(["git", "show", f"{rev}:src/safebasins/wells/elementary.py"], cwd=ROOT, check=True,
                          capture_output=True, text=True).stdout
     path = Path(tempfile.mkdtemp(prefix="safebasins_elementary_before")) / "elementary_before.py"
@@ -107,8 +108,8 @@ def before_cpu(rev: str) -> Any:
     # its rare paths as today's: masked cold calls (symbols of their own)
     modules = (mod, *elementary._MODULES[1:])
     cold = {k: (lambda ns, k=k: cold_call_cpu(getattr(ns, k), f"before{k}"))
-            for k in ("_sin_huge", "_cos_huge") if any(k in vars(m) for m in modules)}
-    return compile_code(modules, njit(error_model="numpy", forceinline=True), prims, cold)
+            for k in elementary.COLD_PATHS if any(k in vars(m) for m in modules)}
+    return compile_code(modules, njit(error_model="numpy", forceinline=True), prims, cold), src
 
 
 def speed(names: list[str], repeat: int, before: str | None = None) -> None:
@@ -118,7 +119,7 @@ def speed(names: list[str], repeat: int, before: str | None = None) -> None:
     y = rng.uniform(-3.0, 3.0, 4096)
     out = np.empty_like(x)
     cpu = elementary.cpu()
-    old = before_cpu(before) if before else None
+    old = before_cpu(before)[0] if before else None
     extra = f" {'before ns':>9s} {'after/before':>12s}  bits" if old else ""
     print(f"\n{'function':9s} {'elementary ns':>14s} {'libm ns':>9s} {'ratio':>6s}{extra}")
     for name in names:

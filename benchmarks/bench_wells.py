@@ -231,14 +231,12 @@ def code_elementary_before(well, rev):
     import bench_elementary  # noqa: PLC0415  (beside this script; imports the test references)
 
     X = sys.modules["safebasins.wells.expression"]
-    old = bench_elementary.before_cpu(rev)
+    old, text = bench_elementary.before_cpu(rev)
     source, joint = well.source, X.joint_source(well.source)
 
     def functions(jit):
         assert jit is compiled.cpu_jit, "the elementary functions before are compiled for the CPU only"
         return X._joint_functions(source, joint, X._compiled_namespace(old))
-    text = subprocess.run(["git", "show", f"{rev}:src/safebasins/wells/elementary.py"], cwd=ROOT, check=True,
-                          capture_output=True, text=True).stdout
     return compiled.target_code(functions, well.barriers, f"{well.name} (elementary {rev})",
                                 f"elementary {text}\0{elementary.MODULE_HASH}\0{source}\0{joint}")
 

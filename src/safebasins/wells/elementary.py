@@ -479,11 +479,13 @@ def sqrt(x: float) -> float:
 #: functions here that are not code (compile_code compiles the others)
 NOT_CODE = ("cpu", "cuda_device", "for_target", "_cold", "_cpu_function")
 _MODULES = (sys.modules[__name__], elementary_dd, elementary_reduction, elementary_trig)
+#: the rare paths the CPU compilation calls out of the lanes (masked cold calls)
+COLD_PATHS = ("_sin_huge", "_cos_huge", "_exp_tiny", "_pow_tiny")
 
 
-def _cold(ns: SimpleNamespace, name: str, nargs: int = 1) -> Any:
-    """The masked cold call (CPU) of the compiled function ``name`` of ``ns`` (``nargs`` floats)."""
-    return cold_call_cpu(getattr(ns, name), name, nargs)
+def _cold(ns: SimpleNamespace, name: str) -> Any:
+    """The masked cold call (CPU) of the compiled function ``name`` of ``ns``."""
+    return cold_call_cpu(getattr(ns, name), name)
 
 
 @functools.cache
@@ -493,8 +495,7 @@ def cpu() -> SimpleNamespace:
     exp's and pow's results near the subnormal range) as masked cold calls.  A namespace of
     dispatchers: ``cpu().sin`` etc."""
     prims = {"fma": fma_cpu, "mul": mul_cpu, "as_bits": as_bits_cpu, "from_bits": from_bits_cpu}
-    cold = {k: functools.partial(_cold, name=k, nargs=n)
-            for k, n in (("_sin_huge", 1), ("_cos_huge", 1), ("_exp_tiny", 1), ("_pow_tiny", 2))}
+    cold = {k: functools.partial(_cold, name=k) for k in COLD_PATHS}
     return compile_code(_MODULES, njit(error_model="numpy", forceinline=True), prims, cold)
 
 

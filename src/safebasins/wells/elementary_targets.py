@@ -155,10 +155,11 @@ def _keep_alive(module: ir.Module, functions: list[ir.Function]) -> None:
     module.globals[keep.name] = keep
 
 
-def cold_call_cpu(dispatcher: Any, name: str, nargs: int = 1) -> Any:
-    """An intrinsic calling the compiled ``dispatcher(x, ...)`` (``nargs`` floats -> float, pure) out
+def cold_call_cpu(dispatcher: Any, name: str) -> Any:
+    """An intrinsic calling the compiled ``dispatcher(x, ...)`` (one or two floats -> float, pure) out
     of line, with masked vector variants: in a vectorised loop only the lanes that reach the call
     make it."""
+    nargs = dispatcher.py_func.__code__.co_argcount
     sig = types.float64(*(types.float64,) * nargs)
     sym = f"safebasins_cold_{name}"
     variants = ",".join(f"_ZGV_LLVM_M{n}{'v' * nargs}_{sym}({sym}_v{n})" for n in VECTOR_WIDTHS)
@@ -182,7 +183,7 @@ def cold_call_cpu(dispatcher: Any, name: str, nargs: int = 1) -> Any:
         def cold(typingctx: Any, x: Any, y: Any) -> Any:
             return sig, codegen
     else:
-        raise ValueError(f"cold_call_cpu: nargs must be 1 or 2, got {nargs!r}")
+        raise ValueError(f"cold_call_cpu: {name} takes {nargs} arguments; one or two are supported")
     return cold
 
 
