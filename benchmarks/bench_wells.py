@@ -33,7 +33,10 @@ that wells/expression.py of git revision REV generates for it (imported from a t
 beside today's package), both in this process, interleaved; ratios to the quartic paired per
 round.  Elementary functions before / after (``--wells-only --elementary-before REV``): each
 expression well also compiled with today's source around wells/elementary.py of revision REV
-(bench_elementary.before_cpu), likewise.
+(bench_elementary.before_cpu), likewise.  Interleave count before / after (``--wells-only
+--interleave-before N``): every well's kernels (the quartic's too) also compiled with LLVM's loop
+interleave count N (0: the cost model's choice) instead of core.numba_target.INTERLEAVE, under a
+key of their own, in this process; escape steps compared (must be equal).
 
 Measured (docs/numerics.md, "Wells"), AMD EPYC (AVX-512), 1 thread, SRKN6b, with one compiled form per well:
 quartic after / before 1.020 dense, 0.957 chart (escape steps equal); time per step vs the quartic:
@@ -58,6 +61,7 @@ import numpy as np
 from safebasins import wells
 from safebasins.numerics import engine, kernels, schemes
 from safebasins.numerics.scheme_code import scheme_code
+from safebasins.core import numba_target
 from safebasins.wells import compiled, elementary
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -241,6 +245,26 @@ def code_elementary_before(well, rev):
                                 f"elementary {text}\0{elementary.MODULE_HASH}\0{source}\0{joint}")
 
 
+class InterleaveJob(Job):
+    """A Job whose kernels are compiled (on the first run) with the loop interleave count
+    ``interleave`` instead of core.numba_target.INTERLEAVE, under keys of their own."""
+
+    def __init__(self, *a, interleave, code, **kw):
+        code = compiled.WellCode(code.name, code.make, code.wpar, code.abs_tracking,
+                                 f"{code.source}\0interleave {interleave}")
+        super().__init__(*a, code=code, **kw)
+        self.interleave = interleave
+
+    def run(self):
+        if self.out is not None:
+            return super().run()
+        saved, numba_target.INTERLEAVE = numba_target.INTERLEAVE, self.interleave
+        try:
+            return super().run()
+        finally:
+            numba_target.INTERLEAVE = saved
+
+
 def wells_only(args):
     """Dense jobs of the quartic and the non-polynomial wells, today's generated code and (with
     --sources-before) the code of that revision's wells/expression.py, interleaved."""
@@ -251,6 +275,9 @@ def wells_only(args):
         dense = dict(F=0.0, Omega=1.0, Psi=0.0, xi_max=0.25, cycles=args.dense_cycles, S=S, integrator=integ,
                      threads=args.threads)
         jobs = [Job("quartic dense, after", kernels, qd, pd, **dense, code=wells.QUARTIC.compiled)]
+        if args.interleave_before is not None:
+            jobs.append(InterleaveJob("quartic dense, before", kernels, qd, pd, **dense,
+                                      code=wells.QUARTIC.compiled, interleave=args.interleave_before))
         for i, (k, spec) in enumerate(TRANSCENDENTAL.items()):
             if k not in args.wells:
                 continue
@@ -265,6 +292,9 @@ def wells_only(args):
             elif args.elementary_before:
                 code = code_elementary_before(w, args.elementary_before)
                 jobs.append(Job(f"{k} dense, before", kernels, *ics, **kw, code=code))
+            elif args.interleave_before is not None:
+                jobs.append(InterleaveJob(f"{k} dense, before", kernels, *ics, **kw, code=w.compiled,
+                                          interleave=args.interleave_before))
         t = time.perf_counter()
         rounds = {}
         best, _ = bench(jobs, args.repeat, rounds)
@@ -280,7 +310,7 @@ def wells_only(args):
                   f"{np.median(paired):.2f} (median of {paired.size} paired rounds, "
                   f"{paired.min():.2f}-{paired.max():.2f})")
         by = {j.name: j for j in jobs}
-        for k in args.wells:
+        for k in ["quartic", *args.wells]:
             if f"{k} dense, before" in by:
                 a, b = np.array(rounds[f"{k} dense, after"]), np.array(rounds[f"{k} dense, before"])
                 same = np.array_equal(by[f"{k} dense, after"].out, by[f"{k} dense, before"].out)
@@ -307,6 +337,9 @@ def main(argv=None):
     ap.add_argument("--elementary-before", default=None,
                     help="with --wells-only: also each expression well around this git revision's "
                          "wells/elementary.py (CPU)")
+    ap.add_argument("--interleave-before", type=int, default=None,
+                    help="with --wells-only: also every well compiled with this loop interleave count "
+                         "(0: LLVM's cost model)")
     ap.add_argument("--wells", nargs="+", default=list(TRANSCENDENTAL), choices=list(TRANSCENDENTAL),
                     help="with --wells-only: which wells")
     args = ap.parse_args(argv)

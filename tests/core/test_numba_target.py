@@ -178,3 +178,37 @@ def test_the_cache_keeps_the_two_widths_apart(tmp_path):
             _probe(code, tmp_path, **narrow), _probe(code, tmp_path, **env)]
     assert [(r["hits"], r["misses"]) for r in runs] == [(0, 1), (0, 1), (1, 0), (1, 0)], runs
     assert len({r["result"] for r in runs}) == 1
+
+
+def test_kernel_compile_interleaves_and_puts_the_default_back(tmp_path):
+    """Inside kernel_compile a vectorised loop is interleaved INTERLEAVE times (each of the body's
+    two multiplications is INTERLEAVE vector multiplications); a loop compiled after it gets the
+    cost model's choice again, as one compiled before it."""
+    counts = _probe("""
+        import json, re
+        from numba import njit, types
+        from safebasins.core import numba_target
+
+        def loop():
+            @njit
+            def f(a, b):
+                for i in range(a.size):
+                    b[i] = a[i] * 3.0 + a[i] * a[i]
+            return f
+
+        arr = types.Array(types.float64, 1, "C")
+        out = []
+        for inside in (False, True, False):
+            f = loop()
+            if inside:
+                with numba_target.kernel_compile():
+                    f.compile((arr, arr))
+            else:
+                f.compile((arr, arr))
+            out.append(len(re.findall(r"fmul <\\d+ x double>", f.inspect_llvm((arr, arr)))))
+        print(json.dumps(out + [numba_target.INTERLEAVE]))
+        """, tmp_path)
+    before, inside, after, interleave = counts
+    assert interleave >= 2
+    assert inside == 2 * interleave, counts
+    assert after == before, counts

@@ -54,12 +54,14 @@ from numba import njit, typeof, types
 from numba.core import errors
 from numba.extending import overload
 
+from safebasins.core.numba_target import VECTOR_LANES, kernel_compile
 from safebasins.numerics.periods import _period_lanes_body, _period_shared_body
 from safebasins.numerics.scheme_code import SchemeCode, scheme_code
 from safebasins.numerics.steps import Floats, Int, Ints, coefs, is_damped, scaled_row, step, wtuple
 from safebasins.wells.compiled import WellCode, abs_tracking, quartic_code, well_energy2
 
-# smallest lane segment of the 4-chain vector loop (lanes run: 4 * segment)
+# smallest lane segment of the 4-chain vector loop (lanes run: 4 * segment; a multiple of
+# VECTOR_LANES)
 MIN_SEGMENT = 16
 # segments per period for the crossing replay (a crossing is replayed over S / SEGMENTS steps)
 SEGMENTS = 4
@@ -237,8 +239,9 @@ def _run_task(well: int, scheme: int, shared: bool, wpar: Floats, task: int, n_t
         if nact == 0:
             break
         # ---------------------------------------------------- one period, vectorised
-        # lanes [0, 4M) with M a multiple of 8 (vector width); idle lanes hold q = p = 0
-        M = max(MIN_SEGMENT, ((nact + 3) // 4 + 7) // 8 * 8)
+        # lanes [0, 4M) with M a multiple of VECTOR_LANES (no scalar remainder in the vector
+        # loops); idle lanes hold q = p = 0
+        M = max(MIN_SEGMENT, ((nact + 3) // 4 + VECTOR_LANES - 1) // VECTOR_LANES * VECTOR_LANES)
         for l in range(nact, 4 * M):
             Q[l] = 0.0
             P[l] = 0.0
@@ -334,12 +337,14 @@ def _ol_period(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P
 def specialised(dispatcher: Any, args: Sequence[Any], n_literal: int = 2) -> Callable[..., Any]:
     """The compiled entry point of ``dispatcher`` for ``args``, whose first ``n_literal`` arguments
     (the kernel key, the scheme key; for _run_task also the shared flag) are taken as numba
-    literals (compiled, or loaded from the on-disk cache, on first use).  Calling it skips numba's dispatch, which would
+    literals (compiled, or loaded from the on-disk cache, on first use; compiled with
+    core.numba_target's interleave count).  Calling it skips numba's dispatch, which would
     first try the non-literal signature at every call."""
     sig = tuple(types.literal(a) for a in args[:n_literal]) + tuple(typeof(a) for a in args[n_literal:])
     entry = _ENTRIES.get((dispatcher, sig))
     if entry is None:
-        dispatcher.compile(sig)
+        with kernel_compile():
+            dispatcher.compile(sig)
         entry = _ENTRIES[(dispatcher, sig)] = dispatcher.overloads[sig].entry_point
     return entry
 
@@ -360,7 +365,7 @@ def _workspace(lanes: int, shared: bool, damped: bool, abs_q: bool, coef: np.nda
                sintab: np.ndarray) -> list[np.ndarray]:
     """The work arrays of one task of :func:`_run_task` (its arguments FS .. CL)."""
     S = sintab.shape[0]
-    Lmem = (max(lanes, 4 * MIN_SEGMENT) + 32 + 7) // 8 * 8     # room for the padded segments
+    Lmem = (max(lanes, 4 * MIN_SEGMENT) + 4 * VECTOR_LANES + 7) // 8 * 8     # room for the padded segments
     Lr = (lanes + 7) // 8 * 8
     Gmax = SEGMENTS if S >= 4 * SEGMENTS else 1
     segs = np.zeros((2, Gmax + 1), np.int64)

@@ -105,7 +105,10 @@ def _period_shared_body(scheme: int, well: int, wpar: Floats, M: Int, Q: Floats,
     scheme and well are compile-time constants: one specialised loop per scheme and well.
 
     The lane loop (j) vectorises; its body advances 4 independent lanes j, M+j, 2M+j, 3M+j
-    so that 4 dependency chains are in flight (the step is latency bound otherwise).
+    so that 4 dependency chains are in flight (the step is latency bound otherwise); the
+    vectoriser also interleaves two vector bodies instruction by instruction
+    (core.numba_target.INTERLEAVE), which a well with elementary functions needs: its chains are
+    too long for the CPU to overlap them as written.
     |q| tracking (the quartic): max 2*H0 and max |q| kept in the step loop.  Signed tracking:
     max 2*H0, q and -q updated in a second lane loop per step.  (Fused, the 4 chains x 5 arrays
     need 190 runtime alias checks, over LLVM's limit of 128 -vectorize-memory-check-threshold,
