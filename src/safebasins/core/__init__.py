@@ -6,7 +6,7 @@ provenance   provenance attributes of API results, the git commit of the source 
 stacking     datasets stacked along a new dimension (variable-length parts padded)
 version      the package version (``safebasins.__version__``)
 numba_cache  where numba caches the compiled kernels of an installed package
-numba_target the vector width numba compiles for (512 bits on a CPU with AVX-512)
+numba_target how numba compiles the kernels: vector width (512 bits with AVX-512), loop interleave count
 statistics   the Wilson interval of escape counts; what a number of paths certifies
 settling     how many map iterations settle damped transients (analyses and cost estimates)
 averaged_theory  the averaged noise theory's solver defaults, smallest grid and horizon (theory, schemas, CLI)

@@ -20,8 +20,8 @@ a well whose force calls elementary functions (sin, exp: 100-150 instructions ea
 dependency chain; the period loops advance 4 lanes' chains per iteration, but written one after
 the other they do not fit the CPU's out-of-order window together, and the step runs at the
 chain's latency.  Interleaved by :data:`INTERLEAVE`, the vector body issues each instruction for
-two vectors side by side: on an AMD Zen 3 (AVX2) a step becomes 1.2x (quartic) to 1.7x (sech^2)
-faster (benchmarks/bench_wells.py ``--interleave-before 0``).  Lanes stay independent and every
+two vectors side by side: on an AMD Zen 3 (AVX2) a step becomes 1.15x (quartic) to 1.6x (Morse)
+faster (benchmarks/bench_wells.py ``--interleave-before 0``; docs/elementary.md).  Lanes stay independent and every
 operation is the same IEEE operation, so no bit of a result changes.  LLVM reads the count from
 a process-wide option: :func:`kernel_compile` sets it under numba's compiler lock for the
 package's kernels only and puts back LLVM's default (0: the cost model's choice) after.  A kernel
