@@ -59,9 +59,9 @@ import numba
 import numpy as np
 
 from safebasins import wells
+from safebasins.core import numba_target
 from safebasins.numerics import engine, kernels, schemes
 from safebasins.numerics.scheme_code import scheme_code
-from safebasins.core import numba_target
 from safebasins.wells import compiled, elementary
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -258,11 +258,8 @@ class InterleaveJob(Job):
     def run(self):
         if self.out is not None:
             return super().run()
-        saved, numba_target.INTERLEAVE = numba_target.INTERLEAVE, self.interleave
-        try:
+        with numba_target.kernel_compile(self.interleave):     # the outer block sets the count
             return super().run()
-        finally:
-            numba_target.INTERLEAVE = saved
 
 
 def wells_only(args):

@@ -1,19 +1,28 @@
 """The vector width of numba's CPU target (safebasins.core.numba_target): 512-bit vectors preferred
 on a host with AVX-512 and nowhere else, never over the user's own choice, a kernel's cache entry
 kept apart per setting.  Each check runs in a fresh interpreter: numba's CPU target takes its
-features once per process."""
+features once per process.  Also: the loop interleave of kernel_compile, and the package's
+compiled functions built without numba's C wrapper."""
 from __future__ import annotations
 
+import importlib
 import json
 import os
+import pkgutil
 import subprocess
 import sys
 import textwrap
 from pathlib import Path
 
 import pytest
+from numba.core.registry import CPUDispatcher
 
+import safebasins.numerics
+import safebasins.theory
+import safebasins.wells
+from safebasins.core import numba_target
 from safebasins.core.numba_target import PREFER_256, wide_vector_features
+from safebasins.wells import compiled
 
 WIDE = "-" + PREFER_256
 #: the variables by which a user chooses numba's target (removed from the probes' environment)
@@ -182,8 +191,9 @@ def test_the_cache_keeps_the_two_widths_apart(tmp_path):
 
 def test_kernel_compile_interleaves_and_puts_the_default_back(tmp_path):
     """Inside kernel_compile a vectorised loop is interleaved INTERLEAVE times (each of the body's
-    two multiplications is INTERLEAVE vector multiplications); a loop compiled after it gets the
-    cost model's choice again, as one compiled before it."""
+    two multiplications is INTERLEAVE vector multiplications); inside nested blocks the outermost
+    block's count holds; a loop compiled after them gets the cost model's choice again, as one
+    compiled before."""
     counts = _probe("""
         import json, re
         from numba import njit, types
@@ -198,9 +208,12 @@ def test_kernel_compile_interleaves_and_puts_the_default_back(tmp_path):
 
         arr = types.Array(types.float64, 1, "C")
         out = []
-        for inside in (False, True, False):
+        for inside in (False, True, "nested", False):
             f = loop()
-            if inside:
+            if inside == "nested":
+                with numba_target.kernel_compile(3), numba_target.kernel_compile():
+                    f.compile((arr, arr))
+            elif inside:
                 with numba_target.kernel_compile():
                     f.compile((arr, arr))
             else:
@@ -208,7 +221,23 @@ def test_kernel_compile_interleaves_and_puts_the_default_back(tmp_path):
             out.append(len(re.findall(r"fmul <\\d+ x double>", f.inspect_llvm((arr, arr)))))
         print(json.dumps(out + [numba_target.INTERLEAVE]))
         """, tmp_path)
-    before, inside, after, interleave = counts
-    assert interleave >= 2
+    before, inside, nested, after, interleave = counts
+    assert interleave >= 2 and interleave != 3
     assert inside == 2 * interleave, counts
+    assert nested == 2 * 3, counts
     assert after == before, counts
+
+
+def test_the_package_compiles_no_c_wrappers():
+    """Every CPU function the engine, the wells and the theory compile is a package_jit (or takes
+    JIT_OPTIONS): numba builds no C-callable wrapper for it."""
+    found = {}
+    for layer in (safebasins.numerics, safebasins.wells, safebasins.theory):
+        for info in pkgutil.walk_packages(layer.__path__, layer.__name__ + "."):
+            module = importlib.import_module(info.name)
+            for name, value in vars(module).items():
+                if isinstance(value, CPUDispatcher) and value.py_func.__module__ == module.__name__:
+                    found[f"{module.__name__}.{name}"] = value.targetoptions.get("no_cfunc_wrapper")
+    assert len(found) > 20, found
+    assert all(found.values()), [name for name, flag in found.items() if not flag]
+    assert numba_target.JIT_OPTIONS.items() <= compiled.LLVM_INLINE.items()

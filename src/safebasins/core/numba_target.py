@@ -21,26 +21,34 @@ dependency chain; the period loops advance 4 lanes' chains per iteration, but wr
 the other they do not fit the CPU's out-of-order window together, and the step runs at the
 chain's latency.  Interleaved by :data:`INTERLEAVE`, the vector body issues each instruction for
 two vectors side by side: on an AMD Zen 3 (AVX2) a step becomes 1.15x (quartic) to 1.6x (Morse)
-faster (benchmarks/bench_wells.py ``--interleave-before 0``; docs/elementary.md).  Lanes stay independent and every
-operation is the same IEEE operation, so no bit of a result changes.  LLVM reads the count from
-a process-wide option: :func:`kernel_compile` sets it under numba's compiler lock for the
-package's kernels only and puts back LLVM's default (0: the cost model's choice) after.  A kernel
-loaded from numba's cache was compiled so; the option's value is in the engine's fingerprint
-(this file is one of numerics.scheme_code.ENGINE_FILES).
+faster (benchmarks/bench_wells.py ``--interleave-before 0``; docs/elementary.md).  Lanes stay
+independent and every operation is the same IEEE operation, so no bit of a result changes.
+LLVM reads the count from a process-wide option: :func:`kernel_compile` sets it under numba's
+compiler lock for the package's kernels only and puts back LLVM's default (0: the cost model's
+choice) after.  A kernel loaded from numba's cache was compiled so; the option's value is in the
+engine's fingerprint (this file is one of numerics.scheme_code.ENGINE_FILES).
+
+Every function the package compiles for the CPU goes through :func:`package_jit` (or takes
+:data:`JIT_OPTIONS`): numba's C-callable wrapper, which the package never calls, is not built.
 """
 from __future__ import annotations
 
 from collections.abc import Iterator
 from contextlib import contextmanager
+from typing import TYPE_CHECKING, Any, Final, Unpack, cast
 
 import llvmlite.binding as llvm
+from numba import njit
 from numba.core import config
 from numba.core.codegen import get_host_cpu_features
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.registry import cpu_target
 
-__all__ = ["PREFER_256", "INTERLEAVE", "VECTOR_LANES", "wide_vector_features", "compiled_features", "configure",
-           "kernel_compile"]
+if TYPE_CHECKING:
+    from numba.core.decorators import _JITOptions, _JITWrapper   # numba's stubs: njit's options, its decorator
+
+__all__ = ["PREFER_256", "INTERLEAVE", "VECTOR_LANES", "JIT_OPTIONS", "package_jit", "wide_vector_features",
+           "compiled_features", "configure", "kernel_compile"]
 
 #: LLVM's tuning feature that caps the loop vectoriser at 256 bits on AVX-512 cores
 PREFER_256 = "prefer-256-bit"
@@ -50,6 +58,19 @@ INTERLEAVE = 2
 #: doubles per vector-loop iteration at most: 8 (512 bits) times INTERLEAVE; a lane loop whose
 #: trip count is a multiple of it has no scalar remainder on any host
 VECTOR_LANES = 8 * INTERLEAVE
+#: numba's options for every function the package compiles for the CPU: no C-callable wrapper.
+#: numba builds one per function and signature for the function's use as a first-class value,
+#: which the package never makes; building and optimising them was about a sixth of the compile of
+#: a first chart (benchmarks/profile_compile.py)
+#: (numba's stubs do not list the option)
+JIT_OPTIONS: Final = cast("_JITOptions", {"no_cfunc_wrapper": True})
+
+
+def package_jit(*, cache: bool = False, **options: Unpack[_JITOptions]) -> _JITWrapper:
+    """``numba.njit(cache=cache, **options)`` with :data:`JIT_OPTIONS`: the decorator of the
+    package's compiled functions."""
+    decorator: _JITWrapper = cast(Any, njit)(cache=cache, **options, **JIT_OPTIONS)
+    return decorator
 
 
 def wide_vector_features(host_features: str) -> str | None:
@@ -89,13 +110,24 @@ def configure() -> str | None:
 
 
 @contextmanager
-def kernel_compile() -> Iterator[None]:
+def kernel_compile(interleave: int = INTERLEAVE) -> Iterator[None]:
     """Compile the package's kernels inside this block: LLVM's loop vectoriser interleaves by
-    :data:`INTERLEAVE` (module docstring), under numba's compiler lock so that no other thread's
-    compile sees the option; LLVM's default is put back on leaving."""
+    ``interleave`` (module docstring), under numba's compiler lock so that no other thread's
+    compile sees the option; LLVM's default is put back on leaving.  Blocks nest: the outermost
+    sets the count (a benchmark compiles the kernels with another count around the engine's
+    own blocks)."""
+    global _depth
     with global_compiler_lock:
-        llvm.set_option("", f"-force-vector-interleave={INTERLEAVE}")
+        outer = _depth == 0
+        if outer:
+            llvm.set_option("", f"-force-vector-interleave={interleave}")
+        _depth += 1
         try:
             yield
         finally:
-            llvm.set_option("", "-force-vector-interleave=0")
+            _depth -= 1
+            if outer:
+                llvm.set_option("", "-force-vector-interleave=0")
+
+
+_depth = 0      # kernel_compile blocks open (in the thread that holds the compiler lock)

@@ -50,26 +50,26 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-from numba import njit, typeof, types
+from numba import typeof, types
 from numba.core import errors
 from numba.extending import overload
 
-from safebasins.core.numba_target import VECTOR_LANES, kernel_compile
+from safebasins.core.numba_target import JIT_OPTIONS, VECTOR_LANES, kernel_compile, package_jit
 from safebasins.numerics.periods import _period_lanes_body, _period_shared_body
 from safebasins.numerics.scheme_code import SchemeCode, scheme_code
 from safebasins.numerics.steps import Floats, Int, Ints, coefs, is_damped, scaled_row, step, wtuple
 from safebasins.wells.compiled import WellCode, abs_tracking, quartic_code, well_energy2
 
 # smallest lane segment of the 4-chain vector loop (lanes run: 4 * segment; a multiple of
-# VECTOR_LANES)
-MIN_SEGMENT = 16
+# VECTOR_LANES, so that no vector loop has a scalar remainder)
+MIN_SEGMENT = VECTOR_LANES
 # segments per period for the crossing replay (a crossing is replayed over S / SEGMENTS steps)
 SEGMENTS = 4
 
 
 # not cached on disk by itself: keyed by the well alone, its cache would not see an edit of steps.py;
 # it is compiled into the cached kernels that call it (their scheme key hashes the engine)
-@njit
+@package_jit()
 def _check_state(well: int, wpar: Floats, i: Int, q: float, p: float, step: Int, thrE2: Floats, thrLo: Floats,
                  thrHi: Floats, iE: Int, iQ: Int, outE: Ints, outQ: Ints) -> tuple[Int, Int]:
     """Record, at `step`, every next-uncrossed threshold the state (q, p) is beyond."""
@@ -97,12 +97,12 @@ def _check_state(well: int, wpar: Floats, i: Int, q: float, p: float, step: Int,
     return iE, iQ
 
 
-@njit(cache=True, inline="always")
+@package_jit(cache=True, inline="always")
 def _finished(iE: Int, iQ: Int, nE: int, nQ: int, stop_any: bool) -> bool | np.bool_:
     return (iE == nE and iQ == nQ) or (stop_any and (iE > 0 or iQ > 0))
 
 
-@njit(cache=True, inline="always")
+@package_jit(cache=True, inline="always")
 def _filters(well: int, wpar: Floats, iE: Int, iQ: Int, thrE2: Floats, thrLo: Floats,
              thrHi: Floats) -> tuple[float, float, float]:
     """(tE, tQ, tN): the lane's next uncrossed 2 xi_max, and the levels its max q (|q| tracking:
@@ -125,7 +125,7 @@ def _filters(well: int, wpar: Floats, iE: Int, iQ: Int, thrE2: Floats, thrLo: Fl
     return tE, tQ, tN
 
 
-@njit(cache=True)
+@package_jit(cache=True)
 def _replay(scheme: int, well: int, wpar: Floats, i: Int, q: float, p: float, period: Int, s0: Int, s1: Int,
             sintab: Floats, c: Floats, F: float, thrE2: Floats, thrLo: Floats, thrHi: Floats, iE: Int, iQ: Int,
             outE: Ints, outQ: Ints, stop_any: bool) -> tuple[Int, Int]:
@@ -146,7 +146,7 @@ def _replay(scheme: int, well: int, wpar: Floats, i: Int, q: float, p: float, pe
     return iE, iQ
 
 
-@njit(cache=True, nogil=True)
+@package_jit(cache=True, nogil=True)
 def _run_task(well: int, scheme: int, shared: bool, wpar: Floats, task: int, n_tasks: int, lanes: int, q0: Floats,
               p0: Floats, pidx: Ints, coef: Floats, hpar: Floats, Fpar: Floats, sintab: Floats, thrE2: Floats,
               thrLo: Floats, thrHi: Floats, cycles: int, stop_any: bool, outE: Ints, outQ: Ints, store: Floats,
@@ -317,7 +317,7 @@ def _period(shared: bool, scheme: int, well: int, wpar: Floats, M: Int, Q: Float
 
 
 # Any on an overload's typing function and its implementation alike (see steps._ol_step)
-@overload(_period)
+@overload(_period, jit_options=JIT_OPTIONS)
 def _ol_period(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, D: Any, ME: Any, MQ: Any,
                MN: Any, coef: Any, FS: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any,
                s1: Any) -> Callable[..., None]:
@@ -445,7 +445,7 @@ def _scheme(scheme: SchemeCode | None, sintab: np.ndarray, coef: np.ndarray) -> 
     return sc
 
 
-@njit(cache=True, nogil=True)
+@package_jit(cache=True, nogil=True)
 def _final_states(well: int, scheme: int, wpar: Floats, q0: Floats, p0: Floats, pidx: Ints, coef: Floats,
                   Fpar: Floats, sintab: Floats, n_periods: int, task: int, n_tasks: int, qo: Floats,
                   po: Floats) -> None:

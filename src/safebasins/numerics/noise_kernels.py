@@ -53,6 +53,7 @@ from numba import literally, njit
 from numba.extending import overload
 
 from safebasins.core.noise_variates import VARIATES
+from safebasins.core.numba_target import package_jit
 from safebasins.numerics import philox
 from safebasins.numerics.kernels import run_tasks, specialised
 from safebasins.numerics.scheme_code import SchemeCode, fingerprint
@@ -181,7 +182,7 @@ def _ol_plus(f: Any, x: Any) -> Any:
 _ONE = np.uint64(1)
 
 
-@njit(cache=True, error_model="numpy")
+@package_jit(cache=True, error_model="numpy")
 def _pairs(rng: Any, k0: Any, k1: Any, k: Any, m: Any, i: Any) -> Any:
     literally(rng)
     n = k.shape[0]
@@ -191,7 +192,7 @@ def _pairs(rng: Any, k0: Any, k1: Any, k: Any, m: Any, i: Any) -> Any:
     return z
 
 
-@njit(cache=True, error_model="numpy")
+@package_jit(cache=True, error_model="numpy")
 def _five_pairs(rng: Any, k0: Any, k1: Any, k: Any, m: Any, i: Any, S: Any) -> Any:
     literally(rng)
     n = k.shape[0]
@@ -227,7 +228,7 @@ def _key(seed: int) -> tuple[np.uint64, np.uint64]:
     return np.uint64(seed & 0xFFFFFFFF), np.uint64(seed >> 32)
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@package_jit(cache=True, inline="always", error_model="numpy")
 def _beyond(well: Any, wpar: Any, q: Any, e: Any, thrE2: Any, lo: Any, hi: Any) -> bool:
     """The engine's criteria (kernels._check_state) for one energy threshold and one bound pair:
     written ``not x <= t`` so that a NaN state is beyond."""
@@ -238,7 +239,7 @@ def _beyond(well: Any, wpar: Any, q: Any, e: Any, thrE2: Any, lo: Any, hi: Any) 
     return (not e <= thrE2) | barrier | (not q <= hi) | (not q >= lo)
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@package_jit(cache=True, nogil=True, error_model="numpy")
 def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, coloured: Any, wpar: Any, task: Any, n_tasks: Any,
                  lanes: Any, q0: Any, p0: Any, n_paths: Any, coef: Any, FS: Any, thrE2: Any, lo: Any, hi: Any,
                  cycles: Any, amp: Any, shift: Any, c1: Any, c2: Any, s_eta: Any, k0: Any, k1: Any, i0: Any, m0: Any,
@@ -368,7 +369,7 @@ def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, coloured: Any, wpar
             CYC[l] += 1
 
 
-@njit(cache=True, nogil=True, error_model="numpy")
+@package_jit(cache=True, nogil=True, error_model="numpy")
 def _final_task(well: Any, scheme: Any, rng: Any, law: Any, coloured: Any, wpar: Any, task: Any, n_tasks: Any, q0: Any,
                 p0: Any, n_paths: Any, coef: Any, FS: Any, n_steps: Any, amp: Any, c1: Any, c2: Any, s_eta: Any,
                 k0: Any, k1: Any, i0: Any, m0: Any, qo: Any, po: Any, eo: Any) -> None:

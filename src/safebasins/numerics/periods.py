@@ -23,9 +23,10 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from numba import njit, types
+from numba import types
 from numba.extending import overload
 
+from safebasins.core.numba_target import JIT_OPTIONS, package_jit
 from safebasins.numerics.steps import (ENERGY2_FROM, Floats, Int, Lane, SplitStep, Step, cpu_helpers, cpu_lane,
                                       cpu_split_step, cpu_step, literal_scheme, wtuple)
 from safebasins.wells.compiled import Coefs, literal_code, cpu_functions, cpu_split
@@ -34,7 +35,7 @@ from safebasins.wells.compiled import Coefs, literal_code, cpu_functions, cpu_sp
 Energy2 = Callable[[Coefs, float, float], float]
 
 
-@njit(cache=True, inline="always")
+@package_jit(cache=True, inline="always")
 def _keep_abs(l: Int, q: float, p: float, e: float, Q: Floats, P: Floats, ME: Floats, MQ: Floats) -> None:
     """Store lane l's new state and update its maxima of 2*H0 (e) and |q| (branch free; NaN wins,
     so that a NaN or inf state is detected as beyond every threshold at the period boundary)."""
@@ -47,14 +48,14 @@ def _keep_abs(l: Int, q: float, p: float, e: float, Q: Floats, P: Floats, ME: Fl
     MQ[l] = x if not x <= m else m
 
 
-@njit(cache=True, inline="always")
+@package_jit(cache=True, inline="always")
 def _maximum(l: Int, x: float, MX: Floats) -> None:
     """MX[l] = max(MX[l], x), branch free; NaN wins: a NaN state propagates, it counts as a crossing."""
     m = MX[l]
     MX[l] = x if not x <= m else m
 
 
-@njit(cache=True, inline="always")
+@package_jit(cache=True, inline="always")
 def _maxima_signed(l: Int, q: float, e: float, ME: Floats, MQ: Floats, MN: Floats) -> None:
     """Update lane l's maxima of 2*H0 (e), q and -q (branch free; NaN wins)."""
     _maximum(l, e, ME)
@@ -62,7 +63,7 @@ def _maxima_signed(l: Int, q: float, e: float, ME: Floats, MQ: Floats, MN: Float
     _maximum(l, -q, MN)
 
 
-@njit(cache=True, inline="always")
+@package_jit(cache=True, inline="always")
 def _reset(n: Int, ME: Floats, MQ: Floats, MN: Floats, signed: bool) -> None:
     for l in range(n):
         ME[l] = -np.inf
@@ -120,7 +121,7 @@ def _period_shared_body(scheme: int, well: int, wpar: Floats, M: Int, Q: Floats,
 
 
 # Any on an overload's typing function and its implementation alike (see steps._ol_step)
-@overload(_period_shared_body)
+@overload(_period_shared_body, jit_options=JIT_OPTIONS)
 def _ol_period_shared_body(scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, D: Any, ME: Any, MQ: Any,
                            MN: Any, c: Any, FS: Any, s0: Any, s1: Any) -> Callable[..., None]:
     H, ABS, STEP, ENERGY2, _ = _arithmetic(scheme, well)
@@ -233,7 +234,7 @@ def _period_lanes_body(scheme: int, well: int, wpar: Floats, M: Int, Q: Floats, 
     raise NotImplementedError("compiled code (numba)")
 
 
-@overload(_period_lanes_body)
+@overload(_period_lanes_body, jit_options=JIT_OPTIONS)
 def _ol_period_lanes_body(scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, D: Any, ME: Any, MQ: Any,
                           MN: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any, s1: Any) -> Callable[..., None]:
     H, ABS, STEP, ENERGY2, LANE = _arithmetic(scheme, well)

@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import numpy as np
 import numpy.typing as npt
-from numba import njit
 
 from safebasins.core import checks
+from safebasins.core.numba_target import package_jit
 from safebasins.numerics import engine, schemes
 from safebasins.numerics.kernels import run_tasks, specialised
 from safebasins.numerics.problem import check_cycles, ensemble_problem
@@ -30,7 +30,7 @@ __all__ = ["barrier_sides", "RIGHT", "LEFT", "NONE"]
 RIGHT, LEFT, NONE = 1, -1, 0
 
 
-@njit(cache=True, nogil=True)
+@package_jit(cache=True, nogil=True)
 def _sides(well: int, scheme: int, wpar: Floats, q0: Floats, p0: Floats, coef: Floats, F: float,
            sintab: Floats, n_steps: int, task: int, n_tasks: int, out: Ints, at: Ints) -> None:
     S = sintab.shape[0]

@@ -31,6 +31,7 @@ from numba import njit, types
 from numba.core import errors
 from numba.extending import overload
 
+from safebasins.core.numba_target import package_jit
 from safebasins.numerics.scheme_code import SchemeCode, code_of_scheme, scheme_code
 from safebasins.wells.compiled import (LLVM_INLINE, Coefs, WellCode, cpu_functions, cpu_jit, cpu_split, energy2_from,
                                       force_from, literal_code, quartic_code, well_energy2, well_force)
@@ -68,19 +69,19 @@ W0 = (0.0,) * 14
 # force, energy2, energy: the quartic for plain loops (tests); not cached on disk, since their
 # quartic key is a global, which numba's cache does not check (an edit of wells/compiled.py would
 # reuse them)
-@njit(inline="always")
+@package_jit(inline="always")
 def force(q: float, f: float) -> float:
     """q^3 - q + f (the quartic), with f = F sin(Omega t_k + Psi)."""
     return well_force(QUARTIC_KEY, W0, q, f)
 
 
-@njit(inline="always")
+@package_jit(inline="always")
 def energy2(q: float, p: float) -> float:
     """2 H0 = p^2 + q^2 - q^4/2 of the quartic (eq 7, untruncated)."""
     return well_energy2(QUARTIC_KEY, W0, q, p)
 
 
-@njit
+@package_jit()
 def energy(q: float, p: float) -> float:
     return 0.5 * energy2(q, p)
 

@@ -32,12 +32,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numba import literally, njit
+from numba import literally
 from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 from scipy.linalg import solve_continuous_lyapunov
 
 from safebasins.core import checks
+from safebasins.core.numba_target import package_jit
 from safebasins.theory import damped
 from safebasins.theory.damped import flow_tilde
 from safebasins.theory.noise_averaging import AveragedDiffusion, averaged_diffusion
@@ -74,7 +75,7 @@ TABLE_NODES = 4097
 #: branch targets of a saddle: an attractor's index, or these
 ESCAPE, UNDECIDED = -1, -2
 
-_flow_tilde: Any = njit(flow_tilde)     # the drift's one formula, compiled for the rays (scalars)
+_flow_tilde: Any = package_jit()(flow_tilde)     # the drift's one formula, compiled for the rays (scalars)
 #: the numba literal of the cached ray kernels: a hash of the drift's module, so that a kernel
 #: cached on disk (which holds the compiled drift) is never reused after an edit of it
 _DRIFT_KEY = int(hashlib.blake2b(Path(damped.__file__).read_bytes(), digest_size=8).hexdigest()[:15], 16)
@@ -97,7 +98,7 @@ def coefficient_table(diff: AveragedDiffusion, n: int = TABLE_NODES) -> FloatArr
                                           v[:, 3], d1[:, 3], v[:, 4], d1[:, 4]], axis=1))
 
 
-@njit
+@package_jit()
 def _flow(tab, J_max, X, Y, F, Om, beta):  # type: ignore[no-untyped-def]
     """Drift (bX, bY), its Jacobian (dbX/dX, dbX/dY, dbY/dX, dbY/dY) and the diffusion's
     (a_t, c, a_t', c') at one point.  With ``g = omega - beta d - Omega``, ``e = a'``:
@@ -122,7 +123,7 @@ def _flow(tab, J_max, X, Y, F, Om, beta):  # type: ignore[no-untyped-def]
     return bX, bY, jxx, jxy, jyx, jyy, r[5], r[7], r[6], r[8]
 
 
-@njit
+@package_jit()
 def _ray_rhs(tab, J_max, X, Y, pX, pY, F, Om, beta):  # type: ignore[no-untyped-def]
     """Characteristics of ``H = b.p + (1/2) p^T A p``, ``A = a_t I + c x x^T``."""
     bX, bY, jxx, jxy, jyx, jyy, at, c, at1, c1 = _flow(tab, J_max, X, Y, F, Om, beta)
@@ -134,7 +135,7 @@ def _ray_rhs(tab, J_max, X, Y, pX, pY, F, Om, beta):  # type: ignore[no-untyped-
             -(jxy * pX + jyy * pY) - 0.5 * gk * Y - c * xp * pY, 0.5 * (pX * ApX + pY * ApY))
 
 
-@njit
+@package_jit()
 def _rk4_step(tab, J_max, F, Om, beta, X, Y, pX, pY, P, dt):  # type: ignore[no-untyped-def]
     """One RK4 step of the rays' equations."""
     h = 0.5 * dt
@@ -148,7 +149,7 @@ def _rk4_step(tab, J_max, F, Om, beta, X, Y, pX, pY, P, dt):  # type: ignore[no-
             P + w * (e1 + 2.0 * e2 + 2.0 * e3 + e4))
 
 
-@njit(cache=True)
+@package_jit(cache=True)
 def _shoot(key, tab, J_max, F, Om, beta, s0, owner, points, dt, steps, stop_radius, exits, near_d,  # type: ignore[no-untyped-def]
            near_phi):
     """RK4 rays from the rows ``(X, Y, pX, pY, Phi)`` of s0 until ``J >= J_max`` (``exits[n]``: Phi,
@@ -196,7 +197,7 @@ def _shoot(key, tab, J_max, F, Om, beta, s0, owner, points, dt, steps, stop_radi
                 break
 
 
-@njit(cache=True)
+@package_jit(cache=True)
 def _flow_points(key, tab, J_max, xs, F, Om, beta):  # type: ignore[no-untyped-def]
     """:func:`_flow` at the rows of xs: (n, 10) (``key``: :data:`_DRIFT_KEY`)."""
     literally(key)

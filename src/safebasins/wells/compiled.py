@@ -103,7 +103,7 @@ def fma_cpu(typingctx: Any, a: Any, b: Any, c: Any) -> Any:
     return sig, codegen
 
 
-@njit(cache=True)
+@numba_target.package_jit(cache=True)
 def _fma_python(a: float, b: float, c: float) -> float:
     return fma_cpu(a, b, c)  # type: ignore[call-arg]  # numba types an intrinsic with its typing context
 
@@ -120,7 +120,7 @@ def mul(a: float, b: float) -> float:
 
 #: the options of the engine's compiled helpers (:func:`cpu_jit`, the overloads' implementations):
 #: each compiled on its own and inlined by LLVM (alwaysinline) into its callers
-LLVM_INLINE: _JITOptions = {"forceinline": True, "error_model": "numpy"}
+LLVM_INLINE: _JITOptions = {**numba_target.JIT_OPTIONS, "forceinline": True, "error_model": "numpy"}
 
 
 @overload(fma, jit_options=LLVM_INLINE)

@@ -48,8 +48,8 @@ from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
 
-from numba import njit
 
+from safebasins.core import numba_target
 from safebasins.wells import elementary_dd, elementary_reduction, elementary_targets, elementary_trig
 from safebasins.wells.elementary_dd import _ABS, _copysign, _dd_mul, _fast_two_sum, _pow2, _two_prod, _two_sum
 from safebasins.wells.elementary_trig import SIN_COS_FAST_LIMIT, cos, sin, sincos, tan
@@ -496,7 +496,7 @@ def cpu() -> SimpleNamespace:
     dispatchers: ``cpu().sin`` etc."""
     prims = {"fma": fma_cpu, "mul": mul_cpu, "as_bits": as_bits_cpu, "from_bits": from_bits_cpu}
     cold = {k: functools.partial(_cold, name=k) for k in COLD_PATHS}
-    return compile_code(_MODULES, njit(error_model="numpy", forceinline=True), prims, cold)
+    return compile_code(_MODULES, numba_target.package_jit(error_model="numpy", forceinline=True), prims, cold)
 
 
 @functools.cache

@@ -27,6 +27,8 @@ from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic, overload
 
+from safebasins.core.numba_target import JIT_OPTIONS
+
 __all__ = ["as_bits", "from_bits", "as_bits_cpu", "from_bits_cpu", "compile_code", "cold_call_cpu",
            "register_cpu_overload", "VECTOR_WIDTHS"]
 
@@ -197,4 +199,4 @@ def register_cpu_overload(generic: Callable[..., Any], compiled: Callable[[], An
            f"    return lambda {', '.join(names)}: impl({', '.join(names)})\n")
     ns = {"compiled": compiled}
     exec(compile(src, f"<overload of {generic.__name__}>", "exec"), ns)   # our own text: the signature
-    overload(generic, jit_options={"forceinline": True, "error_model": "numpy"})(ns["_ol"])
+    overload(generic, jit_options={**JIT_OPTIONS, "forceinline": True, "error_model": "numpy"})(ns["_ol"])

@@ -23,8 +23,9 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from numba import njit
 from numpy.polynomial import chebyshev as _cheb
+
+from safebasins.core.numba_target import package_jit
 
 __all__ = ["EnergyInterpolant", "DEFAULT_TOL", "TOL_RANGE"]
 
@@ -179,7 +180,7 @@ class EnergyInterpolant:
         return val, dv[0] * scale, bottom
 
 
-@njit(cache=True)
+@package_jit(cache=True)
 def _eval_kernel(E: Any, E_split: float, E_b: float, br0: Any, C0: Any, br1: Any, C1: Any, quantities: Any, out: Any,
                  var_out: Any, scale_out: Any, bottom_out: Any) -> None:
     """Piecewise Chebyshev series (Clenshaw) at energies E: for each point the panel variable
