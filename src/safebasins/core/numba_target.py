@@ -69,7 +69,7 @@ JIT_OPTIONS: Final = cast("_JITOptions", {"no_cfunc_wrapper": True})
 def package_jit(*, cache: bool = False, **options: Unpack[_JITOptions]) -> _JITWrapper:
     """``numba.njit(cache=cache, **options)`` with :data:`JIT_OPTIONS`: the decorator of the
     package's compiled functions."""
-    decorator: _JITWrapper = cast(Any, njit)(cache=cache, **options, **JIT_OPTIONS)
+    decorator: _JITWrapper = cast(Any, njit)(cache=cache, **{**options, **JIT_OPTIONS})
     return decorator
 
 
