@@ -16,11 +16,11 @@ from numba.core.caching import NullCache
 from numba.core.registry import CPUDispatcher
 
 from safebasins.core import numba_target
-from safebasins.numerics import kernels, periods, scheme_code, schemes, steps
+from safebasins.numerics import kernels, periods, scheme_code, schemes, steps, well_loops
 from safebasins.wells import compiled
 from tests.import_graph import SRC, closure, graph
 
-ENGINE_MODULES = (kernels, periods, scheme_code, schemes, steps, compiled, numba_target)
+ENGINE_MODULES = (kernels, periods, scheme_code, schemes, steps, well_loops, compiled, numba_target)
 #: cached dispatchers that inline nothing from another file (keyed by their own file alone)
 SELF_CONTAINED = {"safebasins.wells.compiled._fma_python", "safebasins.numerics.steps.wtuple"}
 
@@ -49,7 +49,7 @@ def test_every_cached_kernel_is_specialised_on_the_scheme_key():
             full = f"{mod.__name__}.{name}"
             if "scheme" not in inspect.signature(obj.py_func).parameters and full not in SELF_CONTAINED:
                 bad.append(full)
-    assert bad == [] and cached >= 4        # _run_task, _replay, _final_states, _fma_python
+    assert bad == [] and cached >= 6        # _run_task, _replay, _period_call, _check_call, _final_states, _fma_python
 
 
 def test_an_edit_of_any_engine_file_is_a_new_fingerprint(tmp_path):

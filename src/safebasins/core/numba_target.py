@@ -29,7 +29,8 @@ choice) after.  A kernel loaded from numba's cache was compiled so; the option's
 engine's fingerprint (this file is one of numerics.scheme_code.ENGINE_FILES).
 
 Every function the package compiles for the CPU goes through :func:`package_jit` (or takes
-:data:`JIT_OPTIONS`): numba's C-callable wrapper, which the package never calls, is not built.
+:data:`JIT_OPTIONS`): numba's C-callable wrapper is not built, but for the three functions the
+lane machinery calls through a function pointer (:func:`pointer_jit`).
 """
 from __future__ import annotations
 
@@ -47,7 +48,8 @@ from numba.core.registry import cpu_target
 if TYPE_CHECKING:
     from numba.core.decorators import _JITOptions, _JITWrapper   # numba's stubs: njit's options, its decorator
 
-__all__ = ["PREFER_256", "INTERLEAVE", "VECTOR_LANES", "JIT_OPTIONS", "package_jit", "wide_vector_features",
+__all__ = ["PREFER_256", "INTERLEAVE", "VECTOR_LANES", "JIT_OPTIONS", "POINTER_OPTIONS", "package_jit", "pointer_jit",
+           "wide_vector_features",
            "compiled_features", "configure", "kernel_compile"]
 
 #: LLVM's tuning feature that caps the loop vectoriser at 256 bits on AVX-512 cores
@@ -66,10 +68,22 @@ VECTOR_LANES = 8 * INTERLEAVE
 JIT_OPTIONS: Final = cast("_JITOptions", {"no_cfunc_wrapper": True})
 
 
+#: the options of a function the lane machinery calls through a function pointer
+#: (numerics.well_loops): it keeps the C-callable wrapper, through which such a call goes
+POINTER_OPTIONS: Final = cast("_JITOptions", {"no_cfunc_wrapper": False})
+
+
 def package_jit(*, cache: bool = False, **options: Unpack[_JITOptions]) -> _JITWrapper:
     """``numba.njit(cache=cache, **options)`` with :data:`JIT_OPTIONS`: the decorator of the
     package's compiled functions."""
     decorator: _JITWrapper = cast(Any, njit)(cache=cache, **{**options, **JIT_OPTIONS})
+    return decorator
+
+
+def pointer_jit(*, cache: bool = False, **options: Unpack[_JITOptions]) -> _JITWrapper:
+    """``numba.njit(cache=cache, **options)`` with :data:`POINTER_OPTIONS`: the decorator of a
+    function called through a function pointer."""
+    decorator: _JITWrapper = cast(Any, njit)(cache=cache, **{**options, **POINTER_OPTIONS})
     return decorator
 
 

@@ -50,7 +50,7 @@ Kernel organisation (one thread = one trajectory at a time)
 * Escape check after every step, as on the CPU but without the CPU's segment maxima and
   replay: the step of first crossing is recorded directly.  A branch-free filter (2 H0 > next
   uncrossed 2 xi_max, or |q| > next uncrossed q_max or the barrier) guards the exact scalar
-  bookkeeping, which is kernels._check_state line for line.
+  bookkeeping, which is well_loops._check_state line for line.
 * Persistent threads: the grid holds no more blocks than the GPU keeps resident; a thread
   whose trajectory is finished (every threshold crossed, any with stop_any, or the horizon
   reached) takes the next one from a global atomic counter at the period boundary.  The
@@ -72,7 +72,7 @@ Kernel organisation (one thread = one trajectory at a time)
   once per thread; a split well's V'(q) carried in a register from step to step, as the CPU
   lanes carry it) and its escape tests (make_criteria): |q| tracking compares |q| with the
   q_max thresholds and the barrier, signed tracking compares q with the bound pairs (lo, hi)
-  and the barriers (q_left, q_right), as kernels._check_state.
+  and the barriers (q_left, q_right), as well_loops._check_state.
 """
 from __future__ import annotations
 
@@ -189,7 +189,7 @@ def make_criteria(abs_q: bool) -> tuple[Any, Any, Any]:
     crossed(e, q, tE, tQ, tN): the branch-free filter (2 H0 above the next uncrossed 2 xi_max, q
     beyond the next uncrossed bound or, while an energy threshold is uncrossed, a barrier);
     check_state(i, e, q, step, thrE2, nE, thrLo, thrHi, nQ, iE, iQ, outE, outQ, qL, qR):
-    kernels._check_state with e = energy2(q, p): record `step` for every next uncrossed threshold
+    well_loops._check_state with e = energy2(q, p): record `step` for every next uncrossed threshold
     the state is beyond (outE, outQ flat, row i);
     next_filters(iE, iQ, thrE2, nE, thrLo, thrHi, nQ, qL, qR) -> (tE, tQ, tN) as kernels._filters.
     |q| tracking compares |q| with thrHi (the q_max) and the barrier qR; signed tracking compares

@@ -2,16 +2,19 @@
 
 The schemes are constants (schemes.py) whose steps are generated once (scheme_code.py) and
 compiled for the CPU in steps.py, the vectorised period loops over the lanes live in periods.py,
-the well's force and energy in its compiled form (wells/compiled.py); this module holds the lane
-machinery: escape detection, replay, refill, compaction, and the entry points.
+the well's force and energy in its compiled form (wells/compiled.py), the well's period loop,
+replay and state check in well_loops.py; this module holds the lane machinery: escape detection,
+refill, compaction, and the entry points.
 
 Schemes and wells are compile-time constants of the inline period bodies: `scheme`, the key of a
 scheme's compiled form (scheme_code.SchemeCode.key; the forcing table's width and the coefficient
-table match it) and `well`, the kernel key of a compiled well (wells.compiled.WellCode.key), which
-_run_task takes as numba literals (kernels.specialised): every pair of keys is its own compiled kernel,
-cached on disk and compiled on first use, and holds only its own scheme's and well's code (numba
-@overload on the literal, resolved at typing time).  Keys hash the arithmetic and the engine's
-source, so a cached kernel is never reused after an edit.
+table match it) and `well`, the kernel key of a compiled well (wells.compiled.WellCode.key).  The
+well's three functions (well_loops.py) take both as numba literals: every pair of keys is its own
+compiled code, cached on disk and compiled on first use, holding only its own scheme's and well's
+code (numba @overload on the literal, resolved at typing time).  The machinery, _run_task, takes
+the scheme key, the shared flag and the kind of tracking as literals (kernels.specialised) and
+calls the well's three through function pointers: one cached kernel serves every well.  Keys
+hash the arithmetic and the engine's source, so a cached kernel is never reused after an edit.
 Parallelism: one task per thread (Python threads; the task function releases the GIL).
 
 Every lane's arithmetic is written with explicit fused multiply-adds (llvm.fma), no
@@ -51,14 +54,13 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 from numba import typeof, types
-from numba.core import errors
-from numba.extending import overload
 
-from safebasins.core.numba_target import JIT_OPTIONS, VECTOR_LANES, kernel_compile, package_jit
-from safebasins.numerics.periods import _period_lanes_body, _period_shared_body
+from safebasins.core.numba_target import VECTOR_LANES, kernel_compile, package_jit
 from safebasins.numerics.scheme_code import SchemeCode, scheme_code
 from safebasins.numerics.steps import Floats, Int, Ints, coefs, is_damped, scaled_row, step, wtuple
-from safebasins.wells.compiled import WellCode, abs_tracking, quartic_code, well_energy2
+from safebasins.numerics.well_loops import (CheckFn, PeriodFn, ReplayFn, _finished, check_pointer, period_pointer,
+                                             replay_pointer)
+from safebasins.wells.compiled import WellCode, quartic_code
 
 # smallest lane segment of the 4-chain vector loop (lanes run: 4 * segment; a multiple of
 # VECTOR_LANES, so that no vector loop has a scalar remainder)
@@ -67,43 +69,8 @@ MIN_SEGMENT = VECTOR_LANES
 SEGMENTS = 4
 
 
-# not cached on disk by itself: keyed by the well alone, its cache would not see an edit of steps.py;
-# it is compiled into the cached kernels that call it (their scheme key hashes the engine)
-@package_jit()
-def _check_state(well: int, wpar: Floats, i: Int, q: float, p: float, step: Int, thrE2: Floats, thrLo: Floats,
-                 thrHi: Floats, iE: Int, iQ: Int, outE: Ints, outQ: Ints) -> tuple[Int, Int]:
-    """Record, at `step`, every next-uncrossed threshold the state (q, p) is beyond."""
-    e = well_energy2(well, wtuple(wpar), q, p)
-    nE = thrE2.shape[0]
-    nQ = thrHi.shape[0]
-    # comparisons are written `not x <= t`: a NaN state is beyond every threshold (escaped,
-    # never safe)
-    if abs_tracking(well):
-        aq = abs(q)
-        while iE < nE and (not e <= thrE2[iE] or not aq <= wpar[1]):
-            outE[i, iE] = step
-            iE += 1
-        while iQ < nQ and not aq <= thrHi[iQ]:
-            outQ[i, iQ] = step
-            iQ += 1
-    else:
-        out = not q <= wpar[1] or not q >= wpar[0]
-        while iE < nE and (not e <= thrE2[iE] or out):
-            outE[i, iE] = step
-            iE += 1
-        while iQ < nQ and (not q <= thrHi[iQ] or not q >= thrLo[iQ]):
-            outQ[i, iQ] = step
-            iQ += 1
-    return iE, iQ
-
-
 @package_jit(cache=True, inline="always")
-def _finished(iE: Int, iQ: Int, nE: int, nQ: int, stop_any: bool) -> bool | np.bool_:
-    return (iE == nE and iQ == nQ) or (stop_any and (iE > 0 or iQ > 0))
-
-
-@package_jit(cache=True, inline="always")
-def _filters(well: int, wpar: Floats, iE: Int, iQ: Int, thrE2: Floats, thrLo: Floats,
+def _filters(abs_q: bool, wpar: Floats, iE: Int, iQ: Int, thrE2: Floats, thrLo: Floats,
              thrHi: Floats) -> tuple[float, float, float]:
     """(tE, tQ, tN): the lane's next uncrossed 2 xi_max, and the levels its max q (|q| tracking:
     max |q|) and max -q must exceed to cross its next uncrossed bound or, while an energy
@@ -114,7 +81,7 @@ def _filters(well: int, wpar: Floats, iE: Int, iQ: Int, thrE2: Floats, thrLo: Fl
     tE = thrE2[iE] if iE < nE else inf
     tQ = thrHi[iQ] if iQ < nQ else inf
     tN = inf
-    if abs_tracking(well):
+    if abs_q:
         if iE < nE:
             tQ = min(tQ, wpar[1])
     else:
@@ -125,38 +92,20 @@ def _filters(well: int, wpar: Floats, iE: Int, iQ: Int, thrE2: Floats, thrLo: Fl
     return tE, tQ, tN
 
 
-@package_jit(cache=True)
-def _replay(scheme: int, well: int, wpar: Floats, i: Int, q: float, p: float, period: Int, s0: Int, s1: Int,
-            sintab: Floats, c: Floats, F: float, thrE2: Floats, thrLo: Floats, thrHi: Floats, iE: Int, iQ: Int,
-            outE: Ints, outQ: Ints, stop_any: bool) -> tuple[Int, Int]:
-    """Scalar replay of steps [s0, s1) of a period from the state before step s0 (same
-    arithmetic as the vector loop); records the step of first crossing of every threshold
-    crossed there."""
-    S = sintab.shape[0]
-    nE = thrE2.shape[0]
-    nQ = thrHi.shape[0]
-    w = wtuple(wpar)
-    base = period * S
-    cc = coefs(scheme, c)
-    for s in range(s0, s1):
-        q, p = step(scheme, well, w, q, p, cc, scaled_row(scheme, sintab, s, F))
-        iE, iQ = _check_state(well, wpar, i, q, p, base + s + 1, thrE2, thrLo, thrHi, iE, iQ, outE, outQ)
-        if _finished(iE, iQ, nE, nQ, stop_any):
-            break
-    return iE, iQ
-
-
 @package_jit(cache=True, nogil=True)
-def _run_task(well: int, scheme: int, shared: bool, wpar: Floats, task: int, n_tasks: int, lanes: int, q0: Floats,
-              p0: Floats, pidx: Ints, coef: Floats, hpar: Floats, Fpar: Floats, sintab: Floats, thrE2: Floats,
-              thrLo: Floats, thrHi: Floats, cycles: int, stop_any: bool, outE: Ints, outQ: Ints, store: Floats,
-              do_store: bool, FS: Floats, segs: Ints, lane_f: Floats, snap: Floats, SMN: Floats, lane_i: Ints,
+def _run_task(scheme: int, shared: bool, abs_q: bool, well: int, period_fn: PeriodFn, replay_fn: ReplayFn,
+              check_fn: CheckFn, wpar: Floats, task: int, n_tasks: int, lanes: int, q0: Floats, p0: Floats,
+              pidx: Ints, coef: Floats, hpar: Floats, Fpar: Floats, sintab: Floats, thrE2: Floats, thrLo: Floats,
+              thrHi: Floats, cycles: int, stop_any: bool, outE: Ints, outQ: Ints, store: Floats, do_store: bool,
+              FS: Floats, segs: Ints, lane_f: Floats, snap: Floats, SMN: Floats, lane_i: Ints,
               lane_b: npt.NDArray[np.bool_], lane_t: Floats, CL: Floats) -> None:
     """Trajectories task, task + n_tasks, ... (one thread): the lane machinery of the module
-    docstring.  `well` is the kernel key of a compiled well, `scheme` the key of a scheme code and
-    `shared` whether all trajectories share one parameter set (``coef.shape[0] == 1``: the
-    shared loop, else the per-lane loop); numba literals (:func:`specialised`): one specialised,
-    cached kernel per triple, compiled on first use, with only the period loop it runs.
+    docstring.  `scheme` is the key of a scheme code, `shared` whether all trajectories share one
+    parameter set (``coef.shape[0] == 1``: the shared loop, else the per-lane loop), `abs_q`
+    whether the well tracks |q| (else q and -q); numba literals (:func:`specialised`): one cached
+    kernel per triple, compiled on first use.  The well (its kernel key `well`) enters only
+    through the function pointers of its period loop, replay and state check
+    (numerics.well_loops), compiled for this scheme and shared flag.
     FS .. CL: the task's work arrays (:func:`_workspace`), allocated by the caller: numpy's
     allocation overloads would be compiled anew with every kernel."""
     damped = is_damped(scheme)
@@ -199,7 +148,8 @@ def _run_task(well: int, scheme: int, shared: bool, wpar: Floats, task: int, n_t
                 i = nxt
                 nxt += n_tasks
                 # int64 zeros, not literals: the same _check_state as the replay's (one compile)
-                iE, iQ = _check_state(well, wpar, i, q0[i], p0[i], zero, thrE2, thrLo, thrHi, zero, zero, outE, outQ)
+                iE, iQ = check_fn(scheme, well, wpar, i, q0[i], p0[i], zero, thrE2, thrLo, thrHi, zero, zero, outE,
+                                  outQ)
                 if do_store and iE == 0 and iQ == 0:
                     store[i, 0, 0] = q0[i]
                     store[i, 0, 1] = p0[i]
@@ -213,7 +163,7 @@ def _run_task(well: int, scheme: int, shared: bool, wpar: Floats, task: int, n_t
                     for j in range(NC):
                         CL[j, l] = coef[k, j]
                 traj[l] = i; per[l] = 0; lE[l] = iE; lQ[l] = iQ
-                tE[l], tQ[l], tN[l] = _filters(well, wpar, iE, iQ, thrE2, thrLo, thrHi)
+                tE[l], tQ[l], tN[l] = _filters(abs_q, wpar, iE, iQ, thrE2, thrLo, thrHi)
                 done[l] = False
                 loaded = True
                 break
@@ -252,14 +202,14 @@ def _run_task(well: int, scheme: int, shared: bool, wpar: Floats, task: int, n_t
                 SQ[g, l] = Q[l]
                 SP[g, l] = P[l]
             # segment maxima go straight into the rows SME[g], SMQ[g] (, SMN[g])
-            _period(shared, scheme, well, wpar, M, Q, P, D, SME[g], SMQ[g], SMN[g], coef, FS, HL, CL, FL, sintab,
-                    seg[g], seg[g + 1])
+            period_fn(shared, scheme, well, wpar, M, Q, P, D, SME[g], SMQ[g], SMN[g], coef, FS, HL, CL, FL, sintab,
+                      seg[g], seg[g + 1])
         # ---------------------------------------------------- period boundary
         # vectorised test first: only lanes whose maxima crossed a threshold (or, for the
         # map, every lane) need the scalar bookkeeping below
         for l in range(nact):
             hit[l] = False
-        if abs_tracking(well):
+        if abs_q:
             for g in range(G):
                 for l in range(nact):
                     hit[l] = hit[l] | (not SME[g, l] <= tE[l]) | (not SMQ[g, l] <= tQ[l])
@@ -287,14 +237,14 @@ def _run_task(well: int, scheme: int, shared: bool, wpar: Floats, task: int, n_t
             if hit[l]:
                 for g in range(G):
                     if (not SME[g, l] <= tE[l] or not SMQ[g, l] <= tQ[l]
-                            or (not abs_tracking(well) and not SMN[g, l] <= tN[l])):
+                            or (not abs_q and not SMN[g, l] <= tN[l])):
                         k = pidx[i]
-                        iE, iQ = _replay(scheme, well, wpar, i, SQ[g, l], SP[g, l], per[l] - 1, seg[g], seg[g + 1],
-                                         sintab, coef[k], Fpar[k], thrE2, thrLo, thrHi, iE, iQ, outE, outQ,
-                                         stop_any)
+                        iE, iQ = replay_fn(scheme, well, wpar, i, SQ[g, l], SP[g, l], per[l] - 1, seg[g],
+                                           seg[g + 1], sintab, coef[k], Fpar[k], thrE2, thrLo, thrHi, iE, iQ, outE,
+                                           outQ, stop_any)
                         lE[l] = iE
                         lQ[l] = iQ
-                        tE[l], tQ[l], tN[l] = _filters(well, wpar, iE, iQ, thrE2, thrLo, thrHi)
+                        tE[l], tQ[l], tN[l] = _filters(abs_q, wpar, iE, iQ, thrE2, thrLo, thrHi)
                         if _finished(iE, iQ, nE, nQ, stop_any):
                             break
             fin = _finished(iE, iQ, nE, nQ, stop_any)
@@ -306,32 +256,6 @@ def _run_task(well: int, scheme: int, shared: bool, wpar: Floats, task: int, n_t
             done[l] = d
 
 
-def _period(shared: bool, scheme: int, well: int, wpar: Floats, M: Int, Q: Floats, P: Floats, D: Floats, ME: Floats,
-            MQ: Floats, MN: Floats, coef: Floats, FS: Floats, HL: Floats, CL: Floats, FL: Floats, sintab: Floats,
-            s0: Int, s1: Int) -> None:
-    """Steps [s0, s1) of the period: ``_period_shared`` (one parameter set, coef[0] and the
-    scaled table FS) when the literal ``shared`` is True, else ``_period_lanes`` (per lane).
-    Their bodies are called directly: each compiled function between the task and the loop is
-    one more O3 pass over the linked loop (~0.2 s at the first compile)."""
-    raise NotImplementedError("compiled code (numba)")
-
-
-# Any on an overload's typing function and its implementation alike (see steps._ol_step)
-@overload(_period, jit_options=JIT_OPTIONS)
-def _ol_period(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, D: Any, ME: Any, MQ: Any,
-               MN: Any, coef: Any, FS: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any,
-               s1: Any) -> Callable[..., None]:
-    if not isinstance(shared, types.BooleanLiteral):
-        raise errors.TypingError(f"shared must be a compile-time constant (bool literal), got {shared}")
-    if shared.literal_value:
-        def impl(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, D: Any, ME: Any, MQ: Any,
-                 MN: Any, coef: Any, FS: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any, s1: Any) -> None:
-            _period_shared_body(scheme, well, wpar, M, Q, P, D, ME, MQ, MN, coef[0], FS, s0, s1)
-    else:
-        def impl(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, D: Any, ME: Any, MQ: Any,
-                 MN: Any, coef: Any, FS: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any, s1: Any) -> None:
-            _period_lanes_body(scheme, well, wpar, M, Q, P, D, ME, MQ, MN, HL, CL, FL, sintab, s0, s1)
-    return impl
 
 
 def specialised(dispatcher: Any, args: Sequence[Any], n_literal: int = 2) -> Callable[..., Any]:
@@ -425,11 +349,19 @@ def ensemble(q0: np.ndarray, p0: np.ndarray, pidx: np.ndarray, coef: np.ndarray,
     lo = -hi if thrQlo is None else np.ascontiguousarray(thrQlo, dtype=float)
     sc = _scheme(scheme, sintab, coef)
     shared = bool(coef.shape[0] == 1)
-    args = [code.key, sc.key, shared, code.wpar, 0, int(n_tasks), int(lanes), q0, p0, pidx, coef,
-            hpar, Fpar, sintab, thrE2, lo, hi, int(cycles), bool(stop_any), outE, outQ, store, bool(do_store)]
     work = [_workspace(int(lanes), shared, sc.damped, code.abs_tracking, coef, Fpar, sintab) for _ in range(n_tasks)]
+    t = {name: typeof(a) for name, a in (("wpar", code.wpar), ("coef", coef), ("sintab", sintab), ("thrE2", thrE2),
+                                           ("thrLo", lo), ("thrHi", hi), ("outE", outE), ("outQ", outQ))}
+    FS, _, lane_f, snap, SMN, _, _, _, CL = (typeof(a) for a in work[0])
+    calls = [period_pointer(shared, sc.key, code.key, t["wpar"], t["coef"], FS, lane_f, snap, SMN, CL, t["sintab"]),
+             replay_pointer(sc.key, code.key, t["wpar"], t["sintab"], t["coef"], t["thrE2"], t["thrLo"], t["thrHi"],
+                            t["outE"], t["outQ"]),
+             check_pointer(sc.key, code.key, t["wpar"], t["thrE2"], t["thrLo"], t["thrHi"], t["outE"], t["outQ"])]
+    args = [sc.key, shared, code.abs_tracking, code.key, *calls, code.wpar, 0, int(n_tasks), int(lanes), q0, p0,
+            pidx, coef, hpar, Fpar, sintab, thrE2, lo, hi, int(cycles), bool(stop_any), outE, outQ, store,
+            bool(do_store)]
     entry = specialised(_run_task, args + work[0], n_literal=3)
-    run_tasks(lambda task: entry(*args[:4], task, *args[5:], *work[task]), n_tasks)
+    run_tasks(lambda task: entry(*args[:8], task, *args[9:], *work[task]), n_tasks)
 
 
 def _scheme(scheme: SchemeCode | None, sintab: np.ndarray, coef: np.ndarray) -> SchemeCode:

@@ -230,7 +230,7 @@ def _key(seed: int) -> tuple[np.uint64, np.uint64]:
 
 @package_jit(cache=True, inline="always", error_model="numpy")
 def _beyond(well: Any, wpar: Any, q: Any, e: Any, thrE2: Any, lo: Any, hi: Any) -> bool:
-    """The engine's criteria (kernels._check_state) for one energy threshold and one bound pair:
+    """The engine's criteria (well_loops._check_state) for one energy threshold and one bound pair:
     written ``not x <= t`` so that a NaN state is beyond."""
     if abs_tracking(well):
         barrier = not abs(q) <= wpar[1]

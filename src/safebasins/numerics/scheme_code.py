@@ -50,7 +50,7 @@ __all__ = ["SchemeCode", "scheme_code", "code_of_scheme", "engine_fingerprint", 
 #: width they are compiled for (tests/numerics/test_cache_keys.py checks the list against the
 #: modules the kernels import)
 ENGINE_FILES = (compiled.__file__, numba_target.__file__, *(str(Path(__file__).with_name(name)) for name in
-                ("schemes.py", "scheme_code.py", "steps.py", "periods.py", "kernels.py")))
+                ("schemes.py", "scheme_code.py", "steps.py", "periods.py", "well_loops.py", "kernels.py")))
 
 
 def fingerprint(paths: Iterable[str | Path]) -> str:
@@ -64,7 +64,7 @@ def fingerprint(paths: Iterable[str | Path]) -> str:
 @functools.cache
 def engine_fingerprint() -> str:
     """Hash of the engine's source (:data:`ENGINE_FILES`: the wells' compiled form, the schemes,
-    this module, steps, periods, kernels): part of every scheme key, so an edit of the engine
+    this module, steps, periods, well_loops, kernels): part of every scheme key, so an edit of the engine
     never reuses a kernel cached before it."""
     return fingerprint(ENGINE_FILES)
 
