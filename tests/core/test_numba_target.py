@@ -230,7 +230,7 @@ def test_kernel_compile_interleaves_and_puts_the_default_back(tmp_path):
 
 def test_the_package_compiles_no_c_wrappers_but_for_its_pointers():
     """Every CPU function the engine, the wells and the theory compile is a package_jit (or takes
-    JIT_OPTIONS): numba builds no C-callable wrapper for it; the three the lane machinery calls
+    JIT_OPTIONS): numba builds no C-callable wrapper for it; those the lane machinery calls
     through a function pointer are pointer_jit, and keep theirs."""
     found = {}
     for layer in (safebasins.numerics, safebasins.wells, safebasins.theory):
@@ -240,7 +240,8 @@ def test_the_package_compiles_no_c_wrappers_but_for_its_pointers():
                 if isinstance(value, CPUDispatcher) and value.py_func.__module__ == module.__name__:
                     found[f"{module.__name__}.{name}"] = value.targetoptions.get("no_cfunc_wrapper")
     assert len(found) > 20, found
-    pointers = {f"safebasins.numerics.well_loops.{name}" for name in ("_period_call", "_replay", "_check_call")}
+    pointers = {f"safebasins.numerics.well_loops.{name}"
+                for name in ("_shared_period", "_lanes_period", "_replay", "_check_state")}
     assert {name for name, flag in found.items() if flag is not True} == pointers, found
     assert all(found[name] is False for name in pointers)
     assert numba_target.JIT_OPTIONS.items() <= compiled.LLVM_INLINE.items()

@@ -25,7 +25,7 @@ def test_a_new_well_reuses_the_machinery():
     second = _chart(wells.from_spec({"expression": "q**2/2 - q**3/3 + q**4/(50*(1 + q**2))"}))
     assert set(kernels._run_task.overloads) == machinery
     new = set(well_loops._POINTERS) - pointers
-    assert {d.py_func.__name__ for d, _ in new} == {"_period_call", "_replay", "_check_call"}
+    assert {d.py_func.__name__ for d, _ in new} == {"_shared_period", "_replay", "_check_state"}
     assert len(new) == 3
     assert np.isfinite(first).any() and not np.array_equal(first, second, equal_nan=True)
 

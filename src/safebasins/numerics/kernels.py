@@ -202,8 +202,8 @@ def _run_task(scheme: int, shared: bool, abs_q: bool, well: int, period_fn: Peri
                 SQ[g, l] = Q[l]
                 SP[g, l] = P[l]
             # segment maxima go straight into the rows SME[g], SMQ[g] (, SMN[g])
-            period_fn(shared, scheme, well, wpar, M, Q, P, D, SME[g], SMQ[g], SMN[g], coef, FS, HL, CL, FL, sintab,
-                      seg[g], seg[g + 1])
+            period_fn(scheme, well, wpar, M, Q, P, D, SME[g], SMQ[g], SMN[g], coef, FS, HL, CL, FL, sintab, seg[g],
+                      seg[g + 1])
         # ---------------------------------------------------- period boundary
         # vectorised test first: only lanes whose maxima crossed a threshold (or, for the
         # map, every lane) need the scalar bookkeeping below

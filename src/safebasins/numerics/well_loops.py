@@ -6,9 +6,10 @@ The machinery (the lanes' refill and compaction, the period boundary's bookkeepi
 of the well but calls of these three functions.  It is compiled once per scheme (and shared flag
 and kind of tracking), cached on disk, and takes them as first-class function values (numba's
 ``types.FunctionType``): each is one specialisation, on the numba literals of the scheme's and
-the well's keys (and the shared flag), of a cached dispatcher of this module, reached through its
-C-callable wrapper (:func:`pointer`; these three are the package's functions that keep one:
-``core.numba_target.pointer_jit``).  A new well compiles these three, not the machinery again.
+the well's keys, of a cached dispatcher of this module (the period loop: the shared path's or the
+per-lane path's), reached through its C-callable wrapper (:func:`pointer`; these are the
+package's functions that keep one: ``core.numba_target.pointer_jit``).  A new well compiles its
+three, not the machinery again.
 The keys stay arguments of the pointer's signature, as plain integers that the specialisation
 ignores (they are its compile-time constants); the scheme key, which hashes the engine's source,
 keys every cache entry, so an edit of the engine never reuses one.
@@ -20,11 +21,9 @@ from typing import Any
 
 import numpy as np
 from numba import types
-from numba.core import errors
 from numba.core.typing.templates import Signature
-from numba.extending import overload
 
-from safebasins.core.numba_target import JIT_OPTIONS, kernel_compile, package_jit, pointer_jit
+from safebasins.core.numba_target import kernel_compile, package_jit, pointer_jit
 from safebasins.numerics.periods import _period_lanes_body, _period_shared_body
 from safebasins.numerics.steps import Floats, Int, Ints, coefs, scaled_row, step, wtuple
 from safebasins.wells.compiled import abs_tracking, well_energy2
@@ -37,11 +36,11 @@ ReplayFn = Callable[..., tuple[Int, Int]]
 CheckFn = Callable[..., tuple[Int, Int]]
 
 
-# not cached on disk by itself: keyed by the well alone, its cache would not see an edit of steps.py;
-# it is compiled into the cached functions that call it (their scheme key hashes the engine)
-@package_jit()
-def _check_state(well: int, wpar: Floats, i: Int, q: float, p: float, step: Int, thrE2: Floats, thrLo: Floats,
-                 thrHi: Floats, iE: Int, iQ: Int, outE: Ints, outQ: Ints) -> tuple[Int, Int]:
+# takes the scheme key, unused, for its cache entry: keyed by the well alone, the cache would not see
+# an edit of steps.py
+@pointer_jit(cache=True, nogil=True)
+def _check_state(scheme: int, well: int, wpar: Floats, i: Int, q: float, p: float, step: Int, thrE2: Floats,
+                 thrLo: Floats, thrHi: Floats, iE: Int, iQ: Int, outE: Ints, outQ: Ints) -> tuple[Int, Int]:
     """Record, at `step`, every next-uncrossed threshold the state (q, p) is beyond."""
     e = well_energy2(well, wtuple(wpar), q, p)
     nE = thrE2.shape[0]
@@ -87,53 +86,29 @@ def _replay(scheme: int, well: int, wpar: Floats, i: Int, q: float, p: float, pe
     cc = coefs(scheme, c)
     for s in range(s0, s1):
         q, p = step(scheme, well, w, q, p, cc, scaled_row(scheme, sintab, s, F))
-        iE, iQ = _check_state(well, wpar, i, q, p, base + s + 1, thrE2, thrLo, thrHi, iE, iQ, outE, outQ)
+        iE, iQ = _check_state(scheme, well, wpar, i, q, p, base + s + 1, thrE2, thrLo, thrHi, iE, iQ, outE, outQ)
         if _finished(iE, iQ, nE, nQ, stop_any):
             break
     return iE, iQ
 
 
-def _period(shared: bool, scheme: int, well: int, wpar: Floats, M: Int, Q: Floats, P: Floats, D: Floats, ME: Floats,
-            MQ: Floats, MN: Floats, coef: Floats, FS: Floats, HL: Floats, CL: Floats, FL: Floats, sintab: Floats,
-            s0: Int, s1: Int) -> None:
-    """Steps [s0, s1) of the period: ``_period_shared`` (one parameter set, coef[0] and the
-    scaled table FS) when the literal ``shared`` is True, else ``_period_lanes`` (per lane).
-    Their bodies are called directly: each compiled function between the task and the loop is
-    one more O3 pass over the linked loop (~0.2 s at the first compile)."""
-    raise NotImplementedError("compiled code (numba)")
-
-
-# Any on an overload's typing function and its implementation alike (see steps._ol_step)
-@overload(_period, jit_options=JIT_OPTIONS)
-def _ol_period(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, D: Any, ME: Any, MQ: Any,
-               MN: Any, coef: Any, FS: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any,
-               s1: Any) -> Callable[..., None]:
-    if not isinstance(shared, types.BooleanLiteral):
-        raise errors.TypingError(f"shared must be a compile-time constant (bool literal), got {shared}")
-    if shared.literal_value:
-        def impl(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, D: Any, ME: Any, MQ: Any,
-                 MN: Any, coef: Any, FS: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any, s1: Any) -> None:
-            _period_shared_body(scheme, well, wpar, M, Q, P, D, ME, MQ, MN, coef[0], FS, s0, s1)
-    else:
-        def impl(shared: Any, scheme: Any, well: Any, wpar: Any, M: Any, Q: Any, P: Any, D: Any, ME: Any, MQ: Any,
-                 MN: Any, coef: Any, FS: Any, HL: Any, CL: Any, FL: Any, sintab: Any, s0: Any, s1: Any) -> None:
-            _period_lanes_body(scheme, well, wpar, M, Q, P, D, ME, MQ, MN, HL, CL, FL, sintab, s0, s1)
-    return impl
+# the period loop: the body of the shared path (one parameter set: coef[0] and the scaled table FS)
+# or of the per-lane path, called directly (every compiled function between the machinery and the
+# loop is one more O3 pass over the linked loop, ~0.2-0.4 s at the first compile); one signature
+@pointer_jit(cache=True, nogil=True)
+def _shared_period(scheme: int, well: int, wpar: Floats, M: Int, Q: Floats, P: Floats, D: Floats, ME: Floats,
+                   MQ: Floats, MN: Floats, coef: Floats, FS: Floats, HL: Floats, CL: Floats, FL: Floats,
+                   sintab: Floats, s0: Int, s1: Int) -> None:
+    """Steps [s0, s1) of the period, every lane with the parameter set coef[0]."""
+    _period_shared_body(scheme, well, wpar, M, Q, P, D, ME, MQ, MN, coef[0], FS, s0, s1)
 
 
 @pointer_jit(cache=True, nogil=True)
-def _period_call(shared: bool, scheme: int, well: int, wpar: Floats, M: Int, Q: Floats, P: Floats, D: Floats,
-                 ME: Floats, MQ: Floats, MN: Floats, coef: Floats, FS: Floats, HL: Floats, CL: Floats, FL: Floats,
-                 sintab: Floats, s0: Int, s1: Int) -> None:
-    """:func:`_period`, called through a pointer."""
-    _period(shared, scheme, well, wpar, M, Q, P, D, ME, MQ, MN, coef, FS, HL, CL, FL, sintab, s0, s1)
-
-
-@pointer_jit(cache=True, nogil=True)
-def _check_call(scheme: int, well: int, wpar: Floats, i: Int, q: float, p: float, step: Int, thrE2: Floats,
-                thrLo: Floats, thrHi: Floats, iE: Int, iQ: Int, outE: Ints, outQ: Ints) -> tuple[Int, Int]:
-    """:func:`_check_state`, called through a pointer (the scheme key keys its cache entry)."""
-    return _check_state(well, wpar, i, q, p, step, thrE2, thrLo, thrHi, iE, iQ, outE, outQ)
+def _lanes_period(scheme: int, well: int, wpar: Floats, M: Int, Q: Floats, P: Floats, D: Floats, ME: Floats,
+                  MQ: Floats, MN: Floats, coef: Floats, FS: Floats, HL: Floats, CL: Floats, FL: Floats,
+                  sintab: Floats, s0: Int, s1: Int) -> None:
+    """Steps [s0, s1) of the period, each lane with its own step, amplitude and coefficients."""
+    _period_lanes_body(scheme, well, wpar, M, Q, P, D, ME, MQ, MN, HL, CL, FL, sintab, s0, s1)
 
 
 class Pointer(types.CompileResultWAP):
@@ -174,9 +149,10 @@ def _row(t: types.Array) -> types.Array:
 def period_pointer(shared: bool, scheme: int, well: int, wpar: types.Array, coef: types.Array, FS: types.Array,
                    lane_f: types.Array, snap: types.Array, SMN: types.Array, CL: types.Array,
                    sintab: types.Array) -> Pointer:
-    """:func:`_period_call` for the machinery's argument types (its work arrays' rows)."""
+    """:func:`_shared_period` (``shared``) or :func:`_lanes_period` for the machinery's argument
+    types (its work arrays' rows)."""
     f = _row(lane_f)
-    return pointer(_period_call, (shared, scheme, well),
+    return pointer(_shared_period if shared else _lanes_period, (scheme, well),
                    (wpar, types.int64, f, f, f, _row(_row(snap)), _row(_row(snap)), _row(SMN), coef, FS, f, CL, f,
                     sintab, types.int64, types.int64))
 
@@ -193,7 +169,7 @@ def replay_pointer(scheme: int, well: int, wpar: types.Array, sintab: types.Arra
 
 def check_pointer(scheme: int, well: int, wpar: types.Array, thrE2: types.Array, thrLo: types.Array,
                   thrHi: types.Array, outE: types.Array, outQ: types.Array) -> Pointer:
-    """:func:`_check_call` for the machinery's argument types."""
+    """:func:`_check_state` for the machinery's argument types."""
     i64, f64 = types.int64, types.float64
-    return pointer(_check_call, (scheme, well),
+    return pointer(_check_state, (scheme, well),
                    (wpar, i64, f64, f64, i64, thrE2, thrLo, thrHi, i64, i64, outE, outQ))
