@@ -49,7 +49,7 @@ def test_every_cached_kernel_is_specialised_on_the_scheme_key():
             full = f"{mod.__name__}.{name}"
             if "scheme" not in inspect.signature(obj.py_func).parameters and full not in SELF_CONTAINED:
                 bad.append(full)
-    assert bad == [] and cached >= 6        # _run_task, _replay, _period_call, _check_call, _final_states, _fma_python
+    assert bad == [] and cached >= 6        # _run_task, the well_loops pointer targets, _final_states, _fma_python
 
 
 def test_an_edit_of_any_engine_file_is_a_new_fingerprint(tmp_path):
