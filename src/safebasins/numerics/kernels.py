@@ -58,7 +58,7 @@ from numba import typeof, types
 from safebasins.core.numba_target import VECTOR_LANES, kernel_compile, package_jit
 from safebasins.numerics.scheme_code import SchemeCode, scheme_code
 from safebasins.numerics.steps import Floats, Int, Ints, coefs, is_damped, scaled_row, step, wtuple
-from safebasins.numerics.well_loops import (CheckFn, PeriodFn, ReplayFn, _finished, check_pointer, period_pointer,
+from safebasins.numerics.well_loops import (CheckFn, PeriodFn, ReplayFn, finished, check_pointer, period_pointer,
                                              replay_pointer)
 from safebasins.wells.compiled import WellCode, quartic_code
 
@@ -153,7 +153,7 @@ def _run_task(scheme: int, shared: bool, abs_q: bool, well: int, period_fn: Peri
                 if do_store and iE == 0 and iQ == 0:
                     store[i, 0, 0] = q0[i]
                     store[i, 0, 1] = p0[i]
-                if _finished(iE, iQ, nE, nQ, stop_any) or cycles == 0:
+                if finished(iE, iQ, nE, nQ, stop_any) or cycles == 0:
                     continue
                 k = pidx[i]
                 Q[l] = q0[i]; P[l] = p0[i]
@@ -245,9 +245,9 @@ def _run_task(scheme: int, shared: bool, abs_q: bool, well: int, period_fn: Peri
                         lE[l] = iE
                         lQ[l] = iQ
                         tE[l], tQ[l], tN[l] = _filters(abs_q, wpar, iE, iQ, thrE2, thrLo, thrHi)
-                        if _finished(iE, iQ, nE, nQ, stop_any):
+                        if finished(iE, iQ, nE, nQ, stop_any):
                             break
-            fin = _finished(iE, iQ, nE, nQ, stop_any)
+            fin = finished(iE, iQ, nE, nQ, stop_any)
             if do_store and not fin and iE == 0 and iQ == 0:
                 store[i, per[l], 0] = Q[l]
                 store[i, per[l], 1] = P[l]
@@ -350,13 +350,13 @@ def ensemble(q0: np.ndarray, p0: np.ndarray, pidx: np.ndarray, coef: np.ndarray,
     sc = _scheme(scheme, sintab, coef)
     shared = bool(coef.shape[0] == 1)
     work = [_workspace(int(lanes), shared, sc.damped, code.abs_tracking, coef, Fpar, sintab) for _ in range(n_tasks)]
-    t = {name: typeof(a) for name, a in (("wpar", code.wpar), ("coef", coef), ("sintab", sintab), ("thrE2", thrE2),
-                                           ("thrLo", lo), ("thrHi", hi), ("outE", outE), ("outQ", outQ))}
+    wpar_t, coef_t, sintab_t = typeof(code.wpar), typeof(coef), typeof(sintab)
+    thr_t = [typeof(a) for a in (thrE2, lo, hi)]
+    out_t = [typeof(outE), typeof(outQ)]
     FS, _, lane_f, snap, SMN, _, _, _, CL = (typeof(a) for a in work[0])
-    calls = [period_pointer(shared, sc.key, code.key, t["wpar"], t["coef"], FS, lane_f, snap, SMN, CL, t["sintab"]),
-             replay_pointer(sc.key, code.key, t["wpar"], t["sintab"], t["coef"], t["thrE2"], t["thrLo"], t["thrHi"],
-                            t["outE"], t["outQ"]),
-             check_pointer(sc.key, code.key, t["wpar"], t["thrE2"], t["thrLo"], t["thrHi"], t["outE"], t["outQ"])]
+    calls = [period_pointer(shared, sc.key, code.key, wpar_t, coef_t, FS, lane_f, snap, SMN, CL, sintab_t),
+             replay_pointer(sc.key, code.key, wpar_t, sintab_t, coef_t, *thr_t, *out_t),
+             check_pointer(sc.key, code.key, wpar_t, *thr_t, *out_t)]
     args = [sc.key, shared, code.abs_tracking, code.key, *calls, code.wpar, 0, int(n_tasks), int(lanes), q0, p0,
             pidx, coef, hpar, Fpar, sintab, thrE2, lo, hi, int(cycles), bool(stop_any), outE, outQ, store,
             bool(do_store)]

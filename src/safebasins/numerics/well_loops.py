@@ -28,7 +28,8 @@ from safebasins.numerics.periods import _period_lanes_body, _period_shared_body
 from safebasins.numerics.steps import Floats, Int, Ints, coefs, scaled_row, step, wtuple
 from safebasins.wells.compiled import abs_tracking, well_energy2
 
-__all__ = ["Pointer", "pointer", "period_pointer", "replay_pointer", "check_pointer", "PeriodFn", "ReplayFn", "CheckFn"]
+__all__ = ["Pointer", "pointer", "finished", "period_pointer", "replay_pointer", "check_pointer", "PeriodFn",
+           "ReplayFn", "CheckFn"]
 
 #: the machinery's view of the three (what it passes; the keys as plain integers)
 PeriodFn = Callable[..., None]
@@ -67,7 +68,7 @@ def _check_state(scheme: int, well: int, wpar: Floats, i: Int, q: float, p: floa
 
 
 @package_jit(cache=True, inline="always")
-def _finished(iE: Int, iQ: Int, nE: int, nQ: int, stop_any: bool) -> bool | np.bool_:
+def finished(iE: Int, iQ: Int, nE: int, nQ: int, stop_any: bool) -> bool | np.bool_:
     return (iE == nE and iQ == nQ) or (stop_any and (iE > 0 or iQ > 0))
 
 
@@ -87,7 +88,7 @@ def _replay(scheme: int, well: int, wpar: Floats, i: Int, q: float, p: float, pe
     for s in range(s0, s1):
         q, p = step(scheme, well, w, q, p, cc, scaled_row(scheme, sintab, s, F))
         iE, iQ = _check_state(scheme, well, wpar, i, q, p, base + s + 1, thrE2, thrLo, thrHi, iE, iQ, outE, outQ)
-        if _finished(iE, iQ, nE, nQ, stop_any):
+        if finished(iE, iQ, nE, nQ, stop_any):
             break
     return iE, iQ
 
