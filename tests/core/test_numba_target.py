@@ -230,8 +230,8 @@ def test_kernel_compile_interleaves_and_puts_the_default_back(tmp_path):
 
 def test_the_package_compiles_no_c_wrappers_but_for_its_pointers():
     """Every CPU function the engine, the wells and the theory compile is a package_jit (or takes
-    JIT_OPTIONS): numba builds no C-callable wrapper for it; those the lane machinery calls
-    through a function pointer are pointer_jit, and keep theirs."""
+    JIT_OPTIONS): numba builds no C-callable wrapper for it; those the lane machinery (deterministic
+    or noisy) calls through a function pointer are pointer_jit, and keep theirs."""
     found = {}
     for layer in (safebasins.numerics, safebasins.wells, safebasins.theory):
         for info in pkgutil.walk_packages(layer.__path__, layer.__name__ + "."):
@@ -242,6 +242,7 @@ def test_the_package_compiles_no_c_wrappers_but_for_its_pointers():
     assert len(found) > 20, found
     pointers = {f"safebasins.numerics.well_loops.{name}"
                 for name in ("_shared_period", "_lanes_period", "_replay", "_check_state")}
+    pointers |= {f"safebasins.numerics.noise_loops.{name}" for name in ("_lane_steps", "_lane_enter")}
     assert {name for name, flag in found.items() if flag is not True} == pointers, found
     assert all(found[name] is False for name in pointers)
     assert numba_target.JIT_OPTIONS.items() <= compiled.LLVM_INLINE.items()

@@ -41,7 +41,7 @@ import numpy as np
 from numba import cuda, types, uint64
 
 from safebasins.core import checks
-from safebasins.numerics import cuda_engine, cuda_kernels, noise_kernels, philox
+from safebasins.numerics import cuda_engine, cuda_kernels, noise_kernels, noise_loops, philox
 from safebasins.numerics.scheme_code import SchemeCode, code_of_scheme
 from safebasins.numerics.steps import Floats, Int, Ints
 from safebasins.wells import elementary
@@ -129,8 +129,8 @@ def noise_kernel(well_key: int, scheme_key: int, law: int = noise_kernels.GAUSSI
     step = sc.make(_device, force)
     H = sc.helpers(_device)
     flat_row, flat_coefs = H["flat_row"], H["flat_coefs"]
-    plus = _device(noise_kernels._ol_plus(types.UniTuple(types.float64, sc.width), types.float64))
-    beyond = _retarget(noise_kernels._beyond, abs_tracking=_constant(code.abs_tracking))
+    plus = _device(noise_loops._ol_plus(types.UniTuple(types.float64, sc.width), types.float64))
+    beyond = _retarget(noise_loops.beyond, abs_tracking=_constant(code.abs_tracking))
     gauss2 = _gauss2()
     block, five2 = _five_point()
     UW = np.uint64(sc.width)

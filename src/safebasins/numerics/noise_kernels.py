@@ -35,11 +35,14 @@ b = n ceil(S/16) + floor(s/16), byte r = s mod 16 of its words (w_0, w_1, w_2, w
 t < 4, +2 for t = 4, -2 for t = 5, 0 otherwise).  eta(0) stays Gaussian under either law (one
 draw: its law is the stationary one, not an approximation that vanishes with h).
 
-The kernels are specialised on five numba literals: the well's and the scheme's keys (as the
-engine's, kernels.py), the law of the variates, whether the noise is coloured (white noise
-carries no eta: nothing is added to the forcing) and :data:`RNG_KEY`, a hash of the files inlined from outside the
-engine's fingerprint (this module, numerics/philox.py, wells.elementary), so a kernel cached
-on disk is never reused after an edit of any of them.
+The lanes' machinery (:func:`_escape_task`: the variates, the refill and compaction, the period
+boundary) is specialised on four numba literals: the scheme's key (as the engine's, kernels.py),
+:data:`RNG_KEY`, a hash of the files inlined from outside the engine's fingerprint (this module,
+numerics/philox.py, numerics/noise_loops.py, wells.elementary), the law of the variates and
+whether the noise is coloured (white noise carries no eta: nothing is added to the forcing).  The
+well enters only through the function pointers of its step and checks (numerics.noise_loops), so
+the machinery is compiled once for every well.  :func:`_final_task` is specialised on the well's
+key as well.  A kernel cached on disk is never reused after an edit of any of these files.
 """
 from __future__ import annotations
 
@@ -49,24 +52,26 @@ from fractions import Fraction
 from typing import Any
 
 import numpy as np
-from numba import literally, njit
-from numba.extending import overload
+from numba import literally, njit, typeof
 
 from safebasins.core.noise_variates import VARIATES
 from safebasins.core.numba_target import package_jit
-from safebasins.numerics import philox
+from safebasins.numerics import noise_loops, philox
 from safebasins.numerics.kernels import run_tasks, specialised
+from safebasins.numerics.noise_loops import plus
 from safebasins.numerics.scheme_code import SchemeCode, fingerprint
 from safebasins.numerics.steps import coefs, row, step, wtuple
 from safebasins.wells import elementary
-from safebasins.wells.compiled import LLVM_INLINE, WellCode, abs_tracking, cpu_jit, fma, mul, well_energy2
+from safebasins.wells.compiled import LLVM_INLINE, WellCode, cpu_jit, fma, mul
 
-__all__ = ["RNG_KEY", "MAX_STEPS", "GAUSSIAN", "FIVE_POINT", "LAWS", "StepNoise", "step_noise", "prepare",
+__all__ = ["RNG_KEY", "RNG_FILES", "MAX_STEPS", "GAUSSIAN", "FIVE_POINT", "LAWS", "StepNoise", "step_noise", "prepare",
            "escape_steps", "final_states", "gaussian_pairs", "step_variates", "check_offsets",
            "threshold_array"]
 
+#: the noise code's files outside the engine's fingerprint (wells.elementary: its MODULE_HASH)
+RNG_FILES = (__file__, philox.__file__, noise_loops.__file__)
 #: the numba literal of the random-number and noise code (module docstring)
-RNG_KEY = int(fingerprint([__file__, philox.__file__])[:15], 16) ^ int(elementary.MODULE_HASH[:15], 16)
+RNG_KEY = int(fingerprint(RNG_FILES)[:15], 16) ^ int(elementary.MODULE_HASH[:15], 16)
 #: a path's step index is the counter's first 32-bit word
 MAX_STEPS = 2 ** 32 - 1
 _ZERO = np.uint64(0)
@@ -165,20 +170,6 @@ def _block(k0: Any, k1: Any, b: Any, m: Any, i: Any) -> tuple[Any, Any, Any, Any
     return _philox(np.uint64(b) & _MASK32, np.uint64(m) & _MASK32, np.uint64(i) & _MASK32, _TWO, k0, k1)  # type: ignore[no-any-return]
 
 
-def _plus(f: Any, x: Any) -> Any:
-    """The tuple f with x added to each value (the forcing values plus the coloured noise)."""
-    raise NotImplementedError("compiled code (numba)")
-
-
-@overload(_plus, jit_options=LLVM_INLINE)
-def _ol_plus(f: Any, x: Any) -> Any:
-    n = f.count
-    ns: dict[str, Any] = {"Any": Any}
-    # (numba compares the implementation's parameter annotations with the overload's)
-    exec(f"def impl(f: Any, x: Any) -> Any:\n    return ({''.join(f'f[{j}] + x, ' for j in range(n))})", ns)
-    return ns["impl"]
-
-
 _ONE = np.uint64(1)
 
 
@@ -228,40 +219,25 @@ def _key(seed: int) -> tuple[np.uint64, np.uint64]:
     return np.uint64(seed & 0xFFFFFFFF), np.uint64(seed >> 32)
 
 
-@package_jit(cache=True, inline="always", error_model="numpy")
-def _beyond(well: Any, wpar: Any, q: Any, e: Any, thrE2: Any, lo: Any, hi: Any) -> bool:
-    """The engine's criteria (well_loops._check_state) for one energy threshold and one bound pair:
-    written ``not x <= t`` so that a NaN state is beyond."""
-    if abs_tracking(well):
-        barrier = not abs(q) <= wpar[1]
-    else:
-        barrier = (not q <= wpar[1]) | (not q >= wpar[0])
-    return (not e <= thrE2) | barrier | (not q <= hi) | (not q >= lo)
-
-
 @package_jit(cache=True, nogil=True, error_model="numpy")
-def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, coloured: Any, wpar: Any, task: Any, n_tasks: Any,
-                 lanes: Any, q0: Any, p0: Any, n_paths: Any, coef: Any, FS: Any, thrE2: Any, lo: Any, hi: Any,
-                 cycles: Any, amp: Any, shift: Any, c1: Any, c2: Any, s_eta: Any, k0: Any, k1: Any, i0: Any, m0: Any,
-                 out: Any) -> None:
+def _escape_task(scheme: Any, rng: Any, law: Any, coloured: Any, well: Any, steps_fn: Any, enter_fn: Any, wpar: Any,
+                 task: Any, n_tasks: Any, lanes: Any, q0: Any, p0: Any, n_paths: Any, coef: Any, FS: Any, thrE2: Any,
+                 lo: Any, hi: Any, cycles: Any, amp: Any, shift: Any, c1: Any, c2: Any, s_eta: Any, k0: Any, k1: Any,
+                 i0: Any, m0: Any, out: Any, Q: Any, P: Any, E: Any, Z1: Any, Z2: Any, EN: Any, FIRST: Any,
+                 BASE: Any) -> None:
     """Trajectories j = task, task + n_tasks, ... (path j % n_paths of initial condition
     j // n_paths): out[j * K + k] = the step after which it is first beyond the energy threshold
     thrE2[k] (sorted ascending; a barrier, a bound or a NaN state is beyond all; 0: the initial
     condition, -1: not within cycles periods).  A trajectory runs until it is beyond the largest
     threshold (then beyond all).  Lanes run one forcing period at a time; at the period
     boundary finished lanes are written out and compacted and empty lanes take the next
-    trajectories (every lane is at the same sub-step of the period)."""
+    trajectories (every lane is at the same sub-step of the period).  The well (its key ``well``,
+    a plain integer) enters only through ``steps_fn`` and ``enter_fn``, the pointers of its step
+    and checks (noise_loops); Q .. BASE: the task's lane arrays, zeros, allocated by the caller."""
     S = FS.shape[0]
-    w = wtuple(wpar)
-    c = coefs(scheme, coef[0])
     N = q0.shape[0] * n_paths
     total = np.int64(cycles) * S
     L = np.int64(lanes)
-    Q = np.zeros(L)
-    P = np.zeros(L)
-    E = np.zeros(L)                      # the coloured noise eta of the lane
-    Z1 = np.zeros(L)                     # the step's variates of the lane
-    Z2 = np.zeros(L)
     W0 = np.zeros(L, np.uint64)          # five-point law: the words of the lane's block
     W1 = np.zeros(L, np.uint64)
     W2 = np.zeros(L, np.uint64)
@@ -271,13 +247,8 @@ def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, coloured: Any, wpar
     IC = np.zeros(L, np.int64)
     PATH = np.zeros(L, np.int64)
     J = np.zeros(L, np.int64)
-    BASE = np.zeros(L, np.int64)         # the lane's steps done at the start of this period
     K = thrE2.shape[0]
-    FIRST = np.zeros((K, L), np.int64)   # its first step beyond each threshold (-1: none yet)
     FL = FIRST[K - 1]                    # (beyond the largest: beyond all, the trajectory is done)
-    F0 = FIRST[0]
-    EN = np.zeros(L)                     # the lane's checked energy 2 H0 + shift |p| at this step
-    t0 = thrE2[0]
     nxt = np.int64(task)
     nact = np.int64(0)
     while True:
@@ -305,9 +276,7 @@ def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, coloured: Any, wpar
             i = j // n_paths
             q = q0[i]
             p = p0[i]
-            e = well_energy2(well, w, q, p)
-            for r in range(K):
-                FIRST[r, nact] = 0 if _beyond(well, wpar, q, e, thrE2[r], lo, hi) else -1
+            enter_fn(scheme, well, rng, wpar, q, p, thrE2, lo, hi, FIRST, nact)
             if FL[nact] >= 0 or total == 0:
                 for r in range(K):
                     out[j * K + r] = FIRST[r, nact]
@@ -324,9 +293,7 @@ def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, coloured: Any, wpar
         if nact == 0:
             break
         for s in range(S):
-            f = row(scheme, FS, s)
-            # three lane loops: the Gaussians, the step, the escape check (fused into one body
-            # the same arithmetic spills registers: measured 25% slower); the same numbers either way
+            # the variates in a lane loop of their own; the well's step and checks (noise_loops)
             if law == GAUSSIAN:
                 for l in range(nact):
                     Z1[l], Z2[l] = _gauss2(k0, k1, BASE[l] + s, PATH[l], IC[l])
@@ -339,31 +306,8 @@ def _escape_task(well: Any, scheme: Any, rng: Any, law: Any, coloured: Any, wpar
                 W = W0 if r < 4 else (W1 if r < 8 else (W2 if r < 12 else W3))
                 for l in range(nact):
                     Z1[l], Z2[l] = _five2(W[l], r)
-            for l in range(nact):
-                z1 = Z1[l]
-                z2 = Z2[l]
-                if coloured:
-                    eta = fma(c2, z1, mul(c1, E[l]))
-                    q, p = step(scheme, well, w, Q[l], fma(amp, z1, P[l]), c, _plus(f, eta))
-                    E[l] = fma(c2, z2, mul(c1, eta))
-                else:                    # white noise: no eta to carry or add
-                    q, p = step(scheme, well, w, Q[l], fma(amp, z1, P[l]), c, f)
-                p = fma(amp, z2, p)
-                Q[l] = q
-                P[l] = p
-            for l in range(nact):
-                q = Q[l]
-                p = P[l]
-                e = fma(shift, abs(p), well_energy2(well, w, q, p))
-                EN[l] = e
-                hit = _beyond(well, wpar, q, e, t0, lo, hi) & (F0[l] < 0)
-                F0[l] = BASE[l] + s + 1 if hit else F0[l]
-            for r in range(1, K):        # the further thresholds: one pass each
-                Fr = FIRST[r]
-                t = thrE2[r]
-                for l in range(nact):
-                    hit = _beyond(well, wpar, Q[l], EN[l], t, lo, hi) & (Fr[l] < 0)
-                    Fr[l] = BASE[l] + s + 1 if hit else Fr[l]
+            steps_fn(scheme, well, rng, coloured, wpar, nact, s, Q, P, E, Z1, Z2, EN, FIRST, BASE, coef, FS, thrE2,
+                     lo, hi, amp, shift, c1, c2)
         for l in range(nact):
             BASE[l] += S
             CYC[l] += 1
@@ -400,7 +344,7 @@ def _final_task(well: Any, scheme: Any, rng: Any, law: Any, coloured: Any, wpar:
             f = row(scheme, FS, s)
             if coloured:
                 e = fma(c2, z1, mul(c1, e))
-                q, p = step(scheme, well, w, q, fma(amp, z1, p), c, _plus(f, e))
+                q, p = step(scheme, well, w, q, fma(amp, z1, p), c, plus(f, e))
                 e = fma(c2, z2, mul(c1, e))
             else:
                 q, p = step(scheme, well, w, q, fma(amp, z1, p), c, f)
@@ -504,13 +448,20 @@ def escape_steps(code: WellCode, scheme: SchemeCode, q0: np.ndarray, p0: np.ndar
     thr = threshold_array(thrE2)
     out = np.full(q.size * int(n_paths) * thr.size, -1, np.int64)
     wp = code.wpar if wpar is None else np.ascontiguousarray(wpar, dtype=float)
-    args = [code.key, scheme.key, RNG_KEY, int(noise.law), noise.coloured, wp, 0, int(n_tasks), int(lanes), q, p,
-            int(n_paths),
-            np.ascontiguousarray(coef), FS, thr, float(bounds[0]), float(bounds[1]), int(cycles),
-            float(noise.amp), float(shift), float(noise.c1), float(noise.c2), float(noise.s_eta), k0, k1,
-            int(ic_offset), int(path_offset), out]
-    entry = specialised(_escape_task, args, n_literal=5)
-    run_tasks(lambda task: entry(*args[:6], task, *args[7:]), int(n_tasks))
+    coef = np.ascontiguousarray(coef)
+    L = int(lanes)
+    # each task's lanes: (q, p, eta, Z1, Z2, checked energy), first steps beyond, steps done
+    work = [(*np.zeros((6, L)), np.zeros((thr.size, L), np.int64), np.zeros(L, np.int64)) for _ in range(n_tasks)]
+    lane, FIRST, BASE = typeof(work[0][0]), typeof(work[0][6]), typeof(work[0][7])
+    calls = [noise_loops.steps_pointer(scheme.key, code.key, RNG_KEY, noise.coloured, typeof(wp), lane, FIRST, BASE,
+                                       typeof(coef), typeof(FS), typeof(thr)),
+             noise_loops.enter_pointer(scheme.key, code.key, RNG_KEY, typeof(wp), typeof(thr), FIRST)]
+    args = [scheme.key, RNG_KEY, int(noise.law), noise.coloured, code.key, *calls, wp, 0, int(n_tasks), L, q, p,
+            int(n_paths), coef, FS, thr, float(bounds[0]), float(bounds[1]), int(cycles), float(noise.amp),
+            float(shift), float(noise.c1), float(noise.c2), float(noise.s_eta), k0, k1, int(ic_offset),
+            int(path_offset), out]
+    entry = specialised(_escape_task, [*args, *work[0]], n_literal=4)
+    run_tasks(lambda task: entry(*args[:8], task, *args[9:], *work[task]), int(n_tasks))
     return out.reshape(q.size, int(n_paths)) if np.ndim(thrE2) == 0 else out.reshape(q.size, int(n_paths), thr.size)
 
 
