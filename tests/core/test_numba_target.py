@@ -22,6 +22,7 @@ import safebasins.theory
 import safebasins.wells
 from safebasins.core import numba_target
 from safebasins.core.numba_target import PREFER_256, wide_vector_features
+from safebasins.numerics import noise_loops, well_loops
 from safebasins.wells import compiled
 
 WIDE = "-" + PREFER_256
@@ -245,4 +246,8 @@ def test_the_package_compiles_no_c_wrappers_but_for_its_pointers():
     pointers |= {f"safebasins.numerics.noise_loops.{name}" for name in ("_lane_steps", "_lane_enter")}
     assert {name for name, flag in found.items() if flag is not True} == pointers, found
     assert all(found[name] is False for name in pointers)
+    for layer in (well_loops, noise_loops):
+        for name, value in vars(layer).items():
+            if f"{layer.__name__}.{name}" in pointers:    # called through C only: no CPython wrapper
+                assert value.targetoptions.get("no_cpython_wrapper") is True, name
     assert numba_target.JIT_OPTIONS.items() <= compiled.LLVM_INLINE.items()
