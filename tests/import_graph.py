@@ -11,6 +11,11 @@ import safebasins
 SRC = Path(safebasins.__file__).resolve().parent.parent
 
 
+def module_name(path: str | Path) -> str:
+    """The dotted name of the package's module at ``path`` (a file under ``src/safebasins``)."""
+    return ".".join(Path(path).resolve().relative_to(SRC).with_suffix("").parts)
+
+
 def modules(src: Path = SRC) -> dict[str, tuple[Path, bool]]:
     """Dotted name -> (file, is a package) of every module under ``src/safebasins``."""
     out = {}

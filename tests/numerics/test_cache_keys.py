@@ -18,20 +18,16 @@ from numba.core.registry import CPUDispatcher
 from safebasins.core import numba_target
 from safebasins.numerics import kernels, periods, scheme_code, schemes, steps, well_loops
 from safebasins.wells import compiled
-from tests.import_graph import SRC, closure, graph
+from tests.import_graph import closure, graph, module_name
 
 ENGINE_MODULES = (kernels, periods, scheme_code, schemes, steps, well_loops, compiled, numba_target)
 #: cached dispatchers that inline nothing from another file (keyed by their own file alone)
 SELF_CONTAINED = {"safebasins.wells.compiled._fma_python", "safebasins.numerics.steps.wtuple"}
 
 
-def _module_name(path) -> str:
-    return ".".join(Path(path).resolve().relative_to(SRC).with_suffix("").parts)
-
-
 def test_engine_files_are_what_the_kernels_import():
     want = {"safebasins.numerics.kernels"} | closure(graph(), "safebasins.numerics.kernels")
-    assert {_module_name(p) for p in scheme_code.ENGINE_FILES} | {"safebasins.numerics.kernels"} == want
+    assert {module_name(p) for p in scheme_code.ENGINE_FILES} | {"safebasins.numerics.kernels"} == want
     assert {m.__name__ for m in ENGINE_MODULES} == want
 
 

@@ -3,13 +3,11 @@
 keyed by the scheme, the noise code, the law and the colour of the noise only."""
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from safebasins import wells
-from safebasins.numerics import escape_probability, noise_kernels, noise_loops, philox, well_loops
-from tests.import_graph import SRC, closure, graph
+from safebasins.numerics import escape_probability, noise_kernels, noise_loops, philox, scheme_code, well_loops
+from tests.import_graph import closure, graph, module_name
 
 
 def _escape(well: object, **kw: object) -> np.ndarray:
@@ -44,14 +42,10 @@ def test_coloured_noise_is_another_step_pointer_of_the_same_well():
 def test_the_rng_key_hashes_every_noise_file_outside_the_engine():
     """RNG_KEY (a literal of every noise kernel) hashes the noise modules the kernels import that
     the scheme key does not (numerics.scheme_code.ENGINE_FILES); wells.elementary by its own hash."""
-    def name(path: str) -> str:
-        return ".".join(Path(path).resolve().relative_to(SRC).with_suffix("").parts)
-
-    from safebasins.numerics import scheme_code
-    engine = {name(p) for p in scheme_code.ENGINE_FILES} | {"safebasins.numerics.kernels"}
+    engine = {module_name(p) for p in scheme_code.ENGINE_FILES} | {"safebasins.numerics.kernels"}
     noise = {m for m in closure(graph(), "safebasins.numerics.noise_kernels") | {"safebasins.numerics.noise_kernels"}
              if m.startswith("safebasins.numerics.")} - engine
-    assert {name(p) for p in noise_kernels.RNG_FILES} == noise
+    assert {module_name(p) for p in noise_kernels.RNG_FILES} == noise
     assert {noise_kernels.__file__, noise_loops.__file__, philox.__file__} == set(noise_kernels.RNG_FILES)
     for fn in (noise_loops._lane_steps, noise_loops._lane_enter, noise_kernels._escape_task):
         assert {"rng", "scheme"} <= set(fn.py_func.__code__.co_varnames[:fn.py_func.__code__.co_argcount])
