@@ -15,7 +15,9 @@ elementary (vectorised lanes) against numba's math.* (libm: glibc), both on the 
 With --before REV: also wells/elementary.py of git revision REV (its sibling modules today's),
 compiled for the CPU beside today's in this process and timed in the same interleaved rounds;
 the column after/before is today's time over REV's, and the bits of both on the speed arrays
-are compared (a change meant to keep the bits must print "bits equal").
+are compared (a change meant to keep the bits must print "bits equal").  With --floor: also the
+cost floor of floor_elementary.py (the cheapest polynomial forms, not faithful) where it has
+the function, timed in the same rounds.
 """
 from __future__ import annotations
 
@@ -41,6 +43,7 @@ from safebasins.wells import elementary  # noqa: E402
 from safebasins.wells.compiled import fma_cpu, mul_cpu  # noqa: E402
 from safebasins.wells.elementary_targets import as_bits_cpu, cold_call_cpu, compile_code, from_bits_cpu  # noqa: E402
 from tests.wells import elementary_reference as ref  # noqa: E402
+from floor_elementary import FLOOR, floor_namespace  # noqa: E402  (beside this script)
 
 
 def machine() -> str:
@@ -112,7 +115,7 @@ def before_cpu(rev: str) -> tuple[Any, str]:
     return compile_code(modules, njit(error_model="numpy", forceinline=True), prims, cold), src
 
 
-def speed(names: list[str], repeat: int, before: str | None = None) -> None:
+def speed(names: list[str], repeat: int, before: str | None = None, floor: bool = False) -> None:
     rng = np.random.default_rng(0)
     x = rng.uniform(-10.0, 10.0, 4096)
     pos = rng.uniform(1e-3, 20.0, 4096)
@@ -121,6 +124,8 @@ def speed(names: list[str], repeat: int, before: str | None = None) -> None:
     cpu = elementary.cpu()
     old = before_cpu(before)[0] if before else None
     extra = f" {'before ns':>9s} {'after/before':>12s}  bits" if old else ""
+    flo = floor_namespace() if floor else None
+    extra += f" {'floor ns':>9s} {'elementary/floor':>16s}" if flo else ""
     print(f"\n{'function':9s} {'elementary ns':>14s} {'libm ns':>9s} {'ratio':>6s}{extra}")
     for name in names:
         if name in ("powi", "sincos"):
@@ -133,6 +138,8 @@ def speed(names: list[str], repeat: int, before: str | None = None) -> None:
             jobs["libm"] = _loops(lib, two)
         if old is not None:
             jobs["before"] = _loops(getattr(old, name), two)
+        if flo is not None and name in FLOOR:
+            jobs["floor"] = _loops(getattr(flo, name), two)
         best = dict.fromkeys(jobs, math.inf)
         outs = {}
         for k, fn in jobs.items():
@@ -150,6 +157,9 @@ def speed(names: list[str], repeat: int, before: str | None = None) -> None:
             same = np.array_equal(outs["elementary"].view(np.int64), outs["before"].view(np.int64))
             line += (f" {best['before']:9.2f} {best['elementary'] / best['before']:12.2f}  "
                      f"{'bits equal' if same else 'BITS DIFFER'}")
+        if flo is not None:
+            fl = best.get("floor", math.nan)
+            line += f" {fl:9.2f} {best['elementary'] / fl:16.2f}"
         print(line, flush=True)
 
 
@@ -161,13 +171,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--no-accuracy", action="store_true")
     ap.add_argument("--no-speed", action="store_true")
     ap.add_argument("--before", default=None, help="git revision: also time its wells/elementary.py (after/before)")
+    ap.add_argument("--floor", action="store_true", help="also time the cost floor of floor_elementary.py")
     a = ap.parse_args(argv)
     names = a.only.split(",")
     print("machine:", machine())
     if not a.no_accuracy:
         accuracy(names, a.samples)
     if not a.no_speed:
-        speed(names, a.repeat, a.before)
+        speed(names, a.repeat, a.before, a.floor)
     print("machine after:", machine())
     return 0
 

@@ -36,7 +36,10 @@ expression well also compiled with today's source around wells/elementary.py of 
 (bench_elementary.before_cpu), likewise.  Interleave count before / after (``--wells-only
 --interleave-before N``): every well's kernels (the quartic's too) also compiled with LLVM's loop
 interleave count N (0: the cost model's choice) instead of core.numba_target.INTERLEAVE, under a
-key of their own, in this process; escape steps compared (must be equal).
+key of their own, in this process; escape steps compared (must be equal).  The cost floor
+(``--wells-only --floor``): each expression well also compiled around floor_elementary.py (the
+cheapest polynomial sin, cos, exp, expm1 and tanh, not faithful) instead of wells.elementary,
+likewise: a ratio no faithful version could go below.
 
 Measured (docs/numerics.md, "Wells"), AMD EPYC (AVX-512), 1 thread, SRKN6b, with one compiled form per well:
 quartic after / before 1.020 dense, 0.957 chart (escape steps equal); time per step vs the quartic:
@@ -229,20 +232,35 @@ def code_before(well, before):
                                 f"{elementary.MODULE_HASH}\0{source}"), source
 
 
-def code_elementary_before(well, rev):
-    """The compiled form of expression well ``well`` (today's source and joint form) around
-    wells/elementary.py of git revision ``rev`` (bench_elementary.before_cpu)."""
-    import bench_elementary  # noqa: PLC0415  (beside this script; imports the test references)
-
+def code_around(well, functions_cpu, label, text):
+    """The compiled form of expression well ``well`` (today's source and joint form) around the
+    CPU namespace ``functions_cpu`` of elementary functions instead of wells.elementary's (``text``:
+    their source, in the key)."""
     X = sys.modules["safebasins.wells.expression"]
-    old, text = bench_elementary.before_cpu(rev)
     source, joint = well.source, X.joint_source(well.source)
 
     def functions(jit):
-        assert jit is compiled.cpu_jit, "the elementary functions before are compiled for the CPU only"
-        return X._joint_functions(source, joint, X._compiled_namespace(old))
-    return compiled.target_code(functions, well.barriers, f"{well.name} (elementary {rev})",
-                                f"elementary {text}\0{elementary.MODULE_HASH}\0{source}\0{joint}")
+        assert jit is compiled.cpu_jit, f"{label}: compiled for the CPU only"
+        return X._joint_functions(source, joint, X._compiled_namespace(functions_cpu))
+    return compiled.target_code(functions, well.barriers, f"{well.name} ({label})",
+                                f"{label} {text}\0{elementary.MODULE_HASH}\0{source}\0{joint}")
+
+
+def code_elementary_before(well, rev):
+    """:func:`code_around` wells/elementary.py of git revision ``rev`` (bench_elementary.before_cpu)."""
+    import bench_elementary  # noqa: PLC0415  (beside this script; imports the test references)
+
+    old, text = bench_elementary.before_cpu(rev)
+    return code_around(well, old, f"elementary {rev}", text)
+
+
+def code_floor(well):
+    """:func:`code_around` the cost floor of floor_elementary.py (the cheapest polynomial forms,
+    not faithful)."""
+    import floor_elementary  # noqa: PLC0415  (beside this script)
+
+    text = Path(floor_elementary.__file__).read_text()
+    return code_around(well, floor_elementary.floor_namespace(), "floor", text)
 
 
 class InterleaveJob(Job):
@@ -289,6 +307,8 @@ def wells_only(args):
             elif args.elementary_before:
                 code = code_elementary_before(w, args.elementary_before)
                 jobs.append(Job(f"{k} dense, before", kernels, *ics, **kw, code=code))
+            elif args.floor:
+                jobs.append(Job(f"{k} dense, floor", kernels, *ics, **kw, code=code_floor(w)))
             elif args.interleave_before is not None:
                 jobs.append(InterleaveJob(f"{k} dense, before", kernels, *ics, **kw, code=w.compiled,
                                           interleave=args.interleave_before))
@@ -337,6 +357,8 @@ def main(argv=None):
     ap.add_argument("--interleave-before", type=int, default=None,
                     help="with --wells-only: also every well compiled with this loop interleave count "
                          "(0: LLVM's cost model)")
+    ap.add_argument("--floor", action="store_true",
+                    help="with --wells-only: each well also with the cost floor of floor_elementary.py")
     ap.add_argument("--wells", nargs="+", default=list(TRANSCENDENTAL), choices=list(TRANSCENDENTAL),
                     help="with --wells-only: which wells")
     args = ap.parse_args(argv)

@@ -226,7 +226,8 @@ def main(argv=None):
     for method, tol in (("RK45", 1e-3), ("RK45", 1e-5), ("DOP853", 1e-10)):
         _, nfev, y = ivp_escape((q0, 0.0, 0.0, 1.0, 0.0, 0.25, 2000, method, tol, tol * 1e-3 if method == "RK45" else 1e-12))
         print(f"  {method} rtol {tol:g}: {(H0(*y) - 0.2) / 0.2:+.2e} ({nfev / 2000:.0f} rhs evaluations/cycle)")
-    from safebasins.numerics import kernels
+    from safebasins.numerics import kernels, schemes
+    from safebasins.numerics.scheme_code import scheme_code
     for S in (128, 256, 512):
         h = 2 * np.pi / S
         qq, pp = q0, 0.0
@@ -237,7 +238,7 @@ def main(argv=None):
         print(f"  Heun RK2 {S} steps/cycle: {(H0(qq, pp) - 0.2) / 0.2:+.2e}")
     for S in (32, 256):
         q, p = kernels.final_states(np.array([q0]), np.zeros(1), np.zeros(1, np.int64), schemes.lane_coefficients(1.0, S, "rk4"),
-                              np.array([0.0]), schemes.sine_table(S, 0.0, "rk4"), 2000)
+                              np.array([0.0]), schemes.sine_table(S, 0.0, "rk4"), 2000, scheme=scheme_code("rk4"))
         print(f"  engine RK4 {S} steps/cycle: {(H0(q[0], p[0]) - 0.2) / 0.2:+.2e}")
 
 
