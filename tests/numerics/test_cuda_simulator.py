@@ -19,17 +19,14 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import subprocess
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
 from safebasins.numerics import schemes
+from tests.cuda_simulator import pin_to_one_cpu, run_simulator
 
-SRC = Path(__file__).resolve().parents[2] / "src"
 # wells travel to the subprocess as specs (safebasins.wells.resolve_well): the cubic
 # V = q^2/2 - q^3/3 (a polynomial code, Horner from run-time coefficients) and a well written as
 # an expression (the generic V, dV code; sqrt and division: correctly rounded on every target)
@@ -155,11 +152,8 @@ def child():
 def test_cuda_simulator_matches_cpu_engine_bitwise():
     from tests.numerics.ensemble import run_ensemble
     cases = dict(_cases())
-    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1",
-               PYTHONPATH=os.pathsep.join([str(SRC), os.environ.get("PYTHONPATH", "")]))
     t = time.perf_counter()
-    r = subprocess.run([sys.executable, __file__], env=env, input=json.dumps(cases), capture_output=True,
-                       text=True, timeout=300)
+    r = run_simulator(__file__, json.dumps(cases), timeout=300)
     wall = time.perf_counter() - t
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
     gpu = json.loads(r.stdout.strip().splitlines()[-1])
@@ -198,4 +192,5 @@ def test_missing_gpu_is_an_explicit_error():
 
 
 if __name__ == "__main__":
+    pin_to_one_cpu()
     child()

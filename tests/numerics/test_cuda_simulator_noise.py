@@ -16,10 +16,8 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import pickle
 import re
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -33,8 +31,8 @@ from safebasins.numerics.noise import energy_shift, escape_probability
 from safebasins.numerics.problem import ensemble_problem
 from safebasins.wells.compiled import fma
 from tests.numerics.test_cuda_optional import INSTALL, without_numba_cuda  # noqa: F401  (a fixture)
+from tests.cuda_simulator import pin_to_one_cpu, run_simulator
 
-ROOT = Path(__file__).resolve().parents[2]
 STEPS = 8          # steps per forcing cycle
 CYCLES = 6
 PATHS = 4
@@ -149,12 +147,9 @@ def test_cuda_simulator_noise_matches_cpu_bitwise(tmp_path: Path) -> None:
     assert n_star > STEPS, n_star              # late: earlier differences have propagated
     cases["knife_edge/at"] = dict(knife, thrE2=e_star)
     cases["knife_edge/below"] = dict(knife, thrE2=float(np.nextafter(e_star, -math.inf)))
-    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1",
-               PYTHONPATH=os.pathsep.join([str(ROOT / "src"), str(ROOT), os.environ.get("PYTHONPATH", "")]))
     api_path = tmp_path / "api.pickle"
     t = time.perf_counter()
-    r = subprocess.run([sys.executable, __file__], env=env, input=json.dumps(dict(cases=cases, api=str(api_path))),
-                       capture_output=True, text=True, timeout=600)
+    r = run_simulator(__file__, json.dumps(dict(cases=cases, api=str(api_path))), timeout=600)
     wall = time.perf_counter() - t
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
     gpu = json.loads(r.stdout.strip().splitlines()[-1])
@@ -204,4 +199,5 @@ def test_cuda_without_numba_cuda_names_the_extra(without_numba_cuda: None) -> No
 
 
 if __name__ == "__main__":
+    pin_to_one_cpu()
     child()

@@ -6,18 +6,14 @@ on stdin)."""
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 
 from safebasins import wells
 from tests.numerics import test_cuda_simulator
 from tests.numerics.ensemble import run_ensemble
+from tests.cuda_simulator import run_simulator
 
-ROOT = Path(__file__).resolve().parents[2]
 #: an electrostatic (MEMS) well: elastic restoring force and a Coulomb pull towards the plate at q = 1
 MEMS = {"expression": "q**2/2 - 1/20/(1 - q) + 1/20 + q/20"}
 #: forcing cycles per trajectory: the simulator runs each lane's force in Python (the elementary
@@ -51,10 +47,7 @@ def _cases() -> dict[str, dict[str, object]]:
 
 def test_named_wells_cuda_simulator_matches_cpu_bitwise() -> None:
     cases = _cases()
-    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1",
-               PYTHONPATH=os.pathsep.join([str(ROOT / "src"), str(ROOT), os.environ.get("PYTHONPATH", "")]))
-    r = subprocess.run([sys.executable, test_cuda_simulator.__file__], env=env, input=json.dumps(cases),
-                       capture_output=True, text=True, timeout=600)
+    r = run_simulator(test_cuda_simulator.__file__, json.dumps(cases), timeout=600)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
     gpu = json.loads(r.stdout.strip().splitlines()[-1])
     outcomes = set()

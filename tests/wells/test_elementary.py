@@ -9,10 +9,7 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import subprocess
 import sys
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -21,11 +18,11 @@ from numba import cuda, njit
 
 from safebasins.wells import elementary
 from tests.wells import elementary_reference as ref
+from tests.cuda_simulator import pin_to_one_cpu, run_simulator
 
 N_SAMPLES = 2000
 #: samples per function for the simulator (Python speed)
 N_SIMULATOR = 200
-ROOT = Path(__file__).resolve().parents[2]
 INF, NAN = math.inf, math.nan
 
 # (function, arguments, expected): C99 Annex F (F.10) and IEEE 754 for the square root
@@ -185,10 +182,7 @@ def _simulator_child() -> None:
 
 def test_cpu_python_and_cuda_simulator_give_the_same_bits() -> None:
     cases = _simulator_cases()
-    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1",
-               PYTHONPATH=os.pathsep.join([str(ROOT / "src"), str(ROOT), os.environ.get("PYTHONPATH", "")]))
-    r = subprocess.run([sys.executable, __file__], env=env, input=json.dumps(cases), capture_output=True, text=True,
-                       timeout=300)
+    r = run_simulator(__file__, json.dumps(cases), timeout=300)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
     gpu = json.loads(r.stdout.strip().splitlines()[-1])
     assert sorted(gpu) == sorted(cases)
@@ -211,6 +205,7 @@ def _same_bits(a: np.ndarray, b: np.ndarray) -> bool:
 
 
 if __name__ == "__main__":
+    pin_to_one_cpu()
     _simulator_child()
 
 
